@@ -1,0 +1,52 @@
+# Two commands for everyone: `make lab` (JupyterLab on the course) and `make test`.
+# Everything lives in this folder: the venv, pip's cache, Jupyter's and ROS's files.
+
+PYTHON ?= python3
+VENV   := .venv
+PY     := $(VENV)/bin/python
+STAMP  := $(VENV)/.installed
+HERE   := $(CURDIR)
+
+export PIP_CACHE_DIR       := $(HERE)/.cache/pip
+export JUPYTER_CONFIG_DIR  := $(HERE)/.jupyter/config
+export JUPYTER_DATA_DIR    := $(HERE)/.jupyter/data
+export JUPYTER_RUNTIME_DIR := $(HERE)/.jupyter/runtime
+export IPYTHONDIR          := $(HERE)/.jupyter/ipython
+export MPLCONFIGDIR        := $(HERE)/.cache/matplotlib
+export ROS_HOME            := $(HERE)/.cache/ros
+export ROS_LOG_DIR         := $(HERE)/.cache/ros/log
+export PIP_DISABLE_PIP_VERSION_CHECK := 1
+
+.PHONY: lab test setup learner-notebooks benchmark clean
+
+setup: $(STAMP)
+
+$(STAMP): environment/requirements.txt pyproject.toml
+	@$(PYTHON) -c 'import sys, platform; v = sys.version_info; \
+	  ok = (3, 10) <= v[:2] <= (3, 13) and platform.system() == "Linux" and platform.machine() == "x86_64"; \
+	  sys.exit(0 if ok else "The pip route needs Linux x86_64 and Python 3.10-3.13 (found %s %s, Python %d.%d); see README for RoboStack." % (platform.system(), platform.machine(), v[0], v[1]))'
+	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -r environment/requirements.txt
+	$(PY) -m pip install --quiet --no-deps --editable .
+	@touch $(STAMP)
+
+lab: $(STAMP)
+	$(VENV)/bin/jupyter lab --ServerApp.ip=127.0.0.1 --ServerApp.root_dir=$(HERE) \
+	  --LabApp.default_url=/lab/tree/notebooks
+
+# Unit tests of ros2nb, the notebook checks, then nbval over both notebook folders.
+test: $(STAMP)
+	$(PY) -m pytest tests
+	$(PY) -m pytest --nbval solutions --nbval-current-env --nbval-sanitize-with tests/sanitize.cfg
+	$(PY) -m pytest --nbval-lax notebooks --nbval-current-env
+
+# Regenerate notebooks/ from solutions/ with nbgrader (never edit notebooks/ by hand).
+learner-notebooks: $(STAMP)
+	$(PY) tools/generate_learner_notebooks.py
+
+benchmark: $(STAMP)
+	$(PY) benchmarks/sim_hour.py
+
+clean:
+	rm -rf $(VENV) .cache .jupyter

@@ -1,0 +1,51 @@
+"""Test-session set-up shared by the unit tests and nbval runs (``make test``).
+
+- Every pytest process gets its own ``ROS_DOMAIN_ID`` and keeps discovery on this
+  machine, so two runs never see each other's topics; nbval kernels inherit both.
+- The course workspace goes to a temporary folder removed at the end, so tests never
+  touch a learner's ``workspace/``.
+- Cells tagged ``learner-check`` (a Challenge's check) must raise ``CheckFailed`` with its
+  friendly message in ``notebooks/`` (the challenge is unsolved there) and must pass in
+  ``solutions/``.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+from pathlib import Path
+
+import pytest
+
+_DOMAIN = str(1 + os.getpid() % 100)
+os.environ['ROS_DOMAIN_ID'] = _DOMAIN
+os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+_SCRATCH = Path(tempfile.mkdtemp(prefix='ros2nb-test-'))
+os.environ['ROS2NB_WORKSPACE'] = str(_SCRATCH / 'ROS2_and_RL_Tutorials')
+os.environ.setdefault('MPLBACKEND', 'Agg')
+
+LEARNER_CHECK_TAG = 'learner-check'
+
+
+def pytest_sessionfinish(session, exitstatus) -> None:
+    shutil.rmtree(_SCRATCH, ignore_errors=True)
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_call(item):
+    outcome = yield
+    cell = getattr(item, 'cell', None)
+    if cell is None or LEARNER_CHECK_TAG not in cell.get('metadata', {}).get('tags', []):
+        return
+    errors = [o for o in (item.test_outputs or []) if o.get('output_type') == 'error']
+    learner_version = 'notebooks' in Path(str(item.fspath)).parts
+    if learner_version:
+        if not errors or errors[0].get('ename') != 'CheckFailed':
+            outcome.force_exception(AssertionError(
+                f'{item.name}: an unsolved challenge check must raise CheckFailed with a '
+                f'message for the learner; got {[e.get("ename") for e in errors] or "no error"}'))
+    elif errors:
+        outcome.force_exception(AssertionError(
+            f'{item.name}: the solution does not pass its own check: '
+            f'{errors[0].get("ename")}: {errors[0].get("evalue")}'))

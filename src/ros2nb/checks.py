@@ -1,0 +1,230 @@
+"""Checks behind every Challenge: each raises :class:`CheckFailed` with what is still wrong.
+
+The check cells learners run and the instructors' hidden tests call these same
+functions, so the two cannot drift.  They test behaviour (what a node publishes, what a
+function returns, how a process exits), never the text of the code.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import signal
+import subprocess
+import time
+import xml.etree.ElementTree as ET
+from pathlib import Path
+from typing import Any, Callable, Optional
+
+from .runtime import Ros2nbError
+
+#: The course's clamp range for the simulated sensor (°C); the tutorial's 10.2 floor is fixed.
+MIN_TEMPERATURE_C = 18.0
+MAX_TEMPERATURE_C = 28.0
+#: The monitor's thresholds (°C): strictly above HIGH is "High", strictly below LOW is "Low".
+LOW_THRESHOLD_C = 20.0
+HIGH_THRESHOLD_C = 26.0
+
+
+class CheckFailed(AssertionError):
+    """A challenge is not solved yet; the message says what to change."""
+
+
+def passed(message: str) -> None:
+    """Print the line a passing check shows."""
+    print(f'Check passed: {message}')
+
+
+def _call(function: Callable[..., Any], *args: Any) -> Any:
+    try:
+        return function(*args)
+    except NotImplementedError:
+        raise CheckFailed(f'{function.__name__}() still raises NotImplementedError: replace '
+                          '"raise NotImplementedError()" with your code and run its cell '
+                          'again.') from None
+
+
+def _endpoint_names(node: Any, kind: str) -> dict[str, str]:
+    entities = node.subscriptions if kind == 'subscription' else node.publishers
+    return {node.resolve_topic_name(e.topic_name): e.msg_type.__module__.split('.')[0] + '/msg/'
+            + e.msg_type.__name__ for e in entities}
+
+
+def check_endpoint(node: Any, kind: str, topic: str, type_name: str) -> None:
+    """Check that ``node`` has a publisher or subscription on ``topic`` with ``type_name``.
+
+    Introduced in ``00-setup-and-the-pubsub-idea.ipynb``.
+
+    :param node: an rclpy node.
+    :param kind: ``'publisher'`` or ``'subscription'``.
+    :param topic: e.g. ``'/chatter'``.
+    :param type_name: e.g. ``'std_msgs/msg/String'``.
+    :raises CheckFailed: naming what the node has instead.
+    """
+    from rclpy.node import Node
+    if not isinstance(node, Node):
+        raise CheckFailed(f'Expected a node, got {type(node).__name__}: create it with your '
+                          'class, e.g. LoudListener().')
+    found = _endpoint_names(node, kind)
+    if topic not in found:
+        have = ', '.join(sorted(found)) or 'none'
+        raise CheckFailed(f'Node {node.get_name()} has no {kind} on {topic} (it has: {have}); '
+                          f'check the topic name passed to create_{kind}().')
+    if found[topic] != type_name:
+        raise CheckFailed(f'The {kind} on {topic} uses {found[topic]}, but the topic carries '
+                          f'{type_name}: import and pass that type.')
+    passed(f'{node.get_name()} has a {kind} on {topic} [{type_name}].')
+
+
+def check_expanded_path(path: Any, *, ends_with: str) -> None:
+    """Check a path is absolute, inside the home folder and ends with ``ends_with``.
+
+    Introduced in ``01-create-a-workspace.ipynb``.
+
+    :raises CheckFailed: e.g. for the tutorial's ``/Documents/...`` (no ``~``).
+    """
+    if not isinstance(path, Path):
+        raise CheckFailed(f'Return a pathlib.Path, not {type(path).__name__}.')
+    if '~' in str(path):
+        raise CheckFailed(f'{path} still contains "~": Python does not expand it, call '
+                          '.expanduser().')
+    if Path.home() not in path.parents:
+        raise CheckFailed(f'{path} is not inside your home folder {Path.home()}: a path that '
+                          'starts with "/" starts at the root of the disk.')
+    if not str(path).endswith(ends_with):
+        raise CheckFailed(f'{path} should end with {ends_with}.')
+    passed(f'{path} is inside your home folder.')
+
+
+def package_dependencies(package_xml: Path) -> list[str]:
+    """Return the ``<depend>`` entries of a package.xml, in order (the reference reader)."""
+    return [d.text.strip() for d in ET.parse(package_xml).getroot().findall('depend')
+            if d.text]
+
+
+def check_dependencies(reader: Callable[[Path], list[str]], package_xml: Path) -> None:
+    """Check a learner's package.xml reader against the real file.
+
+    Introduced in ``02-create-a-package.ipynb``.
+
+    :raises CheckFailed: when the result differs from the file's ``<depend>`` tags.
+    """
+    if not Path(package_xml).is_file():
+        raise CheckFailed(f'{package_xml} does not exist: run the pkg_create cell above first.')
+    got = _call(reader, Path(package_xml))
+    want = package_dependencies(Path(package_xml))
+    if not isinstance(got, list):
+        raise CheckFailed(f'Return a list of names, not {type(got).__name__}.')
+    if got != want:
+        raise CheckFailed(f'Got {got}, but package.xml declares {want}: read the text of each '
+                          '<depend> element, in order (test_depend is not a depend).')
+    passed(f'package.xml depends on {", ".join(want)}.')
+
+
+def check_clamp(clamp: Callable[[float], float]) -> None:
+    """Check the sensor's clamp keeps readings inside [18.0, 28.0] °C and leaves others alone.
+
+    Introduced in ``03-write-the-publisher.ipynb``.
+
+    :raises CheckFailed: naming the first input that gave a wrong value.
+    """
+    cases = [(22.3, 22.3), (10.2, MIN_TEMPERATURE_C), (17.99, MIN_TEMPERATURE_C),
+             (18.0, 18.0), (28.0, 28.0), (31.5, MAX_TEMPERATURE_C), (-40.0, MIN_TEMPERATURE_C)]
+    for value, want in cases:
+        got = _call(clamp, value)
+        if not isinstance(got, (int, float)) or not math.isclose(got, want, abs_tol=1e-9):
+            raise CheckFailed(f'{clamp.__name__}({value}) returned {got!r}, expected {want}: '
+                              f'keep values inside [{MIN_TEMPERATURE_C}, {MAX_TEMPERATURE_C}] '
+                              'with min() and max().')
+    passed(f'readings stay inside [{MIN_TEMPERATURE_C}, {MAX_TEMPERATURE_C}] °C.')
+
+
+def check_publisher_samples(samples: list[float], *, seconds: float) -> None:
+    """Check a recorded run of the sensor: one reading per second, walk and clamp respected.
+
+    Introduced in ``03-write-the-publisher.ipynb``.
+
+    :param samples: readings in °C in the order received.
+    :param seconds: simulated seconds the sensor ran.
+    :raises CheckFailed: naming the first rule broken.
+    """
+    if abs(len(samples) - seconds) > 1:
+        raise CheckFailed(f'{len(samples)} readings in {seconds:g} s; expected one per second: '
+                          'check the timer period.')
+    if samples and abs(samples[0] - 22.0) > 0.5 + 1e-4:
+        raise CheckFailed(f'The first reading is {samples[0]:.2f} °C; it should be within '
+                          '0.5 °C of the 22.0 °C start.')
+    for i, (a, b) in enumerate(zip(samples, samples[1:]), start=2):
+        if abs(b - a) > 0.5 + 1e-4:
+            raise CheckFailed(f'Reading {i} jumps {b - a:+.2f} °C; one step is at most ±0.5 °C.')
+    outside = [s for s in samples if not MIN_TEMPERATURE_C - 1e-4 <= s <= MAX_TEMPERATURE_C + 1e-4]
+    if outside:
+        raise CheckFailed(f'{len(outside)} readings are outside [{MIN_TEMPERATURE_C}, '
+                          f'{MAX_TEMPERATURE_C}] °C (e.g. {outside[0]:.2f}): check the clamp.')
+    passed(f'{len(samples)} readings, one per second, steps within ±0.5 °C, all inside '
+           f'[{MIN_TEMPERATURE_C}, {MAX_TEMPERATURE_C}] °C.')
+
+
+def reference_status(temperature_c: float) -> str:
+    """The monitor's rule: ``High`` above 26.0 °C, ``Low`` below 20.0 °C, else ``Normal``."""
+    if temperature_c > HIGH_THRESHOLD_C:
+        return 'High'
+    if temperature_c < LOW_THRESHOLD_C:
+        return 'Low'
+    return 'Normal'
+
+
+def check_classify(classify: Callable[[float], str]) -> None:
+    """Check a status function exactly, including the 20.0 and 26.0 °C boundaries.
+
+    Introduced in ``04-write-the-subscriber.ipynb``.
+
+    :raises CheckFailed: naming the first temperature classified wrongly.
+    """
+    for value in (10.0, 19.99, 20.0, 20.01, 23.0, 25.99, 26.0, 26.01, 30.0):
+        got = _call(classify, value)
+        want = reference_status(value)
+        if got != want:
+            raise CheckFailed(f'{classify.__name__}({value}) returned {got!r}, expected '
+                              f'{want!r}: "above 26" means > 26.0 and "below 20" means < 20.0.')
+    passed('every status is right, including 20.0 and 26.0 (both Normal).')
+
+
+def check_clean_shutdown(package: str, executable: str, *, seconds: float = 3.0,
+                         workspace_path: Optional[Path] = None) -> None:
+    """Run ``ros2 run PACKAGE EXECUTABLE``, press Ctrl+C, and check it exits cleanly.
+
+    Clean means exit code 0 and no traceback, which on Jazzy needs ``main()`` to catch
+    ``KeyboardInterrupt`` and ``ExternalShutdownException`` and call ``rclpy.try_shutdown()``.
+
+    Introduced in ``05-entry-points-and-run.ipynb``.
+
+    :raises CheckFailed: with the process's last error line.
+    """
+    from .workspace import CONSOLE_FORMAT, find_executable, source_workspace
+    try:
+        env = source_workspace(workspace_path)
+        exe = find_executable(package, executable, env)
+    except Ros2nbError as error:
+        raise CheckFailed(f'{error}: build the package first (the colcon_build cell).') from None
+    env.update(PYTHONUNBUFFERED='1', RCUTILS_CONSOLE_OUTPUT_FORMAT=CONSOLE_FORMAT)
+    proc = subprocess.Popen([str(exe)], env=env, text=True, stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, start_new_session=True)
+    time.sleep(seconds)
+    os.killpg(proc.pid, signal.SIGINT)
+    try:
+        output, _ = proc.communicate(timeout=10)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        output, _ = proc.communicate()
+        raise CheckFailed(f'{executable} did not stop within 10 s of Ctrl+C: '
+                          'let KeyboardInterrupt end rclpy.spin().') from None
+    if 'NotImplementedError' in output:
+        raise CheckFailed(f'{executable}: main() still raises NotImplementedError: write it.')
+    if proc.returncode != 0 or 'Traceback' in output:
+        last = [line for line in output.splitlines() if line.strip()][-1:] or ['(no output)']
+        raise CheckFailed(f'{executable} exited with code {proc.returncode} after Ctrl+C '
+                          f'({last[0].strip()}): catch KeyboardInterrupt and '
+                          'ExternalShutdownException, then destroy the node and call '
+                          'rclpy.try_shutdown().')
+    passed(f'{executable} stopped cleanly on Ctrl+C (exit code 0, no traceback).')

@@ -1,0 +1,1 @@
+"""Reference sources of the course (the tutorial code with its mistakes fixed)."""
