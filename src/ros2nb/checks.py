@@ -11,6 +11,7 @@ import math
 import os
 import signal
 import subprocess
+import sys
 import time
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -50,39 +51,48 @@ def _endpoint_names(node: Any, kind: str) -> dict[str, str]:
             + e.msg_type.__name__ for e in entities}
 
 
-def check_endpoint(node: Any, kind: str, topic: str, type_name: str) -> None:
-    """Check that ``node`` has a publisher or subscription on ``topic`` with ``type_name``.
+def check_endpoint(node_class: Callable[[], Any], kind: str, topic: str, type_name: str) -> None:
+    """Check that a node class makes a publisher or subscription on ``topic`` with ``type_name``.
+
+    The node is created, inspected and destroyed again (ROS must be up).
 
     Introduced in ``00-setup-and-the-pubsub-idea.ipynb``.
 
-    :param node: an rclpy node.
+    :param node_class: the class (or any callable returning a node), e.g. ``LoudListener``.
     :param kind: ``'publisher'`` or ``'subscription'``.
     :param topic: e.g. ``'/chatter'``.
     :param type_name: e.g. ``'std_msgs/msg/String'``.
     :raises CheckFailed: naming what the node has instead.
     """
     from rclpy.node import Node
+    node = _call(node_class)
     if not isinstance(node, Node):
-        raise CheckFailed(f'Expected a node, got {type(node).__name__}: create it with your '
-                          'class, e.g. LoudListener().')
-    found = _endpoint_names(node, kind)
+        raise CheckFailed(f'Expected a node, got {type(node).__name__}: pass your Node '
+                          'subclass itself, e.g. LoudListener (no parentheses).')
+    name = node.get_name()
+    try:
+        found = _endpoint_names(node, kind)
+    finally:
+        node.destroy_node()
     if topic not in found:
         have = ', '.join(sorted(found)) or 'none'
-        raise CheckFailed(f'Node {node.get_name()} has no {kind} on {topic} (it has: {have}); '
+        raise CheckFailed(f'Node {name} has no {kind} on {topic} (it has: {have}); '
                           f'check the topic name passed to create_{kind}().')
     if found[topic] != type_name:
         raise CheckFailed(f'The {kind} on {topic} uses {found[topic]}, but the topic carries '
                           f'{type_name}: import and pass that type.')
-    passed(f'{node.get_name()} has a {kind} on {topic} [{type_name}].')
+    passed(f'{name} has a {kind} on {topic} [{type_name}].')
 
 
-def check_expanded_path(path: Any, *, ends_with: str) -> None:
-    """Check a path is absolute, inside the home folder and ends with ``ends_with``.
+def check_expanded_path(make_path: Callable[[], Any], *, ends_with: str) -> None:
+    """Check the path a function returns is absolute, inside home and ends with ``ends_with``.
 
     Introduced in ``01-create-a-workspace.ipynb``.
 
+    :param make_path: the learner's function (called with no arguments).
     :raises CheckFailed: e.g. for the tutorial's ``/Documents/...`` (no ``~``).
     """
+    path = _call(make_path)
     if not isinstance(path, Path):
         raise CheckFailed(f'Return a pathlib.Path, not {type(path).__name__}.')
     if '~' in str(path):
@@ -190,9 +200,9 @@ def check_classify(classify: Callable[[float], str]) -> None:
     passed('every status is right, including 20.0 and 26.0 (both Normal).')
 
 
-def check_clean_shutdown(package: str, executable: str, *, seconds: float = 3.0,
+def check_clean_shutdown(*command: str, seconds: float = 3.0,
                          workspace_path: Optional[Path] = None) -> None:
-    """Run ``ros2 run PACKAGE EXECUTABLE``, press Ctrl+C, and check it exits cleanly.
+    """Run ``ros2 run PACKAGE EXECUTABLE`` (or ``python SCRIPT.py``), press Ctrl+C, check the exit.
 
     Clean means exit code 0 and no traceback, which on Jazzy needs ``main()`` to catch
     ``KeyboardInterrupt`` and ``ExternalShutdownException`` and call ``rclpy.try_shutdown()``.
@@ -201,14 +211,25 @@ def check_clean_shutdown(package: str, executable: str, *, seconds: float = 3.0,
 
     :raises CheckFailed: with the process's last error line.
     """
-    from .workspace import CONSOLE_FORMAT, find_executable, source_workspace
-    try:
-        env = source_workspace(workspace_path)
-        exe = find_executable(package, executable, env)
-    except Ros2nbError as error:
-        raise CheckFailed(f'{error}: build the package first (the colcon_build cell).') from None
+    from .workspace import CONSOLE_FORMAT, find_executable, source_workspace, workspace
+    if len(command) == 1 and command[0].endswith('.py'):
+        script = Path(command[0]).expanduser()
+        script = script if script.is_absolute() else workspace() / script
+        if not script.is_file():
+            raise CheckFailed(f'{script.name} does not exist yet: run the cells that write it.')
+        argv, env, executable = [sys.executable, str(script)], dict(os.environ), script.name
+    elif len(command) == 2:
+        package, executable = command
+        try:
+            env = source_workspace(workspace_path)
+            argv = [str(find_executable(package, executable, env))]
+        except Ros2nbError as error:
+            raise CheckFailed(f'{error}: build the package first (the colcon_build cell).') \
+                from None
+    else:
+        raise ValueError('Pass PACKAGE, EXECUTABLE or a single SCRIPT.py.')
     env.update(PYTHONUNBUFFERED='1', RCUTILS_CONSOLE_OUTPUT_FORMAT=CONSOLE_FORMAT)
-    proc = subprocess.Popen([str(exe)], env=env, text=True, stdout=subprocess.PIPE,
+    proc = subprocess.Popen(argv, env=env, text=True, stdout=subprocess.PIPE,
                             stderr=subprocess.STDOUT, start_new_session=True)
     time.sleep(seconds)
     os.killpg(proc.pid, signal.SIGINT)

@@ -116,6 +116,7 @@ class Runtime:
         rclpy.init(args=['--ros-args', '--disable-stdout-logs', '--disable-external-lib-logs'],
                    domain_id=domain_id,
                    signal_handler_options=SignalHandlerOptions.NO)
+        self.domain_id = rclpy.get_default_context().get_domain_id()
         from rcl_interfaces.msg import Log
         from rosgraph_msgs.msg import Clock
         self._clock_type = Clock
@@ -283,10 +284,11 @@ class Runtime:
                 targets = list(self._nodes.values())
             else:
                 targets = [self.find(node)]
+            names = [target.get_name() for target in targets]
             for target in targets:
                 self._forget(target, destroy=True)
             self.drain()
-        return [t.get_name() for t in targets]
+        return names
 
     def find(self, node: NodeOrName) -> Node:
         if isinstance(node, Node):
@@ -410,11 +412,8 @@ def start(*, domain_id: Optional[int] = None, sim_time: bool = False) -> Runtime
     """
     global _runtime
     if _runtime is not None:
-        wanted = domain_id if domain_id is not None else _runtime.node.get_context() \
-            .get_domain_id()
-        if wanted != _runtime.node.get_context().get_domain_id():
-            raise Ros2nbError('ROS is already up on domain '
-                              f'{_runtime.node.get_context().get_domain_id()}; call '
+        if domain_id is not None and domain_id != _runtime.domain_id:
+            raise Ros2nbError(f'ROS is already up on domain {_runtime.domain_id}; call '
                               'ros2nb.shutdown() first to change the domain id.')
         _runtime.sim_time_default = sim_time
         return _runtime

@@ -14,6 +14,7 @@ import importlib.util
 import json
 import os
 import queue
+import re
 import shlex
 import shutil
 import signal
@@ -271,14 +272,28 @@ def _stream(proc: subprocess.Popen, prefix: str, lines: queue.Queue) -> None:
     lines.put(None)
 
 
+_PY_ERROR = re.compile(r'^\s*(\w+(Error|Exception)): ')
+_PY_FILE = re.compile(r'^\s*File "([^"]+)", line (\d+)')
+
+
 def _build_cause(output: list[str]) -> str:
-    """Pick the line of a failed colcon build that names the cause."""
-    for marker in ('Error:', 'Error ', 'error:', 'No such file', 'not found', 'ERROR'):
+    """Pick the line of a failed colcon build that names the cause.
+
+    A Python error of the package (e.g. ``SyntaxError`` in setup.py) wins over colcon's
+    own ``CalledProcessError`` that wraps it; its file and line are added.
+    """
+    for index in range(len(output) - 1, -1, -1):
+        match = _PY_ERROR.match(output[index])
+        if match and match.group(1) != 'CalledProcessError':
+            where = next((m for m in (_PY_FILE.match(line) for line in
+                                      reversed(output[:index])) if m), None)
+            place = f' ({Path(where.group(1)).name}, line {where.group(2)})' if where else ''
+            return output[index].strip() + place
+    for marker in ('ERROR', 'error:', 'Error'):
         for line in reversed(output):
             if marker in line and not line.startswith(('Failed', 'Summary')):
                 return line.strip()
-    failed = [line for line in output if line.strip().startswith('Failed')]
-    return failed[-1].strip() if failed else 'see the output above'
+    return 'see the output above'
 
 
 def colcon_build(*args: str, workspace_path: Optional[PathLike] = None) -> None:
@@ -415,14 +430,38 @@ def ros2_run(*commands: Sequence[str], seconds: float = 5.0,
     env.setdefault('ROS_LOG_DIR', str((Path(workspace_path) if workspace_path else workspace())
                                       / 'log' / 'ros'))
     argvs = [_command(c[0], c[1], list(c[2:]), env) for c in commands]
+    return run_and_interrupt(*argvs, labels=[c[1] for c in commands], seconds=seconds, env=env)
+
+
+def run_and_interrupt(*argvs: Sequence[str], labels: Optional[Sequence[str]] = None,
+                      seconds: float = 5.0, env: Optional[dict[str, str]] = None) -> list[int]:
+    """Run commands as separate processes, show their output, then send SIGINT (Ctrl+C).
+
+    What :func:`ros2_run` does once it has found the executables; use it for a script,
+    e.g. ``run_and_interrupt(['python3', 'scripts/demo.py'], seconds=3)``.
+
+    Introduced in ``05-entry-points-and-run.ipynb``.
+
+    :param argvs: one argument list per process.
+    :param labels: names for the output prefixes and exit lines; default each argv's
+        file name.
+    :param seconds: wall-clock seconds before SIGINT.
+    :param env: the processes' environment; default the kernel's, with unbuffered output
+        and the course's console format.
+    :return: the exit codes, in order (0 is a clean exit; negative is a signal number).
+    """
+    if env is None:
+        env = dict(os.environ, PYTHONUNBUFFERED='1', RCUTILS_COLORIZED_OUTPUT='0')
+        env.setdefault('RCUTILS_CONSOLE_OUTPUT_FORMAT', CONSOLE_FORMAT)
+    labels = list(labels) if labels is not None else [Path(a[0]).name for a in argvs]
     lines: queue.Queue = queue.Queue()
     procs = []
     try:
-        for number, (command, argv) in enumerate(zip(commands, argvs), start=1):
-            proc = subprocess.Popen(argv, env=env, text=True, stdout=subprocess.PIPE,
+        for number, (label, argv) in enumerate(zip(labels, argvs), start=1):
+            proc = subprocess.Popen(list(argv), env=env, text=True, stdout=subprocess.PIPE,
                                     stderr=subprocess.STDOUT, start_new_session=True)
             procs.append(proc)
-            prefix = f'[{command[1]}-{number}] ' if len(commands) > 1 else ''
+            prefix = f'[{label}-{number}] ' if len(argvs) > 1 else ''
             threading.Thread(target=_stream, args=(proc, prefix, lines), daemon=True).start()
         open_streams = len(procs)
         deadline = time.monotonic() + seconds
@@ -450,6 +489,6 @@ def ros2_run(*commands: Sequence[str], seconds: float = 5.0,
         for proc in procs:
             _stop(proc)
     codes = [proc.wait() for proc in procs]
-    for command, code in zip(commands, codes):
-        print(f'{command[1]} exited with code {code}')
+    for label, code in zip(labels, codes):
+        print(f'{label} exited with code {code}')
     return codes

@@ -1,0 +1,57 @@
+"""Small real nodes the unit tests hand to ros2nb."""
+
+import random
+
+from rclpy.node import Node
+from std_msgs.msg import Float32, String
+
+PERIOD_S = 1.0
+
+
+class Sensor(Node):
+    """A 1 Hz random walk on ``topic``, like the course's temperature sensor."""
+
+    def __init__(self, name: str = 'temperature_sensor', topic: str = 'temperature') -> None:
+        super().__init__(name)
+        self.publisher = self.create_publisher(Float32, topic, 10)
+        self.timer = self.create_timer(PERIOD_S, self.tick)
+        self.value = 22.0
+        self.get_logger().info('started')
+
+    def tick(self) -> None:
+        self.value += random.uniform(-0.5, 0.5)
+        self.publisher.publish(Float32(data=self.value))
+        self.get_logger().info(f'Publishing: {self.value:.2f}C')
+
+
+class Monitor(Node):
+    """Counts and logs what arrives on ``topic``."""
+
+    def __init__(self, name: str = 'temperature_monitor', topic: str = 'temperature') -> None:
+        super().__init__(name)
+        self.received: list[float] = []
+        self.create_subscription(Float32, topic, self.on_message, 10)
+
+    def on_message(self, msg: Float32) -> None:
+        self.received.append(msg.data)
+        self.get_logger().info(f'Temperature: {msg.data:.2f}C')
+
+
+class Broken(Node):
+    """A node whose timer callback raises every time."""
+
+    def __init__(self) -> None:
+        super().__init__('broken')
+        self.create_timer(PERIOD_S, self.explode)
+
+    def explode(self) -> None:
+        raise ZeroDivisionError('division by zero')
+
+
+class Chatter(Node):
+    """Publishes a String once per second."""
+
+    def __init__(self) -> None:
+        super().__init__('chatter_talker')
+        self.publisher = self.create_publisher(String, 'chatter', 10)
+        self.create_timer(PERIOD_S, lambda: self.publisher.publish(String(data='hi')))

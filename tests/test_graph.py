@@ -1,0 +1,109 @@
+"""The graph verbs, on real nodes, compared with what the ros2 CLI prints."""
+
+import math
+import random
+
+import pytest
+
+import ros2nb
+
+from nodes import Monitor, Sensor
+
+
+@pytest.fixture
+def ros():
+    ros2nb.start(sim_time=True)
+    yield
+    ros2nb.shutdown()
+
+
+def test_node_list_hides_internal_node(ros, capsys):
+    ros2nb.add(Sensor())
+    ros2nb.add(Monitor())
+    assert ros2nb.node_list() == ['/temperature_monitor', '/temperature_sensor']
+    assert '/_ros2nb' in ros2nb.node_list(all=True)
+
+
+def test_topic_list_with_types_and_typo_note(ros, capsys):
+    ros2nb.add(Sensor())
+    ros2nb.add(Monitor(topic='temprature'))
+    topics = ros2nb.topic_list(show_types=True)
+    out = capsys.readouterr().out
+    assert {'/temperature', '/temprature', '/rosout', '/parameter_events'} <= set(topics)
+    assert '/temperature [std_msgs/msg/Float32]' in out
+    assert ('Note: /temperature has 1 publisher(s) but no subscription: '
+            'is it a typo of /temprature?') in out
+    assert 'Note: /temprature has 1 subscription(s) but no publisher' in out
+
+
+def test_matched_topics_give_no_note(ros, capsys):
+    ros2nb.add(Sensor())
+    ros2nb.add(Monitor())
+    assert ros2nb.unmatched_topics() == []
+
+
+def test_topic_info_counts_and_qos(ros, capsys):
+    ros2nb.add(Sensor())
+    ros2nb.add(Monitor())
+    assert ros2nb.topic_info('temperature') == {'publishers': 1, 'subscriptions': 1}
+    ros2nb.topic_info('/temperature', verbose=True)
+    out = capsys.readouterr().out
+    assert 'Type: std_msgs/msg/Float32' in out
+    assert 'Node name: temperature_sensor' in out and 'Endpoint type: PUBLISHER' in out
+    assert 'Reliability: RELIABLE' in out and 'Durability: VOLATILE' in out
+
+
+def test_topic_info_unknown_topic_suggests(ros):
+    ros2nb.add(Sensor())
+    with pytest.raises(ros2nb.Ros2nbError, match=r"Unknown topic '/temprature'. Did you mean /temperature\?"):
+        ros2nb.topic_info('temprature')
+
+
+def test_topic_echo_prints_yaml(ros, capsys):
+    random.seed(3)
+    sensor = ros2nb.add(Sensor())
+    messages = ros2nb.topic_echo('temperature', count=2)
+    out = capsys.readouterr().out
+    assert [m.data for m in messages] == pytest.approx([sensor.value - 0, sensor.value], abs=0.6)
+    assert out.count('---') == 2
+    assert f'data: {messages[0].data!r}\n---' in out
+
+
+def test_topic_echo_unknown_type(ros):
+    with pytest.raises(ros2nb.Ros2nbError, match='does not appear to be published yet'):
+        ros2nb.topic_echo('nothing_here')
+
+
+def test_topic_echo_times_out_with_advice(ros, capsys):
+    ros2nb.add(Monitor())
+    got = ros2nb.topic_echo('temperature', 'std_msgs/msg/Float32', count=1, timeout=3)
+    assert got == []
+    assert 'Received 0 of 1 messages in 3 s' in capsys.readouterr().out
+
+
+def test_topic_hz_on_sim_time(ros, capsys):
+    ros2nb.add(Sensor())
+    rate = ros2nb.topic_hz('temperature', window=5)
+    assert rate == pytest.approx(1.0)
+    assert 'average rate: 1.000' in capsys.readouterr().out
+
+
+def test_topic_hz_without_messages(ros, capsys):
+    ros2nb.add(Monitor())
+    assert math.isnan(ros2nb.topic_hz('temperature', 'std_msgs/msg/Float32', timeout=2))
+
+
+def test_record_an_hour(ros, capsys):
+    random.seed(4)
+    ros2nb.add(Sensor())
+    times, values = ros2nb.record('temperature', 3600)
+    assert len(times) == len(values) == 3600
+    assert times[0] == pytest.approx(1.0) and times[-1] == pytest.approx(3600.0)
+    assert 'Publishing' not in capsys.readouterr().out
+
+
+def test_message_type_errors():
+    with pytest.raises(ros2nb.Ros2nbError, match='package/msg/Type'):
+        ros2nb.message_type('Float32')
+    with pytest.raises(ros2nb.Ros2nbError, match='not installed'):
+        ros2nb.message_type('nope_msgs/msg/Nope')

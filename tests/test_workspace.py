@@ -1,0 +1,165 @@
+"""Workspace verbs with the real colcon, real setup.bash and real processes."""
+
+import importlib
+import os
+import shutil
+import sys
+from pathlib import Path
+
+import pytest
+
+import ros2nb
+from ros2nb import checks, course
+
+ws_module = importlib.import_module('ros2nb.workspace')
+
+TUTORIAL_MAIN = '''
+import rclpy
+from rclpy.node import Node
+
+
+def main():
+    rclpy.init()
+    node = Node('tutorial_style')
+    try:
+        rclpy.spin(node)
+    except KeyboardInterrupt:
+        pass
+    node.destroy_node()
+    rclpy.shutdown()
+
+
+main()
+'''
+
+
+@pytest.fixture(scope='module')
+def built(tmp_path_factory):
+    """A workspace with the course's package, reference nodes, entry points, built once."""
+    root = tmp_path_factory.mktemp('course')
+    os.environ[ws_module.WORKSPACE_ENV] = str(root / 'ws')
+    ws_module._current = None
+    ws = course.catch_up(5)
+    setup_py = ws / 'src' / 'sensor_simulator' / 'setup.py'
+    text = setup_py.read_text()
+    entry = ("'console_scripts': [\n"
+             "            'temperature_publisher = sensor_simulator.temperature_publisher:main',\n"
+             "            'temperature_subscriber = sensor_simulator.temperature_subscriber:main',\n"
+             "        ],")
+    assert "'console_scripts': [\n        ]," in text
+    ros2nb.write_file(setup_py, text.replace("'console_scripts': [\n        ],", entry))
+    ros2nb.colcon_build()
+    yield ws
+
+
+def test_create_workspace_like_mkdir_p(tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv(ws_module.WORKSPACE_ENV, str(tmp_path / 'ws'))
+    ws = ros2nb.create_workspace()
+    assert ws == tmp_path / 'ws'
+    for folder in ('src', 'docs', 'scripts', 'resources/images'):
+        assert (ws / folder).is_dir()
+    (ws / 'src' / 'mine.txt').write_text('keep me')
+    assert ros2nb.create_workspace() == ws  # twice is harmless
+    assert (ws / 'src' / 'mine.txt').read_text() == 'keep me'
+
+
+def test_create_workspace_refuses_outside_course(tmp_path):
+    with pytest.raises(ros2nb.Ros2nbError, match='allow_outside_course=True'):
+        ros2nb.create_workspace(tmp_path / 'elsewhere')
+    assert not (tmp_path / 'elsewhere').exists()
+    assert ros2nb.create_workspace(tmp_path / 'elsewhere', allow_outside_course=True).is_dir()
+
+
+def test_create_workspace_file_in_the_way(tmp_path):
+    (tmp_path / 'ws').mkdir()
+    (tmp_path / 'ws' / 'src').write_text('not a folder')
+    with pytest.raises(ros2nb.Ros2nbError, match='is a file, not a folder'):
+        ros2nb.create_workspace(tmp_path / 'ws', allow_outside_course=True)
+
+
+def test_write_file_never_overwrites_learner_edits(tmp_path):
+    ros2nb.create_workspace(tmp_path / 'ws', allow_outside_course=True)
+    target = ros2nb.write_file('scripts/demo.py', 'print(1)\n')
+    assert ros2nb.write_file('scripts/demo.py', 'print(2)\n') == target  # ours: replaced
+    target.write_text('print("my edit")\n')
+    with pytest.raises(ros2nb.FileProtectedError, match='overwrite=True'):
+        ros2nb.write_file('scripts/demo.py', 'print(3)\n')
+    assert target.read_text() == 'print("my edit")\n'
+    ros2nb.write_file('scripts/demo.py', 'print(3)\n', overwrite=True)
+    assert target.read_text() == 'print(3)\n'
+    assert target.with_name('demo.py.bak').read_text() == 'print("my edit")\n'
+
+
+def test_write_part_joins_parts_in_order(tmp_path, capsys):
+    ros2nb.create_workspace(tmp_path / 'ws', allow_outside_course=True)
+    ros2nb.write_part('scripts/parts.py', 2, 'b = 2\n')
+    path = ros2nb.write_part('scripts/parts.py', 1, 'a = 1\n')
+    ros2nb.write_part('scripts/parts.py', 2, 'b = 3\n')  # re-running a part replaces it
+    assert path.read_text() == 'a = 1\n\nb = 3\n'
+    assert 'ws/scripts/parts.py: part 2 saved (parts 1, 2; 3 lines)' in capsys.readouterr().out
+
+
+def test_colcon_build_installs_entry_points(built):
+    lib = built / 'install' / 'sensor_simulator' / 'lib' / 'sensor_simulator'
+    assert sorted(p.name for p in lib.iterdir()) == ['temperature_publisher',
+                                                     'temperature_subscriber']
+
+
+def test_colcon_build_failure_names_cause(built, capsys):
+    with pytest.raises(ros2nb.ColconBuildError, match='found no package'):
+        ros2nb.colcon_build('--packages-select', 'no_such_package')
+    setup_py = built / 'src' / 'sensor_simulator' / 'setup.py'
+    good = setup_py.read_text()
+    try:
+        setup_py.write_text(good + '\nsetup(\n')  # a learner's unfinished edit
+        with pytest.raises(ros2nb.ColconBuildError, match='SyntaxError'):
+            ros2nb.colcon_build('--packages-select', 'sensor_simulator')
+    finally:
+        setup_py.write_text(good)
+
+
+def test_source_workspace_adds_prefix(built, capsys):
+    env = ros2nb.source_workspace(show=True)
+    assert str(built / 'install' / 'sensor_simulator') in env['AMENT_PREFIX_PATH'].split(':')
+    assert 'AMENT_PREFIX_PATH: added ws/install/sensor_simulator' in capsys.readouterr().out
+
+
+def test_ros2_run_errors_match_cli(built):
+    with pytest.raises(ros2nb.Ros2nbError, match=r"^Package 'no_such_pkg' not found$"):
+        ros2nb.ros2_run(('no_such_pkg', 'x'))
+    with pytest.raises(ros2nb.Ros2nbError, match='^No executable found$'):
+        ros2nb.ros2_run(('sensor_simulator', 'no_such_exe'))
+
+
+def test_ros2_run_two_processes_and_ctrl_c(built, capsys):
+    codes = ros2nb.ros2_run(('sensor_simulator', 'temperature_publisher'),
+                            ('sensor_simulator', 'temperature_subscriber'), seconds=4)
+    out = capsys.readouterr().out
+    assert codes == [0, 0]
+    assert '[temperature_publisher-1] [INFO] [temperature_sensor]: Publishing:' in out
+    assert '[temperature_subscriber-2] [INFO] [temperature_monitor]: Temperature:' in out
+    assert '^C' in out and 'Traceback' not in out
+
+
+def test_missing_setup_cfg_gives_no_executable(built, tmp_path):
+    scratch = tmp_path / 'nocfg'
+    shutil.copytree(built / 'src' / 'sensor_simulator', scratch / 'src' / 'sensor_simulator')
+    (scratch / 'src' / 'sensor_simulator' / 'setup.cfg').unlink()
+    ros2nb.colcon_build(workspace_path=scratch)
+    with pytest.raises(ros2nb.Ros2nbError, match='^No executable found$'):
+        ros2nb.ros2_run(('sensor_simulator', 'temperature_publisher'), workspace_path=scratch)
+
+
+def test_clean_shutdown_check(built, capsys):
+    checks.check_clean_shutdown('sensor_simulator', 'temperature_subscriber', seconds=2)
+    assert 'stopped cleanly' in capsys.readouterr().out
+    ros2nb.write_file('scripts/tutorial_main.py', TUTORIAL_MAIN)
+    with pytest.raises(checks.CheckFailed, match='exited with code 1 after Ctrl\\+C'):
+        checks.check_clean_shutdown('scripts/tutorial_main.py', seconds=2)
+
+
+def test_import_file_reloads(built):
+    module = ros2nb.import_file('src/sensor_simulator/sensor_simulator/temperature_subscriber.py')
+    assert module.classify(26.0) == 'Normal' and module.classify(26.01) == 'High'
+    with pytest.raises(ros2nb.Ros2nbError, match='does not exist'):
+        ros2nb.import_file('src/nothing.py')
