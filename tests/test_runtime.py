@@ -64,11 +64,15 @@ def test_same_name_replaces_old_node(ros, capsys):
     second = ros2nb.add(Sensor())
     assert list(ros.nodes) == ['/temperature_sensor']
     assert ros.nodes['/temperature_sensor'] is second
-    with pytest.raises(Exception):
-        first.get_name()  # destroyed: no stale timer left publishing
+    assert list(first.timers) == [] and list(first.publishers) == []  # nothing stale left
     monitor = ros2nb.add(Monitor())
+    capsys.readouterr()
     ros2nb.spin(5)
     assert len(monitor.received) == 5  # one sensor, not two
+    out = capsys.readouterr().out  # the new node's logs still reach the cell
+    assert out.count('[INFO] [temperature_sensor]: Publishing:') == 5
+    assert ros2nb.topic_info('temperature', verbose=True)['publishers'] == 1
+    assert '_NODE_NAME_UNKNOWN_' not in capsys.readouterr().out
 
 
 def test_stop_one_and_all(ros):

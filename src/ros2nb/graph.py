@@ -129,7 +129,7 @@ def _duration(value: Any) -> str:
 def topic_info(topic: str, *, verbose: bool = False) -> dict[str, int]:
     """Print a topic's type and publisher/subscription counts, like ``ros2 topic info [-v]``.
 
-    Introduced in ``03-write-the-publisher.ipynb``.
+    Introduced in ``00-setup-and-the-pubsub-idea.ipynb``.
 
     :param topic: topic name, relative (``temperature``) or absolute (``/temperature``).
     :param verbose: also print every endpoint's node and QoS, like ``-v``.
@@ -271,7 +271,7 @@ def topic_echo(topic: str, msg_type: Optional[str] = None, *, count: int = 1,
 
     Log lines of the running nodes produced meanwhile are printed in order with them.
 
-    Introduced in ``03-write-the-publisher.ipynb``.
+    Introduced in ``00-setup-and-the-pubsub-idea.ipynb``.
 
     :param topic: topic name.
     :param msg_type: e.g. ``'std_msgs/msg/Float32'``; ``None`` takes it from the graph.
@@ -303,7 +303,7 @@ def topic_hz(topic: str, msg_type: Optional[str] = None, *, window: int = 10,
 
     On simulated time the rate is in messages per simulated second.
 
-    Introduced in ``03-write-the-publisher.ipynb``.
+    Introduced in ``00-setup-and-the-pubsub-idea.ipynb``.
 
     :param topic: topic name.
     :param msg_type: as for :func:`topic_echo`.

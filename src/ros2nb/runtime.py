@@ -103,6 +103,7 @@ class Runtime:
         self.sim_now_ns = 0
         self._nodes: dict[str, Node] = {}
         self._sim_enabled: set[str] = set()
+        self._retired: dict[str, list[Node]] = {}
         # (logger name | None for our own lines | CallbackFailure, level, text or failure)
         self._log_lines: collections.deque[tuple] = collections.deque()
         self._dropped_log_lines = 0
@@ -261,13 +262,38 @@ class Runtime:
         with self.exclusive():
             old = self._nodes.get(name)
             if old is not None and old is not node:
-                self._forget(old, destroy=True)
+                self._retire(old)
             self._nodes[name] = node
             self.executor.add_node(node)
             if self.sim_time_default:
                 self._use_sim_time([node], True)
             self.drain()
         return node
+
+    def _retire(self, node: Node) -> None:
+        """Take a replaced node out of service without destroying the node itself.
+
+        rcl registers one /rosout publisher per logger name; destroying the old node would
+        unregister it for the new node of the same name too, and its logs would vanish.
+        So every timer, publisher, subscription and service of the old node is destroyed
+        (nothing stale keeps running) and the empty node is kept until no live node has
+        that name.
+        """
+        name = _fully_qualified_name(node)
+        del self._nodes[name]
+        self._sim_enabled.discard(name)
+        self.executor.remove_node(node)
+        for timer in list(node.timers):
+            node.destroy_timer(timer)
+        for publisher in list(node.publishers):
+            node.destroy_publisher(publisher)
+        for subscription in list(node.subscriptions):
+            node.destroy_subscription(subscription)
+        for service in list(node.services):
+            node.destroy_service(service)
+        for client in list(node.clients):
+            node.destroy_client(client)
+        self._retired.setdefault(name, []).append(node)
 
     def _forget(self, node: Node, *, destroy: bool) -> None:
         name = _fully_qualified_name(node)
@@ -276,7 +302,8 @@ class Runtime:
         self._sim_enabled.discard(name)
         self.executor.remove_node(node)
         if destroy:
-            node.destroy_node()
+            for shell in self._retired.pop(name, []) + [node]:
+                shell.destroy_node()
 
     def stop(self, node: Optional[NodeOrName] = None) -> list[str]:
         with self.exclusive():
@@ -375,6 +402,10 @@ class Runtime:
         self._thread.join()
         for node in list(self._nodes.values()):
             self._forget(node, destroy=True)
+        for shells in self._retired.values():
+            for shell in shells:
+                shell.destroy_node()
+        self._retired.clear()
         self.executor.remove_node(self.node)
         self.node.destroy_node()
         self.executor.shutdown()

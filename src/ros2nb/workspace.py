@@ -152,9 +152,10 @@ def _digest(text: str) -> str:
     return hashlib.sha256(text.encode()).hexdigest()
 
 
-def _record_path(path: Path) -> Path:
-    ws = workspace()
-    return (ws if ws in path.parents else path.parent) / WRITTEN_RECORD
+def _record_path(path: Path) -> Optional[Path]:
+    """The workspace's record file, or None for files outside the workspace (not recorded)."""
+    ws = workspace().resolve()
+    return ws / WRITTEN_RECORD if ws in path.resolve().parents else None
 
 
 def write_file(path: PathLike, text: str, *, overwrite: bool = False) -> Path:
@@ -192,15 +193,22 @@ def write_file(path: PathLike, text: str, *, overwrite: bool = False) -> Path:
 
 def _load_record(path: Path) -> dict[str, str]:
     record_file = _record_path(path)
-    return json.loads(record_file.read_text()) if record_file.is_file() else {}
+    return json.loads(record_file.read_text()) if record_file and record_file.is_file() else {}
 
 
 def remember_written(path: PathLike) -> None:
-    """Record that ros2nb wrote ``path`` as it is now, so a later write may replace it."""
+    """Record that ros2nb wrote ``path`` as it is now, so a later write may replace it.
+
+    Only files inside the current workspace are recorded; others are never replaced
+    without ``overwrite=True``.
+    """
     path = Path(path).resolve()
+    record_file = _record_path(path)
+    if record_file is None:
+        return
     record = _load_record(path)
     record[str(path)] = _digest(path.read_text())
-    _record_path(path).write_text(json.dumps(record, indent=1, sort_keys=True) + '\n')
+    record_file.write_text(json.dumps(record, indent=1, sort_keys=True) + '\n')
 
 
 def import_file(path: PathLike, module_name: Optional[str] = None) -> ModuleType:
