@@ -23,7 +23,6 @@ os.environ['ROS_DOMAIN_ID'] = _DOMAIN
 os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
 _SCRATCH = Path(tempfile.mkdtemp(prefix='ros2nb-test-'))
 os.environ['ROS2NB_WORKSPACE'] = str(_SCRATCH / 'ROS2_and_RL_Tutorials')
-os.environ.setdefault('MPLBACKEND', 'Agg')
 
 LEARNER_CHECK_TAG = 'learner-check'
 
