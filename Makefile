@@ -31,9 +31,10 @@ $(STAMP): environment/requirements.txt pyproject.toml
 	$(PY) -m pip install --quiet --no-deps --editable .
 	@touch $(STAMP)
 
+# Localhost only, token authentication on; --allow-root only where you are root (containers).
 lab: $(STAMP)
 	$(VENV)/bin/jupyter lab --ServerApp.ip=127.0.0.1 --ServerApp.root_dir=$(HERE) \
-	  --LabApp.default_url=/lab/tree/notebooks
+	  --LabApp.default_url=/lab/tree/notebooks $(if $(filter 0,$(shell id -u)),--allow-root)
 
 # Unit tests of ros2nb, the notebook checks, then nbval over both notebook folders.
 test: $(STAMP)
