@@ -292,3 +292,20 @@ def test_maintainer_defaults_follow_git_then_login(tmp_path: pathlib.Path,
     root = ET.parse(pkg_create('named', maintainer_name='Grace') / 'package.xml').getroot()
     assert (root.findtext('maintainer'), root.find('maintainer').get('email')) == (
         'Grace', 'Grace@todo.todo')
+
+
+def test_defers_to_a_real_ros2_on_path(tmp_path, monkeypatch):
+    """With a `ros2` on PATH the real CLI is called (a recording stand-in checks the call)."""
+    bin_dir = tmp_path / 'bin'
+    bin_dir.mkdir()
+    calls = tmp_path / 'calls.txt'
+    stub = bin_dir / 'ros2'
+    stub.write_text(f'#!/bin/sh\necho "$@" >> {calls}\necho created by the real CLI\n')
+    stub.chmod(0o755)
+    monkeypatch.setenv('PATH', f'{bin_dir}{os.pathsep}{os.environ["PATH"]}')
+    pkg_create('sensor_simulator', destination=tmp_path, dependencies=['rclpy', 'std_msgs'],
+               maintainer_name='learner', maintainer_email='learner@example.com')
+    argv = calls.read_text().split()
+    assert argv[:4] == ['pkg', 'create', '--build-type', 'ament_python']
+    assert argv[-4:] == ['--dependencies', 'rclpy', 'std_msgs', 'sensor_simulator']
+    assert not (tmp_path / 'sensor_simulator').exists()  # ros2nb wrote nothing itself

@@ -163,3 +163,14 @@ def test_import_file_reloads(built):
     assert module.classify(26.0) == 'Normal' and module.classify(26.01) == 'High'
     with pytest.raises(ros2nb.Ros2nbError, match='does not exist'):
         ros2nb.import_file('src/nothing.py')
+
+
+def test_ros2_run_defers_to_a_real_ros2_on_path(built, tmp_path, monkeypatch, capsys):
+    """With a `ros2` on PATH, `ros2 run` itself is started (a recording stand-in shows it)."""
+    stub = tmp_path / 'ros2'
+    stub.write_text('#!/bin/sh\necho "real ros2 called with: $@"\n')
+    stub.chmod(0o755)
+    monkeypatch.setenv('PATH', f'{tmp_path}{os.pathsep}{os.environ["PATH"]}')
+    assert ros2nb.ros2_run(('sensor_simulator', 'temperature_publisher'), seconds=1) == [0]
+    assert 'real ros2 called with: run sensor_simulator temperature_publisher' in \
+        capsys.readouterr().out

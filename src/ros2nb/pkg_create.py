@@ -323,7 +323,8 @@ def pkg_create(package_name: str, *, destination: str | os.PathLike = '.',
 
     Introduced in ``02-create-a-package.ipynb``.
 
-    Prints what the command prints and writes exactly the files it writes, with the
+    When a real ``ros2`` is on PATH it runs ``ros2 pkg create`` with the same options.
+    Otherwise it prints what the command prints and writes exactly the files it writes, with the
     same contents, for the same arguments.  The checks all run before anything is
     created, so a refused call never touches the file system, and an existing package
     folder is never modified.
@@ -366,6 +367,22 @@ def pkg_create(package_name: str, *, destination: str | os.PathLike = '.',
     if not maintainer_email:
         maintainer_email = _git_config_email() or maintainer_name + '@todo.todo'
     maintainer = f'{maintainer_name} <{maintainer_email}>'
+
+    real_ros2 = shutil.which('ros2')
+    if real_ros2:  # a real ROS 2 install: let its CLI do the work
+        argv = [real_ros2, 'pkg', 'create', '--build-type', build_type,
+                '--destination-directory', destination_directory,
+                '--description', description, '--license', license,
+                '--maintainer-name', maintainer_name, '--maintainer-email', maintainer_email]
+        if dependencies:
+            argv += ['--dependencies', *dependencies]
+        if node_name:
+            argv += ['--node-name', node_name]
+        done = subprocess.run(argv + [package_name], capture_output=True, text=True)
+        print(done.stdout, end='')
+        if done.returncode != 0:
+            raise PkgCreateError((done.stderr.strip() or done.stdout.strip()).splitlines()[-1])
+        return pathlib.Path(package_path)
 
     print('going to create a new package')
     print('package name:', package_name)
