@@ -159,3 +159,20 @@ def test_wall_clock_spin_runs_in_real_time(ros):
 def test_spin_rejects_negative_seconds(ros):
     with pytest.raises(ValueError, match='zero or more'):
         ros2nb.spin(-1)
+
+
+def test_fixed_node_readded_after_failure_keeps_its_logs(ros, capsys):
+    """Learner flow: a callback raises, they fix the class and re-run the cell."""
+    import gc
+    broken = ros2nb.add(Broken())
+    ros2nb.spin(2)
+    assert '[ERROR] [broken]' in capsys.readouterr().err
+
+    class Fixed(Broken):
+        def explode(self) -> None:
+            self.get_logger().info('fixed')
+
+    broken = ros2nb.add(Fixed())  # drops the learner's last reference to the failed node
+    gc.collect()
+    ros2nb.spin(3)
+    assert capsys.readouterr().out.count('[INFO] [broken]: fixed') == 3

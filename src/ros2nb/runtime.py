@@ -193,7 +193,7 @@ class Runtime:
             with self._lock:
                 self._log_lines.append((CallbackFailure, 0, failure))
             if node is not self.node:
-                self._forget(node, destroy=False)
+                self._retire(node)
         return True
 
     def _spin_in_background(self) -> None:
@@ -271,7 +271,7 @@ class Runtime:
         return node
 
     def _retire(self, node: Node) -> None:
-        """Take a replaced node out of service without destroying the node itself.
+        """Take a replaced or failed node out of service without destroying the node itself.
 
         rcl registers one /rosout publisher per logger name; destroying the old node would
         unregister it for the new node of the same name too, and its logs would vanish.
@@ -295,15 +295,14 @@ class Runtime:
             node.destroy_client(client)
         self._retired.setdefault(name, []).append(node)
 
-    def _forget(self, node: Node, *, destroy: bool) -> None:
+    def _destroy(self, node: Node) -> None:
+        """Stop a running node for good, with the retired nodes of its name."""
         name = _fully_qualified_name(node)
-        if self._nodes.get(name) is node:
-            del self._nodes[name]
+        del self._nodes[name]
         self._sim_enabled.discard(name)
         self.executor.remove_node(node)
-        if destroy:
-            for shell in self._retired.pop(name, []) + [node]:
-                shell.destroy_node()
+        for shell in self._retired.pop(name, []) + [node]:
+            shell.destroy_node()
 
     def stop(self, node: Optional[NodeOrName] = None) -> list[str]:
         with self.exclusive():
@@ -313,7 +312,7 @@ class Runtime:
                 targets = [self.find(node)]
             names = [target.get_name() for target in targets]
             for target in targets:
-                self._forget(target, destroy=True)
+                self._destroy(target)
             self.drain()
         return names
 
@@ -401,7 +400,7 @@ class Runtime:
         self.executor.wake()
         self._thread.join()
         for node in list(self._nodes.values()):
-            self._forget(node, destroy=True)
+            self._destroy(node)
         for shells in self._retired.values():
             for shell in shells:
                 shell.destroy_node()
