@@ -211,10 +211,9 @@ def check_clean_shutdown(*command: str, seconds: float = 3.0,
 
     :raises CheckFailed: with the process's last error line.
     """
-    from .workspace import CONSOLE_FORMAT, find_executable, source_workspace, workspace
+    from .workspace import find_executable, node_process_env, source_workspace, workspace_file
     if len(command) == 1 and command[0].endswith('.py'):
-        script = Path(command[0]).expanduser()
-        script = script if script.is_absolute() else workspace() / script
+        script = workspace_file(command[0])
         if not script.is_file():
             raise CheckFailed(f'{script.name} does not exist yet: run the cells that write it.')
         argv, env, executable = [sys.executable, str(script)], dict(os.environ), script.name
@@ -228,8 +227,7 @@ def check_clean_shutdown(*command: str, seconds: float = 3.0,
                 from None
     else:
         raise ValueError('Pass PACKAGE, EXECUTABLE or a single SCRIPT.py.')
-    env.update(PYTHONUNBUFFERED='1', RCUTILS_CONSOLE_OUTPUT_FORMAT=CONSOLE_FORMAT)
-    proc = subprocess.Popen(argv, env=env, text=True, stdout=subprocess.PIPE,
+    proc = subprocess.Popen(argv, env=node_process_env(env), text=True, stdout=subprocess.PIPE,
                             stderr=subprocess.STDOUT, start_new_session=True)
     time.sleep(seconds)
     os.killpg(proc.pid, signal.SIGINT)

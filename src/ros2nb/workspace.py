@@ -24,7 +24,7 @@ import threading
 import time
 from pathlib import Path
 from types import ModuleType
-from typing import Iterable, Optional, Sequence, Union
+from typing import Iterable, Mapping, Optional, Sequence, Union
 
 from .runtime import Ros2nbError
 
@@ -77,6 +77,16 @@ def workspace() -> Path:
     Introduced in ``01-create-a-workspace.ipynb``.
     """
     return _current if _current is not None else default_workspace()
+
+
+def workspace_file(path: PathLike) -> Path:
+    """Return ``path`` with ``~`` expanded; a relative path is taken inside the current workspace."""
+    path = Path(path).expanduser()
+    return path if path.is_absolute() else workspace() / path
+
+
+def _workspace_or_current(workspace_path: Optional[PathLike]) -> Path:
+    return Path(workspace_path) if workspace_path is not None else workspace()
 
 
 def shown(path: PathLike) -> str:
@@ -173,9 +183,7 @@ def write_file(path: PathLike, text: str, *, overwrite: bool = False) -> Path:
     :return: the file's absolute path.
     :raises FileProtectedError: if the file has changes of yours and ``overwrite`` is false.
     """
-    path = Path(path).expanduser()
-    if not path.is_absolute():
-        path = workspace() / path
+    path = workspace_file(path)
     if path.is_file():
         current = path.read_text()
         if current != text and _load_record(path).get(str(path.resolve())) != _digest(current):
@@ -222,9 +230,7 @@ def import_file(path: PathLike, module_name: Optional[str] = None) -> ModuleType
     :raises Ros2nbError: if the file does not exist.
     :raises SyntaxError: (and anything the file raises at import) unchanged, with its line.
     """
-    path = Path(path).expanduser()
-    if not path.is_absolute():
-        path = workspace() / path
+    path = workspace_file(path)
     if not path.is_file():
         raise Ros2nbError(f'{shown(path)} does not exist: run the cells that write it first.')
     name = module_name or path.stem
@@ -254,9 +260,7 @@ def write_part(path: PathLike, number: int, text: str, *, overwrite: bool = Fals
     :return: the file's absolute path.
     :raises FileProtectedError: as :func:`write_file`.
     """
-    resolved = Path(path).expanduser()
-    if not resolved.is_absolute():
-        resolved = workspace() / resolved
+    resolved = workspace_file(path)
     parts = _parts.setdefault(str(resolved.resolve()), {})
     parts[number] = text.rstrip('\n') + '\n'
     written = write_file(resolved, '\n\n'.join(parts[n].rstrip('\n') for n in sorted(parts))
@@ -315,7 +319,7 @@ def colcon_build(*args: str, workspace_path: Optional[PathLike] = None) -> None:
         nothing.
     :raises Ros2nbError: if colcon is not installed or the workspace has no ``src``.
     """
-    ws = Path(workspace_path) if workspace_path is not None else workspace()
+    ws = _workspace_or_current(workspace_path)
     colcon = _venv_tool('colcon')
     if colcon is None:
         raise Ros2nbError('colcon is not installed: run `make lab` (it installs '
@@ -352,7 +356,7 @@ def source_workspace(workspace_path: Optional[PathLike] = None, *,
     :return: the full environment after sourcing.
     :raises Ros2nbError: if the workspace has not been built yet.
     """
-    ws = Path(workspace_path) if workspace_path is not None else workspace()
+    ws = _workspace_or_current(workspace_path)
     setup = ws / 'install' / 'setup.bash'
     if not setup.is_file():
         raise Ros2nbError(f'{shown(setup)} does not exist yet: run ros2nb.colcon_build() '
@@ -375,6 +379,18 @@ def source_workspace(workspace_path: Optional[PathLike] = None, *,
 
 
 # ------------------------------------------------------------------------- ros2 run
+def node_process_env(base: Mapping[str, str]) -> dict[str, str]:
+    """Return ``base`` plus what a node process started from a notebook needs.
+
+    Unbuffered output (lines arrive as they are printed), no colours, the course's console
+    format without timestamps and discovery on this machine, unless already chosen in ``base``.
+    """
+    env = dict(base, PYTHONUNBUFFERED='1', RCUTILS_COLORIZED_OUTPUT='0')
+    env.setdefault('RCUTILS_CONSOLE_OUTPUT_FORMAT', CONSOLE_FORMAT)
+    env.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+    return env
+
+
 def find_executable(package: str, executable: str, env: dict[str, str]) -> Path:
     """Resolve ``ros2 run PACKAGE EXECUTABLE`` through the ament index, as ros2cli does.
 
@@ -432,11 +448,8 @@ def ros2_run(*commands: Sequence[str], seconds: float = 5.0,
     if not commands:
         raise ValueError("Give at least one command, e.g. ('sensor_simulator', 'temperature_publisher').")
     env = source_workspace(workspace_path)
-    env.update(PYTHONUNBUFFERED='1', RCUTILS_COLORIZED_OUTPUT='0')
-    env.setdefault('RCUTILS_CONSOLE_OUTPUT_FORMAT', CONSOLE_FORMAT)
-    env.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
-    env.setdefault('ROS_LOG_DIR', str((Path(workspace_path) if workspace_path else workspace())
-                                      / 'log' / 'ros'))
+    env = node_process_env(env)
+    env.setdefault('ROS_LOG_DIR', str(_workspace_or_current(workspace_path) / 'log' / 'ros'))
     argvs = [_command(c[0], c[1], list(c[2:]), env) for c in commands]
     return run_and_interrupt(*argvs, labels=[c[1] for c in commands], seconds=seconds, env=env)
 
@@ -459,8 +472,7 @@ def run_and_interrupt(*argvs: Sequence[str], labels: Optional[Sequence[str]] = N
     :return: the exit codes, in order (0 is a clean exit; negative is a signal number).
     """
     if env is None:
-        env = dict(os.environ, PYTHONUNBUFFERED='1', RCUTILS_COLORIZED_OUTPUT='0')
-        env.setdefault('RCUTILS_CONSOLE_OUTPUT_FORMAT', CONSOLE_FORMAT)
+        env = node_process_env(os.environ)
     labels = list(labels) if labels is not None else [Path(a[0]).name for a in argvs]
     lines: queue.Queue = queue.Queue()
     procs = []
