@@ -107,3 +107,16 @@ def test_message_type_errors():
         ros2nb.message_type('Float32')
     with pytest.raises(ros2nb.Ros2nbError, match='not installed'):
         ros2nb.message_type('nope_msgs/msg/Nope')
+
+
+def test_record_wrong_field_fails_at_once(ros):
+    ros2nb.add(Sensor())
+    with pytest.raises(ros2nb.Ros2nbError, match=r"Float32 has no field 'temp'; its fields are data"):
+        ros2nb.record('temperature', 600, field='temp')
+    assert ros2nb.runtime().sim_now_ns == 0  # nothing ran
+
+
+def test_record_unknown_topic_suggests(ros):
+    ros2nb.add(Sensor())
+    with pytest.raises(ros2nb.Ros2nbError, match=r'does not appear to be published yet.*Did you mean /temperature\?'):
+        ros2nb.record('temprature', 10)

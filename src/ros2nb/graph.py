@@ -109,9 +109,13 @@ def topic_list(*, show_types: bool = False) -> list[str]:
     return sorted(topics)
 
 
-def _unknown_topic(topic: str) -> Ros2nbError:
+def _did_you_mean(topic: str) -> str:
     close = difflib.get_close_matches(topic, list(_topics()), n=1)
-    hint = f' Did you mean {close[0]}?' if close else ' Check the name with ros2nb.topic_list().'
+    return f' Did you mean {close[0]}?' if close else ''
+
+
+def _unknown_topic(topic: str) -> Ros2nbError:
+    hint = _did_you_mean(topic) or ' Check the name with ros2nb.topic_list().'
     return Ros2nbError(f"Unknown topic '{topic}'.{hint}")
 
 
@@ -224,19 +228,23 @@ def _echo_qos(topic: str) -> QoSProfile:
     return qos
 
 
-def _collect(topic: str, msg_type: Optional[str], count: int, timeout: float,
-             sim_time: Optional[bool], on_message, *, show_logs: bool = True) -> int:
-    """Subscribe on the kernel's node and run until ``count`` messages or ``timeout``."""
-    rt = runtime()
-    name = _resolve(topic)
+def _topic_type(name: str, msg_type: Optional[str]) -> type:
+    """The message class to subscribe with: ``msg_type``, else the type the graph shows."""
     if msg_type is None:
         types = _topics().get(name)
         if not types:
             raise Ros2nbError(f'WARNING: topic [{name}] does not appear to be published yet. '
                               'Could not determine the type for the passed topic: start its '
-                              'publisher first, or pass msg_type="std_msgs/msg/Float32".')
+                              'publisher first, or pass msg_type="std_msgs/msg/Float32".'
+                              + _did_you_mean(name))
         msg_type = types[0]
-    cls = message_type(msg_type)
+    return message_type(msg_type)
+
+
+def _collect(name: str, cls: type, count: int, timeout: float,
+             sim_time: Optional[bool], on_message, *, show_logs: bool = True) -> int:
+    """Subscribe to topic ``name`` on the kernel's node; run until ``count`` messages or ``timeout``."""
+    rt = runtime()
     received = 0
 
     def callback(msg: Any) -> None:
@@ -290,7 +298,8 @@ def topic_echo(topic: str, msg_type: Optional[str] = None, *, count: int = 1,
         messages.append(msg)
         runtime().emit(to_yaml(msg) + '\n---')
 
-    got = _collect(topic, msg_type, count, timeout, sim_time, show)
+    name = _resolve(topic)
+    got = _collect(name, _topic_type(name, msg_type), count, timeout, sim_time, show)
     if got < count:
         print(f'Received {got} of {count} messages in {timeout:g} s: is the publisher '
               'running, and is the topic name spelled the same in both nodes?')
@@ -322,9 +331,10 @@ def topic_hz(topic: str, msg_type: Optional[str] = None, *, window: int = 10,
     def stamp(_msg: Any) -> None:
         stamps.append(rt.sim_now_ns / 1e9 if use_sim else time.monotonic())
 
-    _collect(topic, msg_type, window + 1, timeout, use_sim, stamp)
+    name = _resolve(topic)
+    _collect(name, _topic_type(name, msg_type), window + 1, timeout, use_sim, stamp)
     if len(stamps) < 2:
-        print(f'No rate: fewer than two messages on {_resolve(topic)} in {timeout:g} s.')
+        print(f'No rate: fewer than two messages on {name} in {timeout:g} s.')
         return math.nan
     gaps = [b - a for a, b in zip(stamps, stamps[1:])]
     rate = 1.0 / statistics.fmean(gaps)
@@ -359,16 +369,16 @@ def record(topic: str, seconds: float, msg_type: Optional[str] = None, *, field:
     values: list[float] = []
 
     def keep(msg: Any) -> None:
-        if not hasattr(msg, field):
-            raise Ros2nbError(f'{type(msg).__name__} has no field {field!r}; its fields are '
-                              f'{", ".join(msg.get_fields_and_field_types())}.')
         now = rt.sim_now_ns / 1e9 if use_sim else time.monotonic()
         times.append(now - start_s)
         values.append(getattr(msg, field))
 
     name = _resolve(topic)
-    if msg_type is None and not _topics().get(name):
-        raise _unknown_topic(name)
-    _collect(topic, msg_type, 2 ** 62, seconds, use_sim, keep, show_logs=False)
+    cls = _topic_type(name, msg_type)
+    fields = cls.get_fields_and_field_types()
+    if field not in fields:  # checked here: raised in the callback it would only be logged
+        raise Ros2nbError(f'{cls.__name__} has no field {field!r}; its fields are '
+                          f'{", ".join(fields)}.')
+    _collect(name, cls, 2 ** 62, seconds, use_sim, keep, show_logs=False)
     print(f'Recorded {len(values)} messages from {name} over {seconds:g} s.')
     return times, values
