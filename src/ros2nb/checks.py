@@ -234,7 +234,7 @@ def check_clean_shutdown(*command: str, seconds: float = 3.0,
     try:
         output, _ = proc.communicate(timeout=10)
     except subprocess.TimeoutExpired:
-        proc.kill()
+        os.killpg(proc.pid, signal.SIGKILL)  # the whole group: nothing outlives the check
         output, _ = proc.communicate()
         raise CheckFailed(f'{executable} did not stop within 10 s of Ctrl+C: '
                           'let KeyboardInterrupt end rclpy.spin().') from None

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import atexit
 import collections
+import contextlib
 import os
 import sys
 import threading
@@ -238,20 +239,14 @@ class Runtime:
                 return total
             total += in_round
 
-    class _Exclusive:
-        def __init__(self, runtime: 'Runtime') -> None:
-            self.runtime = runtime
-
-        def __enter__(self) -> 'Runtime':
-            self.runtime._pause()
-            return self.runtime
-
-        def __exit__(self, *exc_info) -> None:
-            self.runtime._unpause()
-
-    def exclusive(self) -> 'Runtime._Exclusive':
+    @contextlib.contextmanager
+    def exclusive(self) -> Iterator['Runtime']:
         """Context manager: pause the spin thread so this thread may spin the executor."""
-        return Runtime._Exclusive(self)
+        self._pause()
+        try:
+            yield self
+        finally:
+            self._unpause()
 
     # ---------------------------------------------------------------- nodes
     def add(self, node: Node) -> Node:
