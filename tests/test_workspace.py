@@ -174,3 +174,13 @@ def test_ros2_run_defers_to_a_real_ros2_on_path(built, tmp_path, monkeypatch, ca
     assert ros2nb.ros2_run(('sensor_simulator', 'temperature_publisher'), seconds=1) == [0]
     assert 'real ros2 called with: run sensor_simulator temperature_publisher' in \
         capsys.readouterr().out
+
+
+def test_catch_up_says_what_it_created(tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv(ws_module.WORKSPACE_ENV, str(tmp_path / 'ws'))
+    monkeypatch.setattr(ws_module, '_current', None)
+    course.catch_up(3)
+    last = capsys.readouterr().out.splitlines()[-1]  # after pkg create's own output
+    assert last == 'Caught up: created ws, ws/src/sensor_simulator'  # 03 writes the publisher
+    course.catch_up(3)
+    assert capsys.readouterr().out.startswith('Nothing to catch up')

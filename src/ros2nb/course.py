@@ -13,7 +13,7 @@ from importlib import resources
 from pathlib import Path
 
 from .pkg_create import pkg_create
-from .workspace import create_workspace, shown, write_file
+from .workspace import create_workspace, default_workspace, shown, write_file
 
 PACKAGE = 'sensor_simulator'
 DEPENDENCIES = ('rclpy', 'std_msgs')
@@ -48,8 +48,10 @@ def catch_up(notebook: int) -> Path:
     if notebook not in STEPS:
         raise ValueError(f'notebook must be one of {sorted(STEPS)} (got {notebook}).')
     steps = STEPS[notebook]
-    ws = create_workspace()
     done = []
+    if 'workspace' in steps and not default_workspace().is_dir():
+        done.append(shown(default_workspace()))
+    ws = create_workspace()  # also re-creates any missing sub-folder, like mkdir -p
     package = package_path(ws)
     if 'package' in steps and not package.exists():
         pkg_create(PACKAGE, destination=ws / 'src', dependencies=list(DEPENDENCIES),
