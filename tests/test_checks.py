@@ -71,7 +71,7 @@ def test_endpoint():
     try:
         with pytest.raises(CheckFailed, match='no subscription on /chatter'):
             checks.check_endpoint(Listener, 'subscription', '/chatter', 'std_msgs/msg/String')
-        with pytest.raises(CheckFailed, match='No executable|uses std_msgs/msg/String'):
+        with pytest.raises(CheckFailed, match='uses std_msgs/msg/String, but the topic carries std_msgs/msg/Float32'):
             checks.check_endpoint(Listener, 'subscription', '/chater', 'std_msgs/msg/Float32')
         checks.check_endpoint(Listener, 'subscription', '/chater', 'std_msgs/msg/String')
     finally:
