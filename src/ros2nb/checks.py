@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import math
 import os
+import random
+import re
 import signal
 import subprocess
 import sys
@@ -247,3 +249,152 @@ def check_clean_shutdown(*command: str, seconds: float = 3.0,
                           'ExternalShutdownException, then destroy the node and call '
                           'rclpy.try_shutdown().')
     passed(f'{executable} stopped cleanly on Ctrl+C (exit code 0, no traceback).')
+
+
+# --------------------------------------------------------------- behaviour (hidden tests)
+#: Readings the monitor check publishes: both boundaries and their neighbours (°C).
+MONITOR_PROBES_C = (19.5, 19.99, 20.0, 20.01, 23.0, 25.99, 26.0, 26.01, 27.5)
+STATUS_WORDS = re.compile(r'\b(High|Low|Normal)\b')
+
+
+def _node_class(path: Any, class_name: str, module_name: str) -> type:
+    from .workspace import import_file
+    try:
+        module = import_file(path, module_name)
+    except Ros2nbError as error:
+        raise CheckFailed(str(error)) from None
+    except Exception as error:  # the learner's file itself fails to import
+        raise CheckFailed(f'{Path(path).name} does not import: {type(error).__name__}: {error}.') \
+            from None
+    cls = getattr(module, class_name, None)
+    if cls is None:
+        raise CheckFailed(f'{Path(path).name} defines no class {class_name}: check its spelling '
+                          '(the tutorial wrote TemperaturSensor in places).')
+    return cls
+
+
+def _expect_endpoint(node: Any, kind: str, topic: str, type_name: str) -> None:
+    found = _endpoint_names(node, kind)
+    if found.get(topic) != type_name:
+        have = ', '.join(f'{t} [{ty}]' for t, ty in sorted(found.items())) or 'none'
+        raise CheckFailed(f'{node.get_name()} needs a {kind} on {topic} [{type_name}]; it has: '
+                          f'{have}.')
+
+
+def check_publisher_behaviour(path: Any, *, seconds: int = 3600) -> None:
+    """Run the learner's TemperatureSensor on simulated time and check what it publishes.
+
+    Float32 on ``/temperature``, once per simulated second, starting within 0.5 °C of
+    22.0, steps of at most 0.5 °C, always inside the clamp.  Needs ``ros2nb.start(sim_time=True)``.
+
+    Introduced in ``03-write-the-publisher.ipynb`` (hidden test).
+
+    :param path: the learner's ``temperature_publisher.py`` (relative to the workspace).
+    :param seconds: simulated seconds to record.
+    :raises CheckFailed: naming the first rule broken.
+    """
+    from . import graph
+    from .runtime import add, stop
+    cls = _node_class(path, 'TemperatureSensor', 'graded_temperature_publisher')
+    random.seed(0)
+    node = add(_call(cls))
+    try:
+        _expect_endpoint(node, 'publisher', '/temperature', 'std_msgs/msg/Float32')
+        times, values = graph.record('temperature', seconds, 'std_msgs/msg/Float32')
+    finally:
+        stop(node.get_name())
+    gaps = {round(b - a, 6) for a, b in zip(times, times[1:])}
+    if gaps and gaps != {1.0}:
+        raise CheckFailed(f'Readings came {sorted(gaps)} s apart; expected exactly 1 s: use a '
+                          '1.0 s timer period.')
+    check_publisher_samples(values, seconds=seconds)
+
+
+def check_monitor_behaviour(path: Any) -> None:
+    """Publish readings around both thresholds to the learner's monitor and read its logs.
+
+    Every reading must give exactly one log line naming the right status (High above
+    26.0 °C, Low below 20.0 °C, Normal otherwise, boundaries included).
+
+    Introduced in ``04-write-the-subscriber.ipynb`` (hidden test).
+
+    :param path: the learner's ``temperature_subscriber.py``.
+    :raises CheckFailed: naming the first reading handled wrongly.
+    """
+    from rclpy.node import Node
+    from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+    from rcl_interfaces.msg import Log
+    from std_msgs.msg import Float32
+    from .runtime import add, spin, stop
+    cls = _node_class(path, 'TemperatureMonitor', 'graded_temperature_subscriber')
+    monitor = add(_call(cls))
+    logger = monitor.get_logger().name
+    heard: list[str] = []
+    probe = Node('ros2nb_grading_probe')
+    publisher = probe.create_publisher(Float32, 'temperature', 10)
+    probe.create_subscription(
+        Log, '/rosout', lambda m: heard.append(m.msg) if m.name == logger else None,
+        QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE,
+                   durability=DurabilityPolicy.VOLATILE))
+    add(probe)
+    try:
+        _expect_endpoint(monitor, 'subscription', '/temperature', 'std_msgs/msg/Float32')
+        spin(0)
+        for value in MONITOR_PROBES_C:
+            heard.clear()
+            publisher.publish(Float32(data=value))
+            spin(0)
+            statuses = [STATUS_WORDS.findall(line) for line in heard]
+            statuses = [s for s in statuses if s]
+            want = reference_status(value)
+            if len(statuses) != 1:
+                raise CheckFailed(f'For a reading of {value} °C the monitor logged {len(statuses)} '
+                                  'status lines; expected exactly one per message.')
+            if statuses[0] != [want]:
+                raise CheckFailed(f'For {value} °C the monitor logged {statuses[0]}, expected '
+                                  f'{want!r} ("above 26" is > 26.0, "below 20" is < 20.0).')
+    finally:
+        stop(probe.get_name())
+        stop(monitor.get_name())
+    passed(f'the monitor logged the right status for {len(MONITOR_PROBES_C)} readings, '
+           'boundaries included.')
+
+
+def check_package(workspace_path: Optional[Path] = None, *, package: str = 'sensor_simulator',
+                  executables: tuple[str, ...] = ('temperature_publisher',
+                                                  'temperature_subscriber')) -> None:
+    """Check the package: dependencies, setup.cfg, a colcon build and both entry points.
+
+    Introduced in ``05-entry-points-and-run.ipynb`` (hidden test).
+
+    :raises CheckFailed: naming what is missing.
+    """
+    import configparser
+    from .workspace import (ColconBuildError, colcon_build, find_executable,
+                            source_workspace, workspace)
+    ws = Path(workspace_path) if workspace_path is not None else workspace()
+    root = ws / 'src' / package
+    if not (root / 'package.xml').is_file():
+        raise CheckFailed(f'{root / "package.xml"} is missing: create the package (notebook 02).')
+    missing = [d for d in ('rclpy', 'std_msgs') if d not in package_dependencies(root / 'package.xml')]
+    if missing:
+        raise CheckFailed(f'package.xml lacks <depend> on {", ".join(missing)}.')
+    config = configparser.ConfigParser()
+    config.read(root / 'setup.cfg')
+    if config.get('install', 'install_scripts', fallback='') != f'$base/lib/{package}':
+        raise CheckFailed(f'setup.cfg must set [install] install_scripts=$base/lib/{package}, '
+                          'or ros2 run finds no executable.')
+    try:
+        colcon_build('--packages-select', package, workspace_path=ws)
+    except ColconBuildError as error:
+        raise CheckFailed(str(error)) from None
+    env = source_workspace(ws)
+    for executable in executables:
+        try:
+            find_executable(package, executable, env)
+        except Ros2nbError:
+            raise CheckFailed(f"ros2 run {package} {executable}: No executable found; add "
+                              f"'{executable} = {package}.{executable}:main' to console_scripts "
+                              'in setup.py and build again.') from None
+    passed(f'{package} declares rclpy and std_msgs, builds, and installs '
+           f'{", ".join(executables)}.')
