@@ -76,3 +76,9 @@ def test_endpoint():
         checks.check_endpoint(Listener, 'subscription', '/chater', 'std_msgs/msg/String')
     finally:
         ros2nb.shutdown()
+
+
+def test_checks_say_when_ros_was_shut_down():
+    from rclpy.node import Node
+    with pytest.raises(CheckFailed, match=r'was rclpy.shutdown\(\) called\?'):
+        checks.check_endpoint(Node, 'subscription', '/chatter', 'std_msgs/msg/String')

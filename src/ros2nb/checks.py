@@ -19,6 +19,7 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Any, Callable, Optional
 
+from .graph import INFRASTRUCTURE_TOPICS
 from .runtime import Ros2nbError
 
 #: The course's clamp range for the simulated sensor (°C); the tutorial's 10.2 floor is fixed.
@@ -47,6 +48,15 @@ def _call(function: Callable[..., Any], *args: Any) -> Any:
                           'again.') from None
 
 
+def _require_ros() -> None:
+    """Raise CheckFailed when rclpy is not running in this kernel (e.g. after rclpy.shutdown())."""
+    import rclpy
+    if not rclpy.ok():
+        raise CheckFailed('ROS 2 is not running in this kernel (was rclpy.shutdown() called?): '
+                          'restart the kernel and run the notebook from the top; ros2nb.stop() '
+                          'stops nodes without shutting ROS down.')
+
+
 def _endpoint_names(node: Any, kind: str) -> dict[str, str]:
     entities = node.subscriptions if kind == 'subscription' else node.publishers
     return {node.resolve_topic_name(e.topic_name): e.msg_type.__module__.split('.')[0] + '/msg/'
@@ -66,6 +76,7 @@ def check_endpoint(node_class: Callable[[], Any], kind: str, topic: str, type_na
     :param type_name: e.g. ``'std_msgs/msg/String'``.
     :raises CheckFailed: naming what the node has instead.
     """
+    _require_ros()
     from rclpy.node import Node
     node = _call(node_class)
     if not isinstance(node, Node):
@@ -276,7 +287,8 @@ def _node_class(path: Any, class_name: str, module_name: str) -> type:
 def _expect_endpoint(node: Any, kind: str, topic: str, type_name: str) -> None:
     found = _endpoint_names(node, kind)
     if found.get(topic) != type_name:
-        have = ', '.join(f'{t} [{ty}]' for t, ty in sorted(found.items())) or 'none'
+        have = ', '.join(f'{t} [{ty}]' for t, ty in sorted(found.items())
+                         if t not in INFRASTRUCTURE_TOPICS) or 'none'
         raise CheckFailed(f'{node.get_name()} needs a {kind} on {topic} [{type_name}]; it has: '
                           f'{have}.')
 
@@ -293,6 +305,7 @@ def check_publisher_behaviour(path: Any, *, seconds: int = 3600) -> None:
     :param seconds: simulated seconds to record.
     :raises CheckFailed: naming the first rule broken.
     """
+    _require_ros()
     from . import graph
     from .runtime import add, stop
     cls = _node_class(path, 'TemperatureSensor', 'graded_temperature_publisher')
@@ -321,6 +334,7 @@ def check_monitor_behaviour(path: Any) -> None:
     :param path: the learner's ``temperature_subscriber.py``.
     :raises CheckFailed: naming the first reading handled wrongly.
     """
+    _require_ros()
     from rclpy.node import Node
     from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
     from rcl_interfaces.msg import Log

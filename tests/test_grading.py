@@ -1,0 +1,90 @@
+"""Grading a sample class with nbgrader through tools/grade.py (real kernels, real ROS)."""
+
+import csv
+import html
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from grading_samples import EXPECTED, ROOT, build
+
+pytestmark = pytest.mark.timeout(900)  # grading a class takes minutes, not seconds
+CELL_TIMEOUT_S = 15
+NOTEBOOK_TIMEOUT_S = 240
+
+
+def git_status() -> str:
+    return subprocess.run(['git', 'status', '--porcelain', '--ignored'], cwd=ROOT,
+                          capture_output=True, text=True).stdout
+
+
+@pytest.fixture(scope='module')
+def graded(tmp_path_factory):
+    root = tmp_path_factory.mktemp('grading')
+    submissions = build(root / 'submissions')
+    before = git_status()
+    done = subprocess.run(
+        [sys.executable, str(ROOT / 'tools' / 'grade.py'), str(submissions), '--out',
+         str(root / 'grading'), f'--cell-timeout={CELL_TIMEOUT_S}',
+         f'--notebook-timeout={NOTEBOOK_TIMEOUT_S}'],
+        capture_output=True, text=True, timeout=900)
+    return root / 'grading', done, before
+
+
+def test_grading_exits_0_and_leaves_repo_alone(graded):
+    out, done, before = graded
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert git_status() == before  # nothing written to the repository
+    # Learners' code ran only in scratch copies: the course under grading/ only scored.
+    assert 'IPKernelApp' not in (out / 'nbgrader' / 'grading.log').read_text()
+
+
+def test_every_score_and_csv_row(graded):
+    out, done, _ = graded
+    with open(out / 'grades.csv') as stream:
+        rows = list(csv.DictReader(stream))
+    notebooks = sorted(p.stem for p in (ROOT / 'solutions').glob('*.ipynb'))
+    assert len(rows) == len(EXPECTED) * (len(notebooks) + 1)
+    got = {(r['learner'], r['notebook']): float(r['score']) for r in rows}
+    maxima = {r['notebook']: float(r['max_score']) for r in rows if r['learner'] == 'full'}
+    for learner, (scores, _) in EXPECTED.items():
+        for notebook in notebooks:
+            assert got[learner, notebook] == scores.get(notebook, 0), (learner, notebook)
+        assert got[learner, 'TOTAL'] == sum(scores.values())
+    assert maxima == {**{n: float(p) for n, p in zip(notebooks, (1, 1, 1, 3, 3, 5))},
+                      'TOTAL': 14.0}
+
+
+@pytest.mark.parametrize('learner', sorted(EXPECTED))
+def test_feedback_files_name_what_happened(graded, learner):
+    out, _, _ = graded
+    scores, phrases = EXPECTED[learner]
+    for notebook in sorted(p.stem for p in (ROOT / 'solutions').glob('*.ipynb')):
+        page = out / 'feedback' / learner / f'{notebook}.html'
+        assert page.is_file(), page
+        if notebook not in scores:
+            assert 'Not submitted' in page.read_text()
+    for notebook, phrase in phrases.items():
+        page = (out / 'feedback' / learner / f'{notebook}.html').read_text()
+        text = ' '.join(html.unescape(re.sub(r'<[^>]+>', '', page)).split())  # as displayed
+        assert phrase in text, (learner, phrase)
+
+
+def test_gradebook_works_with_nbgrader_export(graded):
+    out, _, _ = graded
+    course = out / 'nbgrader'
+    done = subprocess.run([sys.executable, '-m', 'nbgrader', 'export',
+                           f'--CourseDirectory.root={course}',
+                           f'--CourseDirectory.db_url=sqlite:///{course / "gradebook.db"}',
+                           f'--to={out / "export.csv"}'],
+                          cwd=course, capture_output=True, text=True,
+                          env={**__import__('os').environ,
+                               'PATH': f'{Path(sys.executable).parent}:'
+                                       f'{__import__("os").environ["PATH"]}'})
+    assert done.returncode == 0, done.stderr
+    rows = list(csv.DictReader(open(out / 'export.csv')))
+    assert {r['student_id'] for r in rows} >= {'full', 'partial'}
+    assert float(next(r for r in rows if r['student_id'] == 'full')['score']) == 14.0
