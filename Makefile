@@ -17,7 +17,7 @@ export ROS_HOME            := $(HERE)/.cache/ros
 export ROS_LOG_DIR         := $(HERE)/.cache/ros/log
 export PIP_DISABLE_PIP_VERSION_CHECK := 1
 
-.PHONY: lab test setup learner-notebooks benchmark clean
+.PHONY: lab test setup learner-notebooks benchmark benchmark-grading grade clean
 
 setup: $(STAMP)
 
@@ -48,6 +48,15 @@ learner-notebooks: $(STAMP)
 
 benchmark: $(STAMP)
 	$(PY) benchmarks/sim_hour.py
+
+benchmark-grading: $(STAMP)
+	$(PY) benchmarks/grade_class.py
+
+# Grade a class: SUBMISSIONS is a folder of <learner-id>/NN-*.ipynb or a platform .zip.
+# Output goes to grading/ (git-ignored); FORCE=1 replaces an earlier grading/.
+grade: $(STAMP)
+	@test -n "$(SUBMISSIONS)" || { echo "Usage: make grade SUBMISSIONS=DIR (DIR/<learner-id>/NN-title.ipynb) or SUBMISSIONS=class.zip [FORCE=1]"; exit 2; }
+	$(PY) tools/grade.py "$(SUBMISSIONS)" $(if $(FORCE),--force)
 
 clean:
 	rm -rf $(VENV) .cache .jupyter

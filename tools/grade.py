@@ -120,10 +120,14 @@ def collect_zip(archive: Path, course: Path) -> Path:
     regexp = (r'.*/extracted/(?:.*/)?(?P<student_id>[A-Za-z0-9][A-Za-z0-9_.-]*)/'
               r'(?P<file_id>[^/]+\.ipynb)$')
     code = nbgrader(course, 'zip_collect', ASSIGNMENT, '--force',
-                    f'--FileNameCollector.named_regexp={regexp}', log=course / 'grading.log')
+                    f'--FileNameCollectorPlugin.named_regexp={regexp}',
+                    log=course / 'grading.log')
     if code != 0:
         sys.exit(f'nbgrader zip_collect failed: see {course / "grading.log"}')
     collected = course / 'collected'
+    if not (course / 'submitted').is_dir():
+        sys.exit(f'{archive.name} holds no <learner-id>/NN-title.ipynb files: each notebook must '
+                 'sit in a folder named after its learner.')
     shutil.move(course / 'submitted', collected)
     for learner in collected.iterdir():  # <learner>/<assignment>/NB -> <learner>/NB
         for notebook in (learner / ASSIGNMENT).glob('*.ipynb'):
@@ -193,10 +197,17 @@ def run_one(course: Path, scratch: Path, learner: Learner, notebook: str, domain
     submitted = grader / 'submitted' / learner.name / ASSIGNMENT
     submitted.mkdir(parents=True)
     shutil.copy2(learner.files[notebook], submitted / f'{notebook}.ipynb')
+    home = scratch / 'home'
+    # Every place a kernel, IPython, matplotlib or ROS writes to is inside the scratch
+    # folder (make exports some of them into this repository for `make lab`).
     env = dict(os.environ, ROS_DOMAIN_ID=str(domain), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST',
                ROS2NB_WORKSPACE=str(scratch / 'workspace' / 'ROS2_and_RL_Tutorials'),
-               HOME=str(scratch / 'home'), JUPYTER_RUNTIME_DIR=str(scratch / '.runtime'),
-               ROS_HOME=str(scratch / 'home' / '.ros'), PYTHONUNBUFFERED='1')
+               HOME=str(home), IPYTHONDIR=str(home / '.ipython'),
+               MPLCONFIGDIR=str(home / '.matplotlib'), ROS_HOME=str(home / '.ros'),
+               ROS_LOG_DIR=str(home / '.ros' / 'log'), JUPYTER_CONFIG_DIR=str(home / '.jupyter'),
+               JUPYTER_DATA_DIR=str(home / '.local'), JUPYTER_RUNTIME_DIR=str(home / '.runtime'),
+               PYTHONUNBUFFERED='1')
+    env.pop('PIP_CACHE_DIR', None)
     log = scratch / f'{notebook}.log'
     code = nbgrader(grader, 'autograde', ASSIGNMENT, f'--student={learner.name}',
                     f'--CourseDirectory.notebook_id={notebook}', '--force',
