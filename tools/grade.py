@@ -322,9 +322,11 @@ def main() -> int:
         return 2
     with tempfile.TemporaryDirectory(prefix='ros2nb-grading-') as scratch_root:
         with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+            # Most notebooks first, so the longest learner does not start last.
+            by_size = sorted(learners, key=lambda learner: -len(learner.files))
             jobs = [pool.submit(grade_learner, course, Path(scratch_root), learner, notebooks,
                                 os.getpid() + 7 * i, args.cell_timeout, args.notebook_timeout)
-                    for i, learner in enumerate(learners)]
+                    for i, learner in enumerate(by_size)]
             for job in jobs:
                 job.result()
     graded = [l.name for l in learners if l.files]
