@@ -1,34 +1,89 @@
-"""Catch up on earlier notebooks, so any notebook can be run on its own.
+"""The course's facts, defined once: names, files, the sensor's numbers, the monitor's rule.
 
-Introduced in ``01-create-a-workspace.ipynb``.
+The checks, the grader and the notebooks take every number from here.  The node files
+the learner writes (and ``ros2nb/reference/``) are standalone ROS programs, so they carry
+the same numbers as literals in their constants part; a test keeps them equal to these.
 
-Each step creates only what is missing and never changes a file you wrote; the code it
-writes is the course's reference code (the tutorial's, with its mistakes fixed), kept in
-``ros2nb/reference/``.
+Also :func:`catch_up`, so any notebook can be run on its own.  Introduced in
+``01-create-a-workspace.ipynb``.
 """
 
 from __future__ import annotations
 
+import os
 from importlib import resources
 from pathlib import Path
 
-from .pkg_create import pkg_create
-from .workspace import create_workspace, default_workspace, shown, write_file
-
+# ------------------------------------------------------------------ the package
 PACKAGE = 'sensor_simulator'
 DEPENDENCIES = ('rclpy', 'std_msgs')
 #: Maintainer used in the notebooks, so package.xml is the same on every machine.
 MAINTAINER_NAME = 'learner'
 MAINTAINER_EMAIL = 'learner@example.com'
+#: Files the learner writes, relative to the workspace.
+PUBLISHER_FILE = f'src/{PACKAGE}/{PACKAGE}/temperature_publisher.py'
+SUBSCRIBER_FILE = f'src/{PACKAGE}/{PACKAGE}/temperature_subscriber.py'
+SETUP_PY_FILE = f'src/{PACKAGE}/setup.py'
+SETUP_CFG_FILE = f'src/{PACKAGE}/setup.cfg'
+PACKAGE_XML_FILE = f'src/{PACKAGE}/package.xml'
+#: Entry points (``ros2 run sensor_simulator <executable>``) and what they start.
+PUBLISHER_EXECUTABLE = 'temperature_publisher'
+SUBSCRIBER_EXECUTABLE = 'temperature_subscriber'
+SENSOR_CLASS, SENSOR_NODE = 'TemperatureSensor', 'temperature_sensor'
+MONITOR_CLASS, MONITOR_NODE = 'TemperatureMonitor', 'temperature_monitor'
+
+# ------------------------------------------------------------------ the sensor
+TOPIC = 'temperature'
+MESSAGE_TYPE = 'std_msgs/msg/Float32'
+QUEUE_DEPTH = 10              # messages kept for a slow subscription
+PUBLISH_PERIOD_S = 1.0        # one reading per second
+START_TEMPERATURE_C = 22.0    # room temperature
+MAX_STEP_C = 0.5              # largest change between two readings
+MIN_TEMPERATURE_C = 18.0      # the tutorial's 10.2 was a typo
+MAX_TEMPERATURE_C = 28.0
+
+# ------------------------------------------------------------------ the monitor
+HIGH_ABOVE_C = 26.0           # strictly above: High
+LOW_BELOW_C = 20.0            # strictly below: Low
+STATUSES = ('Low', 'Normal', 'High')
+
+#: Environment variable the grader sets: the course's reference code never stands in.
+GRADING_ENV = 'ROS2NB_GRADING'
 #: Notebook number -> what must exist before it starts.
 STEPS = {1: (), 2: ('workspace',), 3: ('workspace', 'package'),
          4: ('workspace', 'package', 'publisher'),
          5: ('workspace', 'package', 'publisher', 'subscriber')}
 
 
-def reference_source(name: str) -> str:
-    """Return a reference file's text, e.g. ``'temperature_publisher.py'``."""
-    return resources.files('ros2nb.reference').joinpath(name).read_text()
+def monitor_status(temperature_c: float) -> str:
+    """Return the monitor's status for a reading: ``'High'``, ``'Low'`` or ``'Normal'``.
+
+    ``High`` strictly above :data:`HIGH_ABOVE_C`, ``Low`` strictly below
+    :data:`LOW_BELOW_C`, ``Normal`` otherwise (both boundaries are Normal).
+
+    Introduced in ``04-write-the-subscriber.ipynb``.
+
+    :param temperature_c: the reading in °C.
+    """
+    if temperature_c > HIGH_ABOVE_C:
+        return 'High'
+    if temperature_c < LOW_BELOW_C:
+        return 'Low'
+    return 'Normal'
+
+
+def reference_source(name: str) -> str | None:
+    """Return a reference node file's text (e.g. ``'temperature_publisher.py'``), or None.
+
+    None while grading, or where the reference files are not installed: then the course's
+    code never stands in for the learner's.
+    """
+    if os.environ.get(GRADING_ENV):
+        return None
+    try:
+        return resources.files('ros2nb.reference').joinpath(name).read_text()
+    except (FileNotFoundError, ModuleNotFoundError):
+        return None
 
 
 def package_path(workspace: Path) -> Path:
@@ -39,16 +94,22 @@ def package_path(workspace: Path) -> Path:
 def catch_up(notebook: int) -> Path:
     """Create whatever earlier notebooks would have made, if it is missing.
 
+    Each step creates only what is missing and never changes a file you wrote.  The
+    nodes it writes are the course's reference code (the tutorial's, with its mistakes
+    fixed); while grading it writes none, so only your own nodes are graded.
+
     Introduced in ``01-create-a-workspace.ipynb``.
 
     :param notebook: the number of the notebook about to run (1-5).
     :return: the workspace path.
     :raises ValueError: for a notebook number without steps.
     """
+    from .pkg_create import pkg_create
+    from .workspace import create_workspace, default_workspace, shown, write_file
     if notebook not in STEPS:
         raise ValueError(f'notebook must be one of {sorted(STEPS)} (got {notebook}).')
     steps = STEPS[notebook]
-    done = []
+    done, missing = [], []
     if 'workspace' in steps and not default_workspace().is_dir():
         done.append(shown(default_workspace()))
     ws = create_workspace()  # also re-creates any missing sub-folder, like mkdir -p
@@ -59,10 +120,20 @@ def catch_up(notebook: int) -> Path:
         done.append(shown(package))
     for step in ('publisher', 'subscriber'):
         target = package / PACKAGE / f'temperature_{step}.py'
-        if step in steps and not target.exists():
-            write_file(target, reference_source(target.name))
-            target.chmod(0o755)
-            done.append(shown(target))
-    print('Caught up: created ' + ', '.join(done) if done else
-          f'Nothing to catch up: {shown(ws)} has what notebook {notebook:02d} needs.')
+        if step not in steps or target.exists():
+            continue
+        text = reference_source(target.name)
+        if text is None:
+            missing.append(target.name)
+            continue
+        write_file(target, text)
+        target.chmod(0o755)
+        done.append(shown(target))
+    if done:
+        print('Caught up: created ' + ', '.join(done))
+    elif not missing:
+        print(f'Nothing to catch up: {shown(ws)} has what notebook {notebook:02d} needs.')
+    if missing:
+        print(f'Not created: {", ".join(missing)} (only your own nodes count here); the '
+              'cells that use them will fail until you write them.')
     return ws

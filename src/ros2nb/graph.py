@@ -20,7 +20,8 @@ from typing import Any, Optional
 from rclpy.qos import (DurabilityPolicy, QoSPresetProfiles, QoSProfile,
                        ReliabilityPolicy)
 
-from .runtime import Ros2nbError, runtime
+from .errors import Ros2nbError, UsageError
+from .runtime import current_runtime
 
 #: Topics every ROS 2 process has; they are never reported as unmatched.
 INFRASTRUCTURE_TOPICS = ('/rosout', '/parameter_events', '/clock')
@@ -33,7 +34,7 @@ def _hidden(name: str) -> bool:
 
 
 def _resolve(topic: str) -> str:
-    return runtime().node.resolve_topic_name(topic)
+    return current_runtime().node.resolve_topic_name(topic)
 
 
 def node_list(*, all: bool = False) -> list[str]:
@@ -46,7 +47,7 @@ def node_list(*, all: bool = False) -> list[str]:
     :raises Ros2nbError: if ROS is not up (run ``ros2nb.start()``).
     """
     names = sorted({(ns.rstrip('/') + '/' + name) for name, ns in
-                    runtime().node.get_node_names_and_namespaces()})
+                    current_runtime().node.get_node_names_and_namespaces()})
     names = [n for n in names if all or not _hidden(n)]
     for name in names:
         print(name)
@@ -54,35 +55,41 @@ def node_list(*, all: bool = False) -> list[str]:
 
 
 def _topics() -> dict[str, list[str]]:
-    return {name: types for name, types in runtime().node.get_topic_names_and_types()
+    return {name: types for name, types in current_runtime().node.get_topic_names_and_types()
             if not _hidden(name)}
 
 
 def unmatched_topics() -> list[str]:
-    """Return one line per topic that has publishers but no subscriptions, or the reverse.
+    """Return one line per topic whose two sides do not meet.
 
-    A typo such as ``temprature`` in one node makes two such topics.
+    A topic with publishers but no subscriptions (or the reverse), as a typo such as
+    ``temprature`` in one node makes, with the closest other topic name; and a topic used
+    with two message types (a ``Float32`` publisher and a ``Float64`` subscription never
+    exchange a message).
+
+    Introduced in ``00-setup-and-the-pubsub-idea.ipynb`` (through :func:`topic_list`).
 
     :return: human-readable notes, empty when every topic is matched.
     """
-    node = runtime().node
+    node = current_runtime().node
     notes = []
     topics = _topics()
-    for name in sorted(topics):
-        if name in INFRASTRUCTURE_TOPICS:
+    others = [n for n in topics if n not in INFRASTRUCTURE_TOPICS]
+    for name in sorted(others):
+        if len(topics[name]) > 1:
+            uses = [f'{info.topic_type} ({info.node_name})' for info in
+                    [*node.get_publishers_info_by_topic(name),
+                     *node.get_subscriptions_info_by_topic(name)]
+                    if not _hidden(info.node_name)]
+            notes.append(f'{name} is used with {len(topics[name])} message types: '
+                         f'{", ".join(sorted(set(uses)))}; both sides must use the same type')
             continue
         pubs, subs = node.count_publishers(name), node.count_subscribers(name)
-        if pubs and not subs:
-            notes.append(f'{name} has {pubs} publisher(s) but no subscription')
-        elif subs and not pubs:
-            notes.append(f'{name} has {subs} subscription(s) but no publisher')
-    if notes:
-        others = [n for n in topics if n not in INFRASTRUCTURE_TOPICS]
-        for i, note in enumerate(notes):
-            name = note.split()[0]
+        note = (f'{name} has {pubs} publisher(s) but no subscription' if pubs and not subs else
+                f'{name} has {subs} subscription(s) but no publisher' if subs and not pubs else '')
+        if note:
             close = difflib.get_close_matches(name, [o for o in others if o != name], n=1)
-            if close:
-                notes[i] = note + f': is it a typo of {close[0]}?'
+            notes.append(note + (f': is it a typo of {close[0]}?' if close else ''))
     return notes
 
 
@@ -110,7 +117,7 @@ def topic_list(*, show_types: bool = False) -> list[str]:
 
 
 def _did_you_mean(topic: str) -> str:
-    close = difflib.get_close_matches(topic, list(_topics()), n=1)
+    close = difflib.get_close_matches(topic, [t for t in _topics() if t != topic], n=1)
     return f' Did you mean {close[0]}?' if close else ''
 
 
@@ -144,7 +151,7 @@ def topic_info(topic: str, *, verbose: bool = False) -> dict[str, int]:
     topics = _topics()
     if name not in topics:
         raise _unknown_topic(name)
-    node = runtime().node
+    node = current_runtime().node
     pubs = node.get_publishers_info_by_topic(name)
     subs = node.get_subscriptions_info_by_topic(name)
     print(f'Type: {", ".join(topics[name])}')
@@ -220,7 +227,7 @@ def _echo_qos(topic: str) -> QoSProfile:
     qos = QoSProfile(history=qos.history, depth=qos.depth, reliability=qos.reliability,
                      durability=qos.durability)
     offered = [info.qos_profile for info in
-               runtime().node.get_publishers_info_by_topic(topic)]
+               current_runtime().node.get_publishers_info_by_topic(topic)]
     if offered and all(q.reliability == ReliabilityPolicy.RELIABLE for q in offered):
         qos.reliability = ReliabilityPolicy.RELIABLE
     if offered and all(q.durability == DurabilityPolicy.TRANSIENT_LOCAL for q in offered):
@@ -244,7 +251,7 @@ def _topic_type(name: str, msg_type: Optional[str]) -> type:
 def _collect(name: str, cls: type, count: int, timeout: float,
              sim_time: Optional[bool], on_message, *, show_logs: bool = True) -> int:
     """Subscribe to topic ``name`` on the kernel's node; run until ``count`` messages or ``timeout``."""
-    rt = runtime()
+    rt = current_runtime()
     received = 0
 
     def callback(msg: Any) -> None:
@@ -253,19 +260,19 @@ def _collect(name: str, cls: type, count: int, timeout: float,
             received += 1
             on_message(msg)
 
-    use_sim = rt.sim_time_default if sim_time is None else sim_time
+    use_sim = rt.sim_time if sim_time is None else bool(sim_time)
     with rt.exclusive():
         subscription = rt.node.create_subscription(cls, name, callback, _echo_qos(name))
     try:
-        if use_sim:
-            rt.advance_sim_time(timeout, until=lambda: received >= count,
-                                on_step=lambda: rt.print_pending(show_logs=show_logs))
-        else:
-            rt.use_wall_time()
-            deadline = time.monotonic() + timeout
-            while received < count and time.monotonic() < deadline:
-                time.sleep(0.05)
-                rt.print_pending(show_logs=show_logs)
+        with rt.clock(use_sim):
+            if use_sim:
+                rt.advance_sim_time(timeout, until=lambda: received >= count,
+                                    on_step=lambda: rt.print_pending(show_logs=show_logs))
+            else:
+                deadline = time.monotonic() + timeout
+                while received < count and time.monotonic() < deadline:
+                    time.sleep(0.05)
+                    rt.print_pending(show_logs=show_logs)
     finally:
         with rt.exclusive():
             rt.node.destroy_subscription(subscription)
@@ -288,21 +295,23 @@ def topic_echo(topic: str, msg_type: Optional[str] = None, *, count: int = 1,
     :param sim_time: as for :func:`ros2nb.spin`.
     :return: the messages received (fewer than ``count`` if the timeout ran out).
     :raises Ros2nbError: if the topic's type cannot be determined or is not installed.
-    :raises ValueError: if ``count`` is less than 1.
+    :raises UsageError: if ``count`` is less than 1.
     """
     if count < 1:
-        raise ValueError(f'count must be 1 or more (got {count}).')
+        raise UsageError(f'count must be 1 or more (got {count!r}).')
     messages: list[Any] = []
 
     def show(msg: Any) -> None:
         messages.append(msg)
-        runtime().emit(to_yaml(msg) + '\n---')
+        current_runtime().emit(to_yaml(msg) + '\n---')
 
     name = _resolve(topic)
     got = _collect(name, _topic_type(name, msg_type), count, timeout, sim_time, show)
     if got < count:
-        print(f'Received {got} of {count} messages in {timeout:g} s: is the publisher '
-              'running, and is the topic name spelled the same in both nodes?')
+        publishers = current_runtime().node.count_publishers(name)
+        hint = ('is the topic name spelled the same in both nodes?' if publishers else
+                f'{name} has no publisher.' + (_did_you_mean(name) or ' Is the publisher running?'))
+        print(f'Received {got} of {count} messages in {timeout:g} s: {hint}')
     return messages
 
 
@@ -323,9 +332,9 @@ def topic_hz(topic: str, msg_type: Optional[str] = None, *, window: int = 10,
     :raises Ros2nbError: as :func:`topic_echo`.
     """
     if window < 1:
-        raise ValueError(f'window must be 1 or more (got {window}).')
-    rt = runtime()
-    use_sim = rt.sim_time_default if sim_time is None else sim_time
+        raise UsageError(f'window must be 1 or more (got {window!r}).')
+    rt = current_runtime()
+    use_sim = rt.sim_time if sim_time is None else bool(sim_time)
     stamps: list[float] = []
 
     def stamp(_msg: Any) -> None:
@@ -362,8 +371,8 @@ def record(topic: str, seconds: float, msg_type: Optional[str] = None, *, field:
         started, and the field's values; two lists of equal length.
     :raises Ros2nbError: as :func:`topic_echo`, or if the message has no such field.
     """
-    rt = runtime()
-    use_sim = rt.sim_time_default if sim_time is None else sim_time
+    rt = current_runtime()
+    use_sim = rt.sim_time if sim_time is None else bool(sim_time)
     start_s = rt.sim_now_ns / 1e9 if use_sim else time.monotonic()
     times: list[float] = []
     values: list[float] = []

@@ -41,6 +41,7 @@ import shutil
 import subprocess
 from collections.abc import Sequence
 
+from .errors import PkgCreateError
 from .workspace import remember_written
 
 __all__ = [
@@ -166,13 +167,6 @@ def test_pep257():
     rc = main(argv=['.', 'test'])
     assert rc == 0, 'Found code style errors / warnings'
 '''
-
-
-class PkgCreateError(Exception):
-    """``ros2 pkg create`` would refuse (or :func:`pkg_create` cannot reproduce) the request.
-
-    The message is the text the command line prints; nothing has been created.
-    """
 
 
 def expected_files(package_name: str, node_name: str | None = None) -> list[str]:

@@ -2,13 +2,17 @@
 
 Introduced in ``00-setup-and-the-pubsub-idea.ipynb``.
 
-The kernel owns one :class:`Runtime`.  It initialises rclpy without signal
-handlers, spins every node handed to it with ONE ``SingleThreadedExecutor`` in
-ONE background thread, and prints the nodes' log lines (read back from
-``/rosout``) in the cell that called :func:`spin`.  On simulated time the main
-thread pauses that background thread, steps ``/clock`` itself from one timer
-deadline to the next and runs every callback until the graph is idle, so the
-output is identical on every run when ``random`` is seeded.
+The kernel owns one :class:`Runtime`.  It initialises rclpy without signal handlers on
+the kernel's own ROS domain (:mod:`ros2nb.domains`), spins every node handed to it with
+ONE ``SingleThreadedExecutor`` in ONE background thread, and prints the nodes' log lines
+(read back from ``/rosout``) in the cell that made them.
+
+The kernel's clock is chosen once, by :func:`start`: simulated or wall-clock time.  On
+simulated time the nodes are frozen between cells; inside :func:`spin` (and the graph
+verbs) the main thread pauses the background thread, steps ``/clock`` from one timer
+deadline to the next and runs every callback until the graph is idle, so the output is
+identical on every run when ``random`` is seeded.  ``spin(..., sim_time=False)`` in a
+simulated-time kernel runs the nodes on the wall clock for that call only.
 """
 
 from __future__ import annotations
@@ -16,11 +20,11 @@ from __future__ import annotations
 import atexit
 import collections
 import contextlib
+import math
 import os
 import sys
 import threading
 import time
-import traceback
 from dataclasses import dataclass
 from typing import Callable, Iterable, Iterator, Optional, Union
 
@@ -32,6 +36,9 @@ from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 
+from . import domains
+from .errors import Ros2nbError, UsageError
+
 #: Hidden name of the kernel's own node (names starting with ``_`` are hidden
 #: from ``ros2 node list``, as the ros2cli daemon's are).
 INTERNAL_NODE_NAME = '_ros2nb'
@@ -41,14 +48,15 @@ BACKGROUND_WAIT_S = 0.1
 MAX_SIM_STEP_S = 1.0
 #: Log lines kept while no cell is reading them; older ones are counted, not kept.
 MAX_PENDING_LOG_LINES = 2000
+#: Callbacks one idle-wait may run before ros2nb calls it a loop that never ends.
+MAX_CALLBACKS_PER_DRAIN = 100_000
 #: rcl_interfaces/msg/Log levels -> the console's severity names.
 SEVERITY_NAMES = {10: 'DEBUG', 20: 'INFO', 30: 'WARN', 40: 'ERROR', 50: 'FATAL'}
+SHUT_DOWN_MESSAGE = ('ROS 2 was shut down in this kernel (rclpy.shutdown() was called): run '
+                     'ros2nb.shutdown(); ros2nb.start() to bring it back, then re-run the cells '
+                     'that create your nodes.')
 
 NodeOrName = Union[Node, str]
-
-
-class Ros2nbError(RuntimeError):
-    """A ros2nb call could not be done; the message says what to do next."""
 
 
 @dataclass(frozen=True)
@@ -57,8 +65,8 @@ class CallbackFailure:
 
     :ivar node: fully qualified name of the node whose callback raised.
     :ivar callback: qualified name of the callback, e.g. ``TemperatureMonitor.temperature_callback``.
-    :ivar error: ``ExceptionType: message``.
-    :ivar where: the learner's own line, ``line N: source``; empty when none was found.
+    :ivar error: ``ExceptionType: message``, or ros2nb's one-line explanation of it.
+    :ivar where: the learner's own line, ``FILE line N: source``; empty when none was found.
     """
 
     node: str
@@ -75,50 +83,39 @@ class CallbackFailure:
                 'Fix the callback, re-run the cell that creates the node and hand it over again.')
 
 
-def _fully_qualified_name(node: Node) -> str:
-    return node.get_fully_qualified_name()
-
-
-def _learner_frame(exc: BaseException) -> str:
-    """Return ``line N: source`` for the innermost frame outside rclpy and ros2nb."""
-    here = os.path.dirname(os.path.abspath(__file__))
-    rclpy_dir = os.path.dirname(os.path.abspath(rclpy.__file__))
-    found = ''
-    for frame in traceback.extract_tb(exc.__traceback__):
-        path = os.path.abspath(frame.filename)
-        if path.startswith(here) or path.startswith(rclpy_dir):
-            continue
-        shown = os.path.basename(path) if os.path.isfile(path) and 'ipykernel' not in path else 'cell'
-        found = f'in {shown}, line {frame.lineno}: {(frame.line or "").strip()}'
-    return found
-
-
 class Runtime:
     """The kernel's ROS 2 runtime: rclpy context, one executor, one spin thread.
 
     Create it with :func:`start`; use the module-level functions, not this class.
     """
 
-    def __init__(self, *, domain_id: Optional[int], sim_time: bool) -> None:
-        self.sim_time_default = sim_time
+    def __init__(self, *, domain_id: int, sim_time: bool) -> None:
+        #: The kernel's clock: True for simulated time, False for the wall clock.
+        self.sim_time = sim_time
         self.sim_now_ns = 0
         self._nodes: dict[str, Node] = {}
-        self._sim_enabled: set[str] = set()
+        self._on_sim: set[str] = set()
         self._retired: dict[str, list[Node]] = {}
-        # (logger name | None for our own lines | CallbackFailure, level, text or failure)
+        self._our_loggers: set[str] = set()
+        #: /rosout lines received so far, per logger name (the checks count with it).
+        self.log_counts: collections.Counter[str] = collections.Counter()
+        # (cell epoch, logger name | None for our own lines | CallbackFailure, level, text)
         self._log_lines: collections.deque[tuple] = collections.deque()
-        self._dropped_log_lines = 0
+        self._overflow = 0
+        self._epoch = 0
         self._lock = threading.Lock()
         self._pause_requested = threading.Event()
         self._paused = threading.Event()
         self._resume = threading.Event()
         self._stopping = False
         self._exclusive_depth = 0
+        #: Called with (node name, callback name, exception) when a callback raises.
+        self.on_failure: Optional[Callable[[str, str, BaseException], None]] = None
 
         rclpy.init(args=['--ros-args', '--disable-stdout-logs', '--disable-external-lib-logs'],
-                   domain_id=domain_id,
-                   signal_handler_options=SignalHandlerOptions.NO)
-        self.domain_id = rclpy.get_default_context().get_domain_id()
+                   domain_id=domain_id, signal_handler_options=SignalHandlerOptions.NO)
+        self.context = rclpy.get_default_context()
+        self.domain_id = self.context.get_domain_id()
         from rcl_interfaces.msg import Log
         from rosgraph_msgs.msg import Clock
         self._clock_type = Clock
@@ -133,69 +130,99 @@ class Runtime:
                                         name='ros2nb-executor', daemon=True)
         self._thread.start()
 
+    @property
+    def alive(self) -> bool:
+        """False once ROS was shut down under ros2nb (e.g. by ``rclpy.shutdown()``)."""
+        return self.context.ok() and not self._stopping
+
+    def ensure_alive(self) -> None:
+        """:raises Ros2nbError: when ROS 2 was shut down under ros2nb."""
+        if not self.alive:
+            raise Ros2nbError(SHUT_DOWN_MESSAGE)
+
     # ----------------------------------------------------------------- logs
+    def begin_cell(self) -> None:
+        """A new cell starts: lines made before it are no longer news (IPython pre_run_cell)."""
+        self._epoch += 1
+
     def _on_log(self, msg) -> None:
         with self._lock:
+            self.log_counts[msg.name] += 1
             if len(self._log_lines) >= MAX_PENDING_LOG_LINES:
                 self._log_lines.popleft()
-                self._dropped_log_lines += 1
-            self._log_lines.append((msg.name, msg.level, msg.msg))
+                self._overflow += 1
+            self._log_lines.append((self._epoch, msg.name, msg.level, msg.msg))
 
     def emit(self, text: str) -> None:
         """Queue a line of our own (e.g. an echoed message) in order with the log lines."""
         with self._lock:
-            self._log_lines.append((None, 0, text))
+            self._log_lines.append((self._epoch, None, 0, text))
 
-    def _is_ours(self, logger_name: str) -> bool:
+    def _report_failure(self, failure: CallbackFailure) -> None:
+        with self._lock:
+            self._log_lines.append((self._epoch, CallbackFailure, 0, failure))
+
+    def is_ours(self, logger_name: str) -> bool:
         """True for the loggers of nodes handed over (and their child loggers)."""
-        names = [node.get_logger().name for node in list(self._nodes.values())]
-        return any(logger_name == n or logger_name.startswith(n + '.') for n in names)
+        return any(logger_name == n or logger_name.startswith(n + '.')
+                   for n in self._our_loggers)
 
     def print_pending(self, *, show_logs: bool = True) -> int:
-        """Print (from the calling thread) log lines and callback failures collected so far.
+        """Print (from the calling thread) the log lines and callback failures of this cell.
 
-        :return: the number of log lines taken (printed or, with ``show_logs=False``, hidden).
+        Lines made while no cell was running (nodes on the wall clock keep running between
+        cells) are not shown as if they were new: one line says how many there were.
+
+        :param show_logs: ``False`` hides the log lines; failures are always shown.
+        :return: the number of log lines of this cell taken (printed or hidden).
         """
         with self._lock:
             queued, self._log_lines = list(self._log_lines), collections.deque()
-            dropped, self._dropped_log_lines = self._dropped_log_lines, 0
-        if show_logs and dropped:
-            print(f'({dropped} older log lines were not kept)')
-        taken = dropped
-        for name, level, text in queued:
+            overflow, self._overflow = self._overflow, 0
+        earlier = overflow
+        taken = 0
+        lines: list[str] = []
+        for epoch, name, level, text in queued:
             if name is CallbackFailure:
                 sys.stdout.flush()
                 print(text, file=sys.stderr)
                 sys.stderr.flush()
-            elif name is None or self._is_ours(name):
+            elif name is None or self.is_ours(name):
+                if epoch < self._epoch:
+                    earlier += 1
+                    continue
                 taken += 1
-                if show_logs:
-                    print(text if name is None else
-                          f'[{SEVERITY_NAMES.get(level, level)}] [{name}]: {text}')
+                lines.append(text if name is None else
+                             f'[{SEVERITY_NAMES.get(level, level)}] [{name}]: {text}')
+        if earlier and show_logs:
+            print(f'({earlier} log lines made while no cell was running were not shown)')
+        if show_logs and lines:
+            print('\n'.join(lines))
         sys.stdout.flush()
         return taken
 
     # ------------------------------------------------------------- executor
-    def _run_one(self, timeout_sec: float) -> bool:
-        """Run one ready callback; return False when none became ready in time."""
+    def _run_one(self, timeout_sec: float) -> Optional[str]:
+        """Run one ready callback; return its name, or None when none became ready in time."""
         try:
             handler, entity, node = self.executor.wait_for_ready_callbacks(timeout_sec=timeout_sec)
         except TimeoutException:
-            return False
+            return None
         handler()
+        callback = getattr(entity, 'callback', None)
+        label = getattr(callback, '__qualname__', repr(callback))
         error = handler.exception()
         if error is not None:
-            callback = getattr(entity, 'callback', None)
-            failure = CallbackFailure(
-                node=_fully_qualified_name(node),
-                callback=getattr(callback, '__qualname__', repr(callback)),
-                error=f'{type(error).__name__}: {error}',
-                where=_learner_frame(error))
-            with self._lock:
-                self._log_lines.append((CallbackFailure, 0, failure))
+            from .explain import explain_exception, learner_line
+            self._report_failure(CallbackFailure(
+                node=node.get_fully_qualified_name(), callback=label,
+                error=explain_exception(error) or f'{type(error).__name__}: {error}',
+                where=learner_line(error)))
+            if self.on_failure is not None:
+                self.on_failure(node.get_fully_qualified_name(), label, error)
             if node is not self.node:
-                self._retire(node)
-        return True
+                self._discard(node)
+        return label
 
     def _spin_in_background(self) -> None:
         while not self._stopping:
@@ -208,6 +235,11 @@ class Runtime:
                 self._run_one(BACKGROUND_WAIT_S)
             except (ShutdownException, ExternalShutdownException):
                 break
+            except Exception:  # the context was shut down under us (rclpy.shutdown())
+                if self.context.ok():
+                    raise
+                break
+        self._paused.set()  # nobody waits for a pause of a thread that has ended
 
     def _pause(self) -> None:
         if self._exclusive_depth == 0 and self._thread.is_alive():
@@ -227,17 +259,26 @@ class Runtime:
         """Run ready callbacks from this thread until none is ready; return how many ran.
 
         Only call while the background thread is paused (inside :meth:`exclusive`).
+
+        :raises Ros2nbError: when callbacks keep making work for each other without end
+            (e.g. a node that answers every message on its own topic).
         """
-        total = 0
+        counts: collections.Counter[str] = collections.Counter()
         while True:
             # With a zero timeout rclpy ends every wait round with TimeoutException, even
             # one that ran callbacks, so "idle" is a round in which nothing ran.
             in_round = 0
-            while self._run_one(0.0):
+            while (label := self._run_one(0.0)) is not None:
                 in_round += 1
+                counts[label] += 1
+                if sum(counts.values()) > MAX_CALLBACKS_PER_DRAIN:
+                    busiest, times = counts.most_common(1)[0]
+                    raise Ros2nbError(
+                        f'{busiest} ran {times} times without the clock moving: a callback keeps '
+                        'triggering itself (e.g. publishing on the topic it subscribes to); '
+                        'stop that node with ros2nb.stop() and fix it.')
             if in_round == 0:
-                return total
-            total += in_round
+                return sum(counts.values())
 
     @contextlib.contextmanager
     def exclusive(self) -> Iterator['Runtime']:
@@ -250,23 +291,31 @@ class Runtime:
 
     # ---------------------------------------------------------------- nodes
     def add(self, node: Node) -> Node:
-        if not isinstance(node, Node):
-            raise TypeError(f'ros2nb.add() takes an rclpy Node, not {type(node).__name__}: '
-                            'create the node first, e.g. add(TemperatureSensor()).')
-        name = _fully_qualified_name(node)
+        """Hand ``node`` over, replacing a running node of the same name; see :func:`add`."""
+        self.ensure_alive()
+        from .explain import check_node
+        check_node(node, self)
+        name = node.get_fully_qualified_name()
         with self.exclusive():
             old = self._nodes.get(name)
             if old is not None and old is not node:
                 self._retire(old)
             self._nodes[name] = node
+            self._our_loggers.add(node.get_logger().name)
             self.executor.add_node(node)
-            if self.sim_time_default:
-                self._use_sim_time([node], True)
+            self._set_clock([node], self.sim_time)
             self.drain()
         return node
 
+    def _forget(self, node: Node) -> str:
+        name = node.get_fully_qualified_name()
+        self._nodes.pop(name, None)
+        self._on_sim.discard(name)
+        self.executor.remove_node(node)
+        return name
+
     def _retire(self, node: Node) -> None:
-        """Take a replaced or failed node out of service without destroying the node itself.
+        """Take a replaced node out of service without destroying the node itself.
 
         rcl registers one /rosout publisher per logger name; destroying the old node would
         unregister it for the new node of the same name too, and its logs would vanish.
@@ -274,10 +323,7 @@ class Runtime:
         (nothing stale keeps running) and the empty node is kept until no live node has
         that name.
         """
-        name = _fully_qualified_name(node)
-        del self._nodes[name]
-        self._sim_enabled.discard(name)
-        self.executor.remove_node(node)
+        name = self._forget(node)
         for timer in list(node.timers):
             node.destroy_timer(timer)
         for publisher in list(node.publishers):
@@ -290,32 +336,34 @@ class Runtime:
             node.destroy_client(client)
         self._retired.setdefault(name, []).append(node)
 
-    def _destroy(self, node: Node) -> None:
-        """Stop a running node for good, with the retired nodes of its name."""
-        name = _fully_qualified_name(node)
-        del self._nodes[name]
-        self._sim_enabled.discard(name)
-        self.executor.remove_node(node)
+    def _discard(self, node: Node) -> None:
+        """Stop a node for good, with the retired nodes of its name: it leaves the graph."""
+        name = self._forget(node)
         for shell in self._retired.pop(name, []) + [node]:
             shell.destroy_node()
 
     def stop(self, node: Optional[NodeOrName] = None) -> list[str]:
+        """Stop one running node (or all); see :func:`stop`."""
         with self.exclusive():
-            if node is None:
-                targets = list(self._nodes.values())
-            else:
-                targets = [self.find(node)]
+            targets = list(self._nodes.values()) if node is None else [self.find(node)]
             names = [target.get_name() for target in targets]
             for target in targets:
-                self._destroy(target)
-            self.drain()
+                self._discard(target)
+            if self.alive:
+                self.drain()
         return names
 
     def find(self, node: NodeOrName) -> Node:
+        """Return the running node given as a node or a name.
+
+        :raises Ros2nbError: naming the running nodes when there is none of that name.
+        """
         if isinstance(node, Node):
-            key = _fully_qualified_name(node)
-        else:
+            key = node.get_fully_qualified_name()
+        elif isinstance(node, str):
             key = node if node.startswith('/') else '/' + node
+        else:
+            raise UsageError(f'Give a node or its name, not {type(node).__name__}.')
         try:
             return self._nodes[key]
         except KeyError:
@@ -325,33 +373,50 @@ class Runtime:
 
     @property
     def nodes(self) -> dict[str, Node]:
+        """The running nodes handed over, by fully qualified name."""
         return dict(self._nodes)
 
-    # ------------------------------------------------------------ sim time
+    # ----------------------------------------------------------------- clock
     def _publish_clock(self) -> None:
         msg = self._clock_type()
         msg.clock.sec, msg.clock.nanosec = divmod(self.sim_now_ns, 1_000_000_000)
         self._clock_publisher.publish(msg)
 
-    def _use_sim_time(self, nodes: Iterable[Node], enabled: bool) -> None:
-        """Switch nodes to (or from) simulated time; timers restart on the new clock."""
+    def _set_clock(self, nodes: Iterable[Node], sim: bool) -> None:
+        """Put nodes on simulated (or wall-clock) time; the one place that changes a node's clock.
+
+        Timers restart on the new clock, so a period counts from the switch.  Only call
+        while the background thread is paused.
+        """
         changed = []
         for node in nodes:
-            name = _fully_qualified_name(node)
-            if (name in self._sim_enabled) == enabled:
+            name = node.get_fully_qualified_name()
+            if (name in self._on_sim) == sim:
                 continue
-            node.set_parameters([Parameter('use_sim_time', Parameter.Type.BOOL, enabled)])
-            (self._sim_enabled.add if enabled else self._sim_enabled.discard)(name)
+            node.set_parameters([Parameter('use_sim_time', Parameter.Type.BOOL, sim)])
+            (self._on_sim.add if sim else self._on_sim.discard)(name)
             changed.append(node)
         if not changed:
             return
-        if enabled:
+        if sim:
             self._publish_clock()
             self.drain()
         for node in changed:
             for timer in node.timers:
                 if not timer.is_canceled():
                     timer.reset()
+
+    @contextlib.contextmanager
+    def clock(self, sim: bool) -> Iterator['Runtime']:
+        """Run the nodes on the given clock inside the block, then on the kernel's clock again."""
+        with self.exclusive():
+            self._set_clock(self._nodes.values(), sim)
+        try:
+            yield self
+        finally:
+            if self.alive:
+                with self.exclusive():
+                    self._set_clock(self._nodes.values(), self.sim_time)
 
     def _next_timer_ns(self) -> Optional[int]:
         due = [timer.time_until_next_call()
@@ -364,12 +429,13 @@ class Runtime:
                          on_step: Optional[Callable[[], None]] = None) -> float:
         """Step ``/clock`` by ``seconds``, running every callback that becomes due.
 
+        The nodes must be on simulated time (inside :meth:`clock`, or a simulated-time kernel).
+
         :return: simulated seconds actually advanced (less when ``until()`` became true).
         """
         start = self.sim_now_ns
         end = start + round(seconds * 1e9)
         with self.exclusive():
-            self._use_sim_time(self._nodes.values(), True)
             self.drain()
             while self.sim_now_ns < end and not (until and until()):
                 step = self._next_timer_ns()
@@ -382,20 +448,17 @@ class Runtime:
                     on_step()
         return (self.sim_now_ns - start) / 1e9
 
-    def use_wall_time(self) -> None:
-        with self.exclusive():
-            self._use_sim_time(self._nodes.values(), False)
-            self.drain()
-
     # ------------------------------------------------------------ shutdown
     def shutdown(self) -> None:
+        """Stop every node, stop the executor, join its thread and shut rclpy down."""
         self._stopping = True
         self._pause_requested.clear()
         self._resume.set()
-        self.executor.wake()
+        with contextlib.suppress(Exception):  # a shut-down context cannot be woken
+            self.executor.wake()
         self._thread.join()
         for node in list(self._nodes.values()):
-            self._destroy(node)
+            self._discard(node)
         for shells in self._retired.values():
             for shell in shells:
                 shell.destroy_node()
@@ -407,6 +470,7 @@ class Runtime:
 
 
 _runtime: Optional[Runtime] = None
+_original_spin = rclpy.spin
 
 
 def _enable_field_checks() -> None:
@@ -417,51 +481,88 @@ def _enable_field_checks() -> None:
             module.ros_python_check_fields = '1'
 
 
-def start(*, domain_id: Optional[int] = None, sim_time: bool = False) -> Runtime:
-    """Bring ROS 2 up for this kernel; calling it again is harmless.
+def _spin_in_a_cell(node, executor=None) -> None:
+    """``rclpy.spin`` as ros2nb installs it in a kernel: from a cell it explains instead of blocking."""
+    if _runtime is not None and threading.current_thread() is threading.main_thread():
+        raise Ros2nbError('rclpy.spin(node) never returns in a notebook cell (it spins until '
+                          'Ctrl+C): hand the node over with ros2nb.add(node) and let it run with '
+                          'ros2nb.spin(seconds).')
+    return _original_spin(node, executor)
+
+
+def _describe(rt: Runtime) -> str:
+    clock = 'simulated time' if rt.sim_time else 'wall-clock time'
+    own = ' (claimed for this kernel alone)' if domains.claimed_domain() == rt.domain_id else ''
+    return f'domain {rt.domain_id}{own}, {clock}'
+
+
+def start(*, domain_id: Optional[int] = None, sim_time: Optional[bool] = None) -> Runtime:
+    """Bring ROS 2 up for this kernel and say on which domain; calling it again is harmless.
 
     Initialises rclpy with no signal handlers (the kernel's Stop button must not shut ROS
     down), turns on message field checks (``ROS_PYTHON_CHECK_FIELDS=1``), keeps discovery
     on this machine (``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``) unless you set that
-    variable yourself, and starts the background executor thread.
+    variable yourself, puts the kernel on a ROS domain of its own (see
+    :func:`ros2nb.domains.domain_id`) and starts the background executor thread.  In a
+    notebook it also turns ``rclpy.spin(node)`` into a one-line explanation.
 
     Introduced in ``00-setup-and-the-pubsub-idea.ipynb``.
 
-    :param domain_id: ROS domain id (0-101); ``None`` uses ``ROS_DOMAIN_ID`` or 0.
-    :param sim_time: ``True`` puts every node handed over on simulated time, frozen
-        between calls, so that :func:`spin` and the graph verbs print the same output
-        on every run.
+    :param domain_id: ROS domain id (0-232, 0-101 safe on Linux); ``None`` uses
+        ``ROS_DOMAIN_ID`` if set, else a domain claimed for this kernel alone.
+    :param sim_time: ``True`` for simulated time (nodes frozen between calls, the same
+        output on every run), ``False`` for the wall clock; ``None`` keeps the clock of a
+        running kernel (wall clock the first time).
     :return: the kernel's runtime.
-    :raises Ros2nbError: if ROS is already up with another domain id, or rclpy was
-        initialised outside ros2nb.
+    :raises Ros2nbError: if ROS is already up on another domain.
+    :raises DomainsExhaustedError: when every safe domain is taken.
     """
     global _runtime
+    if _runtime is not None and not _runtime.alive:
+        print('ROS 2 had been shut down in this kernel; starting it again.')
+        shutdown()
     if _runtime is not None:
         if domain_id is not None and domain_id != _runtime.domain_id:
             raise Ros2nbError(f'ROS is already up on domain {_runtime.domain_id}; call '
                               'ros2nb.shutdown() first to change the domain id.')
-        _runtime.sim_time_default = sim_time
+        if sim_time is not None and sim_time != _runtime.sim_time:
+            _runtime.sim_time = sim_time
+            with _runtime.exclusive():
+                _runtime._set_clock(_runtime.nodes.values(), sim_time)
+        print(f'ROS 2 is up in this kernel: {_describe(_runtime)}.')
         return _runtime
-    if rclpy.ok():
-        raise Ros2nbError('rclpy was initialised outside ros2nb (rclpy.init() was called); '
-                          'restart the kernel and call ros2nb.start() instead.')
-    if domain_id is not None and not 0 <= domain_id <= 232:
-        raise ValueError(f'domain_id must be between 0 and 232, and 0-101 is safe on Linux '
-                         f'(got {domain_id}).')
+    if domain_id is not None and not (isinstance(domain_id, int) and 0 <= domain_id <= 232):
+        raise UsageError(f'domain_id must be a whole number from 0 to 232, and 0-101 is safe on '
+                         f'Linux (got {domain_id!r}).')
+    if rclpy.ok():  # rclpy.init() was called in this kernel: take over cleanly
+        rclpy.try_shutdown()
+        print('rclpy.init() had been called in this kernel; ros2nb shut that down and starts '
+              'ROS 2 itself (in a notebook, call ros2nb.start() instead of rclpy.init()).')
+    if domain_id is None:
+        domain_id = domains.domain_id()
+    else:
+        os.environ[domains.DOMAIN_ENV] = str(domain_id)
     _enable_field_checks()
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
-    _runtime = Runtime(domain_id=domain_id, sim_time=sim_time)
+    _runtime = Runtime(domain_id=domain_id, sim_time=bool(sim_time))
     atexit.register(shutdown)
+    from . import kernel
+    if kernel.install():  # inside IPython: cell hooks, one-line errors, %%part
+        rclpy.spin = _spin_in_a_cell
+    print(f'ROS 2 is up in this kernel: {_describe(_runtime)}.')
     return _runtime
 
 
-def runtime() -> Runtime:
+def current_runtime() -> Runtime:
     """Return the kernel's runtime.
 
-    :raises Ros2nbError: if :func:`start` has not been called.
+    Introduced in ``00-setup-and-the-pubsub-idea.ipynb``.
+
+    :raises Ros2nbError: if :func:`start` has not been called, or ROS was shut down.
     """
     if _runtime is None:
-        raise Ros2nbError('ROS is not up in this kernel yet: run ros2nb.start() first.')
+        raise Ros2nbError('ROS 2 is not up in this kernel yet: run ros2nb.start() first.')
+    _runtime.ensure_alive()
     return _runtime
 
 
@@ -469,16 +570,23 @@ def add(node: Node) -> Node:
     """Hand a node to the kernel's executor, replacing a running node of the same name.
 
     Re-running the cell that creates a node therefore never doubles it: the old node
-    (its timers and subscriptions) is destroyed first.
+    (its timers and subscriptions) is taken out of service first.  What the node logs
+    while it starts is printed here.  Common mistakes are refused with one line: a timer
+    of period 0, a callback that is not callable (``self.tick()`` instead of
+    ``self.tick``), a message passed instead of its type (``Float32()``), a topic used
+    with another type by another node, a node whose ``__init__`` never called
+    ``super().__init__``.
 
     Introduced in ``00-setup-and-the-pubsub-idea.ipynb``.
 
     :param node: the node to spin in the background.
     :return: the same node, so ``sensor = ros2nb.add(TemperatureSensor())`` works.
-    :raises Ros2nbError: if :func:`start` has not been called.
-    :raises TypeError: if ``node`` is not an rclpy ``Node``.
+    :raises Ros2nbError: if :func:`start` has not been called, or for the mistakes above.
     """
-    return runtime().add(node)
+    rt = current_runtime()
+    rt.add(node)
+    rt.print_pending()
+    return node
 
 
 def stop(node: Optional[NodeOrName] = None) -> list[str]:
@@ -490,7 +598,16 @@ def stop(node: Optional[NodeOrName] = None) -> list[str]:
     :return: names of the nodes stopped.
     :raises Ros2nbError: if no running node has that name, or ROS is not up.
     """
-    return runtime().stop(node)
+    rt = current_runtime()
+    names = rt.stop(node)
+    rt.print_pending()
+    return names
+
+
+def _check_seconds(seconds: float) -> None:
+    if isinstance(seconds, bool) or not isinstance(seconds, (int, float)) \
+            or not math.isfinite(seconds) or seconds < 0:
+        raise UsageError(f'seconds must be a number of seconds, zero or more (got {seconds!r}).')
 
 
 def spin(seconds: float, *, sim_time: Optional[bool] = None, show_logs: bool = True) -> float:
@@ -499,52 +616,66 @@ def spin(seconds: float, *, sim_time: Optional[bool] = None, show_logs: bool = T
     Log lines use the ROS console format without timestamps
     (``[INFO] [temperature_sensor]: Publishing: 22.31C``).  A callback that raises is
     reported here with its node, callback and line, and only that node is stopped.
+    The Stop button ends the spin with one line; the nodes then wait.
 
     Introduced in ``00-setup-and-the-pubsub-idea.ipynb``.
 
     :param seconds: how long to run, in seconds (simulated or wall-clock).
     :param sim_time: ``True`` steps a simulated ``/clock`` (60 s of a 1 Hz node take a
         fraction of a second and the output is the same on every run); ``False`` waits
-        in real time; ``None`` uses the choice given to :func:`start`.
+        in real time; ``None`` uses the kernel's clock, chosen in :func:`start`.
     :param show_logs: ``False`` hides the log lines and prints how many there were.
     :return: seconds actually run.
     :raises Ros2nbError: if ROS is not up.
-    :raises ValueError: if ``seconds`` is negative.
+    :raises UsageError: if ``seconds`` is negative or not a number.
     """
-    rt = runtime()
-    if seconds < 0:
-        raise ValueError(f'seconds must be zero or more (got {seconds}).')
-    use_sim = rt.sim_time_default if sim_time is None else sim_time
-    hidden = 0
+    rt = current_runtime()
+    _check_seconds(seconds)
+    use_sim = rt.sim_time if sim_time is None else bool(sim_time)
+    if not rt.nodes:
+        rt.print_pending(show_logs=show_logs)
+        print('No nodes are running in this kernel: hand yours over with ros2nb.add(node), '
+              'then spin.')
+        return 0.0
+    taken = 0
 
     def flush() -> None:
-        nonlocal hidden
-        hidden += rt.print_pending(show_logs=show_logs)
+        nonlocal taken
+        taken += rt.print_pending(show_logs=show_logs)
 
     flush()
-    if use_sim:
-        ran = rt.advance_sim_time(seconds, on_step=flush)
-    else:
-        rt.use_wall_time()
-        deadline = time.monotonic() + seconds
-        try:
-            while (left := deadline - time.monotonic()) > 0:
-                time.sleep(min(0.1, left))
-                flush()
-        except KeyboardInterrupt:
-            print('Interrupted: the nodes keep running in the background; '
-                  'ros2nb.stop() stops them.')
-        ran = seconds - max(0.0, deadline - time.monotonic())
+    ran = 0.0
+    started_ns, started_wall = rt.sim_now_ns, time.monotonic()
+    try:
+        with rt.clock(use_sim):
+            if use_sim:
+                ran = rt.advance_sim_time(seconds, on_step=flush)
+            else:
+                deadline = time.monotonic() + seconds
+                while (left := deadline - time.monotonic()) > 0:
+                    time.sleep(min(0.1, left))
+                    flush()
+                ran = float(seconds)
+    except KeyboardInterrupt:
+        ran = ((rt.sim_now_ns - started_ns) / 1e9 if use_sim
+               else time.monotonic() - started_wall)
+        flush()
+        print(f'Interrupted after {ran:.1f} of {seconds:g} {"simulated " if use_sim else ""}'
+              's; the nodes wait until the next spin (ros2nb.stop() stops them).')
+        return ran
     flush()
     if not show_logs:
-        print(f'({hidden} log lines hidden)')
+        print(f'({taken} log lines hidden)')
+    elif taken == 0:
+        print(f'(no log lines in {seconds:g} s; running: {", ".join(sorted(rt.nodes))})')
     return ran
 
 
 def shutdown() -> None:
     """Stop every node, stop the executor, join its thread and shut rclpy down.
 
-    Safe to call twice; :func:`start` works again afterwards.
+    Safe to call twice, and after ``rclpy.shutdown()``; :func:`start` works again
+    afterwards (on the same domain).
 
     Introduced in ``00-setup-and-the-pubsub-idea.ipynb``.
     """

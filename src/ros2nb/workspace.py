@@ -9,6 +9,7 @@ then ``<prefix>/lib/<package>/<executable>``) with the same error texts.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import importlib.util
 import json
@@ -24,9 +25,11 @@ import threading
 import time
 from pathlib import Path
 from types import ModuleType
-from typing import Iterable, Mapping, Optional, Sequence, Union
+from typing import Iterable, Iterator, Mapping, Optional, Sequence, Union
 
-from .runtime import Ros2nbError
+from . import domains
+from .errors import ColconBuildError, FileProtectedError, Ros2nbError, UsageError
+from .processes import STOP_GRACE_S, signal_group, stop_process_group
 
 PathLike = Union[str, os.PathLike]
 
@@ -38,20 +41,12 @@ WORKSPACE_NAME = 'ROS2_and_RL_Tutorials'
 WORKSPACE_FOLDERS = ('src', 'docs', 'scripts', 'resources/images')
 #: Where ros2nb records what it wrote, so it never overwrites a file you edited.
 WRITTEN_RECORD = '.ros2nb-written.json'
-#: Seconds a process gets to exit after SIGINT before SIGTERM, then SIGKILL.
-STOP_GRACE_S = 5.0
+#: Where ``%%part`` keeps the parts of each file, so a kernel restart loses none.
+PARTS_RECORD = '.ros2nb-parts.json'
 #: Console format for processes started by ros2nb (timestamps removed, as in the kernel).
 CONSOLE_FORMAT = '[{severity}] [{name}]: {message}'
 
 _current: Optional[Path] = None
-
-
-class ColconBuildError(Ros2nbError):
-    """``colcon build`` failed; the message is the first cause found in its output."""
-
-
-class FileProtectedError(Ros2nbError):
-    """ros2nb refused to overwrite a file you changed."""
 
 
 def course_root() -> Path:
@@ -71,7 +66,7 @@ def default_workspace() -> Path:
     return course_root() / 'workspace' / WORKSPACE_NAME
 
 
-def workspace() -> Path:
+def current_workspace() -> Path:
     """Return the workspace the workspace verbs use (the last one created, else the default).
 
     Introduced in ``01-create-a-workspace.ipynb``.
@@ -82,17 +77,17 @@ def workspace() -> Path:
 def workspace_file(path: PathLike) -> Path:
     """Return ``path`` with ``~`` expanded; a relative path is taken inside the current workspace."""
     path = Path(path).expanduser()
-    return path if path.is_absolute() else workspace() / path
+    return path if path.is_absolute() else current_workspace() / path
 
 
 def _workspace_or_current(workspace_path: Optional[PathLike]) -> Path:
-    return Path(workspace_path) if workspace_path is not None else workspace()
+    return Path(workspace_path) if workspace_path is not None else current_workspace()
 
 
 def shown(path: PathLike) -> str:
     """Return ``path`` as ``<workspace name>/...`` when inside the workspace (same on every machine)."""
     path = Path(path).resolve()
-    ws = workspace().resolve()
+    ws = current_workspace().resolve()
     try:
         return str(Path(ws.name) / path.relative_to(ws))
     except ValueError:
@@ -142,7 +137,7 @@ def tree(path: Optional[PathLike] = None, *, skip: Iterable[str] = ('build', 'in
     :param path: the folder; ``None`` is the current workspace.
     :param skip: folder names whose contents are not listed.
     """
-    top = Path(path) if path is not None else workspace()
+    top = Path(path) if path is not None else current_workspace()
     if not top.is_dir():
         raise Ros2nbError(f'{top} is not a folder: create it first.')
     print(shown(top) + '/')
@@ -164,7 +159,7 @@ def _digest(text: str) -> str:
 
 def _record_path(path: Path) -> Optional[Path]:
     """The workspace's record file, or None for files outside the workspace (not recorded)."""
-    ws = workspace().resolve()
+    ws = current_workspace().resolve()
     return ws / WRITTEN_RECORD if ws in path.resolve().parents else None
 
 
@@ -242,13 +237,36 @@ def import_file(path: PathLike, module_name: Optional[str] = None) -> ModuleType
     return module
 
 
-_parts: dict[str, dict[int, str]] = {}
+_parts_outside: dict[str, dict[int, str]] = {}  # files outside the workspace: this kernel only
+
+
+@contextlib.contextmanager
+def _parts_of(path: Path) -> Iterator[dict[int, str]]:
+    """The stored parts of ``path`` (kept in the workspace, so a kernel restart loses none).
+
+    Changes made inside the block are saved when it ends without an error.
+    """
+    ws = current_workspace().resolve()
+    resolved = path.resolve()
+    if ws not in resolved.parents:
+        yield _parts_outside.setdefault(str(resolved), {})
+        return
+    record_file = ws / PARTS_RECORD
+    record = json.loads(record_file.read_text()) if record_file.is_file() else {}
+    key = str(resolved.relative_to(ws))
+    parts = {int(n): text for n, text in record.get(key, {}).items()}
+    yield parts
+    record[key] = {str(n): parts[n] for n in sorted(parts)}
+    record_file.write_text(json.dumps(record, indent=1, sort_keys=True) + '\n')
 
 
 def write_part(path: PathLike, number: int, text: str, *, overwrite: bool = False) -> Path:
-    """Set part ``number`` of a source file and write the file from all parts so far.
+    """Set part ``number`` of a source file and write the file from all its parts.
 
-    Parts are joined in number order, so cells can be re-run in any order.  Used by the
+    Parts are joined in number order with one blank line between them, so cells can be
+    re-run in any order.  The parts are kept in the workspace (``.ros2nb-parts.json``),
+    so after a kernel restart re-running one part keeps all the others.  Like
+    :func:`write_file`, it never overwrites a file you changed in an editor.  Used by the
     ``%%part FILE N`` cell magic (``%load_ext ros2nb``).
 
     Introduced in ``03-write-the-publisher.ipynb``.
@@ -260,14 +278,21 @@ def write_part(path: PathLike, number: int, text: str, *, overwrite: bool = Fals
     :return: the file's absolute path.
     :raises FileProtectedError: as :func:`write_file`.
     """
+    if isinstance(number, bool) or not isinstance(number, int) or number < 1:
+        raise UsageError(f'A part number is a whole number from 1 up (got {number!r}).')
     resolved = workspace_file(path)
-    parts = _parts.setdefault(str(resolved.resolve()), {})
-    parts[number] = text.rstrip('\n') + '\n'
-    written = write_file(resolved, '\n\n'.join(parts[n].rstrip('\n') for n in sorted(parts))
-                         + '\n', overwrite=overwrite)
+    with _parts_of(resolved) as parts:
+        replaces = resolved.is_file() and not parts
+        new_parts = {**parts, number: text.rstrip('\n') + '\n'}
+        written = write_file(resolved, '\n\n'.join(new_parts[n].rstrip('\n')
+                                                   for n in sorted(new_parts)) + '\n',
+                             overwrite=overwrite)
+        parts.clear()
+        parts.update(new_parts)
     lines = written.read_text().count('\n')
     print(f'{shown(written)}: part {number} saved (parts {", ".join(map(str, sorted(parts)))}; '
-          f'{lines} lines)')
+          f'{lines} lines)' + (' (it replaces the file ros2nb wrote there before)' if replaces
+                               else ''))
     return written
 
 
@@ -382,29 +407,56 @@ def source_workspace(workspace_path: Optional[PathLike] = None, *,
 def node_process_env(base: Mapping[str, str]) -> dict[str, str]:
     """Return ``base`` plus what a node process started from a notebook needs.
 
-    Unbuffered output (lines arrive as they are printed), no colours, the course's console
-    format without timestamps and discovery on this machine, unless already chosen in ``base``.
+    The kernel's ROS domain (claimed now if it was not yet, see :mod:`ros2nb.domains`),
+    unbuffered output (lines arrive as they are printed), no colours, the course's
+    console format without timestamps and discovery on this machine, unless already
+    chosen in ``base``.
     """
     env = dict(base, PYTHONUNBUFFERED='1', RCUTILS_COLORIZED_OUTPUT='0')
+    env.setdefault(domains.DOMAIN_ENV, str(domains.domain_id()))
     env.setdefault('RCUTILS_CONSOLE_OUTPUT_FORMAT', CONSOLE_FORMAT)
     env.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     return env
 
 
-def find_executable(package: str, executable: str, env: dict[str, str]) -> Path:
-    """Resolve ``ros2 run PACKAGE EXECUTABLE`` through the ament index, as ros2cli does.
+_environ_lock = threading.Lock()
 
-    :return: the executable's path, ``<prefix>/lib/<package>/<executable>``.
-    :raises Ros2nbError: ``Package 'PKG' not found`` or ``No executable found``, the CLI's texts.
+
+def find_executable(package: str, executable: str, env: Mapping[str, str]) -> Path:
+    """Resolve ``ros2 run PACKAGE EXECUTABLE`` as ros2cli does, with ``env``'s ament index.
+
+    The package's prefix comes from ``ament_index_python`` (the index that
+    ``AMENT_PREFIX_PATH`` lists); the executable is the one file of that name that may be
+    executed under ``<prefix>/lib/<package>/``.
+
+    Introduced in ``05-entry-points-and-run.ipynb``.
+
+    :param env: an environment such as :func:`source_workspace` returns.
+    :return: the executable's path.
+    :raises Ros2nbError: ``Package 'PKG' not found``, ``No executable found`` or
+        ``Multiple executables found``, the CLI's texts.
     """
-    for prefix in env.get('AMENT_PREFIX_PATH', '').split(os.pathsep):
-        marker = Path(prefix) / 'share' / 'ament_index' / 'resource_index' / 'packages' / package
-        if prefix and marker.is_file():
-            candidate = Path(prefix) / 'lib' / package / executable
-            if candidate.is_file() and os.access(candidate, os.X_OK):
-                return candidate
-            raise Ros2nbError('No executable found')
-    raise Ros2nbError(f"Package '{package}' not found")
+    from ament_index_python.packages import PackageNotFoundError, get_package_prefix
+    with _environ_lock:  # ament_index_python reads AMENT_PREFIX_PATH from os.environ
+        saved = os.environ.get('AMENT_PREFIX_PATH')
+        os.environ['AMENT_PREFIX_PATH'] = env.get('AMENT_PREFIX_PATH', '')
+        try:
+            prefix = Path(get_package_prefix(package))
+        except (PackageNotFoundError, ValueError):
+            raise Ros2nbError(f"Package '{package}' not found") from None
+        finally:
+            if saved is None:
+                os.environ.pop('AMENT_PREFIX_PATH', None)
+            else:
+                os.environ['AMENT_PREFIX_PATH'] = saved
+    found = sorted(path for path in (prefix / 'lib' / package).rglob(executable)
+                   if path.is_file() and os.access(path, os.X_OK)
+                   and not any(part.startswith('.') for part in path.parts[len(prefix.parts):]))
+    if not found:
+        raise Ros2nbError('No executable found')
+    if len(found) > 1:
+        raise Ros2nbError('Multiple executables found: ' + ', '.join(map(str, found)))
+    return found[0]
 
 
 def _command(package: str, executable: str, args: Sequence[str], env: dict[str, str]) -> list[str]:
@@ -412,20 +464,6 @@ def _command(package: str, executable: str, args: Sequence[str], env: dict[str, 
     if real:
         return [real, 'run', package, executable, *args]
     return [str(find_executable(package, executable, env)), *args]
-
-
-def _stop(proc: subprocess.Popen) -> None:
-    for sig, wait in ((signal.SIGINT, STOP_GRACE_S), (signal.SIGTERM, 2.0), (signal.SIGKILL, 2.0)):
-        if proc.poll() is not None:
-            return
-        try:
-            os.killpg(proc.pid, sig)
-        except ProcessLookupError:
-            return
-        try:
-            proc.wait(wait)
-        except subprocess.TimeoutExpired:
-            continue
 
 
 def ros2_run(*commands: Sequence[str], seconds: float = 5.0,
@@ -445,13 +483,42 @@ def ros2_run(*commands: Sequence[str], seconds: float = 5.0,
     :raises Ros2nbError: ``Package 'PKG' not found`` / ``No executable found`` (the CLI's
         texts), or an unbuilt workspace.
     """
-    if not commands:
-        raise ValueError("Give at least one command, e.g. ('sensor_simulator', 'temperature_publisher').")
+    if not commands or not all(isinstance(c, (tuple, list)) and len(c) >= 2 for c in commands):
+        raise UsageError("Give one tuple per process, e.g. ros2_run(('sensor_simulator', "
+                         "'temperature_publisher'), seconds=5).")
     env = source_workspace(workspace_path)
     env = node_process_env(env)
     env.setdefault('ROS_LOG_DIR', str(_workspace_or_current(workspace_path) / 'log' / 'ros'))
     argvs = [_command(c[0], c[1], list(c[2:]), env) for c in commands]
     return run_and_interrupt(*argvs, labels=[c[1] for c in commands], seconds=seconds, env=env)
+
+
+class _KernelNodes:
+    """Keeps the kernel's own nodes running, their log lines in order, while processes run.
+
+    On wall-clock time they run anyway; on simulated time their clock is moved on with the
+    wall clock, so that they and the processes (which run on the wall clock) meet.
+    """
+
+    def __init__(self) -> None:
+        from . import runtime
+        rt = runtime._runtime
+        self.rt = rt if rt is not None and rt.alive and rt.nodes else None
+        self.last = time.monotonic()
+        if self.rt is not None:
+            clock = ('their simulated clock following the wall clock' if self.rt.sim_time
+                     else 'on the wall clock')
+            print(f'(the nodes in this kernel, {", ".join(sorted(self.rt.nodes))}, keep running '
+                  f'meanwhile, {clock})')
+
+    def tick(self) -> None:
+        if self.rt is None or not self.rt.alive:
+            return
+        now = time.monotonic()
+        if self.rt.sim_time:
+            self.rt.advance_sim_time(now - self.last)
+        self.last = now
+        self.rt.print_pending()
 
 
 def run_and_interrupt(*argvs: Sequence[str], labels: Optional[Sequence[str]] = None,
@@ -486,13 +553,15 @@ def run_and_interrupt(*argvs: Sequence[str], labels: Optional[Sequence[str]] = N
         open_streams = len(procs)
         deadline = time.monotonic() + seconds
         interrupted = False
+        kernel_nodes = _KernelNodes()
         while open_streams:
+            kernel_nodes.tick()
             if not interrupted and time.monotonic() >= deadline:
                 interrupted = True
                 print(f'^C  (ros2nb sent SIGINT after {seconds:g} s, as Ctrl+C does)')
                 for proc in procs:
                     if proc.poll() is None:
-                        os.killpg(proc.pid, signal.SIGINT)
+                        signal_group(proc, signal.SIGINT)
             try:
                 line = lines.get(timeout=0.1)
             except queue.Empty:
@@ -507,7 +576,7 @@ def run_and_interrupt(*argvs: Sequence[str], labels: Optional[Sequence[str]] = N
         print('Interrupted: stopping the processes.')
     finally:
         for proc in procs:
-            _stop(proc)
+            stop_process_group(proc)
     codes = [proc.wait() for proc in procs]
     for label, code in zip(labels, codes):
         print(f'{label} exited with code {code}')

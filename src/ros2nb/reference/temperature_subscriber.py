@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""A temperature monitor: classifies every reading on the temperature topic."""
+"""A temperature monitor: judges every reading on the temperature topic."""
 
 import rclpy
 from rclpy.executors import ExternalShutdownException
@@ -7,18 +7,9 @@ from rclpy.node import Node
 from std_msgs.msg import Float32
 
 TOPIC = 'temperature'
-QUEUE_DEPTH = 10
-HIGH_ABOVE_C = 26.0   # strictly above: High
-LOW_BELOW_C = 20.0    # strictly below: Low
-
-
-def classify(temperature_c):
-    """Return 'High', 'Low' or 'Normal' for a reading in °C."""
-    if temperature_c > HIGH_ABOVE_C:
-        return 'High'
-    if temperature_c < LOW_BELOW_C:
-        return 'Low'
-    return 'Normal'
+QUEUE_DEPTH = 10              # messages kept while the callback is busy
+HIGH_ABOVE_C = 26.0           # strictly above: High
+LOW_BELOW_C = 20.0            # strictly below: Low
 
 
 class TemperatureMonitor(Node):
@@ -32,8 +23,13 @@ class TemperatureMonitor(Node):
 
     def temperature_callback(self, msg):
         temperature_c = msg.data
-        self.get_logger().info(
-            f'Temperature: {temperature_c:.2f}C - Status: {classify(temperature_c)}')
+        if temperature_c > HIGH_ABOVE_C:
+            status = 'High'
+        elif temperature_c < LOW_BELOW_C:
+            status = 'Low'
+        else:
+            status = 'Normal'
+        self.get_logger().info(f'Temperature: {temperature_c:.2f}C - Status: {status}')
 
 
 def main(args=None):
@@ -42,7 +38,7 @@ def main(args=None):
     try:
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
-        pass
+        pass  # Ctrl+C or a shutdown from outside: leave quietly
     finally:
         node.destroy_node()   # the tutorial's subscriber never did this
         rclpy.try_shutdown()  # nor this

@@ -1,0 +1,199 @@
+"""One line for each mistake beginners make with rclpy, naming their own line and the fix.
+
+Introduced in ``00-setup-and-the-pubsub-idea.ipynb``; the whole list is in
+``docs/troubleshooting.md``.
+
+Two kinds: :func:`check_node` refuses a node with a mistake when it is handed over
+(before anything runs), and :func:`explain_exception` turns an error that rclpy or a
+message class raised into one line.  The kernel shows that line instead of a traceback
+through rclpy (:mod:`ros2nb.kernel`); a failing callback is reported with it.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import site
+import sysconfig
+import traceback
+from pathlib import Path
+from typing import Any, Optional
+
+from .errors import Ros2nbError
+
+_HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def _library_dirs() -> tuple[str, ...]:
+    dirs = {_HERE, *site.getsitepackages(), site.getusersitepackages()}
+    for key in ('stdlib', 'platstdlib', 'purelib', 'platlib'):
+        dirs.add(sysconfig.get_paths()[key])
+    return tuple(sorted(os.path.abspath(d) + os.sep for d in dirs if d))
+
+
+_LIBRARY_DIRS = _library_dirs()
+
+
+def is_library_file(path: str) -> bool:
+    """True for files of Python, installed packages (rclpy, messages, IPython) and ros2nb."""
+    path = os.path.abspath(path)
+    return path.startswith(_LIBRARY_DIRS) or path.startswith('<frozen')
+
+
+def learner_line(exc: BaseException) -> str:
+    """Return ``cell line N: source`` or ``FILE line N: source`` for the learner's innermost frame."""
+    found = ''
+    for frame in traceback.extract_tb(exc.__traceback__):
+        if is_library_file(frame.filename):
+            continue
+        path = Path(frame.filename)
+        place = path.name if path.is_file() and 'ipykernel' not in frame.filename else 'cell'
+        found = f'{place} line {frame.lineno}: {(frame.line or "").strip()}'
+    return found
+
+
+def _frames(exc: BaseException):
+    tb = exc.__traceback__
+    while tb is not None:
+        yield tb.tb_frame
+        tb = tb.tb_next
+
+
+_FIELD_TYPE = re.compile(r"The '(\w+)' field must be of type '([\w.]+)'")
+_NUMBERS = {'float': 'a decimal number such as 22.0', 'int': 'a whole number such as 10',
+            'str': "text such as 'hello'", 'bool': 'True or False'}
+
+
+def _field_type(exc: AssertionError) -> Optional[str]:
+    match = _FIELD_TYPE.search(str(exc))
+    if not match:
+        return None
+    field, wanted = match.groups()
+    frame = list(_frames(exc))[-1]
+    message = frame.f_locals.get('self')
+    value = frame.f_locals.get('value')
+    owner = type(message).__name__ if message is not None else 'the message'
+    fix = _NUMBERS.get(wanted, f'a {wanted}')
+    if wanted == 'float' and isinstance(value, int) and not isinstance(value, bool):
+        fix = f'{value}.0 or float(...)'
+    return (f"{owner}'s field '{field}' takes {fix}, not {type(value).__name__} {value!r}: "
+            'convert the value before you put it into the message.')
+
+
+def _node_without_init(exc: AttributeError) -> Optional[str]:
+    for frame in _frames(exc):
+        if not frame.f_code.co_filename.endswith(os.path.join('rclpy', 'node.py')):
+            continue
+        obj = frame.f_locals.get('self')
+        if obj is not None and not hasattr(obj, '_Node__node'):
+            name = type(obj).__name__
+            return (f"{name}.__init__ never calls super().__init__('node_name'): make that the "
+                    f'first line of {name}.__init__, before any publisher, timer or subscription.')
+    return None
+
+
+def explain_exception(exc: BaseException) -> Optional[str]:
+    """Return one line explaining a known beginner mistake behind ``exc``, or None.
+
+    :param exc: an exception raised by the learner's code, through rclpy or a message.
+    :return: what went wrong and what to do, or None for anything else (its normal
+        traceback is then the best explanation).
+    """
+    from rclpy.exceptions import NotInitializedException
+    text = str(exc)
+    if isinstance(exc, NotInitializedException):
+        from . import runtime
+        if runtime._runtime is not None:
+            return runtime.SHUT_DOWN_MESSAGE
+        return ('ROS 2 is not up in this kernel yet: run ros2nb.start() first (in a notebook it '
+                'takes the place of rclpy.init()), then create the node again.')
+    if isinstance(exc, RuntimeError) and 'must only be called once' in text:
+        return ('rclpy.init() was called, but ros2nb.start() already brought ROS 2 up in this '
+                'kernel: remove that call; to run a node here hand it to ros2nb.add(node) '
+                '(main() is for `ros2 run`, notebook 05).')
+    if isinstance(exc, AssertionError):
+        return _field_type(exc)
+    if isinstance(exc, AttributeError):
+        return _node_without_init(exc)
+    if type(exc).__name__ == 'RCLError' and 'context is invalid' in text:
+        from . import runtime
+        return runtime.SHUT_DOWN_MESSAGE
+    if isinstance(exc, TypeError) and text.startswith('Expected <class'):
+        return ('publish() takes a message object, not a bare value: create the message '
+                '(msg = Float32()), set msg.data, then publish(msg).')
+    return None
+
+
+# --------------------------------------------------------------- checks at add()
+def _callback_name(callback: Any) -> str:
+    return getattr(callback, '__qualname__', repr(callback))
+
+
+def _type_name(msg_type: Any) -> str:
+    cls = msg_type if isinstance(msg_type, type) else type(msg_type)
+    return f'{cls.__module__.split(".")[0]}/msg/{cls.__name__}'
+
+
+def check_node(node: Any, rt: Any) -> None:
+    """Refuse, with one line, a node that would fail or mislead once it runs.
+
+    Introduced in ``00-setup-and-the-pubsub-idea.ipynb`` (through :func:`ros2nb.add`).
+
+    :param node: what was handed to :func:`ros2nb.add`.
+    :param rt: the kernel's runtime.
+    :raises Ros2nbError: naming the mistake and the fix.
+    """
+    from rclpy.node import Node
+    if isinstance(node, type) and issubclass(node, Node):
+        raise Ros2nbError(f'ros2nb.add() takes a node, not the class {node.__name__}: create '
+                          f'one first, ros2nb.add({node.__name__}()).')
+    if not isinstance(node, Node):
+        raise Ros2nbError(f'ros2nb.add() takes an rclpy Node, not {type(node).__name__}: create '
+                          'the node first, e.g. ros2nb.add(TemperatureSensor()).')
+    if not hasattr(node, '_Node__node'):
+        raise Ros2nbError(f"{type(node).__name__}.__init__ never calls super().__init__('node_name'): "
+                          'make that its first line.')
+    name = node.get_name()
+    if node.context is not rt.context or not node.context.ok():
+        raise Ros2nbError(f'{name} was created before ROS 2 was (re)started in this kernel: run '
+                          'the cell that creates it again, then hand it over.')
+    for timer in node.timers:
+        if not callable(timer.callback):
+            raise Ros2nbError(f'{name} has a timer whose callback is {timer.callback!r}, not a '
+                              'function: pass the method itself (self.publish_temperature, '
+                              'without the parentheses).')
+        if timer.timer_period_ns == 0:
+            raise Ros2nbError(f'{name} has a timer with a period of 0 s for '
+                              f'{_callback_name(timer.callback)}: it would fire without pause; '
+                              'give create_timer a period in seconds, e.g. 1.0.')
+    for kind, entities in (('publisher', node.publishers), ('subscription', node.subscriptions)):
+        for entity in entities:
+            if not isinstance(entity.msg_type, type):
+                cls = type(entity.msg_type).__name__
+                raise Ros2nbError(f'{name} made a {kind} on {entity.topic_name} with a message '
+                                  f'{cls}() instead of the message type: pass {cls} without '
+                                  'the parentheses.')
+            if kind == 'subscription' and not callable(entity.callback):
+                raise Ros2nbError(f'{name} has a subscription on {entity.topic_name} whose '
+                                  f'callback is {entity.callback!r}: pass the method itself, '
+                                  'without the parentheses.')
+    _check_types_agree(node, rt)
+
+
+def _check_types_agree(node: Any, rt: Any) -> None:
+    """Refuse a node whose topic type differs from what other nodes use on that topic."""
+    name = node.get_name()
+    graph = rt.node
+    for kind, entities in (('publishes', node.publishers), ('subscribes to', node.subscriptions)):
+        for entity in entities:
+            topic = node.resolve_topic_name(entity.topic_name)
+            mine = _type_name(entity.msg_type)
+            others = [*graph.get_publishers_info_by_topic(topic),
+                      *graph.get_subscriptions_info_by_topic(topic)]
+            for info in others:
+                if info.node_name in (name, '_ros2nb') or info.topic_type == mine:
+                    continue
+                role = 'publishes' if 'PUBLISHER' in str(info.endpoint_type) else 'subscribes to'
+                raise Ros2nbError(f'{name} {kind} {topic} as {mine}, but {info.node_name} {role} '
+                                  f'it as {info.topic_type}: both sides of a topic must use the '
+                                  'same message type.')

@@ -1,0 +1,98 @@
+"""What ros2nb adds to an IPython kernel: ``%%part``, one-line errors, logs in their cell.
+
+Introduced in ``00-setup-and-the-pubsub-idea.ipynb``.  :func:`ros2nb.start` installs it in
+a notebook; ``%load_ext ros2nb`` does too (notebook 05 runs no ROS in the kernel).
+
+- ``%%part FILE N [--overwrite]`` saves the cell as part N of FILE (:func:`ros2nb.write_part`).
+- Known beginner mistakes raised through rclpy or a message class show as one line
+  naming the learner's own line (:mod:`ros2nb.explain`); other errors keep their normal
+  traceback, and ros2nb's own errors show as their one line.
+- Log lines a cell's nodes made are printed at the end of that cell; lines made while no
+  cell was running are counted, not shown later as if they were new.
+
+All of it goes through IPython's own machinery: a registered cell magic, ``set_custom_exc``
+and the ``pre_run_cell`` / ``post_run_cell`` events.
+"""
+
+from __future__ import annotations
+
+import re
+import shlex
+from typing import Any, Optional
+
+from .errors import UsageError
+
+_INSTALLED = '_ros2nb_installed'
+
+
+def part(line: str, cell: str) -> None:
+    """``%%part FILE N [--overwrite]``: save this cell as part N of FILE.
+
+    Introduced in ``03-write-the-publisher.ipynb``.
+
+    :raises UsageError: if the line is not ``FILE N``, or FILE is an unexpanded ``{NAME}``.
+    """
+    from .workspace import write_part
+    words = shlex.split(line)
+    overwrite = '--overwrite' in words
+    words = [w for w in words if w != '--overwrite']
+    unexpanded = re.fullmatch(r'\{(\w+)\}', words[0]) if words else None
+    if unexpanded:
+        raise UsageError(f'{unexpanded.group(1)} is not defined in this kernel: run the cell near '
+                         f'the top that sets {unexpanded.group(1)}, then this one again.')
+    if len(words) != 2 or not words[1].isdigit():
+        raise UsageError('Usage: %%part FILE N [--overwrite], e.g. '
+                         '%%part src/sensor_simulator/sensor_simulator/temperature_publisher.py 1')
+    write_part(words[0], int(words[1]), cell, overwrite=overwrite)
+
+
+def _before_cell(_info: Any = None) -> None:
+    from . import runtime
+    if runtime._runtime is not None:
+        runtime._runtime.begin_cell()
+
+
+def _after_cell(_result: Any = None) -> None:
+    from . import runtime
+    rt = runtime._runtime
+    if rt is not None and rt.alive:
+        rt.print_pending()
+
+
+def _explain(shell: Any, etype: type, value: BaseException, tb: Any,
+             tb_offset: Optional[int] = None) -> None:
+    """IPython custom exception handler: one line for known mistakes, else the usual display."""
+    from .explain import explain_exception, learner_line
+    try:
+        line = explain_exception(value)
+    except Exception:  # explaining must never hide the original error
+        line = None
+    if line is None:
+        shell.showtraceback((etype, value, tb), tb_offset=tb_offset)
+        return
+    where = learner_line(value)
+    shell._showtraceback(etype, value, [f'{etype.__name__} ({where}): {line}' if where
+                                        else f'{etype.__name__}: {line}'])
+
+
+def install(ip: Any = None) -> bool:
+    """Install ros2nb's IPython additions once; return False outside IPython.
+
+    Introduced in ``00-setup-and-the-pubsub-idea.ipynb``.
+    """
+    if ip is None:
+        try:
+            from IPython import get_ipython
+        except ImportError:
+            return False
+        ip = get_ipython()
+    if ip is None:
+        return False
+    if getattr(ip, _INSTALLED, False):
+        return True
+    ip.register_magic_function(part, magic_kind='cell', magic_name='part')
+    ip.events.register('pre_run_cell', _before_cell)
+    ip.events.register('post_run_cell', _after_cell)
+    ip.set_custom_exc((Exception,), _explain)
+    setattr(ip, _INSTALLED, True)
+    return True
