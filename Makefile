@@ -17,7 +17,7 @@ export ROS_HOME            := $(HERE)/.cache/ros
 export ROS_LOG_DIR         := $(HERE)/.cache/ros/log
 export PIP_DISABLE_PIP_VERSION_CHECK := 1
 
-.PHONY: lab test setup learner-notebooks benchmark benchmark-grading grade clean
+.PHONY: lab test setup solutions learner-notebooks benchmark benchmark-grading grade clean
 
 setup: $(STAMP)
 
@@ -41,6 +41,10 @@ test: $(STAMP)
 	$(PY) -m pytest tests
 	$(PY) -m pytest --nbval solutions --nbval-current-env --nbval-sanitize-with tests/sanitize.cfg
 	$(PY) -m pytest --nbval-lax notebooks --nbval-current-env
+
+# Re-run solutions/ in place so their stored outputs are fresh (then make learner-notebooks).
+solutions: $(STAMP)
+	$(PY) tools/execute_solutions.py
 
 # Regenerate notebooks/ from solutions/ with nbgrader (never edit notebooks/ by hand).
 learner-notebooks: $(STAMP)

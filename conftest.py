@@ -1,7 +1,8 @@
 """Test-session set-up shared by the unit tests and nbval runs (``make test``).
 
-- Every pytest process gets its own ``ROS_DOMAIN_ID`` and keeps discovery on this
-  machine, so two runs never see each other's topics; nbval kernels inherit both.
+- No ``ROS_DOMAIN_ID`` is set: every process that brings ROS up (this pytest process,
+  each nbval kernel, each judge) claims a free domain of its own (ros2nb.domains), so two
+  runs never see each other's topics. Discovery stays on this machine.
 - The course workspace goes to a temporary folder removed at the end, so tests never
   touch a learner's ``workspace/``.
 - Cells tagged ``learner-check`` (a Challenge's check) must raise ``CheckFailed`` with its
@@ -18,8 +19,7 @@ from pathlib import Path
 
 import pytest
 
-_DOMAIN = str(1 + os.getpid() % 100)
-os.environ['ROS_DOMAIN_ID'] = _DOMAIN
+os.environ.pop('ROS_DOMAIN_ID', None)
 os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
 _SCRATCH = Path(tempfile.mkdtemp(prefix='ros2nb-test-'))
 os.environ['ROS2NB_WORKSPACE'] = str(_SCRATCH / 'ROS2_and_RL_Tutorials')

@@ -1,63 +1,276 @@
-"""The challenge checks fail with a helpful message on wrong answers and pass on right ones."""
+"""The checks of every part, against the mistakes learners make: one line each, never the answer.
 
+Each case writes the course's reference node with one real mistake into a workspace and
+runs the check as the grader does (a judge in this process, the learner's code in real
+subject processes, verdicts from the judge's own ROS node). The reference itself passes,
+so every failure below is the mistake's, and the test could not pass with a check that
+says nothing.
+"""
+
+import os
+import re
+import shutil
 from pathlib import Path
 
 import pytest
 
-from ros2nb import checks
-from ros2nb.checks import CheckFailed
+from ros2nb import checks, course, judge
+from ros2nb.errors import CheckFailed, LearnerCodeError
+
+pytestmark = pytest.mark.timeout(300)
+
+PUB, SUB = course.PUBLISHER_FILE, course.SUBSCRIBER_FILE
+#: Fragments of the answers that no failure message may contain.
+ANSWER_CODE = ('create_publisher(', 'create_timer(', 'create_subscription(', 'random.uniform(',
+               'max(MIN_TEMPERATURE_C', '.publish(msg)', 'elif ', 'rclpy.spin(node)')
+MESSAGES: list[str] = []
 
 
+@pytest.fixture(scope='module')
+def session(tmp_path_factory):
+    """A judge session (this process is the judge) on a workspace with the course's package."""
+    import ros2nb
+    from ros2nb import workspace as ws_module
+    root = tmp_path_factory.mktemp('checks')
+    saved = {k: os.environ.get(k) for k in ('ROS2NB_WORKSPACE', judge.IN_JUDGE_ENV)}
+    os.environ['ROS2NB_WORKSPACE'] = str(root / 'ws')
+    os.environ[judge.IN_JUDGE_ENV] = '1'
+    ws_module._current = None
+    ros2nb.course.catch_up(5)
+    judge._session = judge.Session(root / 'ws')
+    yield judge._session
+    judge._session.close()
+    judge._session = None
+    for key, value in saved.items():
+        if value is None:
+            os.environ.pop(key, None)
+        else:
+            os.environ[key] = value
+    ws_module._current = None
+
+
+def mutated(session, relative: str, old, new) -> None:
+    """Write the reference file with ``old`` replaced by ``new`` (or each of several pairs)."""
+    path = session.workspace / relative
+    text = course.reference_source(Path(relative).name)
+    for before, after in zip(*((old, new) if isinstance(old, tuple) else ((old,), (new,)))):
+        assert before in text, before
+        text = text.replace(before, after)
+    path.write_text(text)
+    session.drop(('file', relative))
+
+
+def restore(session, relative: str) -> None:
+    (session.workspace / relative).write_text(course.reference_source(Path(relative).name))
+    session.drop(('file', relative))
+
+
+def fails(check, pattern: str) -> str:
+    with pytest.raises(CheckFailed) as caught:
+        check()
+    message = str(caught.value)
+    MESSAGES.append(message)
+    assert re.search(pattern, message), message
+    assert '\n' not in message
+    return message
+
+
+def test_reference_nodes_pass(session, capsys):
+    for check in (checks.check_sensor_constructor, checks.check_sensor_callback,
+                  checks.check_sensor_main, checks.check_monitor_constructor,
+                  checks.check_monitor_callback, checks.check_monitor_main):
+        check()
+    out = capsys.readouterr().out
+    assert out.count('Check passed:') == 6
+
+
+SENSOR_MISTAKES = [
+    ('placeholder', "        self.publisher_ = self.create_publisher", "        raise NotImplementedError()\n        self.publisher_ = self.create_publisher",
+     checks.check_sensor_constructor, r'still raises NotImplementedError: write your code where it says YOUR CODE HERE'),
+    ('topic typo', "TOPIC = 'temperature'", "TOPIC = 'temprature'",
+     checks.check_sensor_constructor, r'no publisher on /temperature \(it has: /temprature \[std_msgs/msg/Float32\]\): did you mean /temperature\?'),
+    ('message type', 'from std_msgs.msg import Float32', 'from std_msgs.msg import Float64 as Float32',
+     checks.check_sensor_constructor, r'uses std_msgs/msg/Float64, but the topic carries std_msgs/msg/Float32'),
+    ('period', 'PUBLISH_PERIOD_S = 1.0 ', 'PUBLISH_PERIOD_S = 2.0 ',
+     checks.check_sensor_constructor, r'The timer fires every 2 s; the sensor publishes every 1.0 s'),
+    ('start value', 'self.temperature = START_TEMPERATURE_C', 'self.temperature = 0.0',
+     checks.check_sensor_constructor, r'self.temperature starts at 0.0; the walk starts at START_TEMPERATURE_C = 22.0'),
+    ('callback called before part 4 exists',
+     ('self.create_timer(PUBLISH_PERIOD_S, self.publish_temperature)', 'def publish_temperature(self):'),
+     ('self.create_timer(PUBLISH_PERIOD_S, self.publish_temperature())', 'def not_yet_written(self):'),
+     checks.check_sensor_constructor, r'timer whose callback is None, not a function: pass the method itself'),
+    ('class typo', 'class TemperatureSensor(Node):', 'class TemperaturSensor(Node):',
+     checks.check_sensor_constructor, r'defines no class TemperatureSensor \(it defines TemperaturSensor'),
+    ("the tutorial's floor", 'max(MIN_TEMPERATURE_C,', 'max(10.2,',
+     checks.check_sensor_callback, r"below MIN_TEMPERATURE_C = 18.0 °C \(the tutorial's floor of 10.2 °C"),
+    ('no clamp', '''max(MIN_TEMPERATURE_C,
+                               min(MAX_TEMPERATURE_C, self.temperature + step))''', 'self.temperature + step',
+     checks.check_sensor_callback, r'above MAX_TEMPERATURE_C = 28.0 °C: clamp every new reading'),
+    ('step too big', 'random.uniform(-MAX_STEP_C, MAX_STEP_C)', 'random.uniform(-2.0, 2.0)',
+     checks.check_sensor_callback, r'one step of at most ±0.5 °C|one step is at most ±0.5 °C'),
+    ('no step', 'step = random.uniform(-MAX_STEP_C, MAX_STEP_C)', 'step = 0.0',
+     checks.check_sensor_callback, r'Every reading is 22.00 °C: add a random step'),
+    ('int message', 'msg.data = self.temperature', 'msg.data = int(self.temperature)',
+     checks.check_sensor_callback, r"Float32's field 'data' takes \d+\.0 or float\(\.\.\.\), not int \d+.*temperature_publisher.py line \d+: msg.data = int"),
+    ('never published', '        self.publisher_.publish(msg)\n', '',
+     checks.check_sensor_callback, r'publish_temperature ran but nothing arrived on /temperature'),
+    ("the tutorial's main", '''    except (KeyboardInterrupt, ExternalShutdownException):
+        pass  # Ctrl+C or a shutdown from outside: leave quietly
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()  # rclpy.shutdown() would raise if Ctrl+C already shut down''', '''    except KeyboardInterrupt:
+        pass
+    node.destroy_node()
+    rclpy.shutdown()''',
+     checks.check_sensor_main, r'exited with code 1 after Ctrl\+C \(.*RCLError: failed to shutdown'),
+]
+
+
+@pytest.mark.parametrize('label, old, new, check, pattern', SENSOR_MISTAKES,
+                         ids=[m[0] for m in SENSOR_MISTAKES])
+def test_sensor_mistake_gets_one_line(session, label, old, new, check, pattern):
+    mutated(session, PUB, old, new)
+    try:
+        fails(check, pattern)
+    finally:
+        restore(session, PUB)
+
+
+def test_learner_error_shows_their_traceback(session):
+    mutated(session, PUB, 'self.publisher_.publish(msg)', 'self.publisher_.publish(mgs)')
+    try:
+        with pytest.raises(LearnerCodeError) as caught:
+            checks.check_sensor_callback()
+    finally:
+        restore(session, PUB)
+    shown = caught.value._render_traceback_()
+    assert 'NameError' in str(caught.value)
+    assert any('temperature_publisher.py' in line and 'publish_temperature' in line
+               for line in shown)
+    assert not any('ros2nb' in line or 'rclpy' in line for line in shown)  # their lines only
+
+
+MONITOR_MISTAKES = [
+    ('boundaries included', 'if temperature_c > HIGH_ABOVE_C:', 'if temperature_c >= HIGH_ABOVE_C:',
+     checks.check_monitor_callback, r'For 26.0 °C the monitor said High; it should say Normal'),
+    ('lower case', "status = 'High'", "status = 'high'",
+     checks.check_monitor_callback, r'without a status High, Low or Normal \("high": write it High\)'),
+    ('two lines', "        self.get_logger().info(f'Temperature: {temperature_c:.2f}C - Status: {status}')",
+     "        self.get_logger().info(f'Temperature: {temperature_c:.2f}C')\n        self.get_logger().info(f'Status: {status}')",
+     checks.check_monitor_callback, r'logged 2 lines; log exactly one per message'),
+    ('wrong topic', "TOPIC = 'temperature'", "TOPIC = 'temp'",
+     checks.check_monitor_constructor, r'no subscription on /temperature \(it has: /temp \[std_msgs/msg/Float32\]\)'),
+    ("the tutorial's main", '''    finally:
+        node.destroy_node()   # the tutorial's subscriber never did this
+        rclpy.try_shutdown()  # nor this''', '',
+     checks.check_monitor_main, r'main\(\) never destroys its node'),
+]
+
+
+@pytest.mark.parametrize('label, old, new, check, pattern', MONITOR_MISTAKES,
+                         ids=[m[0] for m in MONITOR_MISTAKES])
+def test_monitor_mistake_gets_one_line(session, label, old, new, check, pattern):
+    mutated(session, SUB, old, new)
+    try:
+        fails(check, pattern)
+    finally:
+        restore(session, SUB)
+
+
+def test_package_checks(session, capsys):
+    setup_py = session.workspace / course.SETUP_PY_FILE
+    setup_cfg = session.workspace / course.SETUP_CFG_FILE
+    generated_py, generated_cfg = setup_py.read_text(), setup_cfg.read_text()
+    empty = "        'console_scripts': [\n        ],\n"
+    assert empty in generated_py
+    try:
+        setup_py.write_text(generated_py.replace(empty, "        'console_scripts': [\n"
+                                                 "            # YOUR CODE HERE\n"
+                                                 "            raise NotImplementedError()\n"
+                                                 "        ],\n"))
+        fails(checks.check_entry_points, r'setup.py still holds the placeholder')
+        setup_py.write_text(generated_py)
+        fails(checks.check_entry_points, r'console_scripts has no entry named temperature_publisher')
+        setup_py.write_text(generated_py.replace(empty, (
+            "        'console_scripts': [\n"
+            "            'temperature_publisher = sensor_simulator.publisher:main',\n"
+            "            'temperature_subscriber = sensor_simulator.temperature_subscriber:main',\n"
+            "        ],\n")))
+        fails(checks.check_entry_points, r'temperature_publisher = sensor_simulator.publisher:main: '
+                                         r'it should start main\(\) in sensor_simulator/temperature_publisher.py')
+        setup_py.write_text(generated_py.replace(empty, (
+            "        'console_scripts': [\n"
+            "            'temperature_publisher = sensor_simulator.temperature_publisher:main',\n"
+            "            'temperature_subscriber = sensor_simulator.temperature_subscriber:main',\n"
+            "        ],\n")))
+        setup_cfg.write_text(generated_cfg.replace('$base/lib/sensor_simulator', '$base/bin'))
+        fails(checks.check_setup_cfg, r'\[develop\] script_dir is \$base/bin; ros2 run looks in '
+                                      r'\$base/lib/sensor_simulator')
+        setup_cfg.unlink()
+        fails(checks.check_setup_cfg, r'setup.cfg is missing')
+        setup_cfg.write_text(generated_cfg)
+        # The grader's stand-ins take the place of the nodes: a broken node costs nothing here.
+        (session.workspace / PUB).write_text('raise SystemExit("broken")\n')
+        capsys.readouterr()
+        checks.check_entry_points()
+        checks.check_setup_cfg()
+        checks.check_package_runs()
+        assert capsys.readouterr().out.count('Check passed:') == 3
+    finally:
+        setup_py.write_text(generated_py)
+        setup_cfg.write_text(generated_cfg)
+        restore(session, PUB)
+
+
+def test_no_message_prints_the_answer():
+    assert len(MESSAGES) >= len(SENSOR_MISTAKES) + len(MONITOR_MISTAKES)
+    for message in MESSAGES:
+        assert not any(code in message for code in ANSWER_CODE), message
+
+
+def test_a_check_from_the_kernel_runs_in_a_judge_process(tmp_path, monkeypatch, capsys):
+    """The kernel's path: a judge process of its own, on a domain of its own."""
+    import ros2nb
+    from ros2nb import workspace as ws_module
+    monkeypatch.delenv(judge.IN_JUDGE_ENV, raising=False)
+    monkeypatch.setenv('ROS2NB_WORKSPACE', str(tmp_path / 'ws'))
+    monkeypatch.setattr(ws_module, '_current', None)
+    ros2nb.course.catch_up(5)
+    capsys.readouterr()
+    checks.check_sensor_constructor()
+    assert capsys.readouterr().out.startswith('Check passed: temperature_sensor publishes')
+    shutil.copy(tmp_path / 'ws' / SUB, tmp_path / 'ws' / PUB)  # a monitor where the sensor belongs
+    with pytest.raises(CheckFailed, match='defines no class TemperatureSensor \\(it defines '
+                                          'TemperatureMonitor'):
+        checks.check_sensor_constructor()
+
+
+# ------------------------------------------------------------------ 00-02 in the kernel
 def unsolved(*_args):
     raise NotImplementedError()
 
 
-def test_unsolved_challenge_says_so():
+def test_cell_answers_in_the_kernel(tmp_path):
     with pytest.raises(CheckFailed, match='still raises NotImplementedError'):
-        checks.check_classify(unsolved)
-
-
-def test_classify_boundaries():
-    checks.check_classify(checks.reference_status)
-    with pytest.raises(CheckFailed, match=r"classify\(20.0\) returned 'Low'"):
-        def classify(t):
-            return 'High' if t > 26 else 'Low' if t <= 20 else 'Normal'
-        checks.check_classify(classify)
-
-
-def test_clamp():
-    checks.check_clamp(lambda v: max(18.0, min(28.0, v)))
-    with pytest.raises(CheckFailed, match=r'\(10.2\) returned 10.2'):
-        checks.check_clamp(lambda v: max(10.2, min(28.0, v)))  # the tutorial's floor
-
-
-def test_publisher_samples():
-    good = [22.0 + 0.1 * i for i in range(10)]
-    checks.check_publisher_samples(good, seconds=10)
-    with pytest.raises(CheckFailed, match='one step is at most'):
-        checks.check_publisher_samples([22.0, 23.0] + good[2:], seconds=10)
-    with pytest.raises(CheckFailed, match='expected one per second'):
-        checks.check_publisher_samples(good[:5], seconds=10)
-
-
-def test_expanded_path():
+        checks.check_expanded_path(unsolved, ends_with='W')
     checks.check_expanded_path(lambda: Path('~/Documents/W').expanduser(), ends_with='Documents/W')
     with pytest.raises(CheckFailed, match='root of the disk'):
         checks.check_expanded_path(lambda: Path('/Documents/W'), ends_with='Documents/W')
     with pytest.raises(CheckFailed, match='expanduser'):
         checks.check_expanded_path(lambda: Path('~/Documents/W'), ends_with='Documents/W')
-
-
-def test_dependencies(tmp_path):
-    xml = tmp_path / 'package.xml'
-    xml.write_text('<package format="3"><depend>rclpy</depend><test_depend>x</test_depend>'
+    xml = tmp_path / 'p' / 'package.xml'
+    xml.parent.mkdir()
+    xml.write_text('<package format="3"><name>p</name><version>1.0.0</version>'
+                   '<description>d</description><maintainer email="a@example.com">a</maintainer>'
+                   '<license>MIT</license><depend>rclpy</depend><test_depend>x</test_depend>'
                    '<depend>std_msgs</depend></package>')
-    checks.check_dependencies(checks.package_dependencies, xml)
+    assert checks.package_dependencies(xml) == ['rclpy', 'std_msgs']  # read with catkin_pkg
+    checks.check_dependencies(lambda p: ['rclpy', 'std_msgs'], xml)
     with pytest.raises(CheckFailed, match='test_depend is not a depend'):
         checks.check_dependencies(lambda p: ['rclpy', 'x', 'std_msgs'], xml)
 
 
-def test_endpoint():
+def test_endpoint_in_the_kernel():
     import ros2nb
     from rclpy.node import Node
     from std_msgs.msg import String
@@ -71,7 +284,8 @@ def test_endpoint():
     try:
         with pytest.raises(CheckFailed, match='no subscription on /chatter'):
             checks.check_endpoint(Listener, 'subscription', '/chatter', 'std_msgs/msg/String')
-        with pytest.raises(CheckFailed, match='uses std_msgs/msg/String, but the topic carries std_msgs/msg/Float32'):
+        with pytest.raises(CheckFailed, match='uses std_msgs/msg/String, but the topic carries '
+                                              'std_msgs/msg/Float32'):
             checks.check_endpoint(Listener, 'subscription', '/chater', 'std_msgs/msg/Float32')
         checks.check_endpoint(Listener, 'subscription', '/chater', 'std_msgs/msg/String')
     finally:

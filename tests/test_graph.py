@@ -114,7 +114,7 @@ def test_record_wrong_field_fails_at_once(ros):
     ros2nb.add(Sensor())
     with pytest.raises(ros2nb.Ros2nbError, match=r"Float32 has no field 'temp'; its fields are data"):
         ros2nb.record('temperature', 600, field='temp')
-    assert ros2nb.runtime().sim_now_ns == 0  # nothing ran
+    assert ros2nb.current_runtime().sim_now_ns == 0  # nothing ran
 
 
 def test_record_unknown_topic_suggests(ros):

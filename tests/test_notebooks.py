@@ -51,20 +51,90 @@ def test_carpentries_structure(path):
     assert 'Keypoints' in last, f'{path.name}: last cell must be the Keypoints'
 
 
+def nbgrader(cell: dict) -> dict:
+    return cell['metadata'].get('nbgrader', {})
+
+
 @pytest.mark.parametrize('path', SOLUTIONS, ids=lambda p: p.name)
-def test_every_challenge_has_hint_solution_and_check(path):
+def test_every_answer_has_explanation_hint_points_and_check(path):
+    """Explanation (with a hint and its points) first, then the learner's cell, then its check."""
     cells = load(path)['cells']
-    challenges = [i for i, c in enumerate(cells)
-                  if c['cell_type'] == 'markdown' and re.search(r'^#+ Challenge \d', text(c), re.M)]
-    assert challenges, f'{path.name} has no Challenge'
-    for start in challenges:
-        assert 'Hint' in text(cells[start])
-        following = cells[start + 1:start + 6]
-        kinds = [c['metadata'].get('nbgrader', {}) for c in following]
-        assert any(k.get('solution') for k in kinds), f'{path.name}: no solution cell'
-        checks = [c for c in following if 'learner-check' in c['metadata'].get('tags', [])]
-        assert checks and all('raises-exception' in c['metadata']['tags'] for c in checks)
-        assert all(c['metadata']['nbgrader'].get('grade') for c in checks)
+    answers = [i for i, c in enumerate(cells) if nbgrader(c).get('solution')]
+    assert answers, f'{path.name} has nothing for the learner to write'
+    for index in answers:
+        before = text(cells[index - 1])
+        assert cells[index - 1]['cell_type'] == 'markdown' and 'Hint' in before, (path.name, index)
+        points = re.search(r'\((\d) points?\)', before)
+        assert points, f'{path.name} cell {index}: the explanation does not say the points'
+        check = next(c for c in cells[index + 1:] if c['cell_type'] == 'code')
+        assert 'learner-check' in check['metadata'].get('tags', []), (path.name, index)
+        assert 'raises-exception' in check['metadata']['tags']
+        assert nbgrader(check).get('grade') and nbgrader(check)['points'] == int(points.group(1))
+
+
+@pytest.mark.parametrize('path', SOLUTIONS, ids=lambda p: p.name)
+def test_the_points_the_notebook_states_are_the_points_it_gives(path):
+    cells = load(path)['cells']
+    stated = re.search(r'\*\*Points:\*\* (\d+)', text(cells[0]))
+    assert stated, f'{path.name} does not say its points in its first cell'
+    given = sum(nbgrader(c).get('points', 0) for c in cells if nbgrader(c).get('grade'))
+    assert int(stated.group(1)) == given
+
+
+@pytest.mark.parametrize('path', SOLUTIONS, ids=lambda p: p.name)
+def test_the_judge_can_run_every_graded_cell(path):
+    """Graded cells hold only ros2nb.checks calls, which the judge runs outside the kernel."""
+    from ros2nb import checks, judge
+    for cell in load(path)['cells']:
+        if nbgrader(cell).get('grade'):
+            calls = judge.graded_calls(text(cell))
+            assert calls, (path.name, nbgrader(cell)['grade_id'])
+            assert all(callable(getattr(checks, name, None)) for name, _, _ in calls)
+
+
+NODE_CALLS = ('create_publisher(', 'create_timer(', 'create_subscription(', '.publish(')
+
+
+@pytest.mark.parametrize('path', [p for p in LEARNER if p.name[:2] in ('03', '04')],
+                         ids=lambda p: p.name)
+def test_learner_notebooks_leave_the_nodes_to_the_learner(path):
+    code = '\n'.join(text(c) for c in load(path)['cells'] if c['cell_type'] == 'code')
+    assert not [call for call in NODE_CALLS if call in code]
+
+
+def _file_from_parts(path: Path, variable: str) -> str:
+    from ros2nb.workspace import AUTHOR_MARKERS
+    parts = {}
+    for cell in load(path)['cells']:
+        found = re.match(r'%%part \{' + variable + r'\} (\d+)\n', text(cell))
+        if found:
+            body = '\n'.join(line for line in text(cell)[found.end():].split('\n')
+                             if line.strip() not in AUTHOR_MARKERS)
+            parts[int(found.group(1))] = body.rstrip('\n')
+    return '\n\n'.join(parts[n] for n in sorted(parts)) + '\n'
+
+
+@pytest.mark.parametrize('notebook, variable, reference', [
+    ('03-write-the-publisher.ipynb', 'PUBLISHER', 'temperature_publisher.py'),
+    ('04-write-the-subscriber.ipynb', 'SUBSCRIBER', 'temperature_subscriber.py'),
+])
+def test_solution_parts_are_the_reference_nodes(notebook, variable, reference):
+    from ros2nb import course
+    assert _file_from_parts(ROOT / 'solutions' / notebook, variable) == \
+        course.reference_source(reference)
+
+
+def test_the_node_files_carry_the_course_constants():
+    """The standalone node files spell the numbers out; they must be ros2nb.course's."""
+    import ast
+    from ros2nb import course
+    for reference in ('temperature_publisher.py', 'temperature_subscriber.py'):
+        tree = ast.parse(course.reference_source(reference))
+        constants = {t.id: ast.literal_eval(n.value) for n in tree.body
+                     if isinstance(n, ast.Assign) for t in n.targets if t.id.isupper()}
+        assert constants, reference
+        for name, value in constants.items():
+            assert getattr(course, name) == value, (reference, name)
 
 
 def test_learner_notebooks_have_no_outputs_and_no_solutions():

@@ -1,20 +1,24 @@
 """ros2nb's runtime against real rclpy over real DDS (no mocks of ROS)."""
 
+import importlib
+import os
 import random
+import re
+import signal
+import subprocess
+import sys
 import threading
+import time
 
 import pytest
 import rclpy
 
-import importlib
-import subprocess
-import sys
-
 import ros2nb
-
-rt_module = importlib.import_module('ros2nb.runtime')
+from ros2nb.errors import Ros2nbError, UsageError
 
 from nodes import Broken, Monitor, Sensor
+
+rt_module = importlib.import_module('ros2nb.runtime')
 
 
 @pytest.fixture
@@ -26,24 +30,44 @@ def ros():
 
 def test_import_does_nothing():
     probe = ('import threading, rclpy, ros2nb, os; '
-             'print(rclpy.ok(), threading.active_count(), "ROS_PYTHON_CHECK_FIELDS" in os.environ)')
-    env = {k: v for k, v in __import__('os').environ.items() if k != 'ROS_PYTHON_CHECK_FIELDS'}
+             'print(rclpy.ok(), threading.active_count(), "ROS_PYTHON_CHECK_FIELDS" in os.environ, '
+             '"ROS_DOMAIN_ID" in os.environ)')
+    env = {k: v for k, v in os.environ.items()
+           if k not in ('ROS_PYTHON_CHECK_FIELDS', 'ROS_DOMAIN_ID')}
     out = subprocess.run([sys.executable, '-c', probe], capture_output=True, text=True,
                          env=env, check=True).stdout.split()
-    assert out == ['False', '1', 'False']
+    assert out == ['False', '1', 'False', 'False']
 
 
-def test_start_is_idempotent(ros):
-    assert rt_module._runtime is ros
-    assert ros2nb.start(sim_time=True) is ros
-    assert rclpy.ok()
+def test_start_says_which_domain_and_clock(capsys):
+    ros2nb.start(sim_time=True)
+    try:
+        line = capsys.readouterr().out.strip()
+        domain = os.environ['ROS_DOMAIN_ID']  # inherited by everything the kernel starts
+        assert line in (f'ROS 2 is up in this kernel: domain {domain} (claimed for this kernel '
+                        'alone), simulated time.',
+                        f'ROS 2 is up in this kernel: domain {domain}, simulated time.')
+        assert ros2nb.current_runtime().domain_id == int(domain)
+    finally:
+        ros2nb.shutdown()
+
+
+def test_start_is_idempotent_and_keeps_the_clock(ros):
+    assert ros2nb.start() is ros  # no sim_time given: the kernel keeps simulated time
+    assert ros.sim_time
     threads = [t for t in threading.enumerate() if t.name == 'ros2nb-executor']
     assert len(threads) == 1
+    monitor = ros2nb.add(Monitor())
+    ros2nb.add(Sensor())
+    started = time.monotonic()
+    ros2nb.spin(30)  # the old start() switched to the wall clock: this took 30 s
+    assert time.monotonic() - started < 10
+    assert len(monitor.received) == 30
 
 
 def test_start_refuses_other_domain(ros):
     other = (ros.domain_id + 1) % 100
-    with pytest.raises(ros2nb.Ros2nbError, match='already up on domain'):
+    with pytest.raises(Ros2nbError, match='already up on domain'):
         ros2nb.start(domain_id=other)
 
 
@@ -55,8 +79,41 @@ def test_start_turns_on_field_checks(ros):
 
 def test_calls_before_start_say_what_to_do():
     assert rt_module._runtime is None
-    with pytest.raises(ros2nb.Ros2nbError, match=r'run ros2nb.start\(\) first'):
+    with pytest.raises(Ros2nbError, match=r'run ros2nb.start\(\) first'):
         ros2nb.spin(1)
+
+
+def test_start_takes_over_after_a_learners_rclpy_init(capsys):
+    rclpy.init()  # the wrong fix for "rclpy.init() has not been called"
+    try:
+        ros2nb.start(sim_time=True)
+        assert 'rclpy.init() had been called in this kernel' in capsys.readouterr().out
+        ros2nb.add(Sensor())
+        ros2nb.spin(2)
+        assert capsys.readouterr().out.count('Publishing:') == 2
+    finally:
+        ros2nb.shutdown()
+
+
+def test_after_rclpy_shutdown_one_line_then_recovery(capsys):
+    ros2nb.start(sim_time=True)
+    try:
+        sensor = Sensor()
+        rclpy.shutdown()
+        with pytest.raises(Ros2nbError, match=r'rclpy.shutdown\(\) was called\): run '
+                                              r'ros2nb.shutdown\(\); ros2nb.start\(\)'):
+            ros2nb.add(sensor)
+        with pytest.raises(rclpy.exceptions.NotInitializedException) as caught:
+            Sensor()  # what the learner's next cell does; the kernel shows this line instead
+        from ros2nb.explain import explain_exception
+        assert explain_exception(caught.value).startswith('ROS 2 was shut down in this kernel')
+        ros2nb.shutdown()
+        ros2nb.start(sim_time=True)
+        ros2nb.add(Sensor())
+        ros2nb.spin(1)
+        assert 'Publishing:' in capsys.readouterr().out
+    finally:
+        ros2nb.shutdown()
 
 
 def test_same_name_replaces_old_node(ros, capsys):
@@ -75,12 +132,18 @@ def test_same_name_replaces_old_node(ros, capsys):
     assert '_NODE_NAME_UNKNOWN_' not in capsys.readouterr().out
 
 
+def test_add_prints_what_the_node_logs_while_it_starts(ros, capsys):
+    capsys.readouterr()
+    ros2nb.add(Sensor())
+    assert capsys.readouterr().out == '[INFO] [temperature_sensor]: started\n'
+
+
 def test_stop_one_and_all(ros):
     ros2nb.add(Sensor())
     ros2nb.add(Monitor())
     assert ros2nb.stop('temperature_monitor') == ['temperature_monitor']
     assert list(ros.nodes) == ['/temperature_sensor']
-    with pytest.raises(ros2nb.Ros2nbError, match='No running node'):
+    with pytest.raises(Ros2nbError, match='No running node'):
         ros2nb.stop('temperature_monitor')
     assert ros2nb.stop() == ['temperature_sensor']
     assert ros.nodes == {}
@@ -96,7 +159,16 @@ def test_spin_prints_logs_in_console_format(ros, capsys):
     assert all(line.startswith('[INFO] [temperature_sensor]: Publishing: ') for line in lines[1:])
 
 
-def test_callback_exception_reported_and_executor_alive(ros, capsys):
+def test_spin_without_nodes_says_so(ros, capsys):
+    from rclpy.node import Node
+    Node('handed_to_nobody')  # created, never added
+    capsys.readouterr()
+    assert ros2nb.spin(5) == 0.0
+    assert capsys.readouterr().out == ('No nodes are running in this kernel: hand yours over with '
+                                       'ros2nb.add(node), then spin.\n')
+
+
+def test_callback_exception_reported_and_node_gone(ros, capsys):
     ros2nb.add(Broken())
     monitor = ros2nb.add(Monitor())
     ros2nb.add(Sensor())
@@ -107,6 +179,24 @@ def test_callback_exception_reported_and_executor_alive(ros, capsys):
     assert "raise ZeroDivisionError('division by zero')" in captured.err  # the learner's line
     assert '/broken' not in ros.nodes
     assert len(monitor.received) == 3  # the other nodes kept running
+    assert '/broken' not in ros2nb.node_list()  # gone from the graph, not just forgotten
+
+
+def test_fixed_node_readded_after_failure_keeps_its_logs(ros, capsys):
+    """Learner flow: a callback raises, they fix the class and re-run the cell."""
+    import gc
+    broken = ros2nb.add(Broken())
+    ros2nb.spin(2)
+    assert '[ERROR] [broken]' in capsys.readouterr().err
+
+    class Fixed(Broken):
+        def explode(self) -> None:
+            self.get_logger().info('fixed')
+
+    broken = ros2nb.add(Fixed())  # drops the learner's last reference to the failed node
+    gc.collect()
+    ros2nb.spin(3)
+    assert capsys.readouterr().out.count('[INFO] [broken]: fixed') == 3
 
 
 def test_shutdown_joins_thread_and_allows_restart():
@@ -126,15 +216,15 @@ def _sim_run(seed: int) -> str:
     import contextlib
     import io
     out = io.StringIO()
-    ros2nb.start(sim_time=True)
-    try:
-        with contextlib.redirect_stdout(out):
+    with contextlib.redirect_stdout(out):
+        ros2nb.start(sim_time=True)
+        try:
             random.seed(seed)
             ros2nb.add(Sensor())
             ros2nb.add(Monitor())
             ros2nb.spin(30)
-    finally:
-        ros2nb.shutdown()
+        finally:
+            ros2nb.shutdown()
     return out.getvalue()
 
 
@@ -146,33 +236,123 @@ def test_sim_time_is_deterministic():
     assert _sim_run(8) != first
 
 
-def test_wall_clock_spin_runs_in_real_time(ros):
-    import time
+def test_wall_clock_spin_runs_in_real_time_then_the_kernel_clock_again(ros):
     monitor = ros2nb.add(Monitor())
     ros2nb.add(Sensor())
     started = time.monotonic()
     ros2nb.spin(1.5, sim_time=False)
     assert time.monotonic() - started >= 1.5
     assert 1 <= len(monitor.received) <= 2
+    heard = len(monitor.received)
+    time.sleep(1.5)  # back on simulated time: the nodes wait between cells
+    assert len(monitor.received) == heard
 
 
-def test_spin_rejects_negative_seconds(ros):
-    with pytest.raises(ValueError, match='zero or more'):
-        ros2nb.spin(-1)
+def test_spin_rejects_bad_seconds(ros):
+    for bad in (-1, float('nan'), '5'):
+        with pytest.raises(UsageError, match='seconds must be a number of seconds'):
+            ros2nb.spin(bad)
 
 
-def test_fixed_node_readded_after_failure_keeps_its_logs(ros, capsys):
-    """Learner flow: a callback raises, they fix the class and re-run the cell."""
-    import gc
-    broken = ros2nb.add(Broken())
-    ros2nb.spin(2)
-    assert '[ERROR] [broken]' in capsys.readouterr().err
+def test_stop_during_a_sim_spin_is_one_line(ros, capsys):
+    ros2nb.add(Sensor())
+    capsys.readouterr()
+    timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
+    timer.start()
+    ran = ros2nb.spin(10 ** 7, show_logs=False)
+    timer.join()
+    out = capsys.readouterr().out.splitlines()
+    assert 0 < ran < 10 ** 7
+    assert out[-1].startswith('Interrupted after ') and out[-1].endswith(
+        'simulated s; the nodes wait until the next spin (ros2nb.stop() stops them).')
+    ros2nb.spin(1)  # and the kernel goes on
+    assert 'Publishing:' in capsys.readouterr().out
 
-    class Fixed(Broken):
-        def explode(self) -> None:
-            self.get_logger().info('fixed')
 
-    broken = ros2nb.add(Fixed())  # drops the learner's last reference to the failed node
-    gc.collect()
-    ros2nb.spin(3)
-    assert capsys.readouterr().out.count('[INFO] [broken]: fixed') == 3
+def test_lines_made_while_no_cell_ran_are_counted_not_shown(capsys):
+    rt = ros2nb.start(sim_time=False)
+    try:
+        ros2nb.add(Sensor())
+        rt.begin_cell()  # a cell ends; nodes on the wall clock keep running
+        time.sleep(2.2)
+        rt.begin_cell()  # the next cell starts
+        capsys.readouterr()
+        ros2nb.spin(0)
+        out = capsys.readouterr().out
+        assert re.search(r'^\(\d+ log lines made while no cell was running were not shown\)$',
+                         out.splitlines()[0])
+        assert 'Publishing:' not in out.splitlines()[0]
+    finally:
+        ros2nb.shutdown()
+
+
+def test_timer_of_period_zero_is_refused_at_once(ros):
+    from rclpy.node import Node
+
+    class Busy(Node):
+        def __init__(self):
+            super().__init__('busy')
+            self.create_timer(0, self.tick)
+
+        def tick(self):
+            pass
+
+    started = time.monotonic()
+    with pytest.raises(Ros2nbError, match=r'busy has a timer with a period of 0 s for '
+                                          r'.*Busy.tick: it would fire without pause'):
+        ros2nb.add(Busy())
+    assert time.monotonic() - started < 2
+    assert ros.nodes == {}
+
+
+def test_a_callback_that_triggers_itself_is_stopped_with_one_line(ros):
+    from rclpy.node import Node
+    from std_msgs.msg import Float32
+
+    class Echo(Node):
+        def __init__(self):
+            super().__init__('echo_chamber')
+            self.pub = self.create_publisher(Float32, 'loop', 10)
+            self.create_subscription(Float32, 'loop', self.pub.publish, 10)
+            self.pub.publish(Float32(data=1.0))
+
+    with pytest.raises(Ros2nbError, match='without the clock moving: a callback keeps '
+                                          'triggering itself'):
+        ros2nb.add(Echo())
+
+
+def test_two_types_on_one_topic_are_refused(ros):
+    from rclpy.node import Node
+    from std_msgs.msg import Float64
+
+    class Float64Monitor(Node):
+        def __init__(self):
+            super().__init__('temperature_monitor')
+            self.create_subscription(Float64, 'temperature', lambda m: None, 10)
+
+    ros2nb.add(Sensor())
+    with pytest.raises(Ros2nbError, match='temperature_monitor would subscribe to /temperature as '
+                                          'std_msgs/msg/Float64, but /temperature already carries '
+                                          'std_msgs/msg/Float32 in this kernel'):
+        Float64Monitor()  # refused where it is created, before rcl's C error dump
+
+
+def test_kernel_nodes_keep_running_while_processes_run(ros, tmp_path, capsys):
+    """Simulated time follows the wall clock while ros2_run/run_and_interrupt run processes."""
+    listener = tmp_path / 'listener.py'
+    listener.write_text(
+        'import rclpy\nfrom rclpy.node import Node\nfrom std_msgs.msg import Float32\n'
+        'rclpy.init()\nnode = Node("process_listener")\n'
+        'node.create_subscription(Float32, "temperature", '
+        'lambda m: print(f"heard {m.data:.2f}", flush=True), 10)\n'
+        'try:\n    rclpy.spin(node)\nexcept BaseException:\n    pass\n')
+    ros2nb.add(Sensor())
+    capsys.readouterr()
+    ros2nb.run_and_interrupt([sys.executable, str(listener)], seconds=4)
+    out = capsys.readouterr().out
+    assert 'keep running meanwhile, their simulated clock following the wall clock' in out
+    assert 'heard ' in out  # a process heard the kernel's sensor
+    assert '[INFO] [temperature_sensor]: Publishing:' in out
+
+
+

@@ -197,3 +197,49 @@ def _check_types_agree(node: Any, rt: Any) -> None:
                 raise Ros2nbError(f'{name} {kind} {topic} as {mine}, but {info.node_name} {role} '
                                   f'it as {info.topic_type}: both sides of a topic must use the '
                                   'same message type.')
+
+
+# --------------------------------------------------------------- checks at creation
+_GUARDED = '_ros2nb_guarded'
+
+
+def _refuse_other_type(node: Any, kind: str, msg_type: Any, topic: str) -> None:
+    """Raise before rcl would fail with ``invalid allocator`` and a C error dump."""
+    if not isinstance(msg_type, type) or not hasattr(node, '_Node__node'):
+        return  # rclpy's own error (or check_node at add()) says it better
+    try:
+        name = node.resolve_topic_name(topic)
+        existing = dict(node.get_topic_names_and_types()).get(name, [])
+    except Exception:  # an invalid name: rclpy's own message, with its caret, is best
+        return
+    mine = _type_name(msg_type)
+    others = [t for t in existing if t != mine]
+    if others:
+        verb = 'publish on' if kind == 'publisher' else 'subscribe to'
+        raise Ros2nbError(f'{node.get_name()} would {verb} {name} as {mine}, but {name} already '
+                          f'carries {", ".join(others)} in this kernel: both sides of a topic '
+                          'must use the same message type.')
+
+
+def guard_endpoint_types() -> None:
+    """Make ``create_publisher``/``create_subscription`` refuse a second type on a topic.
+
+    In one process rcl refuses such an endpoint with ``invalid allocator`` after printing a
+    C error dump; across processes the two sides simply never meet.  Installed by
+    :func:`ros2nb.start` in a notebook, so the learner gets one line instead, at their line.
+    """
+    from rclpy.node import Node
+    for method, kind in (('create_publisher', 'publisher'),
+                         ('create_subscription', 'subscription')):
+        original = getattr(Node, method)
+        if getattr(original, _GUARDED, False):
+            continue
+
+        def guarded(self: Any, msg_type: Any, topic: str, *args: Any,
+                    _original: Any = original, _kind: str = kind, **kwargs: Any) -> Any:
+            _refuse_other_type(self, _kind, msg_type, topic)
+            return _original(self, msg_type, topic, *args, **kwargs)
+
+        guarded.__doc__, guarded.__name__ = original.__doc__, method
+        setattr(guarded, _GUARDED, True)
+        setattr(Node, method, guarded)

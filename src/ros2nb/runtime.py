@@ -42,8 +42,9 @@ from .errors import Ros2nbError, UsageError
 #: Hidden name of the kernel's own node (names starting with ``_`` are hidden
 #: from ``ros2 node list``, as the ros2cli daemon's are).
 INTERNAL_NODE_NAME = '_ros2nb'
-#: How long the background thread waits for work before checking for a pause (s).
-BACKGROUND_WAIT_S = 0.1
+#: How long the background thread waits for work before checking for a pause (s); a
+#: pause (every spin, add, stop) waits this long at most.
+BACKGROUND_WAIT_S = 0.02
 #: Longest silence a simulated-time run skips in one step when no timer is due (s).
 MAX_SIM_STEP_S = 1.0
 #: Log lines kept while no cell is reading them; older ones are counted, not kept.
@@ -89,7 +90,7 @@ class Runtime:
     Create it with :func:`start`; use the module-level functions, not this class.
     """
 
-    def __init__(self, *, domain_id: int, sim_time: bool) -> None:
+    def __init__(self, *, domain_id: int, sim_time: bool, background: bool = True) -> None:
         #: The kernel's clock: True for simulated time, False for the wall clock.
         self.sim_time = sim_time
         self.sim_now_ns = 0
@@ -128,7 +129,8 @@ class Runtime:
         self.executor.add_node(self.node)
         self._thread = threading.Thread(target=self._spin_in_background,
                                         name='ros2nb-executor', daemon=True)
-        self._thread.start()
+        if background:  # without it, callbacks run only in drain() (a check's subject)
+            self._thread.start()
 
     @property
     def alive(self) -> bool:
@@ -456,7 +458,8 @@ class Runtime:
         self._resume.set()
         with contextlib.suppress(Exception):  # a shut-down context cannot be woken
             self.executor.wake()
-        self._thread.join()
+        if self._thread.is_alive():
+            self._thread.join()
         for node in list(self._nodes.values()):
             self._discard(node)
         for shells in self._retired.values():
@@ -503,8 +506,10 @@ def start(*, domain_id: Optional[int] = None, sim_time: Optional[bool] = None) -
     down), turns on message field checks (``ROS_PYTHON_CHECK_FIELDS=1``), keeps discovery
     on this machine (``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``) unless you set that
     variable yourself, puts the kernel on a ROS domain of its own (see
-    :func:`ros2nb.domains.domain_id`) and starts the background executor thread.  In a
-    notebook it also turns ``rclpy.spin(node)`` into a one-line explanation.
+    :func:`ros2nb.domains.domain_id`) and starts the background executor thread.  A second
+    message type on a topic is refused with one line when the endpoint is created (rcl
+    would print a C error dump), and in a notebook ``rclpy.spin(node)`` explains itself
+    instead of blocking the cell.
 
     Introduced in ``00-setup-and-the-pubsub-idea.ipynb``.
 
@@ -546,7 +551,8 @@ def start(*, domain_id: Optional[int] = None, sim_time: Optional[bool] = None) -
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     _runtime = Runtime(domain_id=domain_id, sim_time=bool(sim_time))
     atexit.register(shutdown)
-    from . import kernel
+    from . import explain, kernel
+    explain.guard_endpoint_types()
     if kernel.install():  # inside IPython: cell hooks, one-line errors, %%part
         rclpy.spin = _spin_in_a_cell
     print(f'ROS 2 is up in this kernel: {_describe(_runtime)}.')

@@ -73,6 +73,15 @@ def _without_magics(source: str) -> str:
                      for line in source.splitlines())
 
 
+def _placeholder(name: str) -> Callable[..., None]:
+    """A method that does nothing, named like the one it stands in for."""
+    def method(self: Any, *args: Any) -> None:
+        return None
+
+    method.__name__ = method.__qualname__ = name
+    return method
+
+
 class Subject:
     """The state of this process: the learner's namespace, module and node."""
 
@@ -129,7 +138,8 @@ class Subject:
         if self.rt is None:
             from . import domains, runtime
             runtime._enable_field_checks()
-            self.rt = runtime.Runtime(domain_id=domains.domain_id(), sim_time=True)
+            self.rt = runtime.Runtime(domain_id=domains.domain_id(), sim_time=True,
+                                      background=False)
             self.rt.on_failure = self._on_failure
         return self.rt
 
@@ -184,7 +194,7 @@ class Subject:
         missing = [m for m in placeholders if not callable(getattr(node_class, m, None))]
         if missing:  # a later part is not written yet: stand in for it with a no-op
             node_class = type(node_class.__name__, (node_class,),
-                              {m: (lambda self, *args: None) for m in missing})
+                              {m: _placeholder(m) for m in missing})
         if seed is not None:
             random.seed(seed)
         self.published, self.received, self.fired, self.failure = {}, 0, 0, None

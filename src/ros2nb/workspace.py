@@ -43,6 +43,8 @@ WORKSPACE_FOLDERS = ('src', 'docs', 'scripts', 'resources/images')
 WRITTEN_RECORD = '.ros2nb-written.json'
 #: Where ``%%part`` keeps the parts of each file, so a kernel restart loses none.
 PARTS_RECORD = '.ros2nb-parts.json'
+#: nbgrader's marker lines around an answer in the course's own notebooks; not part of a file.
+AUTHOR_MARKERS = ('### BEGIN SOLUTION', '### END SOLUTION')
 #: Console format for processes started by ros2nb (timestamps removed, as in the kernel).
 CONSOLE_FORMAT = '[{severity}] [{name}]: {message}'
 
@@ -185,7 +187,7 @@ def write_file(path: PathLike, text: str, *, overwrite: bool = False) -> Path:
             if not overwrite:
                 raise FileProtectedError(
                     f'{shown(path)} has changes that ros2nb did not write; to keep them do '
-                    'nothing, to replace them run again with overwrite=True (your version '
+                    'nothing, to replace them run again with overwrite=True, or add --overwrite to the %%part line (your version '
                     'is then kept as .bak).')
             shutil.copy2(path, path.with_name(path.name + '.bak'))
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -264,7 +266,7 @@ def write_part(path: PathLike, number: int, text: str, *, overwrite: bool = Fals
     """Set part ``number`` of a source file and write the file from all its parts.
 
     Parts are joined in number order with one blank line between them, so cells can be
-    re-run in any order.  The parts are kept in the workspace (``.ros2nb-parts.json``),
+    re-run in any order.  nbgrader's answer markers (``### BEGIN SOLUTION``) are left out.  The parts are kept in the workspace (``.ros2nb-parts.json``),
     so after a kernel restart re-running one part keeps all the others.  Like
     :func:`write_file`, it never overwrites a file you changed in an editor.  Used by the
     ``%%part FILE N`` cell magic (``%load_ext ros2nb``).
@@ -280,6 +282,7 @@ def write_part(path: PathLike, number: int, text: str, *, overwrite: bool = Fals
     """
     if isinstance(number, bool) or not isinstance(number, int) or number < 1:
         raise UsageError(f'A part number is a whole number from 1 up (got {number!r}).')
+    text = '\n'.join(line for line in text.split('\n') if line.strip() not in AUTHOR_MARKERS)
     resolved = workspace_file(path)
     with _parts_of(resolved) as parts:
         replaces = resolved.is_file() and not parts

@@ -17,11 +17,19 @@ class TemperatureMonitor(Node):
 
     def __init__(self):
         super().__init__('temperature_monitor')
+        # 1. a subscription to Float32 messages on TOPIC that calls
+        #    self.temperature_callback, QUEUE_DEPTH deep -> self.subscription
+        # 2. one log line saying that the node started
         self.subscription = self.create_subscription(
             Float32, TOPIC, self.temperature_callback, QUEUE_DEPTH)
         self.get_logger().info('Temperature Monitor Node Started')
 
     def temperature_callback(self, msg):
+        # 1. the reading is in msg.data
+        # 2. its status: 'High' strictly above HIGH_ABOVE_C, 'Low' strictly below
+        #    LOW_BELOW_C, 'Normal' otherwise (20.0 and 26.0 included)
+        # 3. log one line with the reading (two decimals) and the status,
+        #    e.g. 'Temperature: 23.00C - Status: Normal'
         temperature_c = msg.data
         if temperature_c > HIGH_ABOVE_C:
             status = 'High'
@@ -33,6 +41,8 @@ class TemperatureMonitor(Node):
 
 
 def main(args=None):
+    # as for the sensor: bring rclpy up, create the node, spin it until Ctrl+C or a
+    # shutdown from outside, then destroy the node and shut rclpy down safely
     rclpy.init(args=args)
     node = TemperatureMonitor()
     try:

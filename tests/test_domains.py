@@ -1,0 +1,143 @@
+"""One ROS world per kernel: domain claims between real processes, also of another user."""
+
+import os
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+
+from ros2nb import domains
+
+CLAIM = textwrap.dedent('''
+    import sys, time
+    from ros2nb import domains
+    print(domains.domain_id(), flush=True)
+    time.sleep(float(sys.argv[1]))
+''')
+
+
+def claimer(locks, seconds=60.0, env_extra=None):
+    """A process that claims a domain in ``locks`` and holds it for ``seconds``."""
+    env = {k: v for k, v in os.environ.items() if k != 'ROS_DOMAIN_ID'}
+    env.update({domains.LOCKS_ENV: str(locks), **(env_extra or {})})
+    proc = subprocess.Popen([sys.executable, '-c', CLAIM, str(seconds)], env=env, text=True,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    line = proc.stdout.readline().strip()
+    return proc, line
+
+
+@pytest.fixture
+def locks(tmp_path):
+    return tmp_path / 'locks'
+
+
+def test_two_kernels_get_two_domains_and_the_first_comes_back_after_a_kill(locks):
+    first, a = claimer(locks)
+    second, b = claimer(locks)
+    try:
+        assert a.isdigit() and b.isdigit() and a != b
+        first.kill()  # SIGKILL: no clean-up code runs, the lock goes with the process
+        first.wait()
+        third, c = claimer(locks)
+        assert c == a
+        third.kill()
+    finally:
+        for proc in (first, second):
+            proc.kill()
+            proc.wait()
+    assert oct(locks.stat().st_mode & 0o7777) == '0o1777'  # every user's kernels lock here
+
+
+def test_a_domain_set_by_the_user_is_honoured(locks, monkeypatch):
+    proc, line = claimer(locks, seconds=0, env_extra={'ROS_DOMAIN_ID': '42'})
+    proc.wait()
+    assert line == '42'
+    monkeypatch.setenv('ROS_DOMAIN_ID', 'forty-two')
+    monkeypatch.setattr(domains, '_claimed', None)
+    with pytest.raises(domains.Ros2nbError, match="ROS_DOMAIN_ID='forty-two' is not a domain id"):
+        domains.domain_id()
+
+
+def test_when_every_domain_is_taken_one_line_says_what_to_do(locks):
+    hold = textwrap.dedent('''
+        import fcntl, os, sys, time
+        os.makedirs(sys.argv[1], exist_ok=True)
+        fds = []
+        for d in range(102):
+            fd = os.open(f'{sys.argv[1]}/{d}.lock', os.O_RDONLY | os.O_CREAT, 0o644)
+            fcntl.flock(fd, fcntl.LOCK_EX)
+            fds.append(fd)
+        print('holding', flush=True)
+        time.sleep(60)
+    ''')
+    holder = subprocess.Popen([sys.executable, '-c', hold, str(locks)], stdout=subprocess.PIPE,
+                              text=True)
+    try:
+        assert holder.stdout.readline().strip() == 'holding'
+        proc, line = claimer(locks, seconds=0)
+        err = proc.communicate()[1].strip().splitlines()[-1]
+        assert proc.returncode != 0 and line == ''
+        assert err == ('ros2nb.errors.DomainsExhaustedError: All 102 safe ROS domains (0-101) on '
+                       'this machine are taken by other course kernels or ROS programs: shut down '
+                       'kernels you no longer use (Kernel > Shut Down Kernel), or set '
+                       'ROS_DOMAIN_ID yourself.')
+    finally:
+        holder.kill()
+        holder.wait()
+
+
+def test_a_domain_used_by_a_ros_program_outside_the_course_is_skipped(locks):
+    """A terminal's `ros2 run` on domain 1 holds no lock, but its discovery port is taken."""
+    program = textwrap.dedent('''
+        import rclpy, time
+        rclpy.init(domain_id=1)
+        node = rclpy.create_node('outside_the_course')
+        print('up', flush=True)
+        time.sleep(60)
+    ''')
+    outside = subprocess.Popen([sys.executable, '-c', program], stdout=subprocess.PIPE, text=True,
+                               env={**os.environ, 'ROS_AUTOMATIC_DISCOVERY_RANGE': 'LOCALHOST'})
+    try:
+        assert outside.stdout.readline().strip() == 'up'
+        time.sleep(0.5)
+        proc, line = claimer(locks, seconds=0)
+        proc.wait()
+        assert line not in ('', '1')
+    finally:
+        outside.kill()
+        outside.wait()
+
+
+SYSTEM_PYTHON = '/usr/bin/python3'
+
+
+@pytest.mark.skipif(os.geteuid() != 0 or not os.path.exists(SYSTEM_PYTHON),
+                    reason='needs root (to act as a second user) and a system python3')
+def test_another_users_kernel_gets_another_domain():
+    """Two learners (two Unix users) on one JupyterHub share the lock folder."""
+    import shutil
+    import tempfile
+    tmp_path = Path(tempfile.mkdtemp(prefix='ros2nb-test-users-'))  # reachable by every user
+    locks = tmp_path / 'locks'
+    package = tmp_path / 'shared' / 'ros2nb'  # domains.py needs nothing of ROS: copy it out
+    package.mkdir(parents=True)
+    for name in ('domains.py', 'errors.py'):
+        shutil.copy(Path(domains.__file__).with_name(name), package / name)
+    (package / '__init__.py').write_text('')
+    for folder in (tmp_path, tmp_path / 'shared', package):
+        folder.chmod(0o755)
+    mine, a = claimer(locks)
+    try:
+        other = subprocess.run(
+            [SYSTEM_PYTHON, '-c', CLAIM, '0'], text=True, capture_output=True, user=65534,
+            group=65534, cwd='/', env={'PYTHONPATH': str(tmp_path / 'shared'), 'HOME': '/tmp',
+                                       domains.LOCKS_ENV: str(locks)})
+        assert other.returncode == 0, other.stderr
+        assert other.stdout.strip().isdigit() and other.stdout.strip() != a
+    finally:
+        mine.kill()
+        mine.wait()
+        shutil.rmtree(tmp_path, ignore_errors=True)
