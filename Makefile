@@ -64,3 +64,36 @@ grade: $(STAMP)
 
 clean:
 	rm -rf $(VENV) .cache .jupyter
+
+# ---- Classroom server: JupyterHub on this machine (docs/classroom-server.md) --------------
+# `make hub` (as root): JupyterHub on 127.0.0.1:8000 for the local users of the Unix group
+# ros2-course (settings: environment/jupyterhub_config.py). `make hub-collect CLASS=DIR`
+# copies their notebooks to DIR/<user>/ for `make grade SUBMISSIONS=DIR`.
+# configurable-http-proxy comes from npm, pinned, into .cache/node (never globally);
+# `make test` installs it when npm can, and otherwise goes on (tests/test_jupyterhub.py skips).
+CHP_VERSION := 4.6.3
+CHP_PREFIX  := $(HERE)/.cache/node
+CHP_STAMP   := $(CHP_PREFIX)/.installed-$(CHP_VERSION)
+
+.PHONY: hub hub-proxy hub-proxy-if-possible hub-collect
+
+hub-proxy: $(CHP_STAMP)
+
+$(CHP_STAMP):
+	@command -v npm >/dev/null || { echo "npm not found: install Node.js (18 or newer) with npm, then run make hub-proxy again."; exit 1; }
+	npm install --prefix $(CHP_PREFIX) --cache $(HERE)/.cache/npm --save-exact --no-audit --no-fund --loglevel=error configurable-http-proxy@$(CHP_VERSION)
+	@touch $@
+
+hub-proxy-if-possible:
+	@{ command -v npm >/dev/null && $(MAKE) --no-print-directory hub-proxy; } || echo "configurable-http-proxy not installed (needs npm and its registry): tests/test_jupyterhub.py will skip."
+
+test: hub-proxy-if-possible
+
+hub: $(STAMP) $(CHP_STAMP)
+	@$(PY) tools/hub_singleuser.py --check
+	$(VENV)/bin/jupyterhub -f environment/jupyterhub_config.py
+
+hub-collect: $(STAMP)
+	@test -n "$(CLASS)" || { echo "Usage: make hub-collect CLASS=DIR, then make grade SUBMISSIONS=DIR"; exit 2; }
+	$(PY) tools/hub_collect.py "$(CLASS)"
+# ---- end of the classroom-server block ----------------------------------------------------

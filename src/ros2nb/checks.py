@@ -331,7 +331,7 @@ def _node_name_verdict(info: dict, want: str) -> None:
 
 
 def _started_log_verdict(judge: Session, info: dict, mark: int, cls: str) -> None:
-    if not _caught_up(judge, info, mark, max(1, info['started_lines'])):
+    if info['started_lines'] == 0 or not _caught_up(judge, info, mark, info['started_lines']):
         raise CheckFailed(f'{cls} logged nothing when it started: log a line such as '
                           f"'{cls[:11]} {cls[11:]} Node Started' with the node's logger.")
 
@@ -409,7 +409,7 @@ def _run_sensor(judge: Session, subject: Any, info: dict, seconds: int, *,
     observer = judge.observer
     topic = '/' + course.TOPIC
     observer.watch_readings(topic)
-    if not subject.request('wait_matched', topic=topic, seconds=5.0)['ok']:
+    if not subject.request('wait_matched', topic=topic, seconds=ARRIVAL_TIMEOUT_S)['ok']:
         raise CheckFailed(f'The publisher on {topic} never reached the grader\'s subscription: '
                           f'check its topic name and its type ({course.MESSAGE_TYPE}).')
     base = subject.request('counts')
@@ -707,7 +707,8 @@ def _feed_monitor(judge: Session, readings: tuple[float, ...] | list[float]) -> 
     _monitor_verdict(info, observer.endpoints(info['name'], info['namespace'], info['endpoints']))
     _caught_up(judge, info, mark, info['started_lines'])
     publisher = judge.probe_publisher
-    if not observer.wait_until(lambda: publisher.get_subscription_count() >= 1, 5.0):
+    if not observer.wait_until(lambda: publisher.get_subscription_count() >= 1,
+                               ARRIVAL_TIMEOUT_S):
         raise CheckFailed(f'The grader\'s publisher on /{course.TOPIC} never reached your '
                           'subscription: check its topic name and type.')
     per_reading = []

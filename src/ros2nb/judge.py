@@ -49,8 +49,10 @@ IN_JUDGE_ENV = 'ROS2NB_JUDGE'
 SUBJECT_PREFIX_ENV = 'ROS2NB_SUBJECT_PREFIX'
 #: Seconds a subject may take to answer one command before it counts as hanging.
 REPLY_TIMEOUT_S = 30.0
-#: Seconds the judge waits for what a subject published to arrive over ROS.
-ARRIVAL_TIMEOUT_S = 3.0
+#: Seconds the judge waits for what a subject published to arrive over ROS, and for ROS
+#: discovery to show a subject's node; the wait ends as soon as it is there, so a long
+#: limit costs time only on a busy machine or when the thing never comes.
+ARRIVAL_TIMEOUT_S = 15.0
 #: Seconds one check may take in all when the kernel runs it.
 CHECK_TIMEOUT_S = 300.0
 #: Lines of a subject's own output kept for hints.

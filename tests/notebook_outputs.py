@@ -1,0 +1,74 @@
+"""What nbval compares, for tests that run notebooks themselves (several kernels at once).
+
+Uses nbval's own stream coalescing and its sanitize-file parser, with tests/sanitize.cfg,
+so "the same outputs" means here what it means in ``make test``.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import copy
+import os
+from pathlib import Path
+from typing import Optional
+
+import nbformat
+from nbclient import NotebookClient
+from nbval.plugin import coalesce_streams, get_sanitize_patterns
+
+ROOT = Path(__file__).resolve().parent.parent
+PATTERNS = get_sanitize_patterns((ROOT / 'tests' / 'sanitize.cfg').read_text())
+IGNORED = 'nbval-ignore-output'
+
+
+def sanitize(text: str) -> str:
+    import re
+    for regex, replace in PATTERNS:
+        text = re.sub(regex, replace, text)
+    return text
+
+
+def comparable(nb: nbformat.NotebookNode) -> dict[int, list[str]]:
+    """Per code cell that nbval compares: its sanitized stream texts and error names."""
+    found = {}
+    for index, cell in enumerate(nb.cells):
+        if cell.cell_type != 'code' or IGNORED in cell.metadata.get('tags', []):
+            continue
+        outputs = coalesce_streams(copy.deepcopy(cell.get('outputs', [])))
+        found[index] = [sanitize(f'{o.name}: {o.text}') if o.output_type == 'stream' else
+                        f'error: {o.ename}: {sanitize(o.evalue)}' if o.output_type == 'error'
+                        else o.output_type for o in outputs]
+    return found
+
+
+def differences(stored: nbformat.NotebookNode, ran: nbformat.NotebookNode) -> list[str]:
+    """The cells whose outputs differ, each as ``cell N: stored ... got ...``."""
+    want, got = comparable(stored), comparable(ran)
+    return [f'cell {i}: stored {want[i]!r:.300} got {got.get(i)!r:.300}'
+            for i in want if got.get(i) != want[i]]
+
+
+def kernel_env(domain: Optional[int] = None) -> dict[str, str]:
+    """A kernel's environment: a workspace of its own (a new learner's), in a folder that
+    tests/sanitize.cfg masks; no ROS domain unless one is forced."""
+    import tempfile
+    env = {k: v for k, v in os.environ.items() if k != 'ROS_DOMAIN_ID'}
+    scratch = Path(tempfile.mkdtemp(prefix='ros2nb-test-'))
+    env['ROS2NB_WORKSPACE'] = str(scratch / 'ROS2_and_RL_Tutorials')
+    if domain is not None:
+        env['ROS_DOMAIN_ID'] = str(domain)
+    return env
+
+
+async def _run(nb: nbformat.NotebookNode, env: dict[str, str], timeout: float) -> None:
+    client = NotebookClient(nb, timeout=timeout, kernel_name='python3',
+                            resources={'metadata': {'path': str(ROOT / 'solutions')}})
+    await client.async_execute(env=env)
+
+
+def run_at_once(jobs: list[tuple[nbformat.NotebookNode, dict[str, str]]],
+                timeout: float = 600) -> None:
+    """Execute notebooks in place, each in its own kernel, all at the same time."""
+    async def together() -> None:
+        await asyncio.gather(*(_run(nb, env, timeout) for nb, env in jobs))
+    asyncio.run(together())

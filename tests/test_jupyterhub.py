@@ -1,0 +1,451 @@
+"""A class on one JupyterHub: two learners run notebook 04 at the same time, each on their own.
+
+Everything here is real, nothing is mocked: JupyterHub from the course's venv, loaded with
+the course's ``environment/jupyterhub_config.py``; configurable-http-proxy as ``make
+hub-proxy`` installs it; two single-user servers started through the Hub's REST API, each
+through the course's launcher ``tools/hub_singleuser.py``; and one kernel on each server,
+created with the server's REST API and driven over its kernel websocket with the learner's
+own token. The hub lives in a temporary folder and listens on free ports of 127.0.0.1.
+
+Two learners, ``ada`` and ``grace``, run ``solutions/04-write-the-subscriber.ipynb`` at the
+same time, cell by cell in lockstep. Each must get exactly the stored outputs: for every
+code cell not tagged ``nbval-ignore-output``, the text of its stream outputs and the
+``ename``/``evalue`` of its errors, after ``tests/sanitize.cfg``'s replacements applied as
+nbval's ``--nbval-sanitize-with`` applies them. Images and execution counts are ignored.
+
+For the test, ``DummyAuthenticator`` and ``SimpleLocalProcessSpawner`` replace ``make hub``'s
+PAM and ``LocalProcessSpawner``: the same machine and the same kind of server, but both
+learners run as the Unix user running pytest, each with a home folder of their own in the
+temporary folder (so their own copy of the notebooks and their own ROS workspace).
+
+Neither the hub nor the servers get a ``ROS_DOMAIN_ID`` (it is removed from the hub's
+environment and the course's config does not pass it on), as on a real hub: the learners'
+kernels must keep apart by themselves.
+
+Needs configurable-http-proxy in ``.cache/node`` (``make test`` installs it when npm can);
+without it the test says so in one line and skips.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import difflib
+import json
+import os
+import re
+import secrets
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+import uuid
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Optional
+
+import pytest
+import requests
+from tornado.httpclient import HTTPRequest
+from tornado.websocket import WebSocketClientConnection, websocket_connect
+
+ROOT = Path(__file__).resolve().parent.parent
+PROXY = ROOT / '.cache' / 'node' / 'node_modules' / '.bin' / 'configurable-http-proxy'
+COURSE_CONFIG = ROOT / 'environment' / 'jupyterhub_config.py'
+NOTEBOOK = ROOT / 'solutions' / '04-write-the-subscriber.ipynb'
+SANITIZE = ROOT / 'tests' / 'sanitize.cfg'
+JUPYTERHUB = Path(sys.executable).with_name('jupyterhub')
+LEARNERS = ('ada', 'grace')
+IGNORE_OUTPUT_TAG = 'nbval-ignore-output'
+#: Seconds for the hub to answer, for a server to start, for one cell to run.
+HUB_START_S = 30
+SERVER_START_S = 60
+CELL_S = 60
+#: Variables of the test's environment the hub must not see (conftest.py sets them).
+NOT_FOR_THE_HUB = ('ROS_DOMAIN_ID', 'ROS2NB_WORKSPACE')
+
+pytestmark = pytest.mark.timeout(300)  # 20-55 s on 2 cores; generous for a loaded machine
+
+if not (os.access(PROXY, os.X_OK) and shutil.which('node')):
+    pytest.skip('configurable-http-proxy is not installed (make hub-proxy needs node, npm and '
+                'the npm registry): no JupyterHub to test.', allow_module_level=True)
+
+
+@dataclass
+class Hub:
+    """A running JupyterHub of this test.
+
+    :ivar url: its public URL (the proxy), e.g. ``http://127.0.0.1:40123``.
+    :ivar token: the API token of the test's admin service.
+    :ivar folder: its temporary folder (config, state, log, the learners' homes).
+    :ivar process: the ``jupyterhub`` process.
+    """
+
+    url: str
+    token: str
+    folder: Path
+    process: subprocess.Popen
+
+    @property
+    def log(self) -> Path:
+        return self.folder / 'jupyterhub.log'
+
+    def home(self, learner: str) -> Path:
+        return self.folder / 'home' / learner
+
+    def log_tail(self, lines: int = 40) -> str:
+        """Return the end of the hub's log (its servers write there too)."""
+        text = self.log.read_text(errors='replace') if self.log.exists() else ''
+        return '\n'.join(text.splitlines()[-lines:])
+
+    def api(self, method: str, path: str, **kwargs) -> requests.Response:
+        """Call the Hub's REST API (``/hub/api<path>``) as the test's admin service."""
+        return requests.request(method, f'{self.url}/hub/api{path}', timeout=10,
+                                headers={'Authorization': f'token {self.token}'}, **kwargs)
+
+
+# ----------------------------------------------------------------------------- the hub
+def free_port() -> int:
+    """Return a TCP port of 127.0.0.1 that nothing listens on right now."""
+    with socket.socket() as probe:
+        probe.bind(('127.0.0.1', 0))
+        return probe.getsockname()[1]
+
+
+def write_config(folder: Path, token: str) -> Path:
+    """Write the test's hub config: the course's, with a test login, spawner and ports."""
+    config = folder / 'jupyterhub_test_config.py'
+    extra_args = ['--allow-root'] if os.geteuid() == 0 else []
+    config.write_text(f'''\
+c = get_config()
+load_subconfig({str(COURSE_CONFIG)!r})
+# Test only: any listed name logs in, and every server runs as the user running pytest.
+c.JupyterHub.authenticator_class = 'dummy'
+c.Authenticator.allowed_users = {set(LEARNERS)!r}
+c.JupyterHub.spawner_class = 'simple'
+c.SimpleLocalProcessSpawner.home_dir_template = {str(folder / 'home' / '{username}')!r}
+c.Spawner.args = c.Spawner.args + {extra_args!r}
+c.JupyterHub.bind_url = 'http://127.0.0.1:{free_port()}'
+c.JupyterHub.hub_bind_url = 'http://127.0.0.1:{free_port()}'
+c.ConfigurableHTTPProxy.api_url = 'http://127.0.0.1:{free_port()}'
+c.JupyterHub.services = [{{'name': 'hub-test', 'api_token': {token!r}}}]
+c.JupyterHub.load_roles = [{{'name': 'hub-test', 'services': ['hub-test'],
+                            'scopes': ['admin:users', 'admin:servers', 'tokens']}}]
+''')
+    return config
+
+
+def hub_environment(folder: Path) -> dict[str, str]:
+    """Return this process's environment without a ROS domain or workspace, state in ``folder``."""
+    env = {k: v for k, v in os.environ.items() if k not in NOT_FOR_THE_HUB}
+    env['ROS2_COURSE_HUB_STATE'] = str(folder / 'state')
+    return env
+
+
+def wait_for(check: Callable[[], bool], seconds: float, what: str, hub: Hub) -> None:
+    """Poll ``check`` until it is true; fail with ``what`` and the hub's log after ``seconds``."""
+    deadline = time.monotonic() + seconds
+    while not check():
+        if hub.process.poll() is not None:
+            pytest.fail(f'JupyterHub exited ({hub.process.returncode}) while waiting for '
+                        f'{what}; its log ends:\n{hub.log_tail()}')
+        if time.monotonic() > deadline:
+            pytest.fail(f'{what}: not done after {seconds} s; the hub log ends:\n{hub.log_tail()}')
+        time.sleep(0.2)
+
+
+def answers(hub: Hub) -> bool:
+    """True once the Hub's API answers through the proxy."""
+    try:
+        return hub.api('GET', '/').status_code == 200
+    except requests.ConnectionError:
+        return False
+
+
+def start_hub(folder: Path) -> Hub:
+    """Start JupyterHub in ``folder`` and wait until its API answers through the proxy."""
+    token = secrets.token_hex(32)
+    config = write_config(folder, token)
+    url = re.search(r"bind_url = '(http://[^']+)'", config.read_text()).group(1)
+    with open(folder / 'jupyterhub.log', 'wb') as log:
+        process = subprocess.Popen([str(JUPYTERHUB), '-f', str(config)], cwd=folder,
+                                   env=hub_environment(folder), stdout=log,
+                                   stderr=subprocess.STDOUT, start_new_session=True)
+    hub = Hub(url=url, token=token, folder=folder, process=process)
+    wait_for(lambda: answers(hub), HUB_START_S, 'JupyterHub answering through the proxy', hub)
+    return hub
+
+
+def start_server(hub: Hub, learner: str) -> None:
+    """Create ``learner`` and ask the hub to start their server (does not wait for it)."""
+    created = hub.api('POST', f'/users/{learner}')
+    assert created.status_code in (201, 409), f'creating {learner}: {created.text}'
+    started = hub.api('POST', f'/users/{learner}/server')
+    assert started.status_code in (201, 202), f'starting {learner}: {started.text}'
+
+
+def server_ready(hub: Hub, learner: str) -> bool:
+    """True once the hub reports ``learner``'s server as ready."""
+    server = hub.api('GET', f'/users/{learner}').json().get('servers', {}).get('', {})
+    return bool(server.get('ready'))
+
+
+def learner_token(hub: Hub, learner: str) -> str:
+    """Return a new API token of ``learner``'s own (what their browser session would carry)."""
+    issued = hub.api('POST', f'/users/{learner}/tokens',
+                     json={'note': 'tests/test_jupyterhub.py', 'expires_in': 900})
+    assert issued.status_code == 201, f'token for {learner}: {issued.text}'
+    return issued.json()['token']
+
+
+def processes_in(folder: Path) -> list[int]:
+    """Return the ids of processes whose working folder is inside ``folder``."""
+    found = []
+    for entry in Path('/proc').iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            cwd = Path(os.readlink(entry / 'cwd'))
+        except OSError:
+            continue
+        if cwd == folder or folder in cwd.parents:
+            found.append(int(entry.name))
+    return found
+
+
+def stop_hub(hub: Hub) -> None:
+    """Stop the servers, then the hub (and its proxy); kill whatever of this test is left."""
+    for learner in LEARNERS:
+        try:
+            hub.api('DELETE', f'/users/{learner}/server')
+        except requests.RequestException:
+            pass  # the hub is gone already; what is left is killed below
+    hub.process.send_signal(signal.SIGTERM)
+    try:
+        hub.process.wait(timeout=20)
+    except subprocess.TimeoutExpired:
+        os.killpg(hub.process.pid, signal.SIGKILL)
+        hub.process.wait()
+    for pid in processes_in(hub.folder):
+        try:
+            os.kill(pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+
+
+# ----------------------------------------------------------------------- the kernels
+class Kernel:
+    """One kernel on a learner's server, driven over its websocket channels."""
+
+    def __init__(self, learner: str, connection: WebSocketClientConnection) -> None:
+        self.learner = learner
+        self.connection = connection
+        self.session = uuid.uuid4().hex
+
+    async def execute(self, code: str, seconds: float = CELL_S) -> list[dict]:
+        """Run ``code`` and return its stream and error outputs in nbformat's shape."""
+        msg_id = uuid.uuid4().hex
+        await self.connection.write_message(json.dumps({
+            'channel': 'shell', 'buffers': [], 'metadata': {}, 'parent_header': {},
+            'header': {'msg_id': msg_id, 'msg_type': 'execute_request', 'version': '5.3',
+                       'session': self.session, 'username': self.learner},
+            'content': {'code': code, 'silent': False, 'store_history': True,
+                        'user_expressions': {}, 'allow_stdin': False, 'stop_on_error': True}}))
+        outputs: list[dict] = []
+        idle = replied = False
+        deadline = time.monotonic() + seconds
+        while not (idle and replied):
+            remaining = deadline - time.monotonic()
+            if remaining <= 0:
+                raise AssertionError(f'{self.learner}: a cell ran longer than {seconds} s:\n{code}')
+            raw = await asyncio.wait_for(self.connection.read_message(), remaining)
+            if raw is None:
+                raise AssertionError(f"{self.learner}: the kernel's websocket closed mid-cell")
+            message = json.loads(raw) if isinstance(raw, str) else {}
+            if message.get('parent_header', {}).get('msg_id') != msg_id:
+                continue
+            kind, content = message['msg_type'], message['content']
+            idle = idle or (kind == 'status' and content['execution_state'] == 'idle')
+            replied = replied or kind == 'execute_reply'
+            if kind == 'stream':
+                outputs.append({'output_type': 'stream', 'name': content['name'],
+                                'text': content['text']})
+            elif kind == 'error':
+                outputs.append({'output_type': 'error', 'ename': content['ename'],
+                                'evalue': content['evalue']})
+        return outputs
+
+
+def open_kernel(hub: Hub, learner: str, token: str) -> tuple[str, str]:
+    """Start a kernel on ``learner``'s server in ``notebooks/``; return its id and websocket URL."""
+    started = requests.post(f'{hub.url}/user/{learner}/api/kernels', timeout=30,
+                            headers={'Authorization': f'token {token}'},
+                            json={'name': 'python3', 'path': 'notebooks'})
+    assert started.status_code == 201, f'kernel for {learner}: {started.status_code} {started.text}'
+    kernel_id = started.json()['id']
+    ws = hub.url.replace('http://', 'ws://', 1)
+    return kernel_id, (f'{ws}/user/{learner}/api/kernels/{kernel_id}/channels'
+                       f'?session_id={uuid.uuid4().hex}')
+
+
+async def connect(learner: str, url: str, token: str) -> Kernel:
+    """Open the kernel's websocket channels with the learner's token."""
+    request = HTTPRequest(url, headers={'Authorization': f'token {token}'}, request_timeout=30)
+    return Kernel(learner, await websocket_connect(request))
+
+
+# ------------------------------------------------------------ nbval's comparison rules
+def sanitize_patterns(path: Path) -> list[tuple[str, str]]:
+    """Return the ``regex:``/``replace:`` pairs of a sanitize file, as nbval reads them."""
+    return re.findall(r'^regex: (.*)$\n^replace: (.*)$', path.read_text(), flags=re.MULTILINE)
+
+
+def comparable(outputs: list[dict], patterns: list[tuple[str, str]]) -> list[tuple[str, ...]]:
+    """Return what is compared: streams joined per name (as nbval does) and errors, sanitized."""
+    def clean(text: str) -> str:
+        for regex, replace in patterns:
+            text = re.sub(regex, replace, text)
+        return text
+
+    streams: dict[str, str] = {}
+    errors = []
+    for output in outputs:
+        if output['output_type'] == 'stream':
+            text = output['text'] if isinstance(output['text'], str) else ''.join(output['text'])
+            streams[output['name']] = streams.get(output['name'], '') + text
+        elif output['output_type'] == 'error':
+            errors.append(('error', output['ename'], clean(output['evalue'])))
+    return [('stream', name, clean(text)) for name, text in streams.items()] + errors
+
+
+def difference(want: list[tuple[str, ...]], have: list[tuple[str, ...]], lines: int = 12) -> str:
+    """Return the start of a unified diff between stored and received outputs."""
+    def as_lines(items: list[tuple[str, ...]]) -> list[str]:
+        return [f'{kind} {name}: {line}' for kind, name, text in items
+                for line in text.splitlines() or ['']]
+
+    diff = list(difflib.unified_diff(as_lines(want), as_lines(have), 'stored', 'got', n=1,
+                                     lineterm=''))
+    more = f'\n    ... {len(diff) - lines} more diff lines' if len(diff) > lines else ''
+    return '\n'.join('    ' + line for line in diff[:lines]) + more
+
+
+def code_cells(notebook: Path) -> list[dict]:
+    """Return the notebook's code cells."""
+    return [c for c in json.loads(notebook.read_text())['cells'] if c['cell_type'] == 'code']
+
+
+def source(cell: dict) -> str:
+    text = cell['source']
+    return text if isinstance(text, str) else ''.join(text)
+
+
+def compared(cell: dict) -> bool:
+    return IGNORE_OUTPUT_TAG not in cell.get('metadata', {}).get('tags', [])
+
+
+# ------------------------------------------------------------------------- the class
+PROBE = ('import json, os, sys; print(json.dumps({k: os.environ.get(k) for k in '
+         '("ROS_DOMAIN_ID", "ROS2NB_WORKSPACE", "HOME")} | {"prefix": sys.prefix, '
+         '"cwd": os.getcwd()}))')
+
+
+@dataclass
+class ClassRun:
+    """What each learner's kernel printed: the environment probe and every code cell."""
+
+    hub: Hub
+    probes: dict[str, dict]
+    outputs: dict[str, list[list[dict]]]
+    cells: list[dict]
+    seconds: float
+
+
+async def run_in_lockstep(kernels: dict[str, Kernel], cells: list[dict]) -> dict[str, list]:
+    """Run every cell in all kernels at once; the next cell starts when all have finished."""
+    outputs: dict[str, list] = {learner: [] for learner in kernels}
+    for cell in cells:
+        done = await asyncio.gather(*(k.execute(source(cell)) for k in kernels.values()))
+        for learner, cell_outputs in zip(kernels, done):
+            outputs[learner].append(cell_outputs)
+    return outputs
+
+
+async def run_class(hub: Hub, tokens: dict[str, str], cells: list[dict]) -> tuple[dict, dict]:
+    """Open one kernel per learner, probe its environment, then run the notebook in lockstep."""
+    urls = {learner: open_kernel(hub, learner, tokens[learner])[1] for learner in LEARNERS}
+    kernels = {learner: await connect(learner, urls[learner], tokens[learner])
+               for learner in LEARNERS}
+    try:
+        probes = {}
+        for learner, kernel in kernels.items():
+            printed = await kernel.execute(PROBE)
+            assert [o['output_type'] for o in printed] == ['stream'], printed
+            probes[learner] = json.loads(printed[0]['text'])
+        return probes, await run_in_lockstep(kernels, cells)
+    finally:
+        for kernel in kernels.values():
+            kernel.connection.close()
+
+
+@pytest.fixture(scope='module')
+def class_run():
+    folder = Path(tempfile.mkdtemp(prefix='ros2nb-hub-'))
+    hub: Optional[Hub] = None
+    try:
+        began = time.monotonic()
+        hub = start_hub(folder)
+        for learner in LEARNERS:
+            start_server(hub, learner)
+        for learner in LEARNERS:
+            wait_for(lambda: server_ready(hub, learner), SERVER_START_S,
+                     f"{learner}'s server starting", hub)
+        tokens = {learner: learner_token(hub, learner) for learner in LEARNERS}
+        cells = code_cells(NOTEBOOK)
+        probes, outputs = asyncio.run(run_class(hub, tokens, cells))
+        yield ClassRun(hub, probes, outputs, cells, time.monotonic() - began)
+    finally:
+        if hub is not None:
+            stop_hub(hub)
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+def test_each_learner_runs_in_the_course_venv_with_own_workspace_and_no_ros_domain(class_run):
+    for learner, probe in class_run.probes.items():
+        home = class_run.hub.home(learner)
+        assert probe['ROS_DOMAIN_ID'] is None, (
+            f'{learner}: the hub passed ROS_DOMAIN_ID={probe["ROS_DOMAIN_ID"]} on to the kernel')
+        assert probe['HOME'] == str(home)
+        assert probe['ROS2NB_WORKSPACE'] == str(home / 'ros2-course' / 'workspace' /
+                                                'ROS2_and_RL_Tutorials')
+        assert Path(probe['cwd']) == home / 'ros2-course' / 'notebooks'
+        assert Path(probe['prefix']).resolve() == (ROOT / '.venv').resolve()
+
+
+def test_each_learner_has_own_copy_of_the_learner_notebooks(class_run):
+    shipped = {p.name: p.read_bytes() for p in (ROOT / 'notebooks').glob('*.ipynb')}
+    for learner in LEARNERS:
+        copy = class_run.hub.home(learner) / 'ros2-course' / 'notebooks'
+        assert {p.name: p.read_bytes() for p in copy.glob('*.ipynb')} == shipped
+        monitor = (class_run.hub.home(learner) / 'ros2-course' / 'workspace' /
+                   'ROS2_and_RL_Tutorials' / 'src' / 'sensor_simulator' / 'sensor_simulator' /
+                   'temperature_subscriber.py')
+        assert monitor.is_file(), f"{learner}'s notebook 04 did not write {monitor}"
+
+
+def test_two_learners_at_once_each_get_the_stored_outputs(class_run):
+    patterns = sanitize_patterns(SANITIZE)
+    differences = []
+    for learner, outputs in class_run.outputs.items():
+        for number, (cell, got) in enumerate(zip(class_run.cells, outputs)):
+            if not compared(cell):
+                continue
+            want = comparable(cell.get('outputs', []), patterns)
+            have = comparable(got, patterns)
+            if have != want:
+                differences.append(f'{learner}, code cell {number} ({source(cell)[:50]!r}):\n'
+                                   + difference(want, have))
+    print(f'hub, two servers and notebook 04 twice at once: {class_run.seconds:.0f} s')
+    assert not differences, '\n'.join(differences)

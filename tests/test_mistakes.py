@@ -1,0 +1,205 @@
+"""Beginner mistakes in a real Jupyter kernel: each gets one line naming the learner's line and the fix.
+
+Every case is a cell a learner could write. The kernel is a real IPython kernel with
+ros2nb started as the notebooks start it; the test reads what the learner would see (the
+error output's traceback lines, streams). docs/troubleshooting.md lists the same mistakes.
+"""
+
+import os
+import queue
+import re
+
+import pytest
+from jupyter_client.manager import start_new_kernel
+
+pytestmark = pytest.mark.timeout(300)
+
+
+class Kernel:
+    """A real kernel and a way to run one cell in it."""
+
+    def __init__(self, workspace: str) -> None:
+        env = {k: v for k, v in os.environ.items() if k != 'ROS_DOMAIN_ID'}
+        env['ROS2NB_WORKSPACE'] = workspace
+        self.manager, self.client = start_new_kernel(kernel_name='python3', env=env)
+
+    def run(self, code: str, timeout: float = 60) -> dict:
+        """Run a cell; return its error (ename, traceback) and its stream text."""
+        msg_id = self.client.execute(code)
+        result = {'error': None, 'stdout': '', 'stderr': ''}
+        while True:
+            try:
+                msg = self.client.get_iopub_msg(timeout=timeout)
+            except queue.Empty:
+                raise AssertionError(f'the cell did not finish in {timeout} s: {code!r}') from None
+            if msg['parent_header'].get('msg_id') != msg_id:
+                continue
+            kind, content = msg['msg_type'], msg['content']
+            if kind == 'error':
+                result['error'] = {'ename': content['ename'],
+                                   'traceback': [re.sub(r'\x1b\[[0-9;]*m', '', line)
+                                                 for line in content['traceback']]}
+            elif kind == 'stream':
+                result[content['name']] += content['text']
+            elif kind == 'status' and content['execution_state'] == 'idle':
+                return result
+
+    def one_line(self, code: str, *fragments: str) -> str:
+        """Run a cell that must fail; check it shows one line with every fragment."""
+        result = self.run(code)
+        assert result['error'] is not None, f'no error for {code!r}: {result}'
+        shown = result['error']['traceback']
+        assert len(shown) == 1, shown
+        for fragment in fragments:
+            assert fragment in shown[0], (fragment, shown[0])
+        return shown[0]
+
+    def close(self) -> None:
+        self.client.stop_channels()
+        self.manager.shutdown_kernel(now=True)
+
+
+@pytest.fixture(scope='module')
+def kernel(tmp_path_factory):
+    kernel = Kernel(str(tmp_path_factory.mktemp('mistakes') / 'ws'))
+    kernel.run('%load_ext ros2nb\nimport ros2nb, rclpy\nfrom rclpy.node import Node\n'
+               'from std_msgs.msg import Float32, Float64, String')
+    yield kernel
+    kernel.close()
+
+
+@pytest.fixture
+def ros(kernel):
+    kernel.run('_ = ros2nb.start(sim_time=True)')
+    yield kernel
+    kernel.run('ros2nb.shutdown()')
+
+
+def test_node_before_start(kernel):
+    kernel.run('ros2nb.shutdown()')
+    kernel.one_line("node = Node('early')",
+                    'ROS 2 is not up in this kernel yet: run ros2nb.start() first',
+                    "cell line 1: node = Node('early')")
+
+
+def test_rclpy_init_after_start(ros):
+    ros.one_line('rclpy.init()', 'ros2nb.start() already brought ROS 2 up in this kernel: remove '
+                                 'that call', 'cell line 1: rclpy.init()')
+
+
+def test_main_run_in_the_notebook(ros):
+    ros.run('def main(args=None):\n    rclpy.init(args=args)\n    node = Node("x")\n'
+            '    rclpy.spin(node)\n')
+    ros.one_line('main()', 'main() is for `ros2 run`', 'cell line 2:')
+
+
+def test_rclpy_spin_in_a_cell(ros):
+    ros.one_line("rclpy.spin(Node('spinner'))", 'rclpy.spin(node) never returns in a notebook cell',
+                 'ros2nb.add(node)')
+
+
+def test_continuing_after_rclpy_shutdown_and_the_way_back(kernel):
+    kernel.run('_ = ros2nb.start(sim_time=True)')
+    kernel.run('rclpy.shutdown()')
+    kernel.one_line("Node('after')", 'ROS 2 was shut down in this kernel',
+                    'run ros2nb.shutdown(); ros2nb.start()')
+    back = kernel.run('ros2nb.shutdown(); _ = ros2nb.start(sim_time=True); '
+                      "n = ros2nb.add(Node('after'))")
+    assert back['error'] is None, back
+    kernel.run('ros2nb.shutdown()')
+
+
+@pytest.mark.parametrize('value, fragment', [
+    ('22', "Float32's field 'data' takes 22.0 or float(...), not int 22"),
+    ("'hot'", "Float32's field 'data' takes a decimal number such as 22.0, not str 'hot'"),
+])
+def test_wrong_value_in_a_message(ros, value, fragment):
+    ros.one_line(f'msg = Float32()\nmsg.data = {value}', fragment,
+                 f'cell line 2: msg.data = {value}')
+
+
+def test_node_without_super_init(ros):
+    ros.one_line("class Sensor(Node):\n    def __init__(self):\n"
+                 "        self.pub = self.create_publisher(Float32, 'temperature', 10)\n\n"
+                 'Sensor()', "Sensor.__init__ never calls super().__init__('node_name')",
+                 "cell line 3: self.pub = self.create_publisher")
+
+
+def test_message_instance_instead_of_type(ros):
+    ros.one_line("class Sensor(Node):\n    def __init__(self):\n        super().__init__('s')\n"
+                 "        self.pub = self.create_publisher(Float32(), 'temperature', 10)\n\n"
+                 'ros2nb.add(Sensor())', 'with a message Float32() instead of the message type: '
+                                        'pass Float32 without the parentheses')
+
+
+def test_float32_publisher_and_float64_subscription_in_one_kernel(ros):
+    ros.run("class Sensor(Node):\n    def __init__(self):\n        super().__init__('sensor')\n"
+            "        self.pub = self.create_publisher(Float32, 'temperature', 10)\n\n"
+            'sensor = ros2nb.add(Sensor())')
+    result = ros.run("class Monitor(Node):\n    def __init__(self):\n"
+                     "        super().__init__('monitor')\n"
+                     "        self.create_subscription(Float64, 'temperature', print, 10)\n\n"
+                     'Monitor()')
+    shown = result['error']['traceback']
+    assert shown == ['Ros2nbError: monitor would subscribe to /temperature as std_msgs/msg/Float64, '
+                     'but /temperature already carries std_msgs/msg/Float32 in this kernel: both '
+                     'sides of a topic must use the same message type.']
+    assert 'invalid allocator' not in result['stderr'] + result['stdout']  # no C error dump
+
+
+def test_node_handed_to_nobody(ros):
+    ros.run("class Sensor(Node):\n    def __init__(self):\n        super().__init__('s')\n"
+            "        self.create_timer(1.0, lambda: self.get_logger().info('tick'))\n\nSensor()")
+    assert ros.run('_ = ros2nb.spin(5)')['stdout'] == (
+        'No nodes are running in this kernel: hand yours over with ros2nb.add(node), then spin.\n')
+
+
+def test_class_instead_of_node(ros):
+    ros.one_line("class Sensor(Node):\n    def __init__(self):\n        super().__init__('s')\n\n"
+                 'ros2nb.add(Sensor)', 'ros2nb.add() takes a node, not the class Sensor: create '
+                                       'one first, ros2nb.add(Sensor()).')
+
+
+@pytest.mark.parametrize('timer, fragment', [
+    ('self.create_timer(1.0, self.tick())', "timer whose callback is None, not a function: pass "
+                                            'the method itself'),
+    ('self.create_timer(0, self.tick)', 'a timer with a period of 0 s for '),
+])
+def test_timer_mistakes(ros, timer, fragment):
+    ros.one_line(f"class Ticker(Node):\n    def __init__(self):\n        super().__init__('t')\n"
+                 f"        {timer}\n\n    def tick(self):\n        pass\n\nros2nb.add(Ticker())",
+                 fragment)
+
+
+def test_publishing_a_bare_value(ros):
+    ros.run("class Sensor(Node):\n    def __init__(self):\n        super().__init__('s')\n"
+            "        self.pub = self.create_publisher(Float32, 'temperature', 10)\n"
+            "        self.create_timer(1.0, lambda: self.pub.publish(22.5))\n\n"
+            's = ros2nb.add(Sensor())')
+    stderr = ros.run('_ = ros2nb.spin(2)')['stderr']
+    assert 'publish() takes a message object, not a bare value' in stderr
+    assert stderr.count('[ERROR] [s]') == 1  # reported once; the node is stopped
+
+
+def test_a_part_before_its_file_name_was_set(kernel):
+    kernel.run('%load_ext ros2nb')
+    kernel.one_line('%%part {NOT_SET_YET} 1\nx = 1\n', 'NOT_SET_YET is not defined in this '
+                                                      'kernel: run the cell near the top')
+
+
+def test_stop_during_a_simulated_spin_is_one_line(ros):
+    ros.run("class Sensor(Node):\n    def __init__(self):\n        super().__init__('s')\n"
+            "        self.create_timer(1.0, lambda: None)\n\nsensor = ros2nb.add(Sensor())")
+    import threading
+    threading.Timer(1.0, ros.manager.interrupt_kernel).start()
+    result = ros.run('_ = ros2nb.spin(10 ** 7)')
+    assert result['error'] is None
+    lines = result['stdout'].strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith('Interrupted after '), result
+
+
+def test_a_check_that_fails_is_one_line(ros):
+    result = ros.run('import ros2nb.checks\n'
+                     'ros2nb.checks.check_expanded_path(lambda: "/Documents/W", ends_with="W")')
+    assert result['error']['traceback'] == [
+        "CheckFailed: <lambda>() returned str '/Documents/W'; return a pathlib.Path."]

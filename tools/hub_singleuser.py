@@ -1,0 +1,114 @@
+#!/usr/bin/env python3
+"""Start one learner's Jupyter server on the course's JupyterHub (``make hub``).
+
+JupyterHub's spawner runs this as the learner, with ``HOME`` set to the learner's home and
+``JUPYTERHUB_ROOT_DIR`` set to their course folder (``~/ros2-course``). It
+
+1. creates that folder (readable by the learner only) and copies every learner notebook of
+   the course (``notebooks/*.ipynb``) that is not there yet into its ``notebooks/``. It never
+   replaces a notebook, so the learner's work survives restarts, and a course update only
+   adds the notebooks that are new;
+2. gives the learner their own ROS workspace, ``<course folder>/workspace/ROS2_and_RL_Tutorials``
+   (``ROS2NB_WORKSPACE``, which ros2nb reads);
+3. puts the course's venv first on ``PATH`` and becomes ``jupyterhub-singleuser`` with the
+   arguments the hub passed.
+
+``make hub`` first runs it as ``hub_singleuser.py --check``: when the hub runs as root (so
+that learners' servers run as the learners), every learner must be able to run the venv's
+Python and read the course. A venv built on a Python under ``/root`` (pyenv) fails that.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import stat
+import sys
+from pathlib import Path
+from typing import Mapping, MutableMapping, NoReturn, Optional
+
+#: The course repository (this file is tools/hub_singleuser.py inside it).
+COURSE = Path(__file__).resolve().parent.parent
+#: The learner's course folder when the hub does not say (JupyterHub's notebook_dir).
+DEFAULT_FOLDER = '~/ros2-course'
+#: The tutorial's workspace name; ros2nb shows paths relative to it.
+WORKSPACE_NAME = 'ROS2_and_RL_Tutorials'
+
+
+def learner_folder(env: Mapping[str, str]) -> Path:
+    """Return the learner's course folder: ``$JUPYTERHUB_ROOT_DIR`` or ``~/ros2-course``."""
+    return Path(env.get('JUPYTERHUB_ROOT_DIR') or DEFAULT_FOLDER).expanduser()
+
+
+def copy_missing_notebooks(source: Path, folder: Path) -> list[str]:
+    """Copy each ``*.ipynb`` of ``source`` that ``folder/notebooks`` lacks; never overwrite.
+
+    :param source: the course's ``notebooks/``.
+    :param folder: the learner's course folder; created readable by its owner only.
+    :return: the names of the notebooks copied.
+    """
+    folder.mkdir(mode=0o700, parents=True, exist_ok=True)
+    target = folder / 'notebooks'
+    target.mkdir(exist_ok=True)
+    copied = []
+    for notebook in sorted(source.glob('*.ipynb')):
+        destination = target / notebook.name
+        if not destination.exists() and not destination.is_symlink():
+            shutil.copyfile(notebook, destination)
+            copied.append(notebook.name)
+    return copied
+
+
+def learner_environment(env: MutableMapping[str, str], folder: Path, venv_bin: Path) -> None:
+    """Give the learner their own ROS workspace and the course's venv first on ``PATH``."""
+    env.setdefault('ROS2NB_WORKSPACE', str(folder / 'workspace' / WORKSPACE_NAME))
+    env['PATH'] = os.pathsep.join([str(venv_bin), env.get('PATH', os.defpath)])
+    env['VIRTUAL_ENV'] = str(venv_bin.parent)
+
+
+def closed_to_others(path: Path, *, need: int) -> Optional[Path]:
+    """Return the first folder on the way to ``path``, or ``path``, that other users cannot use.
+
+    :param path: a file or folder; symbolic links are followed.
+    :param need: the permission bits ``path`` itself must grant others (e.g. ``stat.S_IROTH``).
+    :return: the folder or file that blocks other users, or ``None`` if nothing does.
+    """
+    real = path.resolve()
+    for folder in reversed(real.parents):
+        if not folder.stat().st_mode & stat.S_IXOTH:
+            return folder
+    return None if real.stat().st_mode & need == need else real
+
+
+def check_learners_can_use_course(python: Path) -> Optional[str]:
+    """Return why learners could not start the course's server as themselves, or ``None``."""
+    needs = ((python, stat.S_IXOTH), (COURSE / 'tools' / 'hub_singleuser.py', stat.S_IROTH),
+             (COURSE / 'notebooks', stat.S_IROTH | stat.S_IXOTH))
+    for path, need in needs:
+        blocked = closed_to_others(path, need=need)
+        if blocked is not None:
+            return (f'Learners cannot use {path} ({blocked} is closed to other users): put the '
+                    'course where everyone can read it (e.g. /opt/ros2-course) and build its venv '
+                    'on a Python they can run, e.g. make setup PYTHON=/usr/bin/python3.')
+    return None
+
+
+def main(argv: list[str]) -> NoReturn:
+    """Prepare the learner's folder, then replace this process with jupyterhub-singleuser."""
+    venv_bin = Path(sys.executable).parent
+    if argv == ['--check']:
+        problem = check_learners_can_use_course(Path(sys.executable)) if os.geteuid() == 0 else None
+        sys.exit(problem)
+    server = venv_bin / 'jupyterhub-singleuser'
+    if not server.exists():
+        sys.exit(f'{server} is missing: run `make setup` in {COURSE} (it installs jupyterhub).')
+    folder = learner_folder(os.environ)
+    copied = copy_missing_notebooks(COURSE / 'notebooks', folder)
+    if copied:
+        print(f'ros2-course: copied {", ".join(copied)} to {folder / "notebooks"}', file=sys.stderr)
+    learner_environment(os.environ, folder, venv_bin)
+    os.execv(server, [str(server), *argv])
+
+
+if __name__ == '__main__':
+    main(sys.argv[1:])
