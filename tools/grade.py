@@ -1,24 +1,28 @@
 #!/usr/bin/env python3
-"""Grade learners' notebooks with nbgrader: ``make grade SUBMISSIONS=DIR`` (or a .zip).
+"""Grade learners' notebooks: ``make grade SUBMISSIONS=DIR`` (or a platform's .zip).
 
-A thin wrapper around nbgrader (generate_assignment, zip_collect, autograde,
-generate_feedback and its Gradebook); it grades nothing itself.
+DIR/<learner>/ holds a learner's copies of notebooks/NN-*.ipynb (any subset).  nbgrader
+keeps the gradebook, scores the notebooks and writes the feedback; this script decides
+nothing by itself.  Per notebook, three steps, none of which the notebook can reach:
 
-DIR/<learner-id>/ holds a learner's copies of notebooks/NN-*.ipynb (any subset).  A .zip
-from a learning platform is collected with ``nbgrader zip_collect``; inside it each file
-must sit in a folder named after the learner (``<learner-id>/NN-title.ipynb``).
+1. The learner's notebook runs in a sandbox of its own (tools/sandbox.py: its own PID and
+   network namespaces, only its own scratch folder writable, the course, the gradebook,
+   other learners, solutions and hidden tests invisible; time, memory, task, file-size
+   and output limits), on a workspace shared only with that learner's other notebooks.
+2. The judge (``python -m ros2nb.judge grade``) runs every graded cell of the course's
+   source notebook, hidden tests included, on what the learner wrote (their files, the
+   source of their answer cells), in a second sandbox; the learner's code runs there in
+   subject processes with a sandbox of their own, and the verdicts come from the judge.
+3. The judge's results become the outputs of the graded cells of the executed notebook,
+   which nbgrader then scores (without executing anything) and turns into feedback.
 
-Isolation, per notebook: its own ``nbgrader autograde`` process and kernel, its own
-``ROS_DOMAIN_ID``, a time limit per cell and per notebook, and a scratch copy of the
-course outside this repository (one scratch workspace per learner, so notebook 05 builds
-the package that learner wrote in 03 and 04).  The kernel runs as the same user as you:
-for an untrusted class run this inside a container or a VM.  This repository is written
-to only under ``grading/``.
+Without a sandbox (no bubblewrap, no user namespaces) grading refuses to start; with
+``--no-sandbox`` (``NO_SANDBOX=1``) it grades trusted work unsandboxed.
 
-Output (``grading/``): ``grades.csv`` (learner,notebook,score,max_score, then a TOTAL row
-per learner), ``feedback/<learner>/<notebook>.html`` and ``nbgrader/``, an nbgrader course
-folder with its gradebook (``cd grading/nbgrader && nbgrader export`` and the formgrader
-work there).  Exit code 0 when grading itself worked, whatever the learners scored.
+Output (``grading/``): ``grades.csv`` (learner, notebook, score, max_score, then a TOTAL
+row per learner), ``feedback/<learner>/<notebook>.html``, ``notes.json`` and ``nbgrader/``,
+an nbgrader course folder with its gradebook.  Exit code 0 when grading itself worked,
+whatever the learners scored.
 """
 
 from __future__ import annotations
@@ -29,31 +33,41 @@ import csv
 import html
 import json
 import os
-import re
 import shutil
-import signal
 import subprocess
 import sys
 import tempfile
+import time
 import zipfile
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Optional
 
 import nbformat
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import graded_notebook  # noqa: E402
+import sandbox  # noqa: E402
+from submissions import Learner, find_learners, screen_zip  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 SOLUTIONS = ROOT / 'solutions'
 ASSIGNMENT = 'ros2-pubsub'
-LEARNER_ID = re.compile(r'^[A-Za-z0-9][A-Za-z0-9_.-]*$')
-#: Seconds one cell may run before nbgrader interrupts it (a hang scores 0 for that part).
+WORKSPACE_NAME = 'ROS2_and_RL_Tutorials'
+#: Seconds one cell may run before its kernel is interrupted (the next cell still runs).
 CELL_TIMEOUT_S = 120
-#: Seconds one notebook may take in all before its process group is killed.
+#: Seconds one notebook may take in all; then its sandbox is stopped.
 NOTEBOOK_TIMEOUT_S = 600
-#: Notebooks graded at the same time (one kernel each).
+#: Seconds the judge may take for one notebook.
+JUDGE_TIMEOUT_S = 600
+#: Notebooks graded at the same time.
 JOBS = 2
-
+#: Largest executed notebook read back (the runner cuts each cell's output at 100 kB).
+MAX_NOTEBOOK_BYTES = 20_000_000
+#: nbgrader settings of the course under grading/: feedback shows learners' content as text.
+COURSE_CONFIG = 'c = get_config()  # noqa: F821\n'
 SCORE_ONLY_CONFIG = '''\
-# Score notebooks that were already executed in isolation: no execution, keep outputs.
+# Score notebooks that were already run and judged: execute nothing, keep the outputs.
 from nbgrader.converters.autograde import Autograde
 from nbgrader.preprocessors import ClearOutput, Execute
 
@@ -65,37 +79,24 @@ c.Autograde.autograde_preprocessors = [
 '''
 
 
-@dataclass
-class Learner:
-    """One learner's submission and what happened to it."""
+@dataclass(frozen=True)
+class Settings:
+    """How to grade: the limits and whether to sandbox."""
 
-    name: str
-    files: dict[str, Path]
-    notes: dict[str, str] = field(default_factory=dict)
+    cell_timeout: int
+    notebook_timeout: int
+    sandboxed: bool
 
 
-def nbgrader(course: Path, *args: str, env: dict[str, str] | None = None,
-             timeout: float | None = None, log: Path | None = None) -> int:
-    """Run ``nbgrader ARGS`` for the course folder; return its exit code (-9 on timeout)."""
+def nbgrader(course: Path, *args: str, log: Path) -> int:
+    """Run ``nbgrader ARGS`` for the course folder (trusted: it executes nothing of learners')."""
     argv = [sys.executable, '-m', 'nbgrader', *args, f'--CourseDirectory.root={course}',
             f'--CourseDirectory.db_url=sqlite:///{course / "gradebook.db"}', '--log-level=INFO']
-    env = dict(env or os.environ)
-    # nbgrader runs `alembic` by name: the venv's bin/ must come first on PATH.
-    env['PATH'] = os.pathsep.join([str(Path(sys.executable).parent), env.get('PATH', '')])
-    env.setdefault('JUPYTER_CONFIG_DIR', str(course / '.jupyter'))
-    out = open(log, 'a') if log else subprocess.DEVNULL
-    try:
-        proc = subprocess.Popen(argv, cwd=course, env=env, stdout=out, stderr=subprocess.STDOUT,
-                                start_new_session=True)
-        try:
-            return proc.wait(timeout=timeout)
-        except subprocess.TimeoutExpired:
-            os.killpg(proc.pid, signal.SIGKILL)
-            proc.wait()
-            return -9
-    finally:
-        if log:
-            out.close()
+    env = dict(os.environ, JUPYTER_CONFIG_DIR=str(course / '.jupyter'),
+               PATH=os.pathsep.join([str(Path(sys.executable).parent), os.environ['PATH']]))
+    with open(log, 'a') as out:
+        return subprocess.run(argv, cwd=course, env=env, stdout=out, stderr=subprocess.STDOUT,
+                              stdin=subprocess.DEVNULL).returncode
 
 
 def set_up_course(course: Path) -> list[str]:
@@ -104,59 +105,41 @@ def set_up_course(course: Path) -> list[str]:
     source.mkdir(parents=True)
     for notebook in sorted(SOLUTIONS.glob('*.ipynb')):
         shutil.copy2(notebook, source / notebook.name)
-    (course / 'nbgrader_config.py').write_text(
-        'c = get_config()  # noqa: F821\n')
+    (course / 'nbgrader_config.py').write_text(COURSE_CONFIG)
     if nbgrader(course, 'generate_assignment', ASSIGNMENT, '--force',
                 log=course / 'grading.log') != 0:
         sys.exit(f'nbgrader generate_assignment failed: see {course / "grading.log"}')
     return sorted(p.stem for p in source.glob('*.ipynb'))
 
 
-def collect_zip(archive: Path, course: Path) -> Path:
-    """``nbgrader zip_collect`` a platform download; return the folder of learner folders."""
+def collect_zip(archive: Path, course: Path) -> tuple[Path, list[str]]:
+    """nbgrader's ``zip_collect`` on a screened copy of a platform download.
+
+    :return: the folder of learner folders, and one line per member refused.
+    """
     downloaded = course / 'downloaded' / ASSIGNMENT / 'archive'
     downloaded.mkdir(parents=True)
-    shutil.copy2(archive, downloaded / archive.name)
-    regexp = (r'.*/extracted/(?:.*/)?(?P<student_id>[A-Za-z0-9][A-Za-z0-9_.-]*)/'
-              r'(?P<file_id>[^/]+\.ipynb)$')
+    refused = screen_zip(archive, downloaded / archive.name)
+    regexp = r'.*/extracted/(?:.*/)?(?P<student_id>[^/]+)/(?P<file_id>[^/]+\.ipynb)$'
     code = nbgrader(course, 'zip_collect', ASSIGNMENT, '--force',
-                    f'--FileNameCollectorPlugin.named_regexp={regexp}',
-                    log=course / 'grading.log')
-    if code != 0:
-        sys.exit(f'nbgrader zip_collect failed: see {course / "grading.log"}')
+                    f'--FileNameCollectorPlugin.named_regexp={regexp}', log=course / 'grading.log')
     collected = course / 'collected'
-    if not (course / 'submitted').is_dir():
-        sys.exit(f'{archive.name} holds no <learner-id>/NN-title.ipynb files: each notebook must '
-                 'sit in a folder named after its learner.')
-    shutil.move(course / 'submitted', collected)
-    for learner in collected.iterdir():  # <learner>/<assignment>/NB -> <learner>/NB
+    collected.mkdir()
+    if code != 0:
+        refused.append(f'nbgrader zip_collect failed (see {course / "grading.log"}); nothing '
+                       'from the archive was graded')
+        return collected, refused
+    for learner in (course / 'submitted').iterdir() if (course / 'submitted').is_dir() else ():
+        target = collected / learner.name
+        target.mkdir()
         for notebook in (learner / ASSIGNMENT).glob('*.ipynb'):
-            shutil.move(notebook, learner / notebook.name)
-        shutil.rmtree(learner / ASSIGNMENT, ignore_errors=True)
-    return collected
+            shutil.move(notebook, target / notebook.name)
+    shutil.rmtree(course / 'submitted', ignore_errors=True)
+    return collected, refused
 
 
-def find_learners(folder: Path, notebooks: list[str]) -> list[Learner]:
-    """One Learner per sub-folder; files named like a course notebook are kept."""
-    learners = []
-    for entry in sorted(folder.iterdir()):
-        if not entry.is_dir():
-            continue
-        if not LEARNER_ID.match(entry.name):
-            print(f'skipped {entry.name!r}: a learner id uses letters, digits, _ . - only')
-            continue
-        files = {p.stem: p for p in entry.glob('*.ipynb') if p.stem in notebooks}
-        learner = Learner(entry.name, files)
-        for other in sorted(entry.iterdir()):
-            if other.is_file() and other.stem not in files:
-                learner.notes.setdefault('_other', '')
-                learner.notes['_other'] += f'{other.name} is not a course notebook; '
-        learners.append(learner)
-    return learners
-
-
-def readable(path: Path) -> str | None:
-    """Return why a submitted file cannot be graded, or None when it is a valid notebook."""
+def readable(path: Path) -> Optional[str]:
+    """Why a handed-in file cannot be graded, or None when it is a valid notebook."""
     if path.stat().st_size == 0:
         return 'the file is empty'
     try:
@@ -166,119 +149,211 @@ def readable(path: Path) -> str | None:
     return None
 
 
-def note_notebook(course: Path, notebook: str, message: str) -> nbformat.NotebookNode:
-    """The released notebook with ``message`` as the error output of every graded cell.
+# ------------------------------------------------------------------ one notebook
+class Scratch:
+    """One learner's folders outside the repository, shared by their notebooks in order."""
 
-    Scored by nbgrader like any run notebook: each graded cell is 0 and shows why.
+    def __init__(self, root: Path, learner: Learner) -> None:
+        self.top = Path(tempfile.mkdtemp(prefix='learner-', dir=root))
+        self.home = self.top / 'home'
+        self.workspace = self.home / 'workspace' / WORKSPACE_NAME
+        self.home.mkdir()
+        self.top.chmod(0o711)  # the sandboxes' own user may pass, nobody may list
+
+    def judge_folders(self, notebook: str) -> tuple[Path, Path]:
+        """A fresh judge folder (writable by the judge and its subjects) and its inputs."""
+        given, scratch = self.top / f'judge-in-{notebook}', self.top / f'judge-{notebook}'
+        for folder, mode in ((given, 0o755), (scratch, 0o711)):
+            folder.mkdir()
+            folder.chmod(mode)  # the judge's sandbox user reads the given files
+        return given, scratch
+
+
+def _env(home: Path, **extra: str) -> dict[str, str]:
+    """The environment inside a sandbox: everything in the learner's home, grading mode."""
+    venv_bin = str(Path(sys.executable).parent)
+    return {'PATH': f'{venv_bin}:/usr/bin:/bin', 'HOME': str(home), 'LANG': 'C.UTF-8',
+            'PYTHONUNBUFFERED': '1', 'ROS2NB_GRADING': '1', 'TMPDIR': '/tmp',
+            'IPYTHONDIR': str(home / '.ipython'), 'MPLCONFIGDIR': str(home / '.matplotlib'),
+            'JUPYTER_CONFIG_DIR': str(home / '.jupyter'),
+            'JUPYTER_DATA_DIR': str(home / '.local/share/jupyter'),
+            'JUPYTER_RUNTIME_DIR': str(home / '.local/share/jupyter/runtime'),
+            'ROS_HOME': str(home / '.ros'), 'ROS_LOG_DIR': str(home / '.ros/log'), **extra}
+
+
+def run_notebook(scratch: Scratch, notebook: str, prepared: nbformat.NotebookNode,
+                 settings: Settings) -> tuple[nbformat.NotebookNode, dict, Optional[str]]:
+    """Execute the prepared notebook in the learner's sandbox.
+
+    :return: the executed notebook (what ran of it), the runner's status, and a note when
+        the sandbox had to be stopped.
     """
-    nb = nbformat.read(course / 'release' / ASSIGNMENT / f'{notebook}.ipynb', as_version=4)
-    nb.cells.insert(0, nbformat.v4.new_markdown_cell(f'**Grading note:** {message}'))
-    for cell in nb.cells:
-        if cell.cell_type == 'code' and cell.metadata.get('nbgrader', {}).get('grade'):
-            cell.execution_count = 1
-            cell.outputs = [nbformat.v4.new_output(
-                'error', ename='GradingError', evalue=message,
-                traceback=[f'GradingError: {message}'])]
-    return nb
+    folder = scratch.home / 'notebooks'
+    folder.mkdir(exist_ok=True)
+    given, done = folder / f'{notebook}.ipynb', folder / f'{notebook}.run.ipynb'
+    nbformat.write(prepared, given)
+    argv = [sys.executable, str(ROOT / 'tools' / 'notebook_runner.py'), str(given), str(done),
+            f'--cell-timeout={settings.cell_timeout}']
+    env = _env(scratch.home, ROS2NB_WORKSPACE=str(scratch.workspace))
+    limits = sandbox.Limits(wall_s=settings.notebook_timeout)
+    stopped = None
+    if settings.sandboxed:
+        box = sandbox.Sandbox(writable=[scratch.home], env=env, cwd=folder,
+                              readable=[ROOT / 'src', ROOT / 'tools' / 'notebook_runner.py'],
+                              hidden=[ROOT / 'src' / 'ros2nb' / 'reference'])
+        result = box.run(argv, limits, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        if result.timed_out:
+            stopped = (f'it ran longer than the {settings.notebook_timeout} s limit for a '
+                       'notebook and was stopped')
+    else:
+        try:
+            subprocess.run(argv, env=env, cwd=folder, timeout=settings.notebook_timeout,
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        except subprocess.TimeoutExpired:
+            stopped = (f'it ran longer than the {settings.notebook_timeout} s limit for a '
+                       'notebook and was stopped')
+    try:
+        if done.stat().st_size > MAX_NOTEBOOK_BYTES:
+            raise ValueError('too large')
+        executed = nbformat.read(done, as_version=4)
+        status = json.loads(Path(str(done) + '.status.json').read_text())
+    except (OSError, ValueError):  # it deleted, broke or bloated what the runner wrote
+        return prepared, {'ran': 0, 'timed_out': [], 'output_cut': [], 'kernel_died_at': None,
+                          'runner_error': 'its run left no readable notebook'}, stopped
+    return executed, status, stopped
 
 
-def run_one(course: Path, scratch: Path, learner: Learner, notebook: str, domain: int,
-            cell_timeout: int, notebook_timeout: int) -> nbformat.NotebookNode:
-    """Autograde one notebook in a scratch course of its own; return the executed notebook."""
+def judge_notebook(scratch: Scratch, notebook: str, submitted: Path,
+                   settings: Settings) -> tuple[dict, Optional[str]]:
+    """Run the judge on what the learner wrote; return ``{grade_id: result}`` or a problem."""
+    given, folder = scratch.judge_folders(notebook)
+    scratch.workspace.mkdir(parents=True, exist_ok=True)  # notebooks 00 and 01 make none
+    source = given / 'source.ipynb'
+    shutil.copy2(SOLUTIONS / f'{notebook}.ipynb', source)
+    shutil.copy2(submitted, given / 'submission.ipynb')
+    for path in (source, given / 'submission.ipynb'):
+        path.chmod(0o644)
+    home = folder / 'home'
+    home.mkdir()
+    tmp = folder / 'tmp'
+    tmp.mkdir()
+    argv = [sys.executable, '-m', 'ros2nb.judge', 'grade', str(source),
+            str(given / 'submission.ipynb')]
+    env = _env(home, ROS2NB_WORKSPACE=str(scratch.workspace), ROS2NB_JUDGE='1', TMPDIR=str(tmp))
+    limits = sandbox.Limits(wall_s=JUDGE_TIMEOUT_S)
+    if settings.sandboxed:
+        env['FASTDDS_BUILTIN_TRANSPORTS'] = 'UDPv4'  # judge and subjects: own /dev/shm each
+        env['ROS2NB_SUBJECT_PREFIX'] = json.dumps(sandbox.inner_prefix(
+            readable=[scratch.workspace], writable=[folder]))
+        box = sandbox.Sandbox(writable=[folder], env=env, cwd=folder, nested=True,
+                              readable=[ROOT / 'src', scratch.workspace, given],
+                              hidden=[ROOT / 'src' / 'ros2nb' / 'reference'])
+        try:
+            result = box.run(argv, limits, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                             text=True)
+        except OSError as error:  # e.g. the notebook made its workspace unreadable
+            return {}, f'the grader could not check it: {error}'
+        out, err, code, timed_out = result.stdout, result.stderr, result.returncode, \
+            result.timed_out
+    else:
+        try:
+            done = subprocess.run(argv, env={**os.environ, **env}, cwd=folder, text=True,
+                                  capture_output=True, timeout=JUDGE_TIMEOUT_S)
+            out, err, code, timed_out = done.stdout, done.stderr, done.returncode, False
+        except subprocess.TimeoutExpired:
+            out, err, code, timed_out = '', '', -9, True
+    if timed_out:
+        return {}, f'checking it took longer than {JUDGE_TIMEOUT_S} s'
+    try:
+        return json.loads(out.strip().splitlines()[-1]), None
+    except (IndexError, ValueError):
+        last = (err or '').strip().splitlines()[-1:] or ['no message']
+        return {}, f'the grader could not check it (judge exit code {code}: {last[0][:200]})'
+
+
+def _run_note(status: dict, stopped: Optional[str]) -> Optional[str]:
+    """What happened while the notebook ran, in words (None when nothing worth saying)."""
+    notes = [stopped] if stopped else []
+    if status.get('kernel_died_at') is not None:
+        notes.append(f'its kernel died while cell {status["kernel_died_at"] + 1} ran (the '
+                     'process was killed or exited); the cells after it did not run')
+    if status.get('timed_out'):
+        cells = ', '.join(str(i + 1) for i in status['timed_out'])
+        notes.append(f'cell(s) {cells} ran longer than the limit and were interrupted; the '
+                     'cells after them still ran')
+    if status.get('output_cut'):
+        cells = ', '.join(str(i + 1) for i in status['output_cut'])
+        notes.append(f'the output of cell(s) {cells} was cut at 100 kB')
+    if status.get('runner_error'):
+        notes.append(f'running it stopped early: {status["runner_error"]}')
+    return '; '.join(notes) or None
+
+
+def grade_notebook(course: Path, scratch: Scratch, learner: Learner, notebook: str,
+                   settings: Settings) -> nbformat.NotebookNode:
+    """Run, judge and assemble one notebook; return the notebook nbgrader will score."""
+    release = nbformat.read(course / 'release' / ASSIGNMENT / f'{notebook}.ipynb', as_version=4)
     problem = readable(learner.files[notebook])
     if problem:
-        learner.notes[notebook] = problem
-        return note_notebook(course, notebook, f'{problem}; 0 points.')
-    # A fresh nbgrader course per notebook; the workspace is the learner's, across notebooks.
-    grader = scratch / f'course-{notebook}'
-    shutil.copytree(course / 'source', grader / 'source')
-    shutil.copy2(course / 'gradebook.db', grader / 'gradebook.db')
-    shutil.copy2(course / 'nbgrader_config.py', grader / 'nbgrader_config.py')
-    submitted = grader / 'submitted' / learner.name / ASSIGNMENT
-    submitted.mkdir(parents=True)
-    shutil.copy2(learner.files[notebook], submitted / f'{notebook}.ipynb')
-    home = scratch / 'home'
-    # Every place a kernel, IPython, matplotlib or ROS writes to is inside the scratch
-    # folder (make exports some of them into this repository for `make lab`).
-    env = dict(os.environ, ROS_DOMAIN_ID=str(domain), ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST',
-               ROS2NB_WORKSPACE=str(scratch / 'workspace' / 'ROS2_and_RL_Tutorials'),
-               HOME=str(home), IPYTHONDIR=str(home / '.ipython'),
-               MPLCONFIGDIR=str(home / '.matplotlib'), ROS_HOME=str(home / '.ros'),
-               ROS_LOG_DIR=str(home / '.ros' / 'log'), JUPYTER_CONFIG_DIR=str(home / '.jupyter'),
-               JUPYTER_DATA_DIR=str(home / '.local'), JUPYTER_RUNTIME_DIR=str(home / '.runtime'),
-               PYTHONUNBUFFERED='1')
-    env.pop('PIP_CACHE_DIR', None)
-    log = scratch / f'{notebook}.log'
-    code = nbgrader(grader, 'autograde', ASSIGNMENT, f'--student={learner.name}',
-                    f'--CourseDirectory.notebook_id={notebook}', '--force',
-                    f'--Execute.timeout={cell_timeout}', env=env, timeout=notebook_timeout,
-                    log=log)
-    executed = grader / 'autograded' / learner.name / ASSIGNMENT / f'{notebook}.ipynb'
-    if code == 0 and executed.is_file():
-        nb = nbformat.read(executed, as_version=4)
-        timed_out = [c for c in nb.cells for o in c.get('outputs', [])
-                     if o.get('output_type') == 'error' and o.get('ename') == 'CellTimeoutError']
-        if timed_out:
-            learner.notes[notebook] = (f'{len(timed_out)} cell(s) ran longer than '
-                                       f'{cell_timeout} s and were interrupted')
-        return nb
-    text = log.read_text(errors='replace') if log.is_file() else ''
-    if not (grader / 'gradebook.db').is_file() or not (grader / 'source').is_dir():
-        reason = ('it deleted the grading files around it (outside its own folder), so it '
-                  'could not be graded')
-    elif code == -9:
-        reason = f'it ran longer than the {notebook_timeout} s limit for a notebook and was stopped'
-    elif 'DeadKernelError' in text or 'Kernel died' in text or 'kernel died' in text.lower():
-        reason = 'its kernel died while it ran (e.g. the process was killed or exited)'
-    else:
-        errors = [line for line in text.splitlines() if 'Error' in line]
-        reason = 'nbgrader could not run it' + (f': {errors[-1].strip()[:200]}' if errors else '')
-    learner.notes[notebook] = reason
-    return note_notebook(course, notebook, f'{reason}; 0 points.')
+        learner.note(notebook, f'{problem}; 0 points')
+        return graded_notebook.note_notebook(release, f'{problem}; 0 points.')
+    submitted = nbformat.read(learner.files[notebook], as_version=4)
+    prepared = graded_notebook.for_the_run(release, submitted)
+    executed, status, stopped = run_notebook(scratch, notebook, prepared, settings)
+    happened = _run_note(status, stopped)
+    if happened:
+        learner.note(notebook, happened)
+    results, problem = judge_notebook(scratch, notebook, learner.files[notebook], settings)
+    if problem:
+        learner.note(notebook, problem)
+    return graded_notebook.for_scoring(release, executed, results, problem)
 
 
 def grade_learner(course: Path, scratch_root: Path, learner: Learner, notebooks: list[str],
-                  first_domain: int, cell_timeout: int, notebook_timeout: int) -> None:
-    """Run a learner's notebooks in order, each isolated, and file them in the course."""
-    # A folder of its own, not a sibling path another learner's code could guess.
-    scratch = Path(tempfile.mkdtemp(prefix=f'{learner.name}-', dir=scratch_root))
-    target = course / 'submitted' / learner.name / ASSIGNMENT
+                  settings: Settings) -> None:
+    """Grade a learner's notebooks in course order; file them in the nbgrader course."""
+    scratch = Scratch(scratch_root, learner)
+    target = course / 'submitted' / learner.id / ASSIGNMENT
     target.mkdir(parents=True, exist_ok=True)
-    for index, notebook in enumerate(n for n in notebooks if n in learner.files):
-        domain = 1 + (first_domain + index) % 100
-        nb = run_one(course, scratch, learner, notebook, domain, cell_timeout, notebook_timeout)
-        nbformat.write(nb, target / f'{notebook}.ipynb')
-    shutil.rmtree(scratch, ignore_errors=True)
+    try:
+        for notebook in (n for n in notebooks if n in learner.files):
+            nbformat.write(grade_notebook(course, scratch, learner, notebook, settings),
+                           target / f'{notebook}.ipynb')
+    finally:
+        shutil.rmtree(scratch.top, ignore_errors=True)
+
+
+# ------------------------------------------------------------------ results
+def _not_submitted_page(learner: Learner, notebook: str, points: float) -> str:
+    return (f'<!DOCTYPE html><html><head><meta charset="utf-8"><title>{notebook}</title></head>'
+            f'<body><h1>{html.escape(learner.name)}: {notebook}</h1><p>Not submitted: 0 of '
+            f'{points:g} points.</p></body></html>\n')
 
 
 def write_results(course: Path, out: Path, learners: list[Learner],
                   notebooks: list[str]) -> list[list[str]]:
-    """grades.csv from nbgrader's gradebook, and feedback files; return the CSV rows."""
+    """grades.csv from nbgrader's gradebook, and the feedback files; return the CSV rows."""
     from nbgrader.api import Gradebook, MissingEntry
     rows = []
-    feedback = out / 'feedback'
     with Gradebook(f'sqlite:///{course / "gradebook.db"}') as gb:
-        assignment = gb.find_assignment(ASSIGNMENT)
-        maxima = {nb.name: nb.max_score for nb in assignment.notebooks}
+        maxima = {nb.name: nb.max_score for nb in gb.find_assignment(ASSIGNMENT).notebooks}
         for learner in learners:
             total = 0.0
-            (feedback / learner.name).mkdir(parents=True, exist_ok=True)
+            folder = out / 'feedback' / learner.name
+            folder.mkdir(parents=True, exist_ok=True)
             for notebook in notebooks:
                 try:
-                    score = gb.find_submission_notebook(notebook, ASSIGNMENT, learner.name).score
+                    score = gb.find_submission_notebook(notebook, ASSIGNMENT, learner.id).score
                 except MissingEntry:
                     score = 0.0
                 total += score
                 rows.append([learner.name, notebook, f'{score:g}', f'{maxima[notebook]:g}'])
-                made = course / 'feedback' / learner.name / ASSIGNMENT / f'{notebook}.html'
-                page = feedback / learner.name / f'{notebook}.html'
+                made = course / 'feedback' / learner.id / ASSIGNMENT / f'{notebook}.html'
+                page = folder / f'{notebook}.html'
                 if notebook in learner.files and made.is_file():
                     shutil.copy2(made, page)
                 else:
-                    page.write_text(
-                        f'<!DOCTYPE html><html><head><meta charset="utf-8"><title>{notebook}'
-                        f'</title></head><body><h1>{html.escape(learner.name)}: {notebook}</h1>'
-                        f'<p>Not submitted: 0 of {maxima[notebook]:g} points.</p></body></html>\n')
+                    page.write_text(_not_submitted_page(learner, notebook, maxima[notebook]))
             rows.append([learner.name, 'TOTAL', f'{total:g}', f'{sum(maxima.values()):g}'])
     with open(out / 'grades.csv', 'w', newline='') as stream:
         writer = csv.writer(stream)
@@ -287,8 +362,22 @@ def write_results(course: Path, out: Path, learners: list[Learner],
     return rows
 
 
-def main() -> int:
-    parser = argparse.ArgumentParser(description='Grade learners\' notebooks with nbgrader.')
+def score_and_feedback(course: Path) -> None:
+    """nbgrader scores what was filed (executing nothing), then writes the feedback."""
+    log = course / 'grading.log'
+    config = course / 'nbgrader_config.py'
+    # nbgrader reads the course's nbgrader_config.py (its command line has no --config);
+    # the score-only settings are there only for this one run.
+    config.write_text(COURSE_CONFIG + SCORE_ONLY_CONFIG)
+    try:
+        nbgrader(course, 'autograde', ASSIGNMENT, '--force', log=log)
+    finally:
+        config.write_text(COURSE_CONFIG)
+    nbgrader(course, 'generate_feedback', ASSIGNMENT, '--force', log=log)
+
+
+def main(argv: Optional[list[str]] = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('submissions', type=Path, help='folder of learner folders, or a .zip')
     parser.add_argument('--out', type=Path, default=ROOT / 'grading')
     parser.add_argument('--cell-timeout', type=int, default=CELL_TIMEOUT_S)
@@ -296,10 +385,18 @@ def main() -> int:
     parser.add_argument('--jobs', type=int, default=JOBS)
     parser.add_argument('--force', action='store_true',
                         help='replace an earlier grading/ (and any manual grades in it)')
-    args = parser.parse_args()
+    parser.add_argument('--no-sandbox', action='store_true',
+                        help='grade without a sandbox: only for work you trust')
+    args = parser.parse_args(argv)
+    started = time.monotonic()
     submissions, out = args.submissions.resolve(), args.out.resolve()
     if not submissions.exists():
         print(f'{submissions} does not exist: pass SUBMISSIONS=folder-of-learner-folders or a .zip')
+        return 2
+    why = None if args.no_sandbox else sandbox.problem()
+    if why:
+        print(f'No sandbox can be made here ({why}); grading runs learners\' code, so it stops. '
+              'For work you trust, run again with NO_SANDBOX=1 (--no-sandbox).')
         return 2
     if out.exists() and any(out.iterdir()):
         if not args.force:
@@ -311,45 +408,39 @@ def main() -> int:
     course = out / 'nbgrader'
     course.mkdir()
     notebooks = set_up_course(course)
+    refused: list[str] = []
     if submissions.suffix == '.zip':
         if not zipfile.is_zipfile(submissions):
             print(f'{submissions} is not a zip file: download the submissions again.')
             return 2
-        submissions = collect_zip(submissions, course)
-    learners = find_learners(submissions, notebooks)
+        submissions, refused = collect_zip(submissions, course)
+    learners, not_learners = find_learners(submissions, notebooks)
+    refused += not_learners
+    for line in refused:
+        print(f'not graded: {line}')
     if not learners:
-        print(f'{submissions} has no learner folders (<learner-id>/NN-title.ipynb).')
+        print(f'{submissions} has no learner folders (<learner>/NN-title.ipynb).')
         return 2
+    settings = Settings(args.cell_timeout, args.notebook_timeout, not args.no_sandbox)
     with tempfile.TemporaryDirectory(prefix='ros2nb-grading-') as scratch_root:
+        Path(scratch_root).chmod(0o711)
         with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
             # Most notebooks first, so the longest learner does not start last.
-            by_size = sorted(learners, key=lambda learner: -len(learner.files))
-            jobs = [pool.submit(grade_learner, course, Path(scratch_root), learner, notebooks,
-                                os.getpid() + 7 * i, args.cell_timeout, args.notebook_timeout)
-                    for i, learner in enumerate(by_size)]
-            for job in jobs:
+            ordered = sorted(learners, key=lambda learner: -len(learner.files))
+            for job in [pool.submit(grade_learner, course, Path(scratch_root), learner,
+                                    notebooks, settings) for learner in ordered]:
                 job.result()
-    graded = [l.name for l in learners if l.files]
-    log = course / 'grading.log'
-    if graded:  # score what ran (nothing executes here), then write feedback, for everyone
-        config = course / 'nbgrader_config.py'
-        normal = config.read_text()
-        # nbgrader reads the course's nbgrader_config.py (its command line has no --config);
-        # the score-only settings live there only for this one run.
-        config.write_text(normal + SCORE_ONLY_CONFIG)
-        try:
-            nbgrader(course, 'autograde', ASSIGNMENT, '--force', log=log)
-        finally:
-            config.write_text(normal)
-        nbgrader(course, 'generate_feedback', ASSIGNMENT, '--force', log=log)
+    if any(learner.files for learner in learners):
+        score_and_feedback(course)
     rows = write_results(course, out, learners, notebooks)
-    (out / 'notes.json').write_text(json.dumps({l.name: l.notes for l in learners}, indent=1,
-                                               sort_keys=True) + '\n')
+    (out / 'notes.json').write_text(json.dumps(
+        {'learners': {l.name: l.notes for l in learners}, 'not graded': refused},
+        indent=1, sort_keys=True, ensure_ascii=False) + '\n')
     totals = {row[0]: f'{row[2]}/{row[3]}' for row in rows if row[1] == 'TOTAL'}
     for learner in learners:
         notes = '; '.join(f'{k}: {v}' for k, v in sorted(learner.notes.items()))
         print(f'{learner.name}: {totals[learner.name]}' + (f'  ({notes})' if notes else ''))
-    print(f'wrote {out / "grades.csv"} and {out / "feedback"}')
+    print(f'wrote {out / "grades.csv"} and {out / "feedback"} in {time.monotonic() - started:.0f} s')
     return 0
 
 

@@ -21,7 +21,6 @@ import configparser
 import difflib
 import math
 import shutil
-import signal
 import subprocess
 import sys
 import time
@@ -33,7 +32,7 @@ from . import course
 from .errors import CheckFailed, Ros2nbError
 from .judge import (ARRIVAL_TIMEOUT_S, AnswerRef, Session, SubjectHung, in_judge,
                     learner_error, run_in_judge, session, subject_env)
-from .processes import kill_process_group, signal_group
+from .processes import interrupt, kill_process_group
 
 __all__ = [
     'CheckFailed', 'check_dependencies', 'check_endpoint', 'check_entry_points',
@@ -597,7 +596,7 @@ def _main(judge: Session, relative: str, node_name: str) -> str:
                               'first; the checks of the parts above show where.')
         raise CheckFailed(f'{path.name} ended by itself before Ctrl+C (exit code '
                           f'{proc.returncode}); main() should spin until Ctrl+C.')
-    signal_group(proc, signal.SIGINT)
+    interrupt(proc)
     try:
         code = proc.wait(EXIT_AFTER_CTRL_C_S)
     except subprocess.TimeoutExpired:
@@ -970,7 +969,7 @@ def check_setup_cfg() -> None:
 
 
 def _package_runs(judge: Session) -> str:
-    from .workspace import find_executable, node_process_env, source_workspace
+    from .workspace import find_executable, source_workspace
     ws = _built(judge)
     env = source_workspace(ws)
     argvs = []
@@ -979,8 +978,8 @@ def _package_runs(judge: Session) -> str:
             argvs.append([str(find_executable(course.PACKAGE, executable, env))])
         except Ros2nbError as error:
             raise CheckFailed(f'ros2 run {course.PACKAGE} {executable}: {error}') from None
-    env = {**node_process_env(env), **{k: v for k, v in subject_env().items()
-                                       if k.startswith(('ROS_', 'RCUTILS'))}}
+    env.update({k: v for k, v in subject_env().items()  # the judge's domain and transports
+                if k.startswith(('ROS_', 'RCUTILS', 'FASTDDS', 'PYTHONUNBUFFERED'))})
     observer = judge.observer
     mark = len(observer.logs)
     procs = [subprocess.Popen([*_prefix(), *argv], cwd=ws, env=env, text=True,
@@ -991,7 +990,7 @@ def _package_runs(judge: Session) -> str:
     try:
         heard = observer.wait_until(lambda: observer.lines_of(course.MONITOR_NODE, mark), 15.0)
         for proc in procs:
-            signal_group(proc, signal.SIGINT)
+            interrupt(proc)
         codes = []
         for proc in procs:
             try:

@@ -61,3 +61,51 @@ def stop_process_group(proc: subprocess.Popen, *,
 def kill_process_group(proc: subprocess.Popen) -> Optional[int]:
     """Kill ``proc`` and its process group at once (SIGKILL); return the exit code."""
     return stop_process_group(proc, signals=((signal.SIGKILL, TERM_GRACE_S),))
+
+
+def _children() -> dict[int, list[int]]:
+    """Every process's children, read from /proc."""
+    found: dict[int, list[int]] = {}
+    for entry in os.listdir('/proc'):
+        if not entry.isdigit():
+            continue
+        try:
+            with open(f'/proc/{entry}/stat') as stat:
+                fields = stat.read().rsplit(')', 1)[1].split()
+        except OSError:
+            continue
+        found.setdefault(int(fields[1]), []).append(int(entry))
+    return found
+
+
+def _name(pid: int) -> str:
+    try:
+        with open(f'/proc/{pid}/comm') as comm:
+            return comm.read().strip()
+    except OSError:
+        return ''
+
+
+def interrupt(proc: subprocess.Popen, sig: int = signal.SIGINT) -> None:
+    """Press Ctrl+C for ``proc``: send ``sig`` to its process group, as a terminal does.
+
+    A program started inside a sandbox (bubblewrap) is reached past the sandbox's own
+    processes, which would otherwise take the signal and kill the sandbox before the
+    program could handle it: ``sig`` goes to every process under ``proc`` that is not
+    bubblewrap.
+    """
+    if _name(proc.pid) != 'bwrap':
+        signal_group(proc, sig)
+        return
+    children = _children()
+    pending, targets = list(children.get(proc.pid, [])), []
+    while pending:
+        pid = pending.pop()
+        pending.extend(children.get(pid, []))
+        if _name(pid) != 'bwrap':
+            targets.append(pid)
+    for pid in targets:
+        try:
+            os.kill(pid, sig)
+        except ProcessLookupError:
+            pass

@@ -318,4 +318,5 @@ def main(argv: list[str]) -> int:
 
 
 if __name__ == '__main__':
-    sys.exit(main(sys.argv[1:]))
+    from ros2nb import subject as _subject  # one copy of the module, as the judge's own
+    sys.exit(_subject.main(sys.argv[1:]))
