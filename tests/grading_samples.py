@@ -1,13 +1,15 @@
-"""A sample class for the grading test: one full solution, one partly solved, one per hostile case.
+"""A sample class for the grading test: honest learners, and one learner per hostile case.
 
-The samples are built from the current solutions/ and notebooks/ (so they never go stale),
-with the change each case needs.  EXPECTED gives every learner's score per notebook (a
-notebook not listed was not submitted and scores 0) and a phrase the feedback must show.
+Built from the current solutions/ and notebooks/ (so it never goes stale), with the cells each
+case needs. EXPECTED gives every learner's score per notebook (a notebook not listed was not
+handed in and scores 0), and phrases their feedback and their notes must show.
 """
 
 from __future__ import annotations
 
 import shutil
+import textwrap
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import nbformat
@@ -15,45 +17,204 @@ import nbformat
 ROOT = Path(__file__).resolve().parent.parent
 SOLUTION = {p.stem: p for p in (ROOT / 'solutions').glob('*.ipynb')}
 LEARNER = {p.stem: p for p in (ROOT / 'notebooks').glob('*.ipynb')}
-NB00, NB01, NB03, NB04 = (sorted(SOLUTION)[i] for i in (0, 1, 3, 4))
+NB = sorted(SOLUTION)
+NB00, NB01, NB02, NB03, NB04, NB05 = NB
+FULL = dict(zip(NB, (1, 1, 1, 6, 5, 4)))
+#: Marks the hostile processes, so the test can look for survivors.
+MARK = 'ros2nb-hostile-sample'
 
-#: learner -> ({notebook: expected score}, {notebook: phrase in its feedback})
+
+@dataclass
+class Case:
+    """One learner of the sample class and what grading must make of them."""
+
+    scores: dict[str, float]
+    feedback: dict[str, str] = field(default_factory=dict)  # notebook -> phrase shown
+    notes: dict[str, str] = field(default_factory=dict)  # notebook -> phrase in notes.json
+
+
 EXPECTED = {
-    'full': ({n: s for n, s in zip(sorted(SOLUTION), (1, 1, 1, 3, 3, 5))}, {}),
-    'partial': ({NB00: 0, NB01: 1, NB04: 2},
-                {NB00: 'still raises NotImplementedError', NB04: 'still raises NotImplementedError'}),
-    'hang-in-callback': ({NB00: 1}, {NB00: 'CellTimeoutError'}),
-    'kills-kernel': ({NB00: 0}, {NB00: 'kernel died'}),
-    'calls-rclpy-shutdown': ({NB00: 0}, {NB00: 'was rclpy.shutdown() called?'}),
-    'prints-megabytes': ({NB00: 1}, {NB00: 'Check passed'}),
-    'deletes-files': ({NB00: 0}, {NB00: 'it deleted the grading files around it'}),
-    'wrong-topic': ({NB03: 1}, {NB03: 'needs a publisher on /temperature [std_msgs/msg/Float32]; '
-                                      'it has: /temprature [std_msgs/msg/Float32]'}),
-    'wrong-type': ({NB03: 1}, {NB03: 'needs a publisher on /temperature [std_msgs/msg/Float32]; '
-                                     'it has: /temperature [std_msgs/msg/Float64]'}),
-    'empty-file': ({NB00: 0}, {NB00: 'the file is empty'}),
-    'corrupt-file': ({NB00: 0}, {NB00: 'not a valid notebook'}),
+    # ---- what a grade means (the learner writes the code)
+    'untouched': Case({n: 0 for n in NB}, {NB03: 'still raises NotImplementedError'}),
+    'complete': Case(dict(FULL), {NB03: 'an hour of simulated time: 3600 readings'}),
+    'solved-only-04': Case({NB03: 0, NB04: 5}),
+    'handed-in-only-05': Case({NB05: 4}, {NB05: 'ros2 run starts both entry points'}),
+    # ---- the verdict is out of the learner's reach (a publisher with the 10.2 floor: 3 of 6)
+    'replaces-the-checks': Case({NB03: 3}, {NB03: "the tutorial's floor of 10.2"}),
+    'input-transformer': Case({NB03: 3}, {NB03: "the tutorial's floor of 10.2"}),
+    'forges-the-gradebook': Case({NB01: 0}, {NB01: 'gradebooks changed: []'}),
+    # ---- nothing escapes a graded notebook
+    'rewrites-the-course': Case({NB01: 1}, {NB01: 'Read-only file system'}),
+    'outlives-grading': Case({NB01: 1}, {NB01: 'daemon started'}),
+    'ros-saboteur': Case({NB01: 1}, {NB01: 'saboteur started'}),
+    'kills-the-grader': Case({NB01: 1}, {}, {NB01: 'the notebook stopped or killed the processes '
+                                                   'running it'}),
+    'reads-secrets': Case({NB01: 1}, {NB01: 'found: []'}),
+    'deletes-files': Case({NB01: 1}),
+    'prints-50-mb': Case({NB01: 1}, {NB01: 'The grader cut this cell'}, {NB01: 'was cut'}),
+    'script-in-feedback': Case({NB01: 1}),
+    # ---- what happened is said as it happened
+    'kills-its-kernel': Case({NB01: 1}, {}, {NB01: 'its kernel died while cell'}),
+    'hangs-after-a-check': Case({NB01: 1}, {}, {NB01: 'ran longer than the limit and were '
+                                                      'interrupted'}),
+    'hang-in-callback': Case({NB01: 1}, {}, {NB01: 'ran longer than the limit'}),
+    'calls-rclpy-shutdown': Case({NB01: 1}),
+    'empty-file': Case({NB01: 0}, {NB01: 'the file is empty'}, {NB01: 'the file is empty'}),
+    'corrupt-file': Case({NB01: 0}, {NB01: 'not a valid notebook'}, {NB01: 'not a valid notebook'}),
+    # ---- every legal folder name and file name is graded or named
+    'Zoë': Case({NB01: 1}),
+    'two words': Case({NB01: 1}),
+    'browser-copy': Case({NB01: 1}, {}, {NB01: f'graded {NB01} (1).ipynb as {NB01}.ipynb'}),
 }
 
 
-def _with_cell(source: Path, before_check: str) -> nbformat.NotebookNode:
-    """The notebook with a code cell inserted just before its first learner-check cell."""
+def _with_cells(source: Path, cells: dict[int, str], markdown: bool = False
+                ) -> nbformat.NotebookNode:
+    """The notebook with code cells inserted: {position: source}; -1 means before the first check."""
     nb = nbformat.read(source, as_version=4)
-    index = next(i for i, c in enumerate(nb.cells) if 'learner-check' in c.metadata.get('tags', []))
-    nb.cells.insert(index, nbformat.v4.new_code_cell(before_check))
+    for position, code in sorted(cells.items(), reverse=True):
+        if position == -1:
+            position = next(i for i, c in enumerate(nb.cells)
+                            if 'learner-check' in c.metadata.get('tags', []))
+        new = (nbformat.v4.new_markdown_cell(code) if markdown
+               else nbformat.v4.new_code_cell(textwrap.dedent(code)))
+        nb.cells.insert(position, new)
     return nb
 
 
-def _replaced(source: Path, old: str, new: str) -> nbformat.NotebookNode:
+def _after_first_check(source: Path, code: str) -> nbformat.NotebookNode:
     nb = nbformat.read(source, as_version=4)
+    index = next(i for i, c in enumerate(nb.cells) if 'learner-check' in c.metadata.get('tags', []))
+    nb.cells.insert(index + 1, nbformat.v4.new_code_cell(textwrap.dedent(code)))
+    return nb
+
+
+def _replaced(nb: nbformat.NotebookNode, old: str, new: str) -> nbformat.NotebookNode:
     hits = [c for c in nb.cells if old in c.source]
-    assert hits, f'{old!r} not found in {source.name}'
+    assert hits, old
     for cell in hits:
         cell.source = cell.source.replace(old, new)
     return nb
 
 
-HANG_IN_CALLBACK = '''\
+REPLACE_THE_CHECKS = '''
+import ros2nb.checks
+for name in dir(ros2nb.checks):
+    if name.startswith('check_'):
+        setattr(ros2nb.checks, name, lambda *args, **kwargs: print('Check passed: (mine)'))
+'''
+INPUT_TRANSFORMER = '''
+def skip_the_checks(lines):
+    return ['pass\\n'] if any('ros2nb.checks' in line for line in lines) else lines
+
+get_ipython().input_transformers_cleanup.append(skip_the_checks)
+'''
+FORGE_THE_GRADEBOOK = '''
+import os, sqlite3
+changed = []
+for path in {targets!r}:
+    try:
+        if not os.path.exists(path):
+            continue
+        with sqlite3.connect(path) as db:
+            db.execute('UPDATE grade SET manual_score = 100')
+        changed.append(path)
+    except Exception:
+        pass
+print('gradebooks changed:', changed)
+'''
+REWRITE_THE_COURSE = '''
+import ros2nb
+for target in ({init!r}, {readme!r}, {home_file!r}):
+    try:
+        with open(target, 'a') as stream:
+            stream.write('\\n# rewritten by a learner\\n')
+        print('wrote', target)
+    except OSError as error:
+        print(target, error.strerror)
+'''
+OUTLIVE_GRADING = '''
+import os, sys
+code = """
+import time
+# {mark}
+for _ in range(60):
+    for target in {targets!r}:
+        try:
+            open(target, 'w').write('forged\\\\n')
+        except OSError:
+            pass
+    time.sleep(1)
+"""
+child = os.fork()
+if child == 0:
+    os.setsid()
+    if os.fork() == 0:
+        os.execv(sys.executable, [sys.executable, '-c', code, '{mark}'])
+    os._exit(0)
+os.waitpid(child, 0)
+print('daemon started')
+'''
+ROS_SABOTEUR = '''
+import os, subprocess, sys
+code = """
+import time, rclpy
+from std_msgs.msg import Float32
+from rcl_interfaces.msg import Log
+publishers = []
+for domain in range(0, 102, 10):
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=domain)
+    node = rclpy.create_node('temperature_sensor', context=context)
+    publishers.append((node.create_publisher(Float32, 'temperature', 10),
+                       node.create_publisher(Log, 'rosout', 10)))
+for _ in range(600):
+    for temperature, rosout in publishers:
+        temperature.publish(Float32(data=99.0))
+        rosout.publish(Log(name='temperature_monitor', msg='Status: High', level=20))
+    time.sleep(0.1)
+"""
+subprocess.Popen([sys.executable, '-c', code, '{mark}'], start_new_session=True,
+                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+print('saboteur started')
+'''
+KILL_THE_GRADER = '''
+import os, signal
+killed = []
+for pid in os.listdir('/proc'):
+    if pid.isdigit() and int(pid) != os.getpid():
+        try:
+            command = open(f'/proc/{pid}/cmdline', 'rb').read()
+        except OSError:
+            continue
+        if any(word in command for word in (b'grade.py', b'pytest', b'nbgrader', b'judge')):
+            os.kill(int(pid), signal.SIGKILL)
+            killed.append(pid)
+print('killed:', killed)
+os.kill(-1, signal.SIGKILL)  # every process it can reach, its own kernel included
+'''
+READ_SECRETS = '''
+import glob
+patterns = {patterns!r}
+found = [path for pattern in patterns for path in glob.glob(pattern, recursive=True)]
+print('found:', found)
+'''
+DELETE_FILES = '''
+import os, shutil
+for top in ('.', '..', '../..', '../../..', os.path.expanduser('~')):
+    for entry in os.listdir(top):
+        path = os.path.join(top, entry)
+        try:
+            shutil.rmtree(path) if os.path.isdir(path) else os.remove(path)
+        except OSError:
+            pass
+'''
+SCRIPT_OUTPUT = '''
+from IPython.display import HTML, Javascript, display
+display(HTML('<b>bold</b><script>alert("pwned-html")</script>'))
+display(Javascript('alert("pwned-js")'))
+'''
+HANG_IN_CALLBACK = '''
 from rclpy.node import Node
 
 class Stuck(Node):
@@ -69,20 +230,20 @@ ros2nb.add(Stuck())
 ros2nb.spin(3)
 '''
 
-DELETES_FILES = '''\
-import os, shutil
-for target in ('.', '..', '../..', '../../..'):
-    for entry in os.listdir(target):
-        path = os.path.join(target, entry)
-        shutil.rmtree(path, ignore_errors=True) if os.path.isdir(path) else os.remove(path)
-'''
 
+def build(folder: Path, *, grading_out: Path, submissions: Path, decoy_gradebook: Path,
+          home_file: Path, forged: Path) -> Path:
+    """Write the sample class into ``folder`` (one sub-folder per learner); return it.
 
-def build(folder: Path) -> Path:
-    """Write the sample class into ``folder`` (one sub-folder per learner); return it."""
-    def put(learner: str, notebook: str, nb) -> None:
+    :param grading_out: where the grader writes (the hostile cells aim at it).
+    :param submissions: the class folder itself (to look for other learners' work).
+    :param decoy_gradebook: a gradebook outside the grading folder, aimed at too.
+    :param home_file: a file in the real home the hostile cells try to create.
+    :param forged: a file a process left behind would write after grading.
+    """
+    def put(learner: str, notebook: str, nb, name: str | None = None) -> None:
         (folder / learner).mkdir(parents=True, exist_ok=True)
-        target = folder / learner / f'{notebook}.ipynb'
+        target = folder / learner / (name or f'{notebook}.ipynb')
         if isinstance(nb, Path):
             shutil.copy2(nb, target)
         elif isinstance(nb, str):
@@ -90,21 +251,48 @@ def build(folder: Path) -> Path:
         else:
             nbformat.write(nb, target)
 
-    for notebook, path in SOLUTION.items():
-        put('full', notebook, path)
-    put('partial', NB00, LEARNER[NB00])
-    put('partial', NB01, SOLUTION[NB01])
-    put('partial', NB04, LEARNER[NB04])
-    put('hang-in-callback', NB00, _with_cell(SOLUTION[NB00], HANG_IN_CALLBACK))
-    put('kills-kernel', NB00, _with_cell(SOLUTION[NB00],
-                                         'import os, signal\nos.kill(os.getpid(), signal.SIGKILL)'))
-    put('calls-rclpy-shutdown', NB00, _with_cell(SOLUTION[NB00], 'import rclpy\nrclpy.shutdown()'))
-    put('prints-megabytes', NB00, _with_cell(SOLUTION[NB00], "print('x' * 5_000_000)"))
-    put('deletes-files', NB00, _with_cell(SOLUTION[NB00], DELETES_FILES))
-    put('wrong-topic', NB03, _replaced(SOLUTION[NB03], "TOPIC = 'temperature'",
-                                       "TOPIC = 'temprature'"))
-    put('wrong-type', NB03, _replaced(SOLUTION[NB03], 'from std_msgs.msg import Float32',
-                                      'from std_msgs.msg import Float64 as Float32'))
-    put('empty-file', NB00, '')
-    put('corrupt-file', NB00, '{"cells": [{"cell_type": "code", "sou')
+    floor_10_2 = ('max(MIN_TEMPERATURE_C,', 'max(10.2,')
+    for notebook in NB:
+        put('untouched', notebook, LEARNER[notebook])
+        put('complete', notebook, SOLUTION[notebook])
+    put('solved-only-04', NB03, LEARNER[NB03])
+    put('solved-only-04', NB04, SOLUTION[NB04])
+    put('handed-in-only-05', NB05, SOLUTION[NB05])
+    put('replaces-the-checks', NB03, _replaced(
+        _with_cells(SOLUTION[NB03], {3: REPLACE_THE_CHECKS}), *floor_10_2))
+    put('input-transformer', NB03, _replaced(
+        _with_cells(SOLUTION[NB03], {3: INPUT_TRANSFORMER}), *floor_10_2))
+    gradebooks = [str(grading_out / 'nbgrader' / 'gradebook.db'), str(decoy_gradebook),
+                  str(ROOT / 'grading' / 'nbgrader' / 'gradebook.db'), '../gradebook.db',
+                  '../../gradebook.db']
+    put('forges-the-gradebook', NB01, _with_cells(
+        LEARNER[NB01], {3: FORGE_THE_GRADEBOOK.format(targets=gradebooks)}))
+    put('rewrites-the-course', NB01, _with_cells(SOLUTION[NB01], {3: REWRITE_THE_COURSE.format(
+        init=str(ROOT / 'src' / 'ros2nb' / '__init__.py'), readme=str(ROOT / 'README.md'),
+        home_file=str(home_file))}))
+    put('outlives-grading', NB01, _with_cells(SOLUTION[NB01], {3: OUTLIVE_GRADING.format(
+        mark=MARK, targets=[str(grading_out / 'grades.csv'), str(forged)])}))
+    put('ros-saboteur', NB01, _with_cells(SOLUTION[NB01], {3: ROS_SABOTEUR.format(mark=MARK)}))
+    put('kills-the-grader', NB01, _with_cells(SOLUTION[NB01], {-1: KILL_THE_GRADER}))
+    put('reads-secrets', NB01, _with_cells(SOLUTION[NB01], {3: READ_SECRETS.format(patterns=[
+        str(ROOT / 'solutions' / '*'), str(ROOT / 'src' / 'ros2nb' / 'reference' / '*.py'),
+        str(submissions / '*' / '*.ipynb'), str(grading_out / '**' / '*.ipynb'),
+        '/tmp/**/source.ipynb', '/tmp/**/gradebook.db'])}))
+    put('deletes-files', NB01, _with_cells(SOLUTION[NB01], {-1: DELETE_FILES}))
+    put('prints-50-mb', NB01, _with_cells(SOLUTION[NB01], {3: "print('x' * 50_000_000)"}))
+    script = _with_cells(SOLUTION[NB01], {3: SCRIPT_OUTPUT})
+    script.cells.insert(3, nbformat.v4.new_markdown_cell(
+        'My notes <script>alert("pwned-markdown")</script> <img src=x onerror="alert(1)">'))
+    put('script-in-feedback', NB01, script)
+    put('kills-its-kernel', NB01, _with_cells(
+        SOLUTION[NB01], {1: 'import os, signal\nos.kill(os.getpid(), signal.SIGKILL)'}))
+    put('hangs-after-a-check', NB01, _after_first_check(SOLUTION[NB01], 'while True:\n    pass'))
+    put('hang-in-callback', NB01, _with_cells(SOLUTION[NB01], {-1: HANG_IN_CALLBACK}))
+    put('calls-rclpy-shutdown', NB01, _with_cells(
+        SOLUTION[NB01], {-1: 'import rclpy\nrclpy.shutdown()'}))
+    put('empty-file', NB01, '')
+    put('corrupt-file', NB01, '{"cells": [{"cell_type": "code", "sou')
+    put('Zoë', NB01, SOLUTION[NB01])
+    put('two words', NB01, SOLUTION[NB01])
+    put('browser-copy', NB01, SOLUTION[NB01], name=f'{NB01} (1).ipynb')
     return folder

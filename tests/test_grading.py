@@ -1,120 +1,197 @@
-"""Grading a sample class with nbgrader through tools/grade.py (real kernels, real ROS)."""
+"""Grading a sample class with tools/grade.py: real sandboxes, kernels, judges, nbgrader.
+
+The class (tests/grading_samples.py) holds honest learners and one learner per hostile case.
+Every score, every CSV row and every note is checked; then that nothing escaped: the
+repository, the real home and a gradebook outside are byte-identical, and no process of the
+class is left. The honest learners' scores are the ones they earn alone.
+"""
 
 import csv
+import hashlib
 import html
+import json
+import os
 import re
 import subprocess
 import sys
+import time
+import zipfile
 from pathlib import Path
 
 import pytest
 
-from grading_samples import EXPECTED, ROOT, build
+from grading_samples import EXPECTED, MARK, NB01, ROOT, SOLUTION, LEARNER, build
 
-pytestmark = pytest.mark.timeout(900)  # grading a class takes minutes, not seconds
-CELL_TIMEOUT_S = 40  # the hang case waits this long; 15 s was tight for a colcon build under load
-NOTEBOOK_TIMEOUT_S = 240
+sys.path.insert(0, str(ROOT / 'tools'))
+import sandbox  # noqa: E402
+
+pytestmark = [pytest.mark.timeout(1200),
+              pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))]
+CELL_TIMEOUT_S = 30
+NOTEBOOK_TIMEOUT_S = 300
+NOTEBOOKS = sorted(SOLUTION)
 
 
-def repository_files() -> dict[str, tuple[int, int]]:
-    """Every file of the repository (git-ignored ones too, but not .venv/.git): mtime, size."""
+def fingerprint(root: Path, skip=('.venv', '.git', '.cache')) -> dict[str, str]:
+    """Every file under ``root`` (git-ignored ones too): its content's hash."""
     found = {}
-    for path in ROOT.rglob('*'):
-        parts = path.relative_to(ROOT).parts
-        if parts[0] in ('.venv', '.git') or '__pycache__' in parts or not path.is_file():
+    for path in root.rglob('*'):
+        parts = path.relative_to(root).parts
+        if parts[0] in skip or '__pycache__' in parts or not path.is_file():
             continue
-        stat = path.stat()
-        found[str(path.relative_to(ROOT))] = (stat.st_mtime_ns, stat.st_size)
+        found[str(path.relative_to(root))] = hashlib.sha256(path.read_bytes()).hexdigest()
+    return found
+
+
+def survivors() -> list[str]:
+    """Processes whose command line carries the hostile samples' mark."""
+    found = []
+    for entry in os.listdir('/proc'):
+        if entry.isdigit():
+            try:
+                command = Path(f'/proc/{entry}/cmdline').read_bytes()
+            except OSError:
+                continue
+            if MARK.encode() in command and b'pytest' not in command:
+                found.append(entry)
     return found
 
 
 @pytest.fixture(scope='module')
 def graded(tmp_path_factory):
     root = tmp_path_factory.mktemp('grading')
-    submissions = build(root / 'submissions')
-    before = repository_files()
+    out = root / 'grading'
+    decoy = root / 'elsewhere' / 'gradebook.db'
+    decoy.parent.mkdir()
+    decoy.write_bytes(b'SQLite format 3\x00' + b'\x00' * 100)
+    home_file = Path.home() / f'ros2nb-{MARK}-{os.getpid()}'
+    forged = root / 'forged-after-grading.txt'
+    submissions = build(root / 'class', grading_out=out, submissions=root / 'class',
+                        decoy_gradebook=decoy, home_file=home_file, forged=forged)
+    before = fingerprint(ROOT), decoy.read_bytes()
+    started = time.monotonic()
     done = subprocess.run(
-        [sys.executable, str(ROOT / 'tools' / 'grade.py'), str(submissions), '--out',
-         str(root / 'grading'), f'--cell-timeout={CELL_TIMEOUT_S}',
-         f'--notebook-timeout={NOTEBOOK_TIMEOUT_S}'],
-        capture_output=True, text=True, timeout=900)
-    return root / 'grading', done, before
+        [sys.executable, str(ROOT / 'tools' / 'grade.py'), str(submissions), '--out', str(out),
+         f'--cell-timeout={CELL_TIMEOUT_S}', f'--notebook-timeout={NOTEBOOK_TIMEOUT_S}'],
+        capture_output=True, text=True, timeout=1200)
+    print(f'graded {len(EXPECTED)} learners in {time.monotonic() - started:.0f} s')
+    left = survivors()
+    yield out, done, before, decoy, home_file, forged, left
+    home_file.unlink(missing_ok=True)
 
 
-def test_grading_exits_0_and_leaves_repo_alone(graded):
-    out, done, before = graded
+def test_grading_exits_0(graded):
+    _, done, *_ = graded
     assert done.returncode == 0, done.stdout + done.stderr
-    after = repository_files()
-    changed = sorted(p for p in set(before) | set(after) if before.get(p) != after.get(p))
-    assert changed == []  # nothing in the repository was written, not even ignored files
-    # Learners' code ran only in scratch copies: the course under grading/ only scored.
-    assert 'IPKernelApp' not in (out / 'nbgrader' / 'grading.log').read_text()
 
 
 def test_every_score_and_csv_row(graded):
-    out, done, _ = graded
-    with open(out / 'grades.csv') as stream:
+    out, *_ = graded
+    with open(out / 'grades.csv', newline='') as stream:
         rows = list(csv.DictReader(stream))
-    notebooks = sorted(p.stem for p in (ROOT / 'solutions').glob('*.ipynb'))
-    assert len(rows) == len(EXPECTED) * (len(notebooks) + 1)
+    assert len(rows) == len(EXPECTED) * (len(NOTEBOOKS) + 1)
     got = {(r['learner'], r['notebook']): float(r['score']) for r in rows}
-    maxima = {r['notebook']: float(r['max_score']) for r in rows if r['learner'] == 'full'}
-    for learner, (scores, _) in EXPECTED.items():
-        for notebook in notebooks:
-            assert got[learner, notebook] == scores.get(notebook, 0), (learner, notebook)
-        assert got[learner, 'TOTAL'] == sum(scores.values())
-    assert maxima == {**{n: float(p) for n, p in zip(notebooks, (1, 1, 1, 3, 3, 5))},
-                      'TOTAL': 14.0}
+    maxima = {r['notebook']: float(r['max_score']) for r in rows if r['learner'] == 'complete'}
+    for learner, case in EXPECTED.items():
+        for notebook in NOTEBOOKS:
+            assert got[learner, notebook] == case.scores.get(notebook, 0), (learner, notebook)
+        assert got[learner, 'TOTAL'] == sum(case.scores.values()), learner
+    assert maxima == {**dict(zip(NOTEBOOKS, (1.0, 1.0, 1.0, 6.0, 5.0, 4.0))), 'TOTAL': 18.0}
+
+
+def shown(page: Path) -> str:
+    """A feedback page's text as a browser displays it."""
+    return ' '.join(html.unescape(re.sub(r'<[^>]+>', ' ', page.read_text())).split())
 
 
 @pytest.mark.parametrize('learner', sorted(EXPECTED))
-def test_feedback_files_name_what_happened(graded, learner):
-    out, _, _ = graded
-    scores, phrases = EXPECTED[learner]
-    for notebook in sorted(p.stem for p in (ROOT / 'solutions').glob('*.ipynb')):
+def test_feedback_and_notes_say_what_happened(graded, learner):
+    out, *_ = graded
+    case = EXPECTED[learner]
+    notes = json.loads((out / 'notes.json').read_text())['learners'][learner]
+    for notebook in NOTEBOOKS:
         page = out / 'feedback' / learner / f'{notebook}.html'
         assert page.is_file(), page
-        if notebook not in scores:
+        if notebook not in case.scores:
             assert 'Not submitted' in page.read_text()
-    for notebook, phrase in phrases.items():
-        page = (out / 'feedback' / learner / f'{notebook}.html').read_text()
-        text = ' '.join(html.unescape(re.sub(r'<[^>]+>', '', page)).split())  # as displayed
-        assert phrase in text, (learner, phrase)
+        assert page.stat().st_size < 3_000_000  # 50 MB printed, a few hundred kB shown
+    for notebook, phrase in case.feedback.items():
+        assert phrase in shown(out / 'feedback' / learner / f'{notebook}.html'), (learner, phrase)
+    for notebook, phrase in case.notes.items():
+        assert phrase in notes.get(notebook, ''), (learner, notes)
+    if learner == 'kills-its-kernel':
+        assert 'longer than' not in notes[NB01]  # a dead kernel is not a slow one
 
 
-def test_gradebook_works_with_nbgrader_export(graded):
-    out, _, _ = graded
+def test_learners_content_is_text_in_the_feedback(graded):
+    out, *_ = graded
+    for page in (out / 'feedback').rglob('*.html'):
+        text = page.read_text()
+        assert not re.search(r'<script[^>]*>[^<]*pwned', text), page  # no learner script runs
+        assert not re.search(r'<img[^>]*onerror', text, re.IGNORECASE), page
+    text = (out / 'feedback' / 'script-in-feedback' / f'{NB01}.html').read_text()
+    assert '&lt;script&gt;alert("pwned-markdown")&lt;/script&gt;' in text  # shown as text
+
+
+def test_nothing_escaped(graded):
+    out, done, (repository, decoy_bytes), decoy, home_file, forged, left = graded
+    assert left == [], f'processes of the class outlived grading: {left}'
+    time.sleep(3)  # a process left behind would now overwrite these
+    assert not forged.exists()
+    assert fingerprint(ROOT) == repository  # the course, byte for byte, ignored files too
+    assert decoy.read_bytes() == decoy_bytes
+    assert not home_file.exists()
+    with open(out / 'grades.csv') as stream:
+        assert 'forged' not in stream.read()
+
+
+def test_the_gradebook_holds_only_what_nbgrader_scored(graded):
+    """A notebook cannot forge manual scores: none are set, and nbgrader's export agrees."""
+    out, *_ = graded
     course = out / 'nbgrader'
+    export = out / 'export.csv'
     done = subprocess.run([sys.executable, '-m', 'nbgrader', 'export',
                            f'--CourseDirectory.root={course}',
                            f'--CourseDirectory.db_url=sqlite:///{course / "gradebook.db"}',
-                           f'--to={out / "export.csv"}'],
-                          cwd=course, capture_output=True, text=True,
-                          env={**__import__('os').environ,
-                               'PATH': f'{Path(sys.executable).parent}:'
-                                       f'{__import__("os").environ["PATH"]}'})
+                           f'--to={export}'], cwd=course, capture_output=True, text=True,
+                          env={**os.environ, 'PATH': f'{Path(sys.executable).parent}:'
+                                                     f'{os.environ["PATH"]}'})
     assert done.returncode == 0, done.stderr
-    rows = list(csv.DictReader(open(out / 'export.csv')))
-    assert {r['student_id'] for r in rows} >= {'full', 'partial'}
-    assert float(next(r for r in rows if r['student_id'] == 'full')['score']) == 14.0
+    rows = list(csv.DictReader(open(export)))
+    totals = {r['student_id']: float(r['score']) for r in rows}
+    assert totals['complete'] == 18.0 and totals['forges-the-gradebook'] == 0.0
+    import sqlite3
+    with sqlite3.connect(course / 'gradebook.db') as db:
+        assert db.execute('SELECT COUNT(*) FROM grade WHERE manual_score IS NOT NULL'
+                          ).fetchone()[0] == 0
 
 
 def test_zip_from_a_learning_platform(tmp_path):
-    """The zip route goes through nbgrader's zip_collect; learners are the folder names."""
-    import zipfile
-    notebook = sorted((ROOT / 'solutions').glob('*.ipynb'))[0]
+    """nbgrader's zip_collect grades the rest; nested archives and duplicates are refused."""
+    solved, unsolved = SOLUTION[NB01], LEARNER[NB01]
+    inner = tmp_path / 'inner.zip'
+    with zipfile.ZipFile(inner, 'w') as zipped:
+        zipped.write(solved, f'mallory/{NB01}.ipynb')  # would decide who is graded if unpacked
     archive = tmp_path / 'class.zip'
     with zipfile.ZipFile(archive, 'w') as zipped:
-        zipped.write(notebook, f'course-export/ada/{notebook.name}')
-        zipped.write(ROOT / 'notebooks' / notebook.name, f'course-export/bo/{notebook.name}')
+        zipped.write(solved, f'course-export/ada/{NB01}.ipynb')
+        zipped.write(unsolved, f'course-export/bo/{NB01}.ipynb')
+        zipped.write(inner, 'course-export/eve/extra.zip')
+        zipped.write(solved, f'course-export/eve/{NB01}.ipynb')
+        zipped.write(solved, f'course-export/dup/{NB01}.ipynb')
+        zipped.write(unsolved, f'late-export/dup/{NB01}.ipynb')
     done = subprocess.run([sys.executable, str(ROOT / 'tools' / 'grade.py'), str(archive),
                            '--out', str(tmp_path / 'grading'), '--cell-timeout=60'],
                           capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stdout + done.stderr
     rows = {(r['learner'], r['notebook']): r['score']
             for r in csv.DictReader(open(tmp_path / 'grading' / 'grades.csv'))}
-    assert rows['ada', notebook.stem] == '1' and rows['ada', 'TOTAL'] == '1'
-    assert rows['bo', notebook.stem] == '0'
+    assert rows['ada', 'TOTAL'] == '1' and rows['bo', 'TOTAL'] == '0' and rows['eve', 'TOTAL'] == '1'
+    assert not any(learner in ('mallory', 'dup') for learner, _ in rows)
+    assert ('not graded: course-export/eve/extra.zip: an archive inside the archive is not '
+            'unpacked') in done.stdout
+    assert ('not graded: dup: appears in 2 places of the archive (course-export/dup, '
+            'late-export/dup); not graded, send one copy') in done.stdout
 
 
 def test_bad_input_gets_one_line(tmp_path):
@@ -122,10 +199,24 @@ def test_bad_input_gets_one_line(tmp_path):
         return subprocess.run([sys.executable, str(ROOT / 'tools' / 'grade.py'), *args],
                               capture_output=True, text=True)
     missing = grade(str(tmp_path / 'nope'), '--out', str(tmp_path / 'g1'))
-    assert missing.returncode == 2 and 'does not exist' in missing.stdout
+    assert missing.returncode == 2 and missing.stdout.count('\n') == 1
+    assert 'does not exist' in missing.stdout
     (tmp_path / 'g2').mkdir()
     (tmp_path / 'g2' / 'grades.csv').write_text('manual work\n')
     (tmp_path / 'class').mkdir()
     again = grade(str(tmp_path / 'class'), '--out', str(tmp_path / 'g2'))
     assert again.returncode == 2 and 'FORCE=1' in again.stdout
     assert (tmp_path / 'g2' / 'grades.csv').read_text() == 'manual work\n'  # untouched
+
+
+def test_without_a_sandbox_grading_refuses_unless_told(tmp_path):
+    """With bubblewrap not on PATH, one line; NO_SANDBOX=1 is the explicit way round."""
+    (tmp_path / 'class' / 'ada').mkdir(parents=True)
+    env = {**os.environ, 'PATH': str(Path(sys.executable).parent)}  # no /usr/bin: no bwrap
+    done = subprocess.run([sys.executable, str(ROOT / 'tools' / 'grade.py'),
+                           str(tmp_path / 'class'), '--out', str(tmp_path / 'g')],
+                          capture_output=True, text=True, env=env)
+    assert done.returncode == 2
+    assert done.stdout == ("No sandbox can be made here (bubblewrap is not installed: apt-get "
+                           "install bubblewrap); grading runs learners' code, so it stops. For "
+                           "work you trust, run again with NO_SANDBOX=1 (--no-sandbox).\n")
