@@ -17,7 +17,7 @@ export ROS_HOME            := $(HERE)/.cache/ros
 export ROS_LOG_DIR         := $(HERE)/.cache/ros/log
 export PIP_DISABLE_PIP_VERSION_CHECK := 1
 
-.PHONY: lab test setup solutions learner-notebooks benchmark benchmark-grading grade clean
+.PHONY: lab test setup sandbox-tool solutions learner-notebooks benchmark benchmark-grading grade clean
 
 setup: $(STAMP)
 
@@ -37,7 +37,12 @@ lab: $(STAMP)
 	  --LabApp.default_url=/lab/tree/notebooks $(if $(filter 0,$(shell id -u)),--allow-root)
 
 # Unit tests of ros2nb, the notebook checks, then nbval over both notebook folders.
-test: $(STAMP)
+# Grading runs learners' code in bubblewrap sandboxes (Debian's bubblewrap package).
+sandbox-tool:
+	@command -v bwrap >/dev/null || { if [ "$$(id -u)" = 0 ]; then apt-get install -y -q bubblewrap >/dev/null; \
+	  else echo "bubblewrap is not installed: sudo apt-get install bubblewrap (grading and its tests need it)."; fi; }
+
+test: $(STAMP) sandbox-tool
 	$(PY) -m pytest tests
 	$(PY) -m pytest --nbval solutions --nbval-current-env --nbval-sanitize-with tests/sanitize.cfg
 	$(PY) -m pytest --nbval-lax notebooks --nbval-current-env
@@ -58,9 +63,9 @@ benchmark-grading: $(STAMP)
 
 # Grade a class: SUBMISSIONS is a folder of <learner-id>/NN-*.ipynb or a platform .zip.
 # Output goes to grading/ (git-ignored); FORCE=1 replaces an earlier grading/.
-grade: $(STAMP)
-	@test -n "$(SUBMISSIONS)" || { echo "Usage: make grade SUBMISSIONS=DIR (DIR/<learner-id>/NN-title.ipynb) or SUBMISSIONS=class.zip [FORCE=1]"; exit 2; }
-	$(PY) tools/grade.py "$(SUBMISSIONS)" $(if $(FORCE),--force)
+grade: $(STAMP) sandbox-tool
+	@test -n "$(SUBMISSIONS)" || { echo "Usage: make grade SUBMISSIONS=DIR (DIR/<learner>/NN-title.ipynb) or SUBMISSIONS=class.zip [FORCE=1] [NO_SANDBOX=1]"; exit 2; }
+	$(PY) tools/grade.py "$(SUBMISSIONS)" $(if $(FORCE),--force) $(if $(NO_SANDBOX),--no-sandbox)
 
 clean:
 	rm -rf $(VENV) .cache .jupyter

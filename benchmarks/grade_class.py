@@ -38,11 +38,11 @@ def main() -> None:
                                '--out', str(Path(tmp) / 'grading'), f'--jobs={args.jobs}'],
                               capture_output=True, text=True)
         elapsed = time.perf_counter() - started
-        full = sum(1 for line in done.stdout.splitlines() if line.endswith(': 14/14'))
+        full = sum(1 for line in done.stdout.splitlines() if line.endswith(': 18/18'))
     count = args.learners * len(notebooks)
     print(f'graded {args.learners} learners x {len(notebooks)} notebooks ({count} notebooks, '
           f'{args.jobs} at a time) in {elapsed / 60:.1f} min ({elapsed / count:.1f} s per '
-          f'notebook); exit code {done.returncode}; {full} of {args.learners} scored 14/14')
+          f'notebook); exit code {done.returncode}; {full} of {args.learners} scored 18/18')
 
 
 if __name__ == '__main__':
