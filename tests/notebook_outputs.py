@@ -28,17 +28,34 @@ def sanitize(text: str) -> str:
     return text
 
 
+def comparable_outputs(outputs: list) -> list[str]:
+    """What nbval compares of one cell's outputs: sanitized streams (joined as nbval joins
+    them), errors, and the text of displays (nbval skips their images too)."""
+    def one(output: dict) -> nbformat.NotebookNode:
+        output = copy.deepcopy(output)
+        if isinstance(output.get('text'), list):  # as stored in a file: a list of lines
+            output['text'] = ''.join(output['text'])
+        for key, value in output.get('data', {}).items():
+            if isinstance(value, list):
+                output['data'][key] = ''.join(value)
+        return nbformat.from_dict(output)
+
+    joined = coalesce_streams([one(o) for o in outputs])
+    return [sanitize(f'{o.name}: {o.text}') if o.output_type == 'stream' else
+            f'error: {o.ename}: {sanitize(o.evalue)}' if o.output_type == 'error'
+            else f'{o.output_type}: {sanitize(str(o.get("data", {}).get("text/plain", "")))}'
+            for o in joined]
+
+
+def compared(cell: dict) -> bool:
+    """True for the code cells nbval compares (not tagged ``nbval-ignore-output``)."""
+    return cell['cell_type'] == 'code' and IGNORED not in cell['metadata'].get('tags', [])
+
+
 def comparable(nb: nbformat.NotebookNode) -> dict[int, list[str]]:
     """Per code cell that nbval compares: its sanitized stream texts and error names."""
-    found = {}
-    for index, cell in enumerate(nb.cells):
-        if cell.cell_type != 'code' or IGNORED in cell.metadata.get('tags', []):
-            continue
-        outputs = coalesce_streams(copy.deepcopy(cell.get('outputs', [])))
-        found[index] = [sanitize(f'{o.name}: {o.text}') if o.output_type == 'stream' else
-                        f'error: {o.ename}: {sanitize(o.evalue)}' if o.output_type == 'error'
-                        else o.output_type for o in outputs]
-    return found
+    return {index: comparable_outputs(cell.get('outputs', []))
+            for index, cell in enumerate(nb.cells) if compared(cell)}
 
 
 def differences(stored: nbformat.NotebookNode, ran: nbformat.NotebookNode) -> list[str]:

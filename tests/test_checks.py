@@ -126,14 +126,6 @@ SENSOR_MISTAKES = [
 ]
 
 
-@pytest.mark.parametrize('label, old, new, check, pattern', SENSOR_MISTAKES,
-                         ids=[m[0] for m in SENSOR_MISTAKES])
-def test_sensor_mistake_gets_one_line(session, label, old, new, check, pattern):
-    mutated(session, PUB, old, new)
-    try:
-        fails(check, pattern)
-    finally:
-        restore(session, PUB)
 
 
 def test_learner_error_shows_their_traceback(session):
@@ -167,14 +159,17 @@ MONITOR_MISTAKES = [
 ]
 
 
-@pytest.mark.parametrize('label, old, new, check, pattern', MONITOR_MISTAKES,
-                         ids=[m[0] for m in MONITOR_MISTAKES])
-def test_monitor_mistake_gets_one_line(session, label, old, new, check, pattern):
-    mutated(session, SUB, old, new)
+MISTAKES = [(PUB, *m) for m in SENSOR_MISTAKES] + [(SUB, *m) for m in MONITOR_MISTAKES]
+
+
+@pytest.mark.parametrize('file, label, old, new, check, pattern', MISTAKES,
+                         ids=[f'{Path(m[0]).stem}: {m[1]}' for m in MISTAKES])
+def test_a_mistake_gets_one_line(session, file, label, old, new, check, pattern):
+    mutated(session, file, old, new)
     try:
         fails(check, pattern)
     finally:
-        restore(session, SUB)
+        restore(session, file)
 
 
 def test_package_checks(session, capsys):

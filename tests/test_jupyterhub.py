@@ -48,6 +48,7 @@ from typing import Callable, Optional
 
 import pytest
 import requests
+from notebook_outputs import comparable_outputs, compared
 from tornado.httpclient import HTTPRequest
 from tornado.websocket import WebSocketClientConnection, websocket_connect
 
@@ -55,10 +56,8 @@ ROOT = Path(__file__).resolve().parent.parent
 PROXY = ROOT / '.cache' / 'node' / 'node_modules' / '.bin' / 'configurable-http-proxy'
 COURSE_CONFIG = ROOT / 'environment' / 'jupyterhub_config.py'
 NOTEBOOK = ROOT / 'solutions' / '04-write-the-subscriber.ipynb'
-SANITIZE = ROOT / 'tests' / 'sanitize.cfg'
 JUPYTERHUB = Path(sys.executable).with_name('jupyterhub')
 LEARNERS = ('ada', 'grace')
-IGNORE_OUTPUT_TAG = 'nbval-ignore-output'
 #: Seconds for the hub to answer, for a server to start, for one cell to run.
 HUB_START_S = 30
 SERVER_START_S = 60
@@ -245,7 +244,7 @@ class Kernel:
         self.session = uuid.uuid4().hex
 
     async def execute(self, code: str, seconds: float = CELL_S) -> list[dict]:
-        """Run ``code`` and return its stream and error outputs in nbformat's shape."""
+        """Run ``code`` and return its outputs (streams, errors, displays) in nbformat's shape."""
         msg_id = uuid.uuid4().hex
         await self.connection.write_message(json.dumps({
             'channel': 'shell', 'buffers': [], 'metadata': {}, 'parent_header': {},
@@ -275,6 +274,8 @@ class Kernel:
             elif kind == 'error':
                 outputs.append({'output_type': 'error', 'ename': content['ename'],
                                 'evalue': content['evalue']})
+            elif kind in ('display_data', 'execute_result'):
+                outputs.append({'output_type': kind, 'data': content['data']})
         return outputs
 
 
@@ -297,37 +298,11 @@ async def connect(learner: str, url: str, token: str) -> Kernel:
 
 
 # ------------------------------------------------------------ nbval's comparison rules
-def sanitize_patterns(path: Path) -> list[tuple[str, str]]:
-    """Return the ``regex:``/``replace:`` pairs of a sanitize file, as nbval reads them."""
-    return re.findall(r'^regex: (.*)$\n^replace: (.*)$', path.read_text(), flags=re.MULTILINE)
-
-
-def comparable(outputs: list[dict], patterns: list[tuple[str, str]]) -> list[tuple[str, ...]]:
-    """Return what is compared: streams joined per name (as nbval does) and errors, sanitized."""
-    def clean(text: str) -> str:
-        for regex, replace in patterns:
-            text = re.sub(regex, replace, text)
-        return text
-
-    streams: dict[str, str] = {}
-    errors = []
-    for output in outputs:
-        if output['output_type'] == 'stream':
-            text = output['text'] if isinstance(output['text'], str) else ''.join(output['text'])
-            streams[output['name']] = streams.get(output['name'], '') + text
-        elif output['output_type'] == 'error':
-            errors.append(('error', output['ename'], clean(output['evalue'])))
-    return [('stream', name, clean(text)) for name, text in streams.items()] + errors
-
-
-def difference(want: list[tuple[str, ...]], have: list[tuple[str, ...]], lines: int = 12) -> str:
+def difference(want: list[str], have: list[str], lines: int = 12) -> str:
     """Return the start of a unified diff between stored and received outputs."""
-    def as_lines(items: list[tuple[str, ...]]) -> list[str]:
-        return [f'{kind} {name}: {line}' for kind, name, text in items
-                for line in text.splitlines() or ['']]
-
-    diff = list(difflib.unified_diff(as_lines(want), as_lines(have), 'stored', 'got', n=1,
-                                     lineterm=''))
+    diff = list(difflib.unified_diff([l for t in want for l in t.splitlines() or ['']],
+                                     [l for t in have for l in t.splitlines() or ['']],
+                                     'stored', 'got', n=1, lineterm=''))
     more = f'\n    ... {len(diff) - lines} more diff lines' if len(diff) > lines else ''
     return '\n'.join('    ' + line for line in diff[:lines]) + more
 
@@ -340,10 +315,6 @@ def code_cells(notebook: Path) -> list[dict]:
 def source(cell: dict) -> str:
     text = cell['source']
     return text if isinstance(text, str) else ''.join(text)
-
-
-def compared(cell: dict) -> bool:
-    return IGNORE_OUTPUT_TAG not in cell.get('metadata', {}).get('tags', [])
 
 
 # ------------------------------------------------------------------------- the class
@@ -436,14 +407,13 @@ def test_each_learner_has_own_copy_of_the_learner_notebooks(class_run):
 
 
 def test_two_learners_at_once_each_get_the_stored_outputs(class_run):
-    patterns = sanitize_patterns(SANITIZE)
     differences = []
     for learner, outputs in class_run.outputs.items():
         for number, (cell, got) in enumerate(zip(class_run.cells, outputs)):
             if not compared(cell):
                 continue
-            want = comparable(cell.get('outputs', []), patterns)
-            have = comparable(got, patterns)
+            want = comparable_outputs(cell.get('outputs', []))
+            have = comparable_outputs(got)
             if have != want:
                 differences.append(f'{learner}, code cell {number} ({source(cell)[:50]!r}):\n'
                                    + difference(want, have))

@@ -194,6 +194,7 @@ def test_fixed_node_readded_after_failure_keeps_its_logs(ros, capsys):
             self.get_logger().info('fixed')
 
     broken = ros2nb.add(Fixed())  # drops the learner's last reference to the failed node
+    assert broken.get_name() == 'broken'
     gc.collect()
     ros2nb.spin(3)
     assert capsys.readouterr().out.count('[INFO] [broken]: fixed') == 3

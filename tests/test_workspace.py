@@ -5,12 +5,11 @@ import os
 import shutil
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 
 import ros2nb
-from ros2nb import checks, course
+from ros2nb import course
 
 ws_module = importlib.import_module('ros2nb.workspace')
 

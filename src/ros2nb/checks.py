@@ -30,8 +30,8 @@ from typing import Any, Callable, Optional
 
 from . import course
 from .errors import CheckFailed, Ros2nbError
-from .judge import (ARRIVAL_TIMEOUT_S, AnswerRef, Session, SubjectHung, in_judge,
-                    learner_error, run_in_judge, session, subject_env)
+from .judge import (ARRIVAL_TIMEOUT_S, AnswerRef, Session, in_judge, learner_error,
+                    run_in_judge, session, subject_env)
 from .processes import interrupt, kill_process_group
 
 __all__ = [
@@ -804,8 +804,9 @@ def check_monitor_readings() -> None:
 # ------------------------------------------------------------------ the package
 #: The grader's own stand-in nodes, so notebook 05 is graded on its own: they take the
 #: place of temperature_publisher.py and temperature_subscriber.py in the judge's build.
-STAND_IN_PUBLISHER = '''\
-"""Grader's stand-in sensor: a constant reading, five times a second."""
+#: Each is this program with its node's name and what the node does.
+STAND_IN = '''\
+"""Grader's stand-in {name}: a node that only {does}."""
 import rclpy
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
@@ -814,9 +815,8 @@ from std_msgs.msg import Float32
 
 def main(args=None):
     rclpy.init(args=args)
-    node = Node('temperature_sensor')
-    publisher = node.create_publisher(Float32, 'temperature', 10)
-    node.create_timer(0.2, lambda: publisher.publish(Float32(data=21.5)))
+    node = Node('{name}')
+    {setup}
     try:
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
@@ -825,27 +825,14 @@ def main(args=None):
         node.destroy_node()
         rclpy.try_shutdown()
 '''
-STAND_IN_SUBSCRIBER = '''\
-"""Grader's stand-in monitor: logs every reading it hears."""
-import rclpy
-from rclpy.executors import ExternalShutdownException
-from rclpy.node import Node
-from std_msgs.msg import Float32
-
-
-def main(args=None):
-    rclpy.init(args=args)
-    node = Node('temperature_monitor')
-    node.create_subscription(Float32, 'temperature',
-                             lambda m: node.get_logger().info(f'heard {m.data:.2f}'), 10)
-    try:
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
-'''
+STAND_IN_PUBLISHER = STAND_IN.format(
+    name=course.SENSOR_NODE, does='publishes a constant reading five times a second',
+    setup="publisher = node.create_publisher(Float32, 'temperature', 10)\n"
+          "    node.create_timer(0.2, lambda: publisher.publish(Float32(data=21.5)))")
+STAND_IN_SUBSCRIBER = STAND_IN.format(
+    name=course.MONITOR_NODE, does='logs every reading it hears',
+    setup="node.create_subscription(Float32, 'temperature',\n"
+          "                             lambda m: node.get_logger().info(f'heard {m.data:.2f}'), 10)")
 PLACEHOLDER = 'raise NotImplementedError'
 
 
