@@ -121,3 +121,31 @@ def test_record_unknown_topic_suggests(ros):
     ros2nb.add(Sensor())
     with pytest.raises(ros2nb.Ros2nbError, match=r'does not appear to be published yet.*Did you mean /temperature\?'):
         ros2nb.record('temprature', 10)
+
+
+def test_two_message_types_on_one_topic_are_noted(ros, capsys):
+    """Across processes a Float64 subscription just never hears a Float32 publisher."""
+    import subprocess
+    import sys
+    import time
+    code = ('import rclpy, time\nfrom std_msgs.msg import Float64\nrclpy.init()\n'
+            'node = rclpy.create_node("float64_monitor")\n'
+            'node.create_subscription(Float64, "temperature", print, 10)\n'
+            'print("up", flush=True)\ntime.sleep(30)\n')
+    monitor = subprocess.Popen([sys.executable, '-c', code], stdout=subprocess.PIPE, text=True)
+    try:
+        assert monitor.stdout.readline().strip() == 'up'
+        ros2nb.add(Sensor())
+        deadline = time.monotonic() + 15
+        while time.monotonic() < deadline and \
+                len(dict(ros2nb.current_runtime().node.get_topic_names_and_types())
+                    .get('/temperature', [])) < 2:
+            time.sleep(0.1)
+        capsys.readouterr()
+        ros2nb.topic_list()
+        assert ('Note: /temperature is used with 2 message types: std_msgs/msg/Float32 '
+                '(temperature_sensor), std_msgs/msg/Float64 (float64_monitor); both sides must '
+                'use the same type') in capsys.readouterr().out
+    finally:
+        monitor.kill()
+        monitor.wait()

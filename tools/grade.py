@@ -243,8 +243,9 @@ def judge_notebook(scratch: Scratch, notebook: str, submitted: Path,
     limits = sandbox.Limits(wall_s=JUDGE_TIMEOUT_S)
     if settings.sandboxed:
         env['FASTDDS_BUILTIN_TRANSPORTS'] = 'UDPv4'  # judge and subjects: own /dev/shm each
-        env['ROS2NB_SUBJECT_PREFIX'] = json.dumps(sandbox.inner_prefix(
-            readable=[scratch.workspace], writable=[folder]))
+        env['ROS2NB_SUBJECT_PREFIX'] = json.dumps(sandbox.inner_prefix(  # the course may be
+            readable=[scratch.workspace, ROOT / 'src'], writable=[folder],  # under /tmp too
+            hidden=[ROOT / 'src' / 'ros2nb' / 'reference']))
         box = sandbox.Sandbox(writable=[folder], env=env, cwd=folder, nested=True,
                               readable=[ROOT / 'src', scratch.workspace, given],
                               hidden=[ROOT / 'src' / 'ros2nb' / 'reference'])

@@ -190,8 +190,9 @@ def _check_types_agree(node: Any, rt: Any) -> None:
             mine = _type_name(entity.msg_type)
             others = [*graph.get_publishers_info_by_topic(topic),
                       *graph.get_subscriptions_info_by_topic(topic)]
-            for info in others:
-                if info.node_name in (name, '_ros2nb') or info.topic_type == mine:
+            for info in others:  # hidden nodes (ros2nb's, a check's, not yet named) aside
+                if info.node_name == name or info.node_name.startswith('_') \
+                        or info.topic_type == mine:
                     continue
                 role = 'publishes' if 'PUBLISHER' in str(info.endpoint_type) else 'subscribes to'
                 raise Ros2nbError(f'{name} {kind} {topic} as {mine}, but {info.node_name} {role} '
