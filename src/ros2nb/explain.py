@@ -204,18 +204,38 @@ def _check_types_agree(node: Any, rt: Any) -> None:
 _GUARDED = '_ros2nb_guarded'
 
 
+def _local_prefix() -> Optional[bytes]:
+    """The GUID prefix of this process's DDS participant (from ros2nb's own node), if ROS is up."""
+    from . import runtime
+    rt = runtime._runtime
+    if rt is None or not rt.alive:
+        return None
+    if rt.participant_prefix is None:
+        for info in rt.node.get_publishers_info_by_topic('/clock'):
+            if info.node_name == runtime.INTERNAL_NODE_NAME:
+                rt.participant_prefix = bytes(info.endpoint_gid[:12])
+    return rt.participant_prefix
+
+
 def _refuse_other_type(node: Any, kind: str, msg_type: Any, topic: str) -> None:
-    """Raise before rcl would fail with ``invalid allocator`` and a C error dump."""
+    """Raise before rcl would fail with ``invalid allocator`` and a C error dump.
+
+    That happens when an endpoint of this very process already uses the topic with another
+    type; endpoints of other processes are the graph's business (``topic_list`` notes them).
+    """
     if not isinstance(msg_type, type) or not hasattr(node, '_Node__node'):
         return  # rclpy's own error (or check_node at add()) says it better
+    local = _local_prefix()
     try:
         name = node.resolve_topic_name(topic)
-        existing = dict(node.get_topic_names_and_types()).get(name, [])
+        endpoints = [*node.get_publishers_info_by_topic(name),
+                     *node.get_subscriptions_info_by_topic(name)]
     except Exception:  # an invalid name: rclpy's own message, with its caret, is best
         return
     mine = _type_name(msg_type)
-    others = [t for t in existing if t != mine]
-    if others:
+    others = sorted({e.topic_type for e in endpoints if bytes(e.endpoint_gid[:12]) == local
+                     and e.topic_type != mine})
+    if local is not None and others:
         verb = 'publish on' if kind == 'publisher' else 'subscribe to'
         raise Ros2nbError(f'{node.get_name()} would {verb} {name} as {mine}, but {name} already '
                           f'carries {", ".join(others)} in this kernel: both sides of a topic '

@@ -77,12 +77,14 @@ def unmatched_topics() -> list[str]:
     others = [n for n in topics if n not in INFRASTRUCTURE_TOPICS]
     for name in sorted(others):
         if len(topics[name]) > 1:
-            uses = [f'{info.topic_type} ({info.node_name})' for info in
-                    [*node.get_publishers_info_by_topic(name),
-                     *node.get_subscriptions_info_by_topic(name)]
-                    if not _hidden(info.node_name)]
+            owners: dict[str, set[str]] = {t: set() for t in topics[name]}
+            for info in [*node.get_publishers_info_by_topic(name),
+                         *node.get_subscriptions_info_by_topic(name)]:
+                if not _hidden(info.node_name):  # nodes not discovered yet stay unnamed
+                    owners.setdefault(info.topic_type, set()).add(info.node_name)
+            uses = [f'{t} ({", ".join(sorted(o))})' if o else t for t, o in sorted(owners.items())]
             notes.append(f'{name} is used with {len(topics[name])} message types: '
-                         f'{", ".join(sorted(set(uses)))}; both sides must use the same type')
+                         f'{", ".join(uses)}; both sides must use the same type')
             continue
         pubs, subs = node.count_publishers(name), node.count_subscribers(name)
         note = (f'{name} has {pubs} publisher(s) but no subscription' if pubs and not subs else

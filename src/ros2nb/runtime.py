@@ -112,6 +112,8 @@ class Runtime:
         self._exclusive_depth = 0
         #: Called with (node name, callback name, exception) when a callback raises.
         self.on_failure: Optional[Callable[[str, str, BaseException], None]] = None
+        #: This process's DDS participant (the first 12 bytes of its endpoints' GIDs).
+        self.participant_prefix: Optional[bytes] = None
 
         rclpy.init(args=['--ros-args', '--disable-stdout-logs', '--disable-external-lib-logs'],
                    domain_id=domain_id, signal_handler_options=SignalHandlerOptions.NO)
