@@ -65,6 +65,10 @@ EXPECTED = {
     'Zoë': Case({NB01: 1}),
     'two words': Case({NB01: 1}),
     'browser-copy': Case({NB01: 1}, {}, {NB01: f'graded {NB01} (1).ipynb as {NB01}.ipynb'}),
+    'glob[*]chars': Case({NB01: 1}, {}, {'_folder': 'graded under the id learner-'}),
+    # ---- the course's graded cells cannot be removed or re-weighted
+    'deletes-the-check': Case({NB01: 1}, {NB01: 'Check passed'}),
+    'claims-100-points': Case({NB01: 0}),
 }
 
 
@@ -295,4 +299,16 @@ def build(folder: Path, *, grading_out: Path, submissions: Path, decoy_gradebook
     put('Zoë', NB01, SOLUTION[NB01])
     put('two words', NB01, SOLUTION[NB01])
     put('browser-copy', NB01, SOLUTION[NB01], name=f'{NB01} (1).ipynb')
+    put('glob[*]chars', NB01, SOLUTION[NB01])
+    deleted = nbformat.read(SOLUTION[NB01], as_version=4)
+    deleted.cells = [c for c in deleted.cells if 'learner-check' not in c.metadata.get('tags', [])]
+    put('deletes-the-check', NB01, deleted)
+    claims = nbformat.read(LEARNER[NB01], as_version=4)  # unsolved, but its check says 100
+    for cell in claims.cells:
+        if cell.metadata.get('nbgrader', {}).get('grade'):
+            cell.metadata['nbgrader']['points'] = 100
+    claims.cells.append(nbformat.v4.new_code_cell('print("free points")', metadata={
+        'nbgrader': {'grade': True, 'grade_id': 'my-own-points', 'locked': True, 'points': 50,
+                     'solution': False, 'schema_version': 3, 'task': False}}))
+    put('claims-100-points', NB01, claims)
     return folder
