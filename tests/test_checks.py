@@ -114,6 +114,12 @@ SENSOR_MISTAKES = [
      checks.check_sensor_callback, r"Float32's field 'data' takes \d+\.0 or float\(\.\.\.\), not int \d+.*temperature_publisher.py line \d+: msg.data = int"),
     ('never published', '        self.publisher_.publish(msg)\n', '',
      checks.check_sensor_callback, r'publish_temperature ran but nothing arrived on /temperature'),
+    ('self.TOPIC', 'self.create_publisher(Float32, TOPIC, QUEUE_DEPTH)', 'self.create_publisher(Float32, self.TOPIC, QUEUE_DEPTH)',
+     checks.check_sensor_constructor, r'TemperatureSensor\(\) raised: TOPIC is a constant of the file, not of the node: write TOPIC, not self.TOPIC'),
+    ('part 4 not indented', '    def publish_temperature(self):', 'def publish_temperature(self):',
+     checks.check_sensor_callback, r'publish_temperature is written outside the class TemperatureSensor: indent its part by four spaces'),
+    ('shutdown instead of try_shutdown', 'rclpy.try_shutdown()  # rclpy.shutdown() would raise', 'rclpy.shutdown()  # rclpy.shutdown() would raise',
+     checks.check_sensor_main, r'exited with code 1 after Ctrl\+C \(RCLError: failed to shutdown: rcl_shutdown already called on the given context\): shut down with rclpy.try_shutdown\(\) instead of rclpy.shutdown\(\)'),
     ("the tutorial's main", '''    except (KeyboardInterrupt, ExternalShutdownException):
         pass  # Ctrl+C or a shutdown from outside: leave quietly
     finally:
@@ -122,7 +128,7 @@ SENSOR_MISTAKES = [
         pass
     node.destroy_node()
     rclpy.shutdown()''',
-     checks.check_sensor_main, r'exited with code 1 after Ctrl\+C \(.*RCLError: failed to shutdown'),
+     checks.check_sensor_main, r'exited with code 1 after Ctrl\+C \(RCLError: failed to shutdown: .*\): catch ExternalShutdownException around the spin'),
 ]
 
 
@@ -146,7 +152,11 @@ MONITOR_MISTAKES = [
     ('boundaries included', 'if temperature_c > HIGH_ABOVE_C:', 'if temperature_c >= HIGH_ABOVE_C:',
      checks.check_monitor_callback, r'For 26.0 °C the monitor said High; it should say Normal'),
     ('lower case', "status = 'High'", "status = 'high'",
-     checks.check_monitor_callback, r'without a status High, Low or Normal \("high": write it High\)'),
+     checks.check_monitor_callback, r'write the status High, with a capital letter'),
+    ('arguments out of order', 'Float32, TOPIC, self.temperature_callback, QUEUE_DEPTH)', 'Float32, TOPIC, QUEUE_DEPTH, self.temperature_callback)',
+     checks.check_monitor_constructor, r'TemperatureMonitor\(\) raised: the arguments are in the wrong order: create_subscription takes the message type, the topic, the callback and the queue depth'),
+    ('the message for its value', 'temperature_c = msg.data', 'temperature_c = msg',
+     checks.check_monitor_callback, r'temperature_callback raised for 19.99 °C: a Float32 message is not its value: use its field \(data\), e.g. msg.data'),
     ('two lines', "        self.get_logger().info(f'Temperature: {temperature_c:.2f}C - Status: {status}')",
      "        self.get_logger().info(f'Temperature: {temperature_c:.2f}C')\n        self.get_logger().info(f'Status: {status}')",
      checks.check_monitor_callback, r'logged 2 lines; log exactly one per message'),
@@ -188,6 +198,19 @@ def test_package_checks(session, capsys):
         fails(checks.check_entry_points, r'console_scripts has no entry named temperature_publisher')
         setup_py.write_text(generated_py.replace(empty, (
             "        'console_scripts': [\n"
+            "            'temperature_publisher = sensor_simulator.temperature_publisher:main'\n"
+            "            'temperature_subscriber = sensor_simulator.temperature_subscriber:main',\n"
+            "        ],\n")))
+        fails(checks.check_entry_points, r'is two entries run together: end each string in the '
+                                         r'console_scripts list with a comma')
+        setup_py.write_text(generated_py.replace(empty, (
+            "        'console_scripts': [\n"
+            "            'temperature_publisher = sensor_simulator/temperature_publisher.py:main',\n"
+            "        ],\n")))
+        fails(checks.check_entry_points, r'is not written NAME = package.module:function: the '
+                                         r'module is written with dots')
+        setup_py.write_text(generated_py.replace(empty, (
+            "        'console_scripts': [\n"
             "            'temperature_publisher = sensor_simulator.publisher:main',\n"
             "            'temperature_subscriber = sensor_simulator.temperature_subscriber:main',\n"
             "        ],\n")))
@@ -220,7 +243,8 @@ def test_package_checks(session, capsys):
 def test_no_message_prints_the_answer():
     assert len(MESSAGES) >= len(SENSOR_MISTAKES) + len(MONITOR_MISTAKES)
     for message in MESSAGES:
-        assert not any(code in message for code in ANSWER_CODE), message
+        own_line = re.sub(r' \((?:cell|[\w.]+\.py) line \d+: .*\)$', '', message)  # theirs
+        assert not any(code in own_line for code in ANSWER_CODE), message
 
 
 def test_a_check_from_the_kernel_runs_in_a_judge_process(tmp_path, monkeypatch, capsys):

@@ -20,6 +20,7 @@ import ast
 import configparser
 import difflib
 import math
+import re
 import shutil
 import subprocess
 import sys
@@ -197,7 +198,7 @@ def _answer_node_endpoints(ref: AnswerRef) -> tuple[str, list]:
     if reply.get('refused'):
         raise CheckFailed(reply['refused'])
     if not reply['ok']:
-        raise learner_error(f'Creating {ref.name}()', reply['error'])
+        raise learner_error(f'{ref.name}()', reply['error'])
     found = judge.observer.endpoints(reply['name'], reply['namespace'], reply['endpoints'])
     return reply['name'], found
 
@@ -319,7 +320,7 @@ def _new_node(judge: Session, relative: str, cls: str, *, placeholders: tuple[st
     if reply.get('refused'):
         raise CheckFailed(reply['refused'])
     if not reply['ok']:
-        raise learner_error(f'Creating {cls}()', reply['error'])
+        raise learner_error(f'{cls}()', reply['error'])
     return subject, reply
 
 
@@ -418,7 +419,7 @@ def _run_sensor(judge: Session, subject: Any, info: dict, seconds: int, *,
         reply = subject.request('advance', seconds=step_s, seed=seed if number == 0 else None)
         if reply['failure']:
             failure = reply['failure']
-            raise learner_error(f'{failure["callback"]} raised', failure)
+            raise learner_error(failure['callback'], failure)
         want = reply['published'].get(topic, 0) - base['published'].get(topic, 0)
         if not observer.wait_until(lambda: len(observer.readings) - first >= want,
                                    ARRIVAL_TIMEOUT_S):
@@ -605,13 +606,45 @@ def _main(judge: Session, relative: str, node_name: str) -> str:
                           'let KeyboardInterrupt end the spin.') from None
     text = output.text()
     if code != 0 or 'Traceback' in text:
-        raise CheckFailed(f'{path.name} exited with code {code} after Ctrl+C '
-                          f'({_last_line(text)}): catch KeyboardInterrupt and '
-                          'ExternalShutdownException around the spin, and shut down with '
-                          'rclpy.try_shutdown().')
+        last = _error_line(text)
+        raise CheckFailed(f'{path.name} exited with code {code} after Ctrl+C ({last}): '
+                          f'{_ctrl_c_advice(main, last)}.')
     _cleanup_verdict(main)
     return (f'{path.name} stops cleanly on Ctrl+C (exit code 0, no traceback) and cleans up in '
             'finally.')
+
+
+def _caught(main: ast.FunctionDef) -> set[str]:
+    """The exception names ``main()``'s ``except`` clauses catch."""
+    names: set[str] = set()
+    for node in ast.walk(main):
+        if isinstance(node, ast.ExceptHandler) and node.type is not None:
+            for part in ast.walk(node.type):
+                if isinstance(part, (ast.Name, ast.Attribute)):
+                    names.add(part.id if isinstance(part, ast.Name) else part.attr)
+    return names
+
+
+def _ctrl_c_advice(main: ast.FunctionDef, error: str) -> str:
+    """What to change in main(), from how it failed after Ctrl+C and what it catches."""
+    caught = _caught(main)
+    if 'rcl_shutdown already called' in error and \
+            {'KeyboardInterrupt', 'ExternalShutdownException'} <= caught:
+        return ('shut down with rclpy.try_shutdown() instead of rclpy.shutdown(): on Jazzy '
+                'Ctrl+C has already shut rclpy down')
+    missing = [name for name in ('KeyboardInterrupt', 'ExternalShutdownException')
+               if name not in caught]
+    if missing:
+        return (f'catch {" and ".join(missing)} around the spin (both end it on Jazzy), and shut '
+                'down with rclpy.try_shutdown()')
+    return 'clean up in a finally: block with node.destroy_node() and rclpy.try_shutdown()'
+
+
+def _error_line(text: str) -> str:
+    """The last line of a traceback, without module paths or rcl's C source location."""
+    line = _last_line(text)
+    line = re.sub(r'^(?:[A-Za-z_][\w]*\.)+(?=\w+(?:Error|Exception)\b)', '', line)
+    return re.sub(r', at /\S+:\d+$', '', line)
 
 
 def _prefix() -> list[str]:
@@ -719,7 +752,7 @@ def _feed_monitor(judge: Session, readings: tuple[float, ...] | list[float]) -> 
                                 seconds=ARRIVAL_TIMEOUT_S)
         if reply['failure']:
             failure = reply['failure']
-            raise learner_error(f'{failure["callback"]} raised for {value} °C', failure)
+            raise learner_error(failure['callback'], failure, context=f' for {value} °C')
         if not reply['ok']:
             raise CheckFailed(f'The reading {value} °C never reached temperature_callback: is it '
                               'the subscription\'s callback?')
@@ -730,7 +763,6 @@ def _feed_monitor(judge: Session, readings: tuple[float, ...] | list[float]) -> 
 
 def _statuses_verdict(readings: tuple[float, ...] | list[float], lines: list[list[str]], *,
                       with_value: bool) -> None:
-    import re
     words = re.compile(r'\b(High|Low|Normal)\b')
     for value, said in zip(readings, lines):
         want = course.monitor_status(value)
@@ -743,10 +775,12 @@ def _statuses_verdict(readings: tuple[float, ...] | list[float], lines: list[lis
         found = words.findall(said[0])
         if not found:
             lower = re.search(r'\b(high|low|normal)\b', said[0], re.IGNORECASE)
-            hint = (f' ("{lower.group(0)}": write it {lower.group(0).capitalize()})' if lower
-                    else '')
-            raise CheckFailed(f'For {value} °C the monitor logged "{said[0]}", without a status '
-                              f'High, Low or Normal{hint}.')
+            if lower:
+                raise CheckFailed(f'For {value} °C the monitor logged "{said[0]}": write the '
+                                  f'status {lower.group(0).capitalize()}, with a capital letter, '
+                                  f'as High, Low and Normal are written.')
+            raise CheckFailed(f'For {value} °C the monitor logged "{said[0]}", without a status: '
+                              'add High, Low or Normal to the line.')
         if found != [want]:
             rule = (f'only readings strictly above {course.HIGH_ABOVE_C} °C are High and strictly '
                     f'below {course.LOW_BELOW_C} °C Low')
@@ -844,6 +878,39 @@ def _package_source(judge: Session) -> Path:
     return source
 
 
+def _console_scripts(setup_py: Path) -> Optional[list[Any]]:
+    """The ``console_scripts`` list of ``setup(entry_points=...)`` as written, or None."""
+    try:
+        tree = ast.parse(setup_py.read_text())
+    except (SyntaxError, OSError):
+        return None  # the build says where
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Dict):
+            for key, value in zip(node.keys, node.values):
+                if isinstance(key, ast.Constant) and key.value == 'console_scripts' \
+                        and isinstance(value, ast.List):
+                    return value.elts
+    return None
+
+
+def _entry_point_syntax_verdict(setup_py: Path) -> None:
+    """Each console_scripts string must read ``NAME = package.module:function``."""
+    from importlib.metadata import EntryPoint
+    for element in _console_scripts(setup_py) or []:
+        if not (isinstance(element, ast.Constant) and isinstance(element.value, str)):
+            continue
+        entry = element.value
+        if entry.count('=') > 1:
+            raise CheckFailed(f'"{entry[:70]}..." is two entries run together: end each string '
+                              'in the console_scripts list with a comma.')
+        name, _, target = entry.partition('=')
+        match = EntryPoint.pattern.match(target.strip()) if name.strip() else None
+        if match is None or not match.group('attr'):
+            raise CheckFailed(f'"{entry}" is not written NAME = package.module:function: the '
+                              'module is written with dots, like an import, without .py, and '
+                              'the function follows a colon.')
+
+
 def _built(judge: Session) -> Path:
     """Build a copy of the learner's package, with the grader's stand-in nodes; cached.
 
@@ -857,9 +924,10 @@ def _built(judge: Session) -> Path:
     if digest in judge.builds:
         return judge.builds[digest]
     for name in ('setup.py', 'setup.cfg'):
-        if PLACEHOLDER in (source / name).read_text():
+        if (source / name).is_file() and PLACEHOLDER in (source / name).read_text():
             raise CheckFailed(f'{name} still holds the placeholder "raise NotImplementedError()": '
                               'replace it with your lines and run that cell again.')
+    _entry_point_syntax_verdict(source / 'setup.py')
     ws = judge.scratch / f'build-{digest}'
     package = ws / 'src' / course.PACKAGE
     shutil.copytree(source, package, ignore=shutil.ignore_patterns('__pycache__', '*.egg-info'))
@@ -933,8 +1001,8 @@ def _setup_cfg(judge: Session) -> str:
     for section, key in (('develop', 'script_dir'), ('install', 'install_scripts')):
         got = config.get(section, key, fallback=None)
         if got is None:
-            raise CheckFailed(f'setup.cfg has no {key} in a [{section}] section; ros2 run looks in '
-                              f'{want}.')
+            raise CheckFailed(f'setup.cfg has no {key} in its [{section}] section; ros2 run '
+                              f'looks in {want}.')
         if got.strip() != want:
             raise CheckFailed(f'[{section}] {key} is {got.strip()}; ros2 run looks in {want}.')
     ws = _built(judge)

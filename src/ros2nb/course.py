@@ -10,6 +10,8 @@ Also :func:`catch_up`, so any notebook can be run on its own.  Introduced in
 
 from __future__ import annotations
 
+import contextlib
+import io
 import os
 from importlib import resources
 from pathlib import Path
@@ -115,8 +117,9 @@ def catch_up(notebook: int) -> Path:
     ws = create_workspace()  # also re-creates any missing sub-folder, like mkdir -p
     package = package_path(ws)
     if 'package' in steps and not package.exists():
-        pkg_create(PACKAGE, destination=ws / 'src', dependencies=list(DEPENDENCIES),
-                   maintainer_name=MAINTAINER_NAME, maintainer_email=MAINTAINER_EMAIL)
+        with contextlib.redirect_stdout(io.StringIO()):  # notebook 02 shows pkg create's lines
+            pkg_create(PACKAGE, destination=ws / 'src', dependencies=list(DEPENDENCIES),
+                       maintainer_name=MAINTAINER_NAME, maintainer_email=MAINTAINER_EMAIL)
         done.append(shown(package))
     for step in ('publisher', 'subscriber'):
         target = package / PACKAGE / f'temperature_{step}.py'

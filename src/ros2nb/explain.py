@@ -80,6 +80,54 @@ def _field_type(exc: AssertionError) -> Optional[str]:
             'convert the value before you put it into the message.')
 
 
+def _learner_frame(exc: BaseException) -> Any:
+    """The innermost frame of the learner's own code (a cell or their file), or None."""
+    found = None
+    tb = exc.__traceback__
+    while tb is not None:
+        if not is_library_file(tb.tb_frame.f_code.co_filename):
+            found = tb.tb_frame
+        tb = tb.tb_next
+    return found
+
+
+_NO_ATTRIBUTE = re.compile(r"^'(\w+)' object has no attribute '(\w+)'")
+
+
+def _missing_attribute(exc: AttributeError) -> Optional[str]:
+    """``self.TOPIC`` for a module constant, or a method written outside its class."""
+    match = _NO_ATTRIBUTE.match(str(exc))
+    frame = _learner_frame(exc)
+    if not match or frame is None:
+        return None
+    owner, name = match.groups()
+    found = frame.f_globals.get(name)
+    if found is None:
+        return None
+    if name.isupper():
+        return (f'{name} is a constant of the file, not of the node: write {name}, not '
+                f'self.{name}.')
+    if callable(found) and not isinstance(found, type):
+        return (f'{name} is written outside the class {owner}: indent its part by four spaces, '
+                'so that it becomes a method of the class.')
+    return None
+
+
+def _message_not_a_value(exc: TypeError) -> Optional[str]:
+    """A message used where its number is meant: ``msg > 26`` instead of ``msg.data > 26``."""
+    frame = _learner_frame(exc)
+    if frame is None:
+        return None
+    for value in frame.f_locals.values():
+        cls = type(value)
+        if hasattr(cls, 'get_fields_and_field_types') and \
+                re.search(rf'\b{cls.__name__}\b', str(exc)):
+            fields = ', '.join(cls.get_fields_and_field_types())
+            return (f'a {cls.__name__} message is not its value: use its field ({fields}), e.g. '
+                    'msg.data.')
+    return None
+
+
 def _node_without_init(exc: AttributeError) -> Optional[str]:
     for frame in _frames(exc):
         if not frame.f_code.co_filename.endswith(os.path.join('rclpy', 'node.py')):
@@ -114,13 +162,19 @@ def explain_exception(exc: BaseException) -> Optional[str]:
     if isinstance(exc, AssertionError):
         return _field_type(exc)
     if isinstance(exc, AttributeError):
-        return _node_without_init(exc)
+        return _node_without_init(exc) or _missing_attribute(exc)
     if type(exc).__name__ == 'RCLError' and 'context is invalid' in text:
         from . import runtime
         return runtime.SHUT_DOWN_MESSAGE
     if isinstance(exc, TypeError) and text.startswith('Expected <class'):
         return ('publish() takes a message object, not a bare value: create the message '
                 '(msg = Float32()), set msg.data, then publish(msg).')
+    if isinstance(exc, TypeError) and text.startswith('Expected QoSProfile or int'):
+        return ('the arguments are in the wrong order: create_subscription takes the message '
+                'type, the topic, the callback and the queue depth (create_publisher: the type, '
+                'the topic and the depth); something else came where the depth belongs.')
+    if isinstance(exc, TypeError):
+        return _message_not_a_value(exc)
     return None
 
 

@@ -293,19 +293,24 @@ class SubjectProcess:
             os.close(self._replies)
 
 
-def learner_error(summary: str, error: dict) -> CheckFailed:
+def learner_error(what: str, error: dict, *, context: str = '') -> CheckFailed:
     """The CheckFailed for an exception the learner's code raised in a subject.
 
-    A known mistake gets its one line; ``NotImplementedError`` says which gap to fill;
-    anything else shows the learner's own traceback (their frames only).
+    A gap left unwritten says which one; a known mistake gets its one line; anything else
+    shows the learner's own traceback (their frames only).
+
+    :param what: whose code raised, e.g. ``TemperatureSensor.publish_temperature``.
+    :param error: the subject's description of the exception.
+    :param context: what it was doing, e.g. `` for 19.99 °C``.
     """
     if error.get('type') == 'NotImplementedError':
-        return CheckFailed(f'{summary} still raises NotImplementedError: write your code where '
-                           'it says YOUR CODE HERE and run that cell again.')
+        return CheckFailed(f'{what} still raises NotImplementedError{context}: write your code '
+                           'where it says YOUR CODE HERE and run that cell again.')
     if error.get('explanation'):
         where = error.get('where')
-        return CheckFailed(f'{summary}: {error["explanation"]}' + (f' ({where})' if where else ''))
-    return LearnerCodeError(f'{summary}: {error["type"]}: {error["message"]}',
+        return CheckFailed(f'{what} raised{context}: {error["explanation"]}'
+                           + (f' ({where})' if where else ''))
+    return LearnerCodeError(f'{what} raised{context}: {error["type"]}: {error["message"]}',
                             error.get('traceback', []))
 
 
@@ -366,7 +371,7 @@ class Session:
                 raise CheckFailed(f'{path.name} does not exist yet: run the %%part cells that '
                                   'write it, from part 1 on.')
             if not reply['ok']:
-                raise learner_error(f'{path.name} does not import', reply['error'])
+                raise learner_error(path.name, reply['error'], context=' on import')
 
         return self.subject(('file', relative), load)
 
