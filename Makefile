@@ -39,8 +39,9 @@ lab: $(STAMP)
 # Unit tests of ros2nb, the notebook checks, then nbval over both notebook folders.
 # Grading runs learners' code in bubblewrap sandboxes (Debian's bubblewrap package).
 sandbox-tool:
-	@command -v bwrap >/dev/null || { if [ "$$(id -u)" = 0 ]; then apt-get install -y -q bubblewrap >/dev/null; \
-	  else echo "bubblewrap is not installed: sudo apt-get install bubblewrap (grading and its tests need it)."; fi; }
+	@command -v bwrap >/dev/null || [ "$$(id -u)" != 0 ] || apt-get install -y -q bubblewrap >/dev/null 2>&1 \
+	  || { apt-get update -q >/dev/null 2>&1 && apt-get install -y -q bubblewrap >/dev/null 2>&1; } || true
+	@command -v bwrap >/dev/null || echo "bubblewrap is not installed (sudo apt-get install bubblewrap): grading refuses to run and its tests skip."
 
 test: $(STAMP) sandbox-tool
 	$(PY) -m pytest tests
