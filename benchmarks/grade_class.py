@@ -10,6 +10,7 @@ time per notebook.  Usage: ``make benchmark-grading`` or
 from __future__ import annotations
 
 import argparse
+import csv
 import shutil
 import subprocess
 import sys
@@ -38,11 +39,16 @@ def main() -> None:
                                '--out', str(Path(tmp) / 'grading'), f'--jobs={args.jobs}'],
                               capture_output=True, text=True)
         elapsed = time.perf_counter() - started
-        full = sum(1 for line in done.stdout.splitlines() if line.endswith(': 18/18'))
+        with open(Path(tmp) / 'grading' / 'grades.csv', newline='') as stream:
+            totals = [row['score'] for row in csv.DictReader(stream) if row['notebook'] == 'TOTAL']
+        full = totals.count('18')
+        notes = [line for line in done.stdout.splitlines() if '(' in line][:3]
     count = args.learners * len(notebooks)
     print(f'graded {args.learners} learners x {len(notebooks)} notebooks ({count} notebooks, '
           f'{args.jobs} at a time) in {elapsed / 60:.1f} min ({elapsed / count:.1f} s per '
           f'notebook); exit code {done.returncode}; {full} of {args.learners} scored 18/18')
+    for line in notes:
+        print(f'  note: {line[:300]}')
 
 
 if __name__ == '__main__':

@@ -36,7 +36,8 @@ class Case:
 EXPECTED = {
     # ---- what a grade means (the learner writes the code)
     'untouched': Case({n: 0 for n in NB}, {NB03: 'still raises NotImplementedError'}),
-    'complete': Case(dict(FULL), {NB03: 'an hour of simulated time: 3600 readings'}),
+    'complete': Case(dict(FULL), {NB03: 'an hour of simulated time: 3600 readings'},
+                     {n: '' for n in NB}),  # nothing to note
     'solved-only-04': Case({NB03: 0, NB04: 5}),
     'handed-in-only-05': Case({NB05: 4}, {NB05: 'ros2 run starts both entry points'}),
     # ---- the verdict is out of the learner's reach (a publisher with the 10.2 floor: 3 of 6)

@@ -287,7 +287,7 @@ def _run_note(status: dict, stopped: Optional[str]) -> Optional[str]:
         notes.append(f'the output of cell(s) {cells} was cut (too large to keep)')
     if status.get('runner_error'):
         notes.append(f'running it stopped early: {status["runner_error"]}')
-    if not notes and status.get('ran', 0) < status.get('cells', 0):
+    if not notes and not status.get('finished'):
         notes.append(f'its run ended at cell {status["ran"] + 1} of {status["cells"]}: the '
                      'notebook stopped or killed the processes running it')
     return '; '.join(notes) or None

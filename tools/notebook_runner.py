@@ -99,7 +99,7 @@ def main(argv: list[str]) -> int:
     args = parser.parse_args(argv)
     nb = nbformat.read(args.notebook, as_version=4)
     status: dict = {'ran': 0, 'cells': len(nb.cells), 'timed_out': [], 'output_cut': [],
-                    'kernel_died_at': None}
+                    'kernel_died_at': None, 'finished': False}
     timeout_error = {'ename': 'CellTimeoutError',
                      'evalue': f'the grader stopped this cell after {args.cell_timeout} s',
                      'traceback': [f'CellTimeoutError: the grader stopped this cell after '
@@ -111,6 +111,7 @@ def main(argv: list[str]) -> int:
     save(nb, args.out, status)
     try:
         client.execute()
+        status['finished'] = True
     except DeadKernelError:
         status['kernel_died_at'] = status['ran']
     except Exception as error:  # nbclient could not go on: say why, keep what ran
