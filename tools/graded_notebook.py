@@ -14,16 +14,12 @@ import html
 from typing import Any, Optional
 
 import nbformat
+from ros2nb.judge import nbgrader_metadata as nbgrader
 
 #: What the learner's kernel runs in place of a graded cell.
 CHECKED_OUTSIDE = '# Checked by the grader, outside this notebook (ros2nb.judge).'
 #: Output types shown in feedback as they are; others (HTML, JavaScript, SVG) are dropped.
 SAFE_MIME_TYPES = ('text/plain', 'image/png', 'image/jpeg')
-
-
-def nbgrader(cell: Any) -> dict:
-    value = cell.get('metadata', {}).get('nbgrader', {})
-    return value if isinstance(value, dict) else {}
 
 
 def graded_ids(release: nbformat.NotebookNode) -> list[str]:

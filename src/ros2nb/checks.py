@@ -31,6 +31,7 @@ from typing import Any, Callable, Optional
 
 from . import course
 from .errors import CheckFailed, Ros2nbError
+from .graph import node_endpoints
 from .judge import (ARRIVAL_TIMEOUT_S, AnswerRef, Session, in_judge, learner_error,
                     run_in_judge, session, subject_env)
 from .processes import interrupt, kill_process_group
@@ -146,14 +147,6 @@ def _endpoint_verdict(node: str, found: list[tuple[str, str, str]], kind: str, t
                       '__init__ and keep it in an attribute of the node.')
 
 
-def _local_endpoints(node: Any) -> list[tuple[str, str, str]]:
-    return [(kind, node.resolve_topic_name(e.topic_name),
-             f'{e.msg_type.__module__.split(".")[0]}/msg/{e.msg_type.__name__}')
-            for kind, entities in (('publisher', node.publishers),
-                                   ('subscription', node.subscriptions))
-            for e in entities]
-
-
 def check_endpoint(node_class: Any, kind: str, topic: str, type_name: str) -> None:
     """Check that a node class makes a publisher or subscription on ``topic`` with ``type_name``.
 
@@ -184,7 +177,7 @@ def _kernel_node_endpoints(node_class: Any) -> tuple[str, list]:
         raise CheckFailed(f'Expected a node, got {type(node).__name__}: pass your Node '
                           'subclass itself, e.g. LoudListener (no parentheses).')
     try:
-        return node.get_name(), _local_endpoints(node)
+        return node.get_name(), node_endpoints(node)
     finally:
         node.destroy_node()
 
@@ -580,11 +573,7 @@ def _main(judge: Session, relative: str, node_name: str) -> str:
     if main is None:
         raise CheckFailed(f'{path.name} has no main() function yet: write part 5.')
     observer = judge.observer
-    proc = subprocess.Popen([*_prefix(), sys.executable, str(path)], cwd=judge.workspace,
-                            env=subject_env(), text=True, stdin=subprocess.DEVNULL,
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                            start_new_session=True)
-    output = _Collected(proc)
+    proc, output = judge.start([sys.executable, str(path)], cwd=judge.workspace)
     observer.wait_until(lambda: proc.poll() is not None or observer.has_node(node_name), 10.0)
     time.sleep(RUN_BEFORE_CTRL_C_S)
     if proc.poll() is not None:
@@ -645,26 +634,6 @@ def _error_line(text: str) -> str:
     line = _last_line(text)
     line = re.sub(r'^(?:[A-Za-z_][\w]*\.)+(?=\w+(?:Error|Exception)\b)', '', line)
     return re.sub(r', at /\S+:\d+$', '', line)
-
-
-def _prefix() -> list[str]:
-    from .judge import subject_prefix
-    return subject_prefix()
-
-
-class _Collected:
-    """All output of a process, read in a thread."""
-
-    def __init__(self, proc: subprocess.Popen) -> None:
-        import threading
-        self.lines: list[str] = []
-        self._thread = threading.Thread(target=lambda: self.lines.extend(proc.stdout or []),
-                                        daemon=True)
-        self._thread.start()
-
-    def text(self) -> str:
-        self._thread.join(2.0)
-        return ''.join(self.lines)
 
 
 def _last_line(text: str) -> str:
@@ -1037,11 +1006,8 @@ def _package_runs(judge: Session) -> str:
                 if k.startswith(('ROS_', 'RCUTILS', 'FASTDDS', 'PYTHONUNBUFFERED'))})
     observer = judge.observer
     mark = len(observer.logs)
-    procs = [subprocess.Popen([*_prefix(), *argv], cwd=ws, env=env, text=True,
-                              stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                              stderr=subprocess.STDOUT, start_new_session=True)
-             for argv in argvs]
-    outputs = [_Collected(proc) for proc in procs]
+    started = [judge.start(argv, cwd=ws, env=env) for argv in argvs]
+    procs, outputs = [proc for proc, _ in started], [output for _, output in started]
     try:
         heard = observer.wait_until(lambda: observer.lines_of(course.MONITOR_NODE, mark), 15.0)
         for proc in procs:

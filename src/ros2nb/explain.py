@@ -11,15 +11,17 @@ through rclpy (:mod:`ros2nb.kernel`); a failing callback is reported with it.
 
 from __future__ import annotations
 
+import linecache
 import os
 import re
 import site
 import sysconfig
-import traceback
 from pathlib import Path
+from types import TracebackType
 from typing import Any, Optional
 
 from .errors import Ros2nbError
+from .graph import type_name
 
 _HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -40,16 +42,25 @@ def is_library_file(path: str) -> bool:
     return path.startswith(_LIBRARY_DIRS) or path.startswith('<frozen')
 
 
+def _learner_entry(exc: BaseException) -> Optional[TracebackType]:
+    """The innermost traceback entry in the learner's own code (a cell or their file)."""
+    found, tb = None, exc.__traceback__
+    while tb is not None:
+        if not is_library_file(tb.tb_frame.f_code.co_filename):
+            found = tb
+        tb = tb.tb_next
+    return found
+
+
 def learner_line(exc: BaseException) -> str:
     """Return ``cell line N: source`` or ``FILE line N: source`` for the learner's innermost frame."""
-    found = ''
-    for frame in traceback.extract_tb(exc.__traceback__):
-        if is_library_file(frame.filename):
-            continue
-        path = Path(frame.filename)
-        place = path.name if path.is_file() and 'ipykernel' not in frame.filename else 'cell'
-        found = f'{place} line {frame.lineno}: {(frame.line or "").strip()}'
-    return found
+    entry = _learner_entry(exc)
+    if entry is None:
+        return ''
+    filename = entry.tb_frame.f_code.co_filename
+    path = Path(filename)
+    place = path.name if path.is_file() and 'ipykernel' not in filename else 'cell'
+    return f'{place} line {entry.tb_lineno}: {linecache.getline(filename, entry.tb_lineno).strip()}'
 
 
 def _frames(exc: BaseException):
@@ -82,13 +93,8 @@ def _field_type(exc: AssertionError) -> Optional[str]:
 
 def _learner_frame(exc: BaseException) -> Any:
     """The innermost frame of the learner's own code (a cell or their file), or None."""
-    found = None
-    tb = exc.__traceback__
-    while tb is not None:
-        if not is_library_file(tb.tb_frame.f_code.co_filename):
-            found = tb.tb_frame
-        tb = tb.tb_next
-    return found
+    entry = _learner_entry(exc)
+    return entry.tb_frame if entry is not None else None
 
 
 _NO_ATTRIBUTE = re.compile(r"^'(\w+)' object has no attribute '(\w+)'")
@@ -183,11 +189,6 @@ def _callback_name(callback: Any) -> str:
     return getattr(callback, '__qualname__', repr(callback))
 
 
-def _type_name(msg_type: Any) -> str:
-    cls = msg_type if isinstance(msg_type, type) else type(msg_type)
-    return f'{cls.__module__.split(".")[0]}/msg/{cls.__name__}'
-
-
 def check_node(node: Any, rt: Any) -> None:
     """Refuse, with one line, a node that would fail or mislead once it runs.
 
@@ -241,7 +242,7 @@ def _check_types_agree(node: Any, rt: Any) -> None:
     for kind, entities in (('publishes', node.publishers), ('subscribes to', node.subscriptions)):
         for entity in entities:
             topic = node.resolve_topic_name(entity.topic_name)
-            mine = _type_name(entity.msg_type)
+            mine = type_name(entity.msg_type)
             others = [*graph.get_publishers_info_by_topic(topic),
                       *graph.get_subscriptions_info_by_topic(topic)]
             for info in others:  # hidden nodes (ros2nb's, a check's, not yet named) aside
@@ -286,7 +287,7 @@ def _refuse_other_type(node: Any, kind: str, msg_type: Any, topic: str) -> None:
                      *node.get_subscriptions_info_by_topic(name)]
     except Exception:  # an invalid name: rclpy's own message, with its caret, is best
         return
-    mine = _type_name(msg_type)
+    mine = type_name(msg_type)
     others = sorted({e.topic_type for e in endpoints if bytes(e.endpoint_gid[:12]) == local
                      and e.topic_type != mine})
     if local is not None and others:

@@ -29,6 +29,23 @@ INFRASTRUCTURE_TOPICS = ('/rosout', '/parameter_events', '/clock')
 DEFAULT_WAIT_S = 10.0
 
 
+def type_name(msg_type: Any) -> str:
+    """The ROS name of a message class (or of an instance of it), e.g. ``std_msgs/msg/Float32``."""
+    cls = msg_type if isinstance(msg_type, type) else type(msg_type)
+    return f'{cls.__module__.split(".")[0]}/msg/{cls.__name__}'
+
+
+def node_endpoints(node: Any) -> list[tuple[str, str, str]]:
+    """A node's own publishers and subscriptions: ``(kind, topic, type)``, topics resolved.
+
+    Introduced in ``00-setup-and-the-pubsub-idea.ipynb`` (through the checks).
+    """
+    return [(kind, node.resolve_topic_name(e.topic_name), type_name(e.msg_type))
+            for kind, entities in (('publisher', node.publishers),
+                                   ('subscription', node.subscriptions))
+            for e in entities]
+
+
 def _hidden(name: str) -> bool:
     return any(part.startswith('_') for part in name.split('/') if part)
 

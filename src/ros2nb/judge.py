@@ -382,13 +382,21 @@ class Session:
 
         return self.subject(('cells', ref.sources), load)
 
-    def run(self, argv: list[str], *, seconds: float, cwd: Path,
-            env: Optional[dict[str, str]] = None) -> tuple[int, str]:
-        """Run a program of the learner's (sandboxed while grading); return code and output."""
+    def start(self, argv: list[str], *, cwd: Path,
+              env: Optional[dict[str, str]] = None) -> tuple[subprocess.Popen, '_Output']:
+        """Start a program of the learner's (sandboxed while grading) in a session of its own.
+
+        :return: the process, and its output (stdout and stderr), collected as it comes.
+        """
         proc = subprocess.Popen([*subject_prefix(), *argv], cwd=cwd, env=env or subject_env(),
                                 text=True, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                                 stderr=subprocess.STDOUT, start_new_session=True)
-        output = _Output(proc.stdout)
+        return proc, _Output(proc.stdout)
+
+    def run(self, argv: list[str], *, seconds: float, cwd: Path,
+            env: Optional[dict[str, str]] = None) -> tuple[int, str]:
+        """Run a program of the learner's (sandboxed while grading); return code and output."""
+        proc, output = self.start(argv, cwd=cwd, env=env)
         try:
             code = proc.wait(seconds)
         except subprocess.TimeoutExpired:
@@ -541,7 +549,8 @@ def _text(cell: dict) -> str:
     return source if isinstance(source, str) else ''.join(source)
 
 
-def _nbgrader(cell: dict) -> dict:
+def nbgrader_metadata(cell: dict) -> dict:
+    """A notebook cell's nbgrader metadata (empty when it has none, or none that makes sense)."""
     meta = cell.get('metadata', {})
     value = meta.get('nbgrader', {}) if isinstance(meta, dict) else {}
     return value if isinstance(value, dict) else {}
@@ -562,13 +571,13 @@ def grade(source: dict, submission: dict) -> dict[str, dict]:
     from . import checks
     context = [_text(c) for c in _cells(source) if CONTEXT_TAG in
                c.get('metadata', {}).get('tags', [])]
-    answers = [_text(c) for c in _cells(submission) if _nbgrader(c).get('solution')
+    answers = [_text(c) for c in _cells(submission) if nbgrader_metadata(c).get('solution')
                and c.get('cell_type') == 'code']
     sources = tuple(context + answers)
     names = {name: AnswerRef(name, sources) for text in answers for name in _defined_names(text)}
     results = {}
     for cell in _cells(source):
-        meta = _nbgrader(cell)
+        meta = nbgrader_metadata(cell)
         if not meta.get('grade') or cell.get('cell_type') != 'code':
             continue
         results[meta['grade_id']] = result = {'passed': True, 'lines': []}

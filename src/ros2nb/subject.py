@@ -181,6 +181,7 @@ class Subject:
                  seed: Optional[int]) -> dict:
         from rclpy.node import Node
         from .errors import Ros2nbError
+        from .graph import node_endpoints
         rt = self._runtime()
         if self.node is not None:
             if self.node.get_fully_qualified_name() in rt.nodes:
@@ -222,15 +223,7 @@ class Subject:
                 'started_lines': rt.log_counts[logger] - logged_before.get(logger, 0),
                 'placeholders': missing, 'attributes': facts,
                 'timers': timers,
-                'endpoints': self._endpoints(node), **self._counts()}
-
-    @staticmethod
-    def _endpoints(node: Any) -> list[list[str]]:
-        return [[kind, node.resolve_topic_name(e.topic_name),
-                 f'{e.msg_type.__module__.split(".")[0]}/msg/{e.msg_type.__name__}']
-                for kind, entities in (('publisher', node.publishers),
-                                       ('subscription', node.subscriptions))
-                for e in entities]
+                'endpoints': node_endpoints(node), **self._counts()}
 
     def _counts(self) -> dict:
         rt = self._runtime()
