@@ -8,6 +8,7 @@ import pytest
 import ros2nb
 
 from nodes import Monitor, Sensor
+from waiting import wait_for
 
 
 @pytest.fixture
@@ -127,20 +128,19 @@ def test_two_message_types_on_one_topic_are_noted(ros, capsys):
     """Across processes a Float64 subscription just never hears a Float32 publisher."""
     import subprocess
     import sys
-    import time
-    code = ('import rclpy, time\nfrom std_msgs.msg import Float64\nrclpy.init()\n'
+    code = ('import rclpy\nfrom std_msgs.msg import Float64\nrclpy.init()\n'
             'node = rclpy.create_node("float64_monitor")\n'
             'node.create_subscription(Float64, "temperature", print, 10)\n'
-            'print("up", flush=True)\ntime.sleep(30)\n')
+            'print("up", flush=True)\nrclpy.spin(node)\n')
     monitor = subprocess.Popen([sys.executable, '-c', code], stdout=subprocess.PIPE, text=True)
     try:
         assert monitor.stdout.readline().strip() == 'up'
         ros2nb.add(Sensor())
-        deadline = time.monotonic() + 15
         graph = ros2nb.current_runtime().node
-        while time.monotonic() < deadline and 'float64_monitor' not in [
-                info.node_name for info in graph.get_subscriptions_info_by_topic('/temperature')]:
-            time.sleep(0.1)
+        wait_for(lambda: 'float64_monitor' in [
+            info.node_name for info in graph.get_subscriptions_info_by_topic('/temperature')],
+            'float64_monitor in the graph',
+            seen=lambda: graph.get_node_names_and_namespaces())
         capsys.readouterr()
         ros2nb.topic_list()
         assert ('Note: /temperature is used with 2 message types: std_msgs/msg/Float32 '

@@ -20,6 +20,7 @@ from __future__ import annotations
 import atexit
 import collections
 import contextlib
+import gc
 import math
 import os
 import sys
@@ -471,7 +472,23 @@ class Runtime:
         self.executor.remove_node(self.node)
         self.node.destroy_node()
         self.executor.shutdown()
+        _destroy_stray_nodes(self.context)
         rclpy.try_shutdown()
+
+
+def _destroy_stray_nodes(context: rclpy.context.Context) -> None:
+    """Destroy every node still alive on ``context``: made in a cell, never handed over, or kept
+    in a variable after ``rclpy.shutdown()``.
+
+    rcl keeps one /rosout publisher per logger name for the whole process.  A node of an
+    ended context that Python's garbage collector frees later (whenever that happens)
+    unregisters its name's publisher, which by then belongs to the new node of that name:
+    the new node's log lines would stop reaching the cell part-way through a spin.
+    """
+    for candidate in gc.get_objects():
+        if isinstance(candidate, Node) and candidate.context is context:
+            with contextlib.suppress(Exception):  # already destroyed, or half-built
+                candidate.destroy_node()
 
 
 _runtime: Optional[Runtime] = None
