@@ -188,39 +188,29 @@ def test_package_checks(session, capsys):
     generated_py, generated_cfg = setup_py.read_text(), setup_cfg.read_text()
     empty = "        'console_scripts': [\n        ],\n"
     assert empty in generated_py
+    publisher = "'temperature_publisher = sensor_simulator.temperature_publisher:main'"
+    subscriber = "'temperature_subscriber = sensor_simulator.temperature_subscriber:main'"
+
+    def entries(*lines: str) -> None:
+        """setup.py as pkg_create wrote it, with these lines in its console_scripts list."""
+        setup_py.write_text(generated_py.replace(empty, "        'console_scripts': [\n" + ''.join(
+            f'            {line}\n' for line in lines) + '        ],\n'))
+
     try:
-        setup_py.write_text(generated_py.replace(empty, "        'console_scripts': [\n"
-                                                 "            # YOUR CODE HERE\n"
-                                                 "            raise NotImplementedError()\n"
-                                                 "        ],\n"))
+        entries('# YOUR CODE HERE', 'raise NotImplementedError()')
         fails(checks.check_entry_points, r'setup.py still holds the placeholder')
-        setup_py.write_text(generated_py)
+        entries()
         fails(checks.check_entry_points, r'console_scripts has no entry named temperature_publisher')
-        setup_py.write_text(generated_py.replace(empty, (
-            "        'console_scripts': [\n"
-            "            'temperature_publisher = sensor_simulator.temperature_publisher:main'\n"
-            "            'temperature_subscriber = sensor_simulator.temperature_subscriber:main',\n"
-            "        ],\n")))
+        entries(publisher, subscriber + ',')  # no comma after the first
         fails(checks.check_entry_points, r'is two entries run together: end each string in the '
                                          r'console_scripts list with a comma')
-        setup_py.write_text(generated_py.replace(empty, (
-            "        'console_scripts': [\n"
-            "            'temperature_publisher = sensor_simulator/temperature_publisher.py:main',\n"
-            "        ],\n")))
+        entries("'temperature_publisher = sensor_simulator/temperature_publisher.py:main',")
         fails(checks.check_entry_points, r'is not written NAME = package.module:function: the '
                                          r'module is written with dots')
-        setup_py.write_text(generated_py.replace(empty, (
-            "        'console_scripts': [\n"
-            "            'temperature_publisher = sensor_simulator.publisher:main',\n"
-            "            'temperature_subscriber = sensor_simulator.temperature_subscriber:main',\n"
-            "        ],\n")))
+        entries("'temperature_publisher = sensor_simulator.publisher:main',", subscriber + ',')
         fails(checks.check_entry_points, r'temperature_publisher = sensor_simulator.publisher:main: '
                                          r'it should start main\(\) in sensor_simulator/temperature_publisher.py')
-        setup_py.write_text(generated_py.replace(empty, (
-            "        'console_scripts': [\n"
-            "            'temperature_publisher = sensor_simulator.temperature_publisher:main',\n"
-            "            'temperature_subscriber = sensor_simulator.temperature_subscriber:main',\n"
-            "        ],\n")))
+        entries(publisher + ',', subscriber + ',')
         setup_cfg.write_text(generated_cfg.replace('$base/lib/sensor_simulator', '$base/bin'))
         fails(checks.check_setup_cfg, r'\[develop\] script_dir is \$base/bin; ros2 run looks in '
                                       r'\$base/lib/sensor_simulator')
