@@ -4,7 +4,10 @@
   each nbval kernel, each judge) claims a free domain of its own (ros2nb.domains), so two
   runs never see each other's topics. Discovery stays on this machine.
 - The course workspace goes to a temporary folder removed at the end, so tests never
-  touch a learner's ``workspace/``.
+  touch a learner's ``workspace/``.  So do the files every kernel writes (IPython's
+  history, Jupyter's connection files): tests run side by side (pytest-xdist, one
+  process per worker, each with this set-up of its own), and while one of them checks
+  that grading leaves the repository byte-identical no other may write into it.
 - Cells tagged ``learner-check`` (a Challenge's check) must raise ``CheckFailed`` with its
   friendly message in ``notebooks/`` (the challenge is unsolved there) and must pass in
   ``solutions/``.
@@ -23,6 +26,8 @@ os.environ.pop('ROS_DOMAIN_ID', None)
 os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
 _SCRATCH = Path(tempfile.mkdtemp(prefix='ros2nb-test-'))
 os.environ['ROS2NB_WORKSPACE'] = str(_SCRATCH / 'ROS2_and_RL_Tutorials')
+os.environ['IPYTHONDIR'] = str(_SCRATCH / 'ipython')
+os.environ['JUPYTER_RUNTIME_DIR'] = str(_SCRATCH / 'jupyter-runtime')
 
 LEARNER_CHECK_TAG = 'learner-check'
 

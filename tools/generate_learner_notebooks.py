@@ -20,6 +20,9 @@ import sys
 import tempfile
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from nbgrader_cli import nbgrader_argv  # noqa: E402
+
 ROOT = Path(__file__).resolve().parent.parent
 SOLUTIONS = ROOT / 'solutions'
 NOTEBOOKS = ROOT / 'notebooks'
@@ -40,9 +43,9 @@ def generate(out: Path) -> list[Path]:
                    JUPYTER_DATA_DIR=str(course / 'data'),
                    PATH=os.pathsep.join([str(Path(sys.executable).parent), os.environ['PATH']]))
         done = subprocess.run(
-            [sys.executable, '-m', 'nbgrader', 'generate_assignment', ASSIGNMENT,
-             f'--CourseDirectory.root={course}', '--force', '--log-level=ERROR',
-             f'--CourseDirectory.db_url=sqlite:///{course / "gradebook.db"}'],
+            nbgrader_argv('generate_assignment', ASSIGNMENT,
+                          f'--CourseDirectory.root={course}', '--force', '--log-level=ERROR',
+                          f'--CourseDirectory.db_url=sqlite:///{course / "gradebook.db"}'),
             cwd=course, env=env, capture_output=True, text=True)
         if done.returncode != 0:
             sys.exit(f'nbgrader generate_assignment failed:\n{done.stdout}{done.stderr}')

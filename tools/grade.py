@@ -34,6 +34,7 @@ import html
 import json
 import os
 import shutil
+import stat
 import subprocess
 import sys
 import tempfile
@@ -48,6 +49,7 @@ import nbformat
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import graded_notebook  # noqa: E402
 import sandbox  # noqa: E402
+from nbgrader_cli import nbgrader_argv  # noqa: E402
 from submissions import Learner, find_learners, screen_zip  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -60,8 +62,8 @@ CELL_TIMEOUT_S = 120
 NOTEBOOK_TIMEOUT_S = 600
 #: Seconds the judge may take for one notebook.
 JUDGE_TIMEOUT_S = 600
-#: Notebooks graded at the same time.
-JOBS = 2
+#: Notebooks graded at the same time: one more than the CPUs (a notebook often waits).
+JOBS = (os.cpu_count() or 1) + 1
 #: Largest executed notebook read back (the runner cuts each cell's output at 100 kB).
 MAX_NOTEBOOK_BYTES = 20_000_000
 #: nbgrader settings of the course under grading/: feedback shows learners' content as text.
@@ -90,7 +92,7 @@ class Settings:
 
 def nbgrader(course: Path, *args: str, log: Path) -> int:
     """Run ``nbgrader ARGS`` for the course folder (trusted: it executes nothing of learners')."""
-    argv = [sys.executable, '-m', 'nbgrader', *args, f'--CourseDirectory.root={course}',
+    argv = [*nbgrader_argv(*args), f'--CourseDirectory.root={course}',
             f'--CourseDirectory.db_url=sqlite:///{course / "gradebook.db"}', '--log-level=INFO']
     env = dict(os.environ, JUPYTER_CONFIG_DIR=str(course / '.jupyter'),
                PATH=os.pathsep.join([str(Path(sys.executable).parent), os.environ['PATH']]))
@@ -160,6 +162,25 @@ class Scratch:
         self.home.mkdir()
         self.top.chmod(0o711)  # the sandboxes' own user may pass, nobody may list
 
+    def snapshot(self, notebook: str) -> Path:
+        """A copy of the workspace as ``notebook``'s run left it, for that notebook's judge.
+
+        The judge reads the copy while the learner's next notebook runs (and changes the
+        workspace).  Links are copied as links, never followed; colcon's ``build``,
+        ``install`` and ``log`` and anything that is not a file, folder or link stay behind
+        (the judge builds a package of its own when it needs one).
+        """
+        target = self.top / f'workspace-{notebook}' / WORKSPACE_NAME
+        target.parent.mkdir()
+        target.parent.chmod(0o755)
+        if self.workspace.is_dir() and not self.workspace.is_symlink():
+            shutil.copytree(self.workspace, target, symlinks=True, ignore=_not_for_the_judge(
+                self.workspace))
+        else:
+            target.mkdir()  # notebooks 00 and 01 make none
+        target.chmod(0o755)
+        return target
+
     def judge_folders(self, notebook: str) -> tuple[Path, Path]:
         """A fresh judge folder (writable by the judge and its subjects) and its inputs."""
         given, scratch = self.top / f'judge-in-{notebook}', self.top / f'judge-{notebook}'
@@ -167,6 +188,18 @@ class Scratch:
             folder.mkdir()
             folder.chmod(mode)  # the judge's sandbox user reads the given files
         return given, scratch
+
+
+def _not_for_the_judge(workspace: Path):
+    """``copytree``'s ignore function for :meth:`Scratch.snapshot`."""
+    def ignored(folder: str, names: list[str]) -> list[str]:
+        skip = {'build', 'install', 'log'} if Path(folder) == workspace else set()
+        for name in names:
+            mode = os.lstat(os.path.join(folder, name)).st_mode
+            if not (stat.S_ISREG(mode) or stat.S_ISDIR(mode) or stat.S_ISLNK(mode)):
+                skip.add(name)  # a FIFO or device would block or mislead the copy
+        return sorted(skip)
+    return ignored
 
 
 def _env(home: Path, **extra: str) -> dict[str, str]:
@@ -223,11 +256,14 @@ def run_notebook(scratch: Scratch, notebook: str, prepared: nbformat.NotebookNod
     return executed, status, stopped
 
 
-def judge_notebook(scratch: Scratch, notebook: str, submitted: Path,
-                   settings: Settings) -> tuple[dict, Optional[str]]:
-    """Run the judge on what the learner wrote; return ``{grade_id: result}`` or a problem."""
+def judge_notebook(scratch: Scratch, notebook: str, submitted: Path, settings: Settings,
+                   workspace: Path) -> tuple[dict, Optional[str]]:
+    """Run the judge on what the learner wrote; return ``{grade_id: result}`` or a problem.
+
+    :param workspace: the snapshot of the learner's workspace this notebook left
+        (:meth:`Scratch.snapshot`).
+    """
     given, folder = scratch.judge_folders(notebook)
-    scratch.workspace.mkdir(parents=True, exist_ok=True)  # notebooks 00 and 01 make none
     source = given / 'source.ipynb'
     shutil.copy2(SOLUTIONS / f'{notebook}.ipynb', source)
     shutil.copy2(submitted, given / 'submission.ipynb')
@@ -239,15 +275,15 @@ def judge_notebook(scratch: Scratch, notebook: str, submitted: Path,
     tmp.mkdir()
     argv = [sys.executable, '-m', 'ros2nb.judge', 'grade', str(source),
             str(given / 'submission.ipynb')]
-    env = _env(home, ROS2NB_WORKSPACE=str(scratch.workspace), ROS2NB_JUDGE='1', TMPDIR=str(tmp))
+    env = _env(home, ROS2NB_WORKSPACE=str(workspace), ROS2NB_JUDGE='1', TMPDIR=str(tmp))
     limits = sandbox.Limits(wall_s=JUDGE_TIMEOUT_S)
     if settings.sandboxed:
         env['FASTDDS_BUILTIN_TRANSPORTS'] = 'UDPv4'  # judge and subjects: own /dev/shm each
         env['ROS2NB_SUBJECT_PREFIX'] = json.dumps(sandbox.inner_prefix(  # the course may be
-            readable=[scratch.workspace, ROOT / 'src'], writable=[folder],  # under /tmp too
+            readable=[workspace, ROOT / 'src'], writable=[folder],  # under /tmp too
             hidden=[ROOT / 'src' / 'ros2nb' / 'reference']))
         box = sandbox.Sandbox(writable=[folder], env=env, cwd=folder, nested=True,
-                              readable=[ROOT / 'src', scratch.workspace, given],
+                              readable=[ROOT / 'src', workspace, given],
                               hidden=[ROOT / 'src' / 'ros2nb' / 'reference'])
         try:
             result = box.run(argv, limits, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
@@ -293,37 +329,63 @@ def _run_note(status: dict, stopped: Optional[str]) -> Optional[str]:
     return '; '.join(notes) or None
 
 
-def grade_notebook(course: Path, scratch: Scratch, learner: Learner, notebook: str,
-                   settings: Settings) -> nbformat.NotebookNode:
-    """Run, judge and assemble one notebook; return the notebook nbgrader will score."""
-    release = nbformat.read(course / 'release' / ASSIGNMENT / f'{notebook}.ipynb', as_version=4)
-    problem = readable(learner.files[notebook])
-    if problem:
-        learner.note(notebook, f'{problem}; 0 points')
-        return graded_notebook.note_notebook(release, f'{problem}; 0 points.')
-    submitted = nbformat.read(learner.files[notebook], as_version=4)
-    prepared = graded_notebook.for_the_run(release, submitted)
-    executed, status, stopped = run_notebook(scratch, notebook, prepared, settings)
-    happened = _run_note(status, stopped)
-    if happened:
-        learner.note(notebook, happened)
-    results, problem = judge_notebook(scratch, notebook, learner.files[notebook], settings)
-    if problem:
-        learner.note(notebook, problem)
-    return graded_notebook.for_scoring(release, executed, results, problem)
+class Judges:
+    """The judges of a class, working while the learners' next notebooks run.
+
+    A notebook's judge needs only what that notebook left (a snapshot of the workspace
+    and the submitted file), so it runs beside the learner's next notebook.
+    """
+
+    def __init__(self, jobs: int) -> None:
+        self._pool = concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs),
+                                                           thread_name_prefix='judge')
+
+    def submit(self, *arguments: object) -> concurrent.futures.Future:
+        return self._pool.submit(judge_notebook, *arguments)
+
+    def close(self) -> None:
+        self._pool.shutdown(wait=True)
 
 
 def grade_learner(course: Path, scratch_root: Path, learner: Learner, notebooks: list[str],
-                  settings: Settings) -> None:
-    """Grade a learner's notebooks in course order; file them in the nbgrader course."""
+                  settings: Settings, judges: Judges) -> None:
+    """Grade a learner's notebooks in course order; file them in the nbgrader course.
+
+    The notebooks run one after the other (each on the workspace the previous ones left);
+    each one's judge starts as soon as it has run.
+    """
     scratch = Scratch(scratch_root, learner)
     target = course / 'submitted' / learner.id / ASSIGNMENT
     target.mkdir(parents=True, exist_ok=True)
+    judged = []
     try:
         for notebook in (n for n in notebooks if n in learner.files):
-            nbformat.write(grade_notebook(course, scratch, learner, notebook, settings),
+            release = nbformat.read(course / 'release' / ASSIGNMENT / f'{notebook}.ipynb',
+                                    as_version=4)
+            problem = readable(learner.files[notebook])
+            if problem:
+                learner.note(notebook, f'{problem}; 0 points')
+                nbformat.write(graded_notebook.note_notebook(release, f'{problem}; 0 points.'),
+                               target / f'{notebook}.ipynb')
+                continue
+            submitted = nbformat.read(learner.files[notebook], as_version=4)
+            prepared = graded_notebook.for_the_run(release, submitted)
+            executed, status, stopped = run_notebook(scratch, notebook, prepared, settings)
+            happened = _run_note(status, stopped)
+            if happened:
+                learner.note(notebook, happened)
+            verdict = judges.submit(scratch, notebook, learner.files[notebook], settings,
+                                    scratch.snapshot(notebook))
+            judged.append((notebook, release, executed, verdict))
+        for notebook, release, executed, verdict in judged:
+            results, problem = verdict.result()
+            if problem:
+                learner.note(notebook, problem)
+            nbformat.write(graded_notebook.for_scoring(release, executed, results, problem),
                            target / f'{notebook}.ipynb')
     finally:
+        for _notebook, _release, _executed, verdict in judged:
+            concurrent.futures.wait([verdict])  # nothing of the scratch is removed in use
         shutil.rmtree(scratch.top, ignore_errors=True)
 
 
@@ -428,12 +490,16 @@ def main(argv: Optional[list[str]] = None) -> int:
     settings = Settings(args.cell_timeout, args.notebook_timeout, not args.no_sandbox)
     with tempfile.TemporaryDirectory(prefix='ros2nb-grading-') as scratch_root:
         Path(scratch_root).chmod(0o711)
-        with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-            # Most notebooks first, so the longest learner does not start last.
-            ordered = sorted(learners, key=lambda learner: -len(learner.files))
-            for job in [pool.submit(grade_learner, course, Path(scratch_root), learner,
-                                    notebooks, settings) for learner in ordered]:
-                job.result()
+        judges = Judges(args.jobs)
+        try:
+            with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+                # Most notebooks first, so the longest learner does not start last.
+                ordered = sorted(learners, key=lambda learner: -len(learner.files))
+                for job in [pool.submit(grade_learner, course, Path(scratch_root), learner,
+                                        notebooks, settings, judges) for learner in ordered]:
+                    job.result()
+        finally:
+            judges.close()
     if any(learner.files for learner in learners):
         score_and_feedback(course)
     rows = write_results(course, out, learners, notebooks)

@@ -1,0 +1,78 @@
+"""Grading from the instructor's command line: a platform's zip, bad input, no sandbox.
+
+Apart from tests/test_grading.py (one sample class, graded once) so that the two run side
+by side under pytest-xdist (``--dist loadfile`` keeps a file on one worker).
+"""
+
+import csv
+import os
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import pytest
+
+from grading_samples import LEARNER, NB01, ROOT, SOLUTION
+
+sys.path.insert(0, str(ROOT / 'tools'))
+import sandbox  # noqa: E402
+
+pytestmark = [pytest.mark.timeout(1200),
+              pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))]
+
+
+def test_zip_from_a_learning_platform(tmp_path):
+    """nbgrader's zip_collect grades the rest; nested archives and duplicates are refused."""
+    solved, unsolved = SOLUTION[NB01], LEARNER[NB01]
+    inner = tmp_path / 'inner.zip'
+    with zipfile.ZipFile(inner, 'w') as zipped:
+        zipped.write(solved, f'mallory/{NB01}.ipynb')  # would decide who is graded if unpacked
+    archive = tmp_path / 'class.zip'
+    with zipfile.ZipFile(archive, 'w') as zipped:
+        zipped.write(solved, f'course-export/ada/{NB01}.ipynb')
+        zipped.write(unsolved, f'course-export/bo/{NB01}.ipynb')
+        zipped.write(inner, 'course-export/eve/extra.zip')
+        zipped.write(solved, f'course-export/eve/{NB01}.ipynb')
+        zipped.write(solved, f'course-export/dup/{NB01}.ipynb')
+        zipped.write(unsolved, f'late-export/dup/{NB01}.ipynb')
+    done = subprocess.run([sys.executable, str(ROOT / 'tools' / 'grade.py'), str(archive),
+                           '--out', str(tmp_path / 'grading'), '--cell-timeout=60'],
+                          capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stdout + done.stderr
+    rows = {(r['learner'], r['notebook']): r['score']
+            for r in csv.DictReader(open(tmp_path / 'grading' / 'grades.csv'))}
+    assert rows['ada', 'TOTAL'] == '1' and rows['bo', 'TOTAL'] == '0' and rows['eve', 'TOTAL'] == '1'
+    assert not any(learner in ('mallory', 'dup') for learner, _ in rows)
+    assert ('not graded: course-export/eve/extra.zip: an archive inside the archive is not '
+            'unpacked') in done.stdout
+    assert ('not graded: dup: appears in 2 places of the archive (course-export/dup, '
+            'late-export/dup); not graded, send one copy') in done.stdout
+
+
+def test_bad_input_gets_one_line(tmp_path):
+    def grade(*args):
+        return subprocess.run([sys.executable, str(ROOT / 'tools' / 'grade.py'), *args],
+                              capture_output=True, text=True)
+    missing = grade(str(tmp_path / 'nope'), '--out', str(tmp_path / 'g1'))
+    assert missing.returncode == 2 and missing.stdout.count('\n') == 1
+    assert 'does not exist' in missing.stdout
+    (tmp_path / 'g2').mkdir()
+    (tmp_path / 'g2' / 'grades.csv').write_text('manual work\n')
+    (tmp_path / 'class').mkdir()
+    again = grade(str(tmp_path / 'class'), '--out', str(tmp_path / 'g2'))
+    assert again.returncode == 2 and 'FORCE=1' in again.stdout
+    assert (tmp_path / 'g2' / 'grades.csv').read_text() == 'manual work\n'  # untouched
+
+
+def test_without_a_sandbox_grading_refuses_unless_told(tmp_path):
+    """With bubblewrap not on PATH, one line; NO_SANDBOX=1 is the explicit way round."""
+    (tmp_path / 'class' / 'ada').mkdir(parents=True)
+    env = {**os.environ, 'PATH': str(Path(sys.executable).parent)}  # no /usr/bin: no bwrap
+    done = subprocess.run([sys.executable, str(ROOT / 'tools' / 'grade.py'),
+                           str(tmp_path / 'class'), '--out', str(tmp_path / 'g')],
+                          capture_output=True, text=True, env=env)
+    assert done.returncode == 2
+    assert done.stdout == ("No sandbox can be made here (bubblewrap is not installed: apt-get "
+                           "install bubblewrap); grading runs learners' code, so it stops. For "
+                           "work you trust, run again with NO_SANDBOX=1 (--no-sandbox).\n")
