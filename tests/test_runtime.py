@@ -298,6 +298,36 @@ def test_stop_during_a_sim_spin_is_one_line(ros, capsys):
     assert 'Publishing:' in capsys.readouterr().out
 
 
+def test_stop_in_the_middle_of_rclpy_taking_a_callback_leaves_the_node_alive(ros, capsys):
+    """The Stop button can land after rclpy marked a node's callback group busy and before
+    it ran the callback; that node then never ran again ("no log lines", for ever). Here the
+    interrupt comes at exactly that point, once."""
+    from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
+
+    class InterruptedOnce(MutuallyExclusiveCallbackGroup):
+        pressed = False
+
+        def beginning_execution(self, entity):
+            began = super().beginning_execution(entity)
+            if not InterruptedOnce.pressed:
+                InterruptedOnce.pressed = True
+                raise KeyboardInterrupt  # where a real Ctrl+C sometimes lands
+            return began
+
+    class Ticker(Sensor):
+        def __init__(self):
+            super().__init__('ticker')
+            self.destroy_timer(self.timer)
+            self.timer = self.create_timer(1.0, self.tick, callback_group=InterruptedOnce())
+
+    ros2nb.add(Ticker())
+    capsys.readouterr()
+    ros2nb.spin(3)
+    assert 'Interrupted after' in capsys.readouterr().out
+    ros2nb.spin(2)  # the reading due at 1 s (never taken), then 2 s and 3 s
+    assert capsys.readouterr().out.count('[INFO] [ticker]: Publishing:') == 3
+
+
 def test_lines_made_while_no_cell_ran_are_counted_not_shown(capsys):
     rt = ros2nb.start(sim_time=False)
     try:

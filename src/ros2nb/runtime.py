@@ -211,9 +211,12 @@ class Runtime:
         """Run one ready callback; return its name, or None when none became ready in time."""
         try:
             handler, entity, node = self.executor.wait_for_ready_callbacks(timeout_sec=timeout_sec)
+            handler()
         except TimeoutException:
             return None
-        handler()
+        except KeyboardInterrupt:  # the Stop button, while rclpy waited or ran a callback
+            self._recover_from_interrupt()
+            raise
         callback = getattr(entity, 'callback', None)
         label = getattr(callback, '__qualname__', repr(callback))
         error = handler.exception()
@@ -228,6 +231,26 @@ class Runtime:
             if node is not self.node:
                 self._discard(node)
         return label
+
+    def _recover_from_interrupt(self) -> None:
+        """Undo what an interrupted callback left half done in rclpy's executor.
+
+        rclpy marks an entity as taken and its callback group as busy before it calls the
+        callback, and clears both after; a KeyboardInterrupt in between (the Stop button)
+        leaves them set, and that node's timers and subscriptions never run again.  Only
+        this thread runs callbacks here, so after an interrupt none is running: every
+        entity is free again, and unfinished work is dropped (a message not taken stays in
+        its queue, a timer not called stays due, so the next wait finds them again).
+        """
+        with contextlib.suppress(AttributeError):
+            self.executor._tasks = []
+        for node in [self.node, *self._nodes.values()]:
+            for entity in (*node.timers, *node.subscriptions, *node.services, *node.clients,
+                           *node.guards, *node.waitables):
+                entity._executor_event = False
+                group = entity.callback_group
+                if getattr(group, '_active_entity', None) is not None:
+                    group._active_entity = None
 
     def _spin_in_background(self) -> None:
         while not self._stopping:
