@@ -43,24 +43,13 @@ sandbox-tool:
 	  || { apt-get update -q >/dev/null 2>&1 && apt-get install -y -q bubblewrap >/dev/null 2>&1; } || true
 	@command -v bwrap >/dev/null || echo "bubblewrap is not installed (sudo apt-get install bubblewrap): grading refuses to run and its tests skip."
 
-# Three steps, always all three: one failure never hides the others; the summary at the
-# end gives each step's result, and make fails if any step failed. Tests run side by side
-# (pytest-xdist; every worker and kernel claims a ROS domain of its own).
+# Three steps, always all three (tests/run_steps.sh): tests/ with pytest-xdist, and nbval
+# over solutions/ and notebooks/ alongside it; one failure never hides the others, the
+# results come together at the end, and make fails if any step failed.
 TEST_WORKERS ?= 3
-PYTEST_STEPS := \
-  "tests/|tests -n $(TEST_WORKERS) --dist loadfile --durations=15" \
-  "nbval solutions/|--nbval solutions --nbval-current-env --nbval-sanitize-with tests/sanitize.cfg" \
-  "nbval notebooks/|--nbval-lax notebooks --nbval-current-env"
 
 test: $(STAMP) sandbox-tool
-	@failed=0; summary=""; \
-	for step in $(PYTEST_STEPS); do \
-	  name=$${step%%|*}; args=$${step#*|}; began=$$(date +%s); \
-	  echo "=== make test: $$name"; \
-	  if $(PY) -m pytest $$args; then result=passed; else result="FAILED (exit $$?)"; failed=1; fi; \
-	  summary="$$summary$$(printf '  %-17s %s in %s s' "$$name" "$$result" $$(( $$(date +%s) - began )))\n"; \
-	done; \
-	printf "=== make test: results\n$$summary"; exit $$failed
+	@tests/run_steps.sh $(PY) $(TEST_WORKERS)
 
 # Re-run solutions/ in place so their stored outputs are fresh (then make learner-notebooks).
 solutions: $(STAMP)

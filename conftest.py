@@ -53,3 +53,16 @@ def pytest_runtest_call(item):
         outcome.force_exception(AssertionError(
             f'{item.name}: the solution does not pass its own check: '
             f'{errors[0].get("ename")}: {errors[0].get("evalue")}'))
+
+
+#: Test files that take longest, started first so that pytest-xdist's workers finish
+#: together (scheduling only: no test depends on it).
+LONGEST_FIRST = ('test_grading.py', 'test_jupyterhub.py', 'test_isolation.py',
+                 'test_grading_cli.py', 'test_checks.py', 'test_sandbox.py')
+
+
+def pytest_collection_modifyitems(config, items) -> None:
+    def rank(item) -> int:
+        name = Path(str(item.fspath)).name
+        return LONGEST_FIRST.index(name) if name in LONGEST_FIRST else len(LONGEST_FIRST)
+    items.sort(key=rank)  # stable: the order inside a file is kept

@@ -50,8 +50,9 @@ BACKGROUND_WAIT_S = 0.02
 MAX_SIM_STEP_S = 1.0
 #: Log lines kept while no cell is reading them; older ones are counted, not kept.
 MAX_PENDING_LOG_LINES = 2000
-#: Callbacks one idle-wait may run before ros2nb calls it a loop that never ends.
-MAX_CALLBACKS_PER_DRAIN = 100_000
+#: Callbacks one idle-wait may run before ros2nb calls it a loop that never ends (a burst
+#: of a few thousand messages to many subscriptions stays well below).
+MAX_CALLBACKS_PER_DRAIN = 10_000
 #: rcl_interfaces/msg/Log levels -> the console's severity names.
 SEVERITY_NAMES = {10: 'DEBUG', 20: 'INFO', 30: 'WARN', 40: 'ERROR', 50: 'FATAL'}
 SHUT_DOWN_MESSAGE = ('ROS 2 was shut down in this kernel (rclpy.shutdown() was called): run '

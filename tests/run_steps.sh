@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# `make test`: the three test steps, every time, then their results together.
+#
+#   1. tests/ with pytest-xdist (in the foreground: its output is what you watch);
+#   2. nbval over solutions/ (every deterministic output compared);
+#   3. nbval over notebooks/ (every check of an unwritten part must fail with its message).
+#
+# Steps 2 and 3 run alongside step 1, each in its own pytest process (every process and
+# kernel claims a ROS domain and a workspace of its own); their output is kept in a log
+# and shown once step 1 has ended.  One failure never hides another: the exit code is 1
+# if any step failed.  Usage: tests/run_steps.sh PYTHON WORKERS
+set -u
+python=$1 workers=$2
+logs=$(mktemp -d "${TMPDIR:-/tmp}/ros2nb-make-test-XXXXXX")
+trap 'rm -rf "$logs"' EXIT
+
+run() {  # run NAME ARGS...: pytest ARGS, exit code to $logs/NAME.rc, seconds to $logs/NAME.s
+    local name=$1 began=$SECONDS
+    shift
+    "$python" -m pytest "$@"
+    echo $? > "$logs/$name.rc"
+    echo $((SECONDS - began)) > "$logs/$name.s"
+}
+
+run solutions --nbval solutions --nbval-current-env --nbval-sanitize-with tests/sanitize.cfg \
+    > "$logs/solutions.log" 2>&1 &
+run notebooks --nbval-lax notebooks --nbval-current-env > "$logs/notebooks.log" 2>&1 &
+echo "=== make test: tests/ (nbval over solutions/ and notebooks/ runs alongside)"
+run tests tests -n "$workers" --dist loadfile --durations=15
+wait
+for name in solutions notebooks; do
+    echo "=== make test: nbval $name/ (ran alongside tests/)"
+    cat "$logs/$name.log"
+done
+failed=0
+echo "=== make test: results"
+for name in tests solutions notebooks; do
+    rc=$(cat "$logs/$name.rc" 2>/dev/null || echo 'none')
+    label=$([ "$name" = tests ] && echo 'tests/' || echo "nbval $name/")
+    if [ "$rc" = 0 ]; then result=passed; else result="FAILED (exit $rc)"; failed=1; fi
+    printf '  %-17s %s in %s s\n' "$label" "$result" "$(cat "$logs/$name.s" 2>/dev/null || echo '?')"
+done
+exit $failed
