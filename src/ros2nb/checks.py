@@ -24,7 +24,6 @@ import re
 import shutil
 import subprocess
 import sys
-import time
 from hashlib import sha256
 from pathlib import Path
 from typing import Any, Callable, Optional
@@ -54,8 +53,8 @@ SENSOR_SEED, CEILING_SEED, FLOOR_SEED = 7, 2, 1
 CLAMP_PROBES_C = (course.MAX_TEMPERATURE_C - 0.05, course.MIN_TEMPERATURE_C + 0.05)
 #: Readings the monitor callback check sends: both boundaries and their neighbours (°C).
 BOUNDARY_READINGS_C = (19.99, 20.0, 23.0, 26.0, 26.01, 18.5, 27.5)
-#: Seconds a node process gets before Ctrl+C, and after it to exit.
-RUN_BEFORE_CTRL_C_S, EXIT_AFTER_CTRL_C_S = 2.0, 10.0
+#: Seconds a node process gets to exit after Ctrl+C (which comes once its node spins).
+EXIT_AFTER_CTRL_C_S = 10.0
 
 
 def passed(message: str) -> None:
@@ -573,9 +572,14 @@ def _main(judge: Session, relative: str, node_name: str) -> str:
     if main is None:
         raise CheckFailed(f'{path.name} has no main() function yet: write part 5.')
     observer = judge.observer
+    judge.drop(('file', relative))  # the node runs alone, as in a terminal: one of its name
     proc, output = judge.start([sys.executable, str(path)], cwd=judge.workspace)
-    observer.wait_until(lambda: proc.poll() is not None or observer.has_node(node_name), 10.0)
-    time.sleep(RUN_BEFORE_CTRL_C_S)
+    # Ctrl+C once the node spins (it answers a parameter call), as a learner presses it
+    # once the node runs: earlier, a busy machine would decide what the learner is told.
+    observer.wait_until(lambda: proc.poll() is not None or observer.has_node(node_name),
+                        ARRIVAL_TIMEOUT_S)
+    if proc.poll() is None:
+        observer.spins(node_name)
     if proc.poll() is not None:
         text = output.text()
         if 'NotImplementedError' in text:
@@ -1009,7 +1013,8 @@ def _package_runs(judge: Session) -> str:
     started = [judge.start(argv, cwd=ws, env=env) for argv in argvs]
     procs, outputs = [proc for proc, _ in started], [output for _, output in started]
     try:
-        heard = observer.wait_until(lambda: observer.lines_of(course.MONITOR_NODE, mark), 15.0)
+        heard = observer.wait_until(lambda: observer.lines_of(course.MONITOR_NODE, mark),
+                                    ARRIVAL_TIMEOUT_S)
         for proc in procs:
             interrupt(proc)
         codes = []
