@@ -17,7 +17,7 @@ export ROS_HOME            := $(HERE)/.cache/ros
 export ROS_LOG_DIR         := $(HERE)/.cache/ros/log
 export PIP_DISABLE_PIP_VERSION_CHECK := 1
 
-.PHONY: lab test setup sandbox-tool solutions learner-notebooks benchmark benchmark-grading grade clean
+.PHONY: lab test setup sandbox-tool solutions learner-notebooks bench grade clean
 
 setup: $(STAMP)
 
@@ -59,11 +59,9 @@ solutions: $(STAMP)
 learner-notebooks: $(STAMP)
 	$(PY) tools/generate_learner_notebooks.py
 
-benchmark: $(STAMP)
-	$(PY) benchmarks/sim_hour.py
-
-benchmark-grading: $(STAMP)
-	$(PY) benchmarks/grade_class.py
+# ros2nb against bare rclpy, and grading seconds per notebook (benchmarks/bench.py).
+bench: $(STAMP) sandbox-tool
+	$(PY) benchmarks/bench.py $(BENCH_ARGS)
 
 # Grade a class: SUBMISSIONS is a folder of <learner-id>/NN-*.ipynb or a platform .zip.
 # Output goes to grading/ (git-ignored); FORCE=1 replaces an earlier grading/.

@@ -284,14 +284,17 @@ def test_spin_rejects_bad_seconds(ros):
 
 
 def test_stop_during_a_sim_spin_is_one_line(ros, capsys):
-    ros2nb.add(Sensor())
+    class StopAtTen(Sensor):  # Ctrl+C at 10 simulated s: it lands while the spin runs
+        def tick(self):
+            super().tick()
+            if ros.sim_now_ns == 10 * 10 ** 9:
+                os.kill(os.getpid(), signal.SIGINT)
+
+    ros2nb.add(StopAtTen())
     capsys.readouterr()
-    timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
-    timer.start()
     ran = ros2nb.spin(10 ** 7, show_logs=False)
-    timer.join()
     out = capsys.readouterr().out.splitlines()
-    assert 0 < ran < 10 ** 7
+    assert ran == 10
     assert out[-1].startswith('Interrupted after ') and out[-1].endswith(
         'simulated s; the nodes wait until the next spin (ros2nb.stop() stops them).')
     ros2nb.spin(1)  # and the kernel goes on

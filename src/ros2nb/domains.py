@@ -33,9 +33,13 @@ SAFE_DOMAINS = range(0, 102)
 CLAIM_ORDER = (*range(1, 102), 0)
 LOCKS_ENV = 'ROS2NB_DOMAIN_LOCKS'
 DOMAIN_ENV = 'ROS_DOMAIN_ID'
-#: Fast DDS's first unicast discovery port of domain d is PORT_BASE + PORT_PER_DOMAIN * d
-#: + 10 (RTPS port mapping); in use means some ROS process already lives on domain d.
+#: Fast DDS's unicast discovery port of participant p on domain d is PORT_BASE +
+#: PORT_PER_DOMAIN * d + 10 + 2 * p (RTPS port mapping); any of them in use means some ROS
+#: process already lives on domain d.  A participant takes the first free index, so one
+#: started while index 0 was taken keeps index 1 after index 0's process has ended.
 PORT_BASE, PORT_PER_DOMAIN = 7400, 250
+#: Participant indexes probed per domain (one per ROS process on this machine).
+PARTICIPANTS_PROBED = 16
 
 _claimed: Optional[tuple[int, int]] = None  # (domain, fd holding its lock)
 
@@ -76,12 +80,13 @@ def _try_lock(folder: Path, domain: int) -> Optional[int]:
 
 def _used_by_other_ros(domain: int) -> bool:
     """True when a ROS process outside the course already has a participant on ``domain``."""
-    port = PORT_BASE + PORT_PER_DOMAIN * domain + 10
-    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
-        try:
-            probe.bind(('127.0.0.1', port))
-        except OSError:
-            return True
+    for participant in range(PARTICIPANTS_PROBED):
+        port = PORT_BASE + PORT_PER_DOMAIN * domain + 10 + 2 * participant
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as probe:
+            try:
+                probe.bind(('127.0.0.1', port))
+            except OSError:
+                return True
     return False
 
 

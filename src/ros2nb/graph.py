@@ -21,7 +21,7 @@ from rclpy.qos import (DurabilityPolicy, QoSPresetProfiles, QoSProfile,
                        ReliabilityPolicy)
 
 from .errors import Ros2nbError, UsageError
-from .runtime import current_runtime
+from .runtime import QUIET_SUBSCRIPTION, current_runtime
 
 #: Topics every ROS 2 process has; they are never reported as unmatched.
 INFRASTRUCTURE_TOPICS = ('/rosout', '/parameter_events', '/clock')
@@ -281,7 +281,8 @@ def _collect(name: str, cls: type, count: int, timeout: float,
 
     use_sim = rt.sim_time if sim_time is None else bool(sim_time)
     with rt.exclusive():
-        subscription = rt.node.create_subscription(cls, name, callback, _echo_qos(name))
+        subscription = rt.node.create_subscription(cls, name, callback, _echo_qos(name),
+                                                   event_callbacks=QUIET_SUBSCRIPTION)
     try:
         with rt.clock(use_sim):
             if use_sim:

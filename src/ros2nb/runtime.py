@@ -32,10 +32,13 @@ from typing import Callable, Iterable, Iterator, Optional, Union
 import rclpy
 from rclpy.executors import (ExternalShutdownException, ShutdownException,
                              SingleThreadedExecutor, TimeoutException)
+from rclpy.clock import ROSClock
+from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
+from rclpy.time import Time
 
 from . import domains
 from .errors import Ros2nbError, UsageError
@@ -60,6 +63,9 @@ SHUT_DOWN_MESSAGE = ('ROS 2 was shut down in this kernel (rclpy.shutdown() was c
                      'that create your nodes.')
 
 NodeOrName = Union[Node, str]
+#: For ros2nb's own subscriptions: no QoS event handlers (rclpy's default warns of
+#: incompatible QoS, which the kernel's own subscriptions choose to accept).
+QUIET_SUBSCRIPTION = SubscriptionEventCallbacks(use_default_callbacks=False)
 
 
 @dataclass(frozen=True)
@@ -125,11 +131,17 @@ class Runtime:
         from rosgraph_msgs.msg import Clock
         self._clock_type = Clock
         self.executor = SingleThreadedExecutor()
-        self.node = Node(INTERNAL_NODE_NAME)
-        self._clock_publisher = self.node.create_publisher(Clock, '/clock', 10)
+        # The kernel's own node serves nothing and logs nothing: every entity a node has is
+        # one more in every wait of the executor, and it waits thousands of times a second.
+        self.node = Node(INTERNAL_NODE_NAME, start_parameter_services=False, enable_rosout=False,
+                         parameter_overrides=[Parameter('start_type_description_service',
+                                                        Parameter.Type.BOOL, False)])
+        self._clock_publisher = self.node.create_publisher(
+            Clock, '/clock', 10, event_callbacks=PublisherEventCallbacks(use_default_callbacks=False))
         rosout_qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE,
                                 durability=DurabilityPolicy.TRANSIENT_LOCAL)
-        self.node.create_subscription(Log, '/rosout', self._on_log, rosout_qos)
+        self.node.create_subscription(Log, '/rosout', self._on_log, rosout_qos,
+                                      event_callbacks=QUIET_SUBSCRIPTION)
         self.executor.add_node(self.node)
         self._thread = threading.Thread(target=self._spin_in_background,
                                         name='ros2nb-executor', daemon=True)
@@ -407,8 +419,20 @@ class Runtime:
 
     # ----------------------------------------------------------------- clock
     def _publish_clock(self) -> None:
+        """Tell everyone the simulated time: ``/clock``, and the kernel's own nodes at once.
+
+        The nodes of this kernel would learn it from ``/clock`` a callback later; setting
+        their ROS clocks directly (rclpy's own ``set_ros_time_override``, what their time
+        source does with the message) lets their timers fire in the same wait round.  The
+        message still goes out, for processes and for clocks ros2nb does not know.
+        """
         msg = self._clock_type()
         msg.clock.sec, msg.clock.nanosec = divmod(self.sim_now_ns, 1_000_000_000)
+        now = Time(nanoseconds=self.sim_now_ns)
+        for name in self._on_sim:
+            clock = self._nodes[name].get_clock()
+            if isinstance(clock, ROSClock) and clock.ros_time_is_active:
+                clock.set_ros_time_override(now)
         self._clock_publisher.publish(msg)
 
     def _set_clock(self, nodes: Iterable[Node], sim: bool) -> None:

@@ -1,0 +1,166 @@
+#!/usr/bin/env python3
+"""``make bench``: how ros2nb compares with bare rclpy, and how fast grading is, in one run.
+
+Every figure is the median of ``--reps`` fresh runs (default 5), with the spread (fastest
+and slowest), measured in one run on this machine, the peers interleaved so that whatever
+else the machine does falls on both alike.
+
+1. One simulated hour of the course's sensor, recorded: ros2nb (as notebook 03 does it) and
+   a bare rclpy program doing the same work (benchmarks/peers.py); their ratio (bare's
+   seconds over ros2nb's: 1.0 is as fast as bare rclpy) and ros2nb's speed in real time.
+2. From starting the sensor to the first reading heard: in a kernel's runtime, and as two
+   separate processes (what ``ros2 run`` starts).
+3. Grading, in seconds per notebook: one learner who handed in the six notebooks complete
+   (every cell runs, every check passes) and one who handed them in untouched, each graded
+   alone with tools/grade.py in its sandboxes, nbgrader's set-up and feedback included.
+
+Targets (issue "Fast and steady"): simulated hour >= 0.9 x bare rclpy and >= 1000x real
+time; grading <= 10 s per notebook for a complete learner.
+
+4. Only when asked (``--only class``): a whole class of ``--learners`` complete learners
+   graded at once (``tools/grade.py``'s default jobs), minutes in all and seconds per notebook.
+
+Usage: ``make bench`` or ``python benchmarks/bench.py [--reps N] [--only sim|first|grading]``;
+``make bench BENCH_ARGS='--only class --learners 30'`` for a class.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+PEERS = Path(__file__).resolve().parent / 'peers.py'
+SIMULATED_S = 3600
+
+
+def peer(what: str, key: str = 'seconds') -> float:
+    """What one fresh run of ``peers.py WHAT`` reports: wall seconds, or ``cpu_seconds``."""
+    done = subprocess.run([sys.executable, str(PEERS), what], capture_output=True, text=True,
+                          timeout=600)
+    if done.returncode != 0:
+        sys.exit(f'{what} failed: {done.stderr.strip()[-500:]}')
+    return json.loads(done.stdout.strip().splitlines()[-1])[key]
+
+
+def both(what: str) -> tuple[float, float]:
+    """Wall and CPU seconds of one fresh run of ``peers.py WHAT``."""
+    done = subprocess.run([sys.executable, str(PEERS), what], capture_output=True, text=True,
+                          timeout=600)
+    if done.returncode != 0:
+        sys.exit(f'{what} failed: {done.stderr.strip()[-500:]}')
+    reply = json.loads(done.stdout.strip().splitlines()[-1])
+    return reply['seconds'], reply['cpu_seconds']
+
+
+def grading_seconds_per_notebook(folder: str) -> float:
+    """Grade one learner who handed in every notebook of ``folder``; seconds per notebook."""
+    notebooks = sorted((ROOT / folder).glob('*.ipynb'))
+    with tempfile.TemporaryDirectory(prefix='ros2nb-bench-') as tmp:
+        learner = Path(tmp) / 'class' / 'learner'
+        learner.mkdir(parents=True)
+        for notebook in notebooks:
+            shutil.copy2(notebook, learner / notebook.name)
+        started = time.perf_counter()
+        done = subprocess.run([sys.executable, str(ROOT / 'tools' / 'grade.py'),
+                               str(learner.parent), '--out', str(Path(tmp) / 'grading')],
+                              capture_output=True, text=True, timeout=1800)
+        elapsed = time.perf_counter() - started
+    if done.returncode != 0:
+        sys.exit(f'grading {folder}/ failed: {done.stdout[-500:]}{done.stderr[-500:]}')
+    return elapsed / len(notebooks)
+
+
+def grade_class(learners: int) -> tuple[float, int, str]:
+    """Grade ``learners`` learners who each handed in the complete notebooks.
+
+    :return: seconds in all, notebooks graded, and how many scored full marks (``k of n``).
+    """
+    notebooks = sorted((ROOT / 'solutions').glob('*.ipynb'))
+    with tempfile.TemporaryDirectory(prefix='ros2nb-bench-') as tmp:
+        for number in range(1, learners + 1):
+            learner = Path(tmp) / 'class' / f'learner{number:02d}'
+            learner.mkdir(parents=True)
+            for notebook in notebooks:
+                shutil.copy2(notebook, learner / notebook.name)
+        started = time.perf_counter()
+        subprocess.run([sys.executable, str(ROOT / 'tools' / 'grade.py'), str(Path(tmp) / 'class'),
+                        '--out', str(Path(tmp) / 'grading')], capture_output=True, timeout=7200)
+        elapsed = time.perf_counter() - started
+        with open(Path(tmp) / 'grading' / 'grades.csv', newline='') as stream:
+            totals = [r for r in csv.DictReader(stream) if r['notebook'] == 'TOTAL']
+    full = sum(1 for r in totals if float(r['score']) == float(r['max_score']))
+    return elapsed, learners * len(notebooks), f'{full} of {learners}'
+
+
+def interleaved(measures: dict[str, callable], reps: int) -> dict[str, list[float]]:
+    """Run every measure once per round, ``reps`` rounds; return the seconds of each."""
+    times: dict[str, list[float]] = {name: [] for name in measures}
+    for _ in range(reps):
+        for name, measure in measures.items():
+            times[name].append(measure())
+    return times
+
+
+def row(label: str, seconds: list[float], note: str = '') -> str:
+    median = statistics.median(seconds)
+    return (f'| {label} | {median:.2f} | {min(seconds):.2f}–{max(seconds):.2f} | '
+            f'{len(seconds)} | {note} |')
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('--reps', type=int, default=5)
+    parser.add_argument('--only', choices=('sim', 'first', 'grading', 'class'))
+    parser.add_argument('--learners', type=int, default=30, help='class size for --only class')
+    args = parser.parse_args()
+    lines = ['| measure | median s | spread s | runs | |', '|---|---|---|---|---|']
+    if args.only in (None, 'sim'):
+        runs = interleaved({'ros2nb': lambda: both('sim-hour-ros2nb'),
+                            'bare': lambda: both('sim-hour-bare')}, args.reps)
+        wall = {k: [w for w, _ in v] for k, v in runs.items()}
+        cpu = {k: [c for _, c in v] for k, v in runs.items()}
+        ours, bare = (statistics.median(wall[k]) for k in ('ros2nb', 'bare'))
+        lines.append(row('simulated hour, ros2nb', wall['ros2nb'],
+                         f'{SIMULATED_S / ours:.0f}x real time (target >= 1000x)'))
+        lines.append(row('simulated hour, bare rclpy', wall['bare'],
+                         f'{SIMULATED_S / bare:.0f}x real time'))
+        lines.append(f'| speed ratio, bare seconds / ros2nb seconds | {bare / ours:.2f} | | | '
+                     'target >= 0.9 |')
+        ours_cpu, bare_cpu = (statistics.median(cpu[k]) for k in ('ros2nb', 'bare'))
+        lines.append(row('simulated hour, ros2nb, CPU s of the process', cpu['ros2nb']))
+        lines.append(row('simulated hour, bare rclpy, CPU s of the process', cpu['bare']))
+        lines.append(f'| CPU ratio, bare / ros2nb | {bare_cpu / ours_cpu:.2f} | | | less '
+                     'sensitive to a busy machine than wall time |')
+    if args.only in (None, 'first'):
+        first = interleaved({'kernel': lambda: peer('first-message-kernel'),
+                             'processes': lambda: peer('first-message-processes')}, args.reps)
+        lines.append(row('first message, in a kernel', first['kernel'],
+                         'the sensor publishes every 1 s'))
+        lines.append(row('first message, two processes', first['processes'],
+                         'process start and discovery included'))
+    if args.only in (None, 'grading'):
+        graded = interleaved({'complete': lambda: grading_seconds_per_notebook('solutions'),
+                              'untouched': lambda: grading_seconds_per_notebook('notebooks')},
+                             args.reps)
+        lines.append(row('grading, complete learner, per notebook', graded['complete'],
+                         'target <= 10 s'))
+        lines.append(row('grading, untouched learner, per notebook', graded['untouched']))
+    if args.only == 'class':
+        elapsed, count, full = grade_class(args.learners)
+        lines.append(f'| a class of {args.learners} complete learners | {elapsed:.0f} | | 1 | '
+                     f'{elapsed / 60:.1f} min, {elapsed / count:.1f} s per notebook; {full} '
+                     'with the highest total |')
+    print('\n'.join(lines))
+
+
+if __name__ == '__main__':
+    main()

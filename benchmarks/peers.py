@@ -1,0 +1,162 @@
+"""What ``make bench`` times, one measurement per run: ``python benchmarks/peers.py WHAT``.
+
+Each run is a fresh process (its own ROS domain, nothing warm), prints one JSON line with
+its wall-clock seconds (and, for the simulated hour, the CPU seconds of the process), and is started by ``benchmarks/bench.py``, which interleaves the
+peers and repeats them.
+
+- ``sim-hour-ros2nb``: one simulated hour of the course's sensor recorded in a kernel's way
+  (``ros2nb.start(sim_time=True)``, ``ros2nb.add``, ``ros2nb.record``), as notebook 03 does.
+- ``sim-hour-bare``: the same work in a bare rclpy program: the same sensor file, a recorder
+  node, a ``/clock`` publisher and a ``SingleThreadedExecutor`` spun until each reading is in.
+- ``first-message-kernel``: from creating the sensor in a kernel's runtime (wall clock) to
+  the first reading received by a monitor node in the same process.
+- ``first-message-processes``: from starting the sensor and the monitor as two processes
+  (what ``ros2 run`` starts) to the monitor printing its first reading.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import importlib.util
+import io
+import json
+import os
+import random
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+from types import ModuleType
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / 'src'))
+
+from ros2nb import course  # noqa: E402
+
+SIMULATED_S = 3600
+SEED = 2024
+
+
+def reference_module(name: str) -> ModuleType:
+    """Import the course's reference node file ``name`` (e.g. ``temperature_publisher``)."""
+    folder = Path(tempfile.mkdtemp(prefix='ros2nb-bench-'))
+    path = folder / f'{name}.py'
+    path.write_text(course.reference_source(f'{name}.py'))
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module  # as an import does (rclpy's logger looks its file up there)
+    spec.loader.exec_module(module)
+    return module
+
+
+def sim_hour_ros2nb() -> tuple[float, float]:
+    import ros2nb
+    sensor = reference_module('temperature_publisher')
+    with contextlib.redirect_stdout(io.StringIO()):
+        ros2nb.start(sim_time=True)
+        random.seed(SEED)
+        ros2nb.add(sensor.TemperatureSensor())
+        started = time.perf_counter(), time.process_time()
+        _, values = ros2nb.record(course.TOPIC, SIMULATED_S)
+        elapsed = time.perf_counter() - started[0], time.process_time() - started[1]
+        ros2nb.shutdown()
+    assert len(values) == SIMULATED_S, len(values)
+    return elapsed
+
+
+def sim_hour_bare() -> tuple[float, float]:
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+    from rclpy.parameter import Parameter
+    from rosgraph_msgs.msg import Clock
+    from std_msgs.msg import Float32
+    from ros2nb import domains
+    sensor_module = reference_module('temperature_publisher')
+    rclpy.init(args=['--ros-args', '--disable-stdout-logs', '--disable-external-lib-logs'],
+               domain_id=domains.domain_id())  # a domain of its own, as ros2nb's
+    random.seed(SEED)
+    sensor = sensor_module.TemperatureSensor()
+    sensor.set_parameters([Parameter('use_sim_time', Parameter.Type.BOOL, True)])
+    recorder = Node('recorder')
+    values: list[float] = []
+    recorder.create_subscription(Float32, course.TOPIC, lambda m: values.append(m.data), 10)
+    clock = recorder.create_publisher(Clock, '/clock', 10)
+    executor = SingleThreadedExecutor()
+    executor.add_node(sensor)
+    executor.add_node(recorder)
+    tick = Clock()
+    clock.publish(tick)  # time 0: the sensor's clock starts, its timer counts from here
+    executor.spin_once(timeout_sec=0.1)
+    for timer in sensor.timers:
+        timer.reset()
+    started = time.perf_counter(), time.process_time()
+    for second in range(1, SIMULATED_S + 1):
+        tick.clock.sec = second
+        clock.publish(tick)
+        while len(values) < second:
+            executor.spin_once(timeout_sec=1.0)
+    elapsed = time.perf_counter() - started[0], time.process_time() - started[1]
+    executor.shutdown()
+    sensor.destroy_node()
+    recorder.destroy_node()
+    rclpy.try_shutdown()
+    assert len(values) == SIMULATED_S, len(values)
+    return elapsed
+
+
+def first_message_kernel() -> float:
+    import ros2nb
+    from rclpy.node import Node
+    from std_msgs.msg import Float32
+    sensor_module = reference_module('temperature_publisher')
+    with contextlib.redirect_stdout(io.StringIO()):
+        ros2nb.start(sim_time=False)
+        heard: list[float] = []
+        monitor = Node('bench_monitor')
+        monitor.create_subscription(Float32, course.TOPIC,
+                                    lambda m: heard.append(time.perf_counter()), 10)
+        ros2nb.add(monitor)
+        started = time.perf_counter()
+        ros2nb.add(sensor_module.TemperatureSensor())
+        while not heard:
+            time.sleep(0.001)
+        ros2nb.shutdown()
+    return heard[0] - started
+
+
+def first_message_processes() -> float:
+    from ros2nb import domains
+    folder = Path(tempfile.mkdtemp(prefix='ros2nb-bench-'))
+    files = []
+    for name in ('temperature_publisher', 'temperature_subscriber'):
+        files.append(folder / f'{name}.py')
+        files[-1].write_text(course.reference_source(f'{name}.py'))
+    env = dict(os.environ, PYTHONUNBUFFERED='1', ROS_DOMAIN_ID=str(domains.domain_id()),
+               ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+    started = time.perf_counter()
+    procs = [subprocess.Popen([sys.executable, str(f)], env=env, stdout=subprocess.PIPE,
+                              stderr=subprocess.STDOUT, text=True, start_new_session=True)
+             for f in files]
+    try:
+        for line in procs[1].stdout:
+            if 'Temperature:' in line:
+                return time.perf_counter() - started
+        raise RuntimeError('the monitor process ended without hearing a reading')
+    finally:
+        for proc in procs:
+            proc.kill()
+            proc.wait()
+
+
+MEASURES = {'sim-hour-ros2nb': sim_hour_ros2nb, 'sim-hour-bare': sim_hour_bare,
+            'first-message-kernel': first_message_kernel,
+            'first-message-processes': first_message_processes}
+
+if __name__ == '__main__':
+    if len(sys.argv) != 2 or sys.argv[1] not in MEASURES:
+        sys.exit(f'Usage: peers.py {"|".join(MEASURES)}')
+    measured = MEASURES[sys.argv[1]]()
+    wall, cpu = measured if isinstance(measured, tuple) else (measured, None)
+    print(json.dumps({'seconds': wall, 'cpu_seconds': cpu}))
