@@ -62,7 +62,7 @@ def test_start_is_idempotent_and_keeps_the_clock(ros):
     ros2nb.add(Sensor())
     started = time.monotonic()
     ros2nb.spin(30)  # the old start() switched to the wall clock: this took 30 s
-    assert time.monotonic() - started < 10
+    assert time.monotonic() - started < 29  # 30 simulated s, not 30 real ones
     assert len(monitor.received) == 30
 
 
@@ -364,7 +364,7 @@ def test_timer_of_period_zero_is_refused_at_once(ros):
     with pytest.raises(Ros2nbError, match=r'busy has a timer with a period of 0 s for '
                                           r'.*Busy.tick: it would fire without pause'):
         ros2nb.add(Busy())
-    assert time.monotonic() - started < 2
+    assert time.monotonic() - started < 29  # the old add() hung; a busy machine takes seconds
     assert ros.nodes == {}
 
 
