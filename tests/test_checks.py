@@ -14,7 +14,10 @@ from pathlib import Path
 
 import pytest
 
-from ros2nb import checks, course, judge
+from ros2nb import checks, course
+from ros2nb.checks.base import bind_judge
+from ros2nb.checks.dispatch import IN_JUDGE_ENV
+from ros2nb.judge.session import Session
 from ros2nb.errors import CheckFailed, LearnerCodeError
 
 pytestmark = pytest.mark.timeout(300)
@@ -30,17 +33,18 @@ MESSAGES: list[str] = []
 def session(tmp_path_factory):
     """A judge session (this process is the judge) on a workspace with the course's package."""
     import ros2nb
-    from ros2nb import workspace as ws_module
+    from ros2nb.terminal import workspace as ws_module
     root = tmp_path_factory.mktemp('checks')
-    saved = {k: os.environ.get(k) for k in ('ROS2NB_WORKSPACE', judge.IN_JUDGE_ENV)}
+    saved = {k: os.environ.get(k) for k in ('ROS2NB_WORKSPACE', IN_JUDGE_ENV)}
     os.environ['ROS2NB_WORKSPACE'] = str(root / 'ws')
-    os.environ[judge.IN_JUDGE_ENV] = '1'
+    os.environ[IN_JUDGE_ENV] = '1'
     ws_module._current = None
     ros2nb.course.catch_up(5)
-    judge._session = judge.Session(root / 'ws')
-    yield judge._session
-    judge._session.close()
-    judge._session = None
+    session = Session(root / 'ws')
+    bind_judge(session)  # this process is the judge
+    yield session
+    bind_judge(None)
+    session.close()
     for key, value in saved.items():
         if value is None:
             os.environ.pop(key, None)
@@ -240,8 +244,8 @@ def test_no_message_prints_the_answer():
 def test_a_check_from_the_kernel_runs_in_a_judge_process(tmp_path, monkeypatch, capsys):
     """The kernel's path: a judge process of its own, on a domain of its own."""
     import ros2nb
-    from ros2nb import workspace as ws_module
-    monkeypatch.delenv(judge.IN_JUDGE_ENV, raising=False)
+    from ros2nb.terminal import workspace as ws_module
+    monkeypatch.delenv(IN_JUDGE_ENV, raising=False)
     monkeypatch.setenv('ROS2NB_WORKSPACE', str(tmp_path / 'ws'))
     monkeypatch.setattr(ws_module, '_current', None)
     ros2nb.course.catch_up(5)

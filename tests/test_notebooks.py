@@ -84,7 +84,8 @@ def test_the_points_the_notebook_states_are_the_points_it_gives(path):
 @pytest.mark.parametrize('path', SOLUTIONS, ids=lambda p: p.name)
 def test_the_judge_can_run_every_graded_cell(path):
     """Graded cells hold only ros2nb.checks calls, which the judge runs outside the kernel."""
-    from ros2nb import checks, judge
+    from ros2nb import checks
+    from ros2nb.judge import grading as judge
     for cell in load(path)['cells']:
         if nbgrader(cell).get('grade'):
             calls = judge.graded_calls(text(cell))
@@ -103,7 +104,7 @@ def test_learner_notebooks_leave_the_nodes_to_the_learner(path):
 
 
 def _file_from_parts(path: Path, variable: str) -> str:
-    from ros2nb.workspace import AUTHOR_MARKERS
+    from ros2nb.terminal.files import AUTHOR_MARKERS
     parts = {}
     for cell in load(path)['cells']:
         found = re.match(r'%%part \{' + variable + r'\} (\d+)\n', text(cell))
@@ -145,7 +146,7 @@ def test_learner_notebooks_have_no_outputs_and_no_solutions():
 
 
 def test_learner_notebooks_in_sync_with_solutions():
-    done = subprocess.run([sys.executable, str(ROOT / 'tools' / 'generate_learner_notebooks.py'),
+    done = subprocess.run([str(Path(sys.executable).with_name('ros2nb-learner-notebooks')),
                            '--check'], capture_output=True, text=True)
     assert done.returncode == 0, done.stdout + done.stderr
 

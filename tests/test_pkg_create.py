@@ -1,4 +1,4 @@
-"""Tests for ros2nb.pkg_create: the files and output of Jazzy's ``ros2 pkg create``."""
+"""Tests for ros2nb.terminal.pkg_create: the files and output of Jazzy's ``ros2 pkg create``."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from ros2nb.pkg_create import (AMENT_PYTHON_TEST_DEPENDENCIES, EXPECTED_FILES_AMENT_PYTHON,
+from ros2nb.terminal.pkg_create import (AMENT_PYTHON_TEST_DEPENDENCIES, EXPECTED_FILES_AMENT_PYTHON,
                                PkgCreateError, expected_files, pkg_create)
 
 NAME = 'sensor_simulator'

@@ -19,7 +19,7 @@ from ros2nb.errors import Ros2nbError, UsageError
 from nodes import PERIOD_S, Broken, Monitor, Sensor
 from waiting import PATIENCE_S, wait_until
 
-rt_module = importlib.import_module('ros2nb.runtime')
+rt_module = importlib.import_module('ros2nb.runtime.current')
 
 
 @pytest.fixture
@@ -106,8 +106,9 @@ def test_after_rclpy_shutdown_one_line_then_recovery(capsys):
             ros2nb.add(sensor)
         with pytest.raises(rclpy.exceptions.NotInitializedException) as caught:
             Sensor()  # what the learner's next cell does; the kernel shows this line instead
-        from ros2nb.explain import explain_exception
-        assert explain_exception(caught.value).startswith('ROS 2 was shut down in this kernel')
+        from ros2nb.explain.exceptions import explain_exception
+        assert explain_exception(caught.value, ros_started=rt_module.kernel_runtime() is not None
+                                 ).startswith('ROS 2 was shut down in this kernel')
         ros2nb.shutdown()
         ros2nb.start(sim_time=True)
         ros2nb.add(Sensor())

@@ -11,7 +11,7 @@ import pytest
 import ros2nb
 from ros2nb import course
 
-ws_module = importlib.import_module('ros2nb.workspace')
+ws_module = importlib.import_module('ros2nb.terminal.workspace')
 
 TUTORIAL_MAIN = '''
 import rclpy
@@ -204,6 +204,27 @@ def test_processes_inherit_the_kernels_domain(built, capsys):
     ros2nb.run_and_interrupt([sys.executable, '-c', 'import os; print(os.environ["ROS_DOMAIN_ID"])'],
                              seconds=5)
     assert capsys.readouterr().out.splitlines()[0] == str(domain)
+
+
+SLOW_START = """
+import time
+time.sleep(2)  # a program still starting (imports, discovery) on a busy machine
+print('ready', flush=True)
+try:
+    while True:
+        time.sleep(0.05)
+except KeyboardInterrupt:
+    print('stopped cleanly', flush=True)
+"""
+
+
+def test_ctrl_c_waits_until_every_process_has_started(capsys):
+    """Ctrl+C's countdown starts once a process has printed its first line: before, 1 s
+    after launch it landed in the start-up and the program died with a traceback."""
+    codes = ros2nb.run_and_interrupt([sys.executable, '-c', SLOW_START], seconds=1)
+    out = capsys.readouterr().out
+    assert codes == [0], out
+    assert out.index('ready') < out.index('^C') < out.index('stopped cleanly')
 
 
 def test_ros2_run_defers_to_a_real_ros2_on_path(built, tmp_path, monkeypatch, capsys):

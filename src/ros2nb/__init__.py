@@ -2,23 +2,29 @@
 
 Importing ``ros2nb`` does nothing by itself: call :func:`start` to bring ROS up.
 Each public function names the notebook that introduces it in its docstring.
+
+Where each part runs (docs/architecture.md): ``kernel``, ``runtime``, ``terminal``,
+``explain`` and ``checks`` in the learner's kernel; ``judge`` in a judge process that
+decides from outside; ``subject`` in the processes that run the learner's code for the
+judge.  The instructor's side is the package ``ros2nb_instructor``.
 """
 
 from . import checks, course, domains
 from .errors import (CheckFailed, ColconBuildError, DomainsExhaustedError, FileProtectedError,
                      LearnerCodeError, PkgCreateError, Ros2nbError, UsageError)
-from .graph import (message_type, node_list, record, topic_echo, topic_hz, topic_info,
-                    topic_list, unmatched_topics)
-from .pkg_create import pkg_create
-from .runtime import add, current_runtime, shutdown, spin, start, stop
-from .workspace import (colcon_build, create_workspace, current_workspace, find_executable,
-                        import_file, ros2_run, run_and_interrupt, source_workspace, tree,
-                        write_file, write_part)
+from .kernel import add, install, shutdown, spin, start, stop
+from .runtime import current_runtime
+from .terminal.colcon import colcon_build, source_workspace
+from .terminal.echo import message_type, record, topic_echo, topic_hz
+from .terminal.files import import_file, write_file, write_part
+from .terminal.pkg_create import pkg_create
+from .terminal.run import find_executable, ros2_run, run_and_interrupt
+from .terminal.topic import node_list, topic_info, topic_list, unmatched_topics
+from .terminal.workspace import create_workspace, current_workspace, tree
 
 
 def load_ipython_extension(ipython) -> None:
     """``%load_ext ros2nb``: the ``%%part FILE N`` cell magic and one-line errors (notebook 03)."""
-    from .kernel import install
     install(ipython)
 
 

@@ -1,6 +1,6 @@
 """The course's facts, defined once: names, files, the sensor's numbers, the monitor's rule.
 
-The checks, the grader and the notebooks take every number from here.  The node files
+The checks, the judge and the notebooks take every number from here.  No ROS import.  The node files
 the learner writes (and ``ros2nb/reference/``) are standalone ROS programs, so they carry
 the same numbers as literals in their constants part; a test keeps them equal to these.
 
@@ -15,6 +15,10 @@ import io
 import os
 from importlib import resources
 from pathlib import Path
+
+from .terminal.files import write_file
+from .terminal.pkg_create import pkg_create
+from .terminal.workspace import create_workspace, default_workspace, shown
 
 # ------------------------------------------------------------------ the package
 PACKAGE = 'sensor_simulator'
@@ -106,8 +110,6 @@ def catch_up(notebook: int) -> Path:
     :return: the workspace path.
     :raises ValueError: for a notebook number without steps.
     """
-    from .pkg_create import pkg_create
-    from .workspace import create_workspace, default_workspace, shown, write_file
     if notebook not in STEPS:
         raise ValueError(f'notebook must be one of {sorted(STEPS)} (got {notebook}).')
     steps = STEPS[notebook]

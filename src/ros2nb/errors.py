@@ -10,6 +10,12 @@ message, and the lines of ros2nb would only hide it.
 from __future__ import annotations
 
 
+#: What a learner is told whenever ROS was shut down under ros2nb in their kernel.
+SHUT_DOWN_MESSAGE = ('ROS 2 was shut down in this kernel (rclpy.shutdown() was called): run '
+                     'ros2nb.shutdown(); ros2nb.start() to bring it back, then re-run the cells '
+                     'that create your nodes.')
+
+
 class _OneLine:
     """Mixin: IPython shows ``Type: message`` and nothing else."""
 

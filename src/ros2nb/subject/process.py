@@ -1,4 +1,4 @@
-"""The process that runs the learner's code for a check: ``python -m ros2nb.subject IN OUT``.
+"""What a subject process does for the judge: load the learner's code, run it, report raw facts.
 
 Introduced in ``03-write-the-publisher.ipynb`` (every check of a node runs one).
 
@@ -16,7 +16,6 @@ from __future__ import annotations
 import importlib.util
 import json
 import math
-import os
 import random
 import sys
 import time
@@ -24,6 +23,14 @@ import traceback
 from pathlib import Path
 from types import ModuleType
 from typing import Any, Callable, Optional
+
+from rclpy.node import Node
+
+from .. import domains
+from ..endpoints import node_endpoints
+from ..errors import Ros2nbError
+from ..explain.exceptions import explain_exception, is_library_file, learner_line
+from ..runtime import Runtime, enable_field_checks
 
 #: Exit code when a command could not even be read.
 PROTOCOL_ERROR = 3
@@ -51,7 +58,6 @@ def decode_argument(value: Any) -> Any:
 
 def describe_error(error: BaseException) -> dict:
     """The learner-facing facts of an exception: type, message, explanation, their traceback."""
-    from .explain import explain_exception, is_library_file, learner_line
     frames = [f for f in traceback.extract_tb(error.__traceback__)
               if not is_library_file(f.filename) and not f.filename.startswith('<ros2nb')]
     lines = ['Traceback (most recent call last):'] if frames else []
@@ -136,10 +142,8 @@ class Subject:
     # ---------------------------------------------------------------- nodes
     def _runtime(self):
         if self.rt is None:
-            from . import domains, runtime
-            runtime._enable_field_checks()
-            self.rt = runtime.Runtime(domain_id=domains.domain_id(), sim_time=True,
-                                      background=False)
+            enable_field_checks()
+            self.rt = Runtime(domain_id=domains.domain_id(), sim_time=True, background=False)
             self.rt.on_failure = self._on_failure
         return self.rt
 
@@ -179,9 +183,6 @@ class Subject:
 
     def new_node(self, cls: str, placeholders: list[str], attributes: list[str],
                  seed: Optional[int]) -> dict:
-        from rclpy.node import Node
-        from .errors import Ros2nbError
-        from .graph import node_endpoints
         rt = self._runtime()
         if self.node is not None:
             if self.node.get_fully_qualified_name() in rt.nodes:
@@ -297,19 +298,3 @@ def serve(commands: Any, replies: Any) -> None:
         replies.flush()
     if subject.rt is not None:
         subject.rt.shutdown()
-
-
-def main(argv: list[str]) -> int:
-    """Entry point: ``python -m ros2nb.subject IN_FD OUT_FD``."""
-    if len(argv) != 2:
-        print('Usage: python -m ros2nb.subject IN_FD OUT_FD (started by ros2nb.judge).',
-              file=sys.stderr)
-        return PROTOCOL_ERROR
-    with os.fdopen(int(argv[0]), 'r') as commands, os.fdopen(int(argv[1]), 'w') as replies:
-        serve(commands, replies)
-    return 0
-
-
-if __name__ == '__main__':
-    from ros2nb import subject as _subject  # one copy of the module, as the judge's own
-    sys.exit(_subject.main(sys.argv[1:]))

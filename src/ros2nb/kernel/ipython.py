@@ -2,6 +2,7 @@
 
 Introduced in ``00-setup-and-the-pubsub-idea.ipynb``.  :func:`ros2nb.start` installs it in
 a notebook; ``%load_ext ros2nb`` does too (notebook 05 runs no ROS in the kernel).
+Runs in the learner's kernel.
 
 - ``%%part FILE N [--overwrite]`` saves the cell as part N of FILE (:func:`ros2nb.write_part`).
 - Known beginner mistakes raised through rclpy or a message class show as one line
@@ -18,9 +19,13 @@ from __future__ import annotations
 
 import re
 import shlex
+import sys
 from typing import Any, Optional
 
-from .errors import UsageError
+from ..errors import UsageError
+from ..explain.exceptions import explain_exception, learner_line
+from ..runtime import kernel_runtime
+from ..terminal.files import write_part
 
 _INSTALLED = '_ros2nb_installed'
 
@@ -32,7 +37,6 @@ def part(line: str, cell: str) -> None:
 
     :raises UsageError: if the line is not ``FILE N``, or FILE is an unexpanded ``{NAME}``.
     """
-    from .workspace import write_part
     words = shlex.split(line)
     overwrite = '--overwrite' in words
     words = [w for w in words if w != '--overwrite']
@@ -47,14 +51,13 @@ def part(line: str, cell: str) -> None:
 
 
 def _before_cell(_info: Any = None) -> None:
-    from . import runtime
-    if runtime._runtime is not None:
-        runtime._runtime.begin_cell()
+    rt = kernel_runtime()
+    if rt is not None:
+        rt.begin_cell()
 
 
 def _after_cell(_result: Any = None) -> None:
-    from . import runtime
-    rt = runtime._runtime
+    rt = kernel_runtime()
     if rt is not None and rt.alive:
         rt.print_pending()
 
@@ -62,9 +65,8 @@ def _after_cell(_result: Any = None) -> None:
 def _explain(shell: Any, etype: type, value: BaseException, tb: Any,
              tb_offset: Optional[int] = None) -> None:
     """IPython custom exception handler: one line for known mistakes, else the usual display."""
-    from .explain import explain_exception, learner_line
     try:
-        line = explain_exception(value)
+        line = explain_exception(value, ros_started=kernel_runtime() is not None)
     except Exception:  # explaining must never hide the original error
         line = None
     if line is None:
@@ -80,12 +82,9 @@ def install(ip: Any = None) -> bool:
 
     Introduced in ``00-setup-and-the-pubsub-idea.ipynb``.
     """
-    if ip is None:
-        try:
-            from IPython import get_ipython
-        except ImportError:
-            return False
-        ip = get_ipython()
+    if ip is None:  # IPython is imported wherever it runs; ros2nb never imports it itself
+        loaded = sys.modules.get('IPython')
+        ip = loaded.get_ipython() if loaded is not None else None
     if ip is None:
         return False
     if getattr(ip, _INSTALLED, False):

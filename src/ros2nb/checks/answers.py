@@ -1,0 +1,53 @@
+"""The learner's answer cells (notebooks 00-02), called in a subject: what comes back.
+
+Part of :mod:`ros2nb.checks`.  Only plain values travel back from the learner's function
+(a path, a list of names, a number); anything else is known by its type and its repr.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from ..errors import CheckFailed
+from .base import AnswerRef, current_judge, learner_error
+
+
+def answer_results(ref: AnswerRef, inputs: list[list[Any]]) -> list[dict]:
+    """Call the learner's function ``ref`` (from their answer cell) in a subject."""
+    subject = current_judge().answer_subject(ref)
+    reply = subject.request('call', name=ref.name, inputs=inputs)
+    if reply.get('undefined'):
+        raise CheckFailed(f'{ref.name} is not defined in your answer cell: define it there '
+                          '(and run the cell) without renaming it.')
+    return reply['outputs']
+
+
+def decoded(output: dict, label: str) -> Any:
+    """One output of :func:`answer_results` as a Python value; a raised error is raised."""
+    if 'error' in output:
+        raise learner_error(label, output['error'])
+    result = output['result']
+    if result['type'] == 'Path':
+        return Path(result['value'])
+    if result['type'] in ('list', 'tuple'):
+        return [item['value'] for item in result['value']]
+    if result['type'] in ('str', 'float', 'int', 'bool', 'NoneType'):
+        return result['value']
+    return Opaque(result['type'], result['value'])
+
+
+class Opaque:
+    """A value of a type the judge does not rebuild; only its type and repr travel."""
+
+    def __init__(self, type_name: str, text: str) -> None:
+        self.type_name, self.text = type_name, text
+
+    def __repr__(self) -> str:
+        return self.text
+
+
+def type_name_of(value: Any) -> str:
+    """The type's name of a value from :func:`decoded` (an :class:`Opaque` keeps its own)."""
+    return value.type_name if isinstance(value, Opaque) else type(value).__name__
+

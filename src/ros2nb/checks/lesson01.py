@@ -1,0 +1,41 @@
+"""Checks of notebook 01, create a workspace: a path that ``~`` really expands into the home folder.
+
+Part of :mod:`ros2nb.checks`.  The learner's function is called in the kernel there; the
+judge calls it from the learner's answer cell in a subject (:mod:`.answers`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from ..errors import CheckFailed
+from .answers import answer_results, decoded, type_name_of
+from .base import AnswerRef, call_learner, passed
+
+
+def check_expanded_path(make_path: Any, *, ends_with: str) -> None:
+    """Check the path a function returns is absolute, inside home and ends with ``ends_with``.
+
+    Introduced in ``01-create-a-workspace.ipynb``.
+
+    :param make_path: the learner's function (called with no arguments).
+    :param ends_with: how the path must end, e.g. ``'Documents/ROS2_and_RL_Tutorials'``.
+    :raises CheckFailed: e.g. for the tutorial's ``/Documents/...`` (no ``~``).
+    """
+    if isinstance(make_path, AnswerRef):
+        path = decoded(answer_results(make_path, [[]])[0], f'{make_path.name}()')
+    else:
+        path = call_learner(make_path)
+    if not isinstance(path, Path):
+        raise CheckFailed(f'{make_path.__name__}() returned {type_name_of(path)} {path!r}; return '
+                          'a pathlib.Path.')
+    if '~' in str(path):
+        raise CheckFailed(f'{path} still contains "~": Python does not expand it, call '
+                          '.expanduser().')
+    if Path.home() not in path.parents:
+        raise CheckFailed(f'{path} is not inside your home folder {Path.home()}: a path that '
+                          'starts with "/" starts at the root of the disk.')
+    if not str(path).endswith(ends_with):
+        raise CheckFailed(f'{path} should end with {ends_with}.')
+    passed(f'{path} is inside your home folder.')

@@ -1,0 +1,89 @@
+"""Checks of notebook 02, create a package: a package.xml's ``<depend>`` entries, as catkin_pkg reads them.
+
+Part of :mod:`ros2nb.checks`.  The learner's reader is called in the kernel there; the
+judge calls it from the learner's answer cell in a subject, also on a package.xml of its own.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Optional
+
+from catkin_pkg.package import InvalidPackage, parse_package
+
+from .. import course
+from ..errors import CheckFailed, Ros2nbError
+from ..terminal.workspace import current_workspace
+from .answers import answer_results, decoded, type_name_of
+from .base import AnswerRef, call_learner, current_judge, passed
+
+
+def package_dependencies(package_xml: Path) -> list[str]:
+    """Return the ``<depend>`` entries of a package.xml, in order, as catkin_pkg reads them.
+
+    A ``<depend>`` is needed to build, to export and to run, so it is a name that shows up
+    in all three of catkin_pkg's lists.
+
+    Introduced in ``02-create-a-package.ipynb``.
+
+    :raises Ros2nbError: when the file is not a valid package.xml.
+    """
+    try:
+        package = parse_package(str(package_xml))
+    except (InvalidPackage, OSError) as error:
+        raise Ros2nbError(f'{package_xml} is not a valid package.xml: {error}') from None
+    exported = {d.name for d in package.build_export_depends}
+    run = {d.name for d in package.exec_depends}
+    return [d.name for d in package.build_depends if d.name in exported and d.name in run]
+
+
+#: package.xml files the grader feeds a learner's reader, beyond the course's own.
+_EXTRA_PACKAGE_XML = '''<?xml version="1.0"?>
+<package format="3">
+  <name>graded_reader</name>
+  <version>1.2.3</version>
+  <description>A package.xml of the grader's own.</description>
+  <maintainer email="grader@example.com">grader</maintainer>
+  <license>Apache-2.0</license>
+  <buildtool_depend>ament_python</buildtool_depend>
+  <depend>geometry_msgs</depend>
+  <test_depend>python3-pytest</test_depend>
+  <depend>  rclpy  </depend>
+  <depend>sensor_msgs</depend>
+  <export><build_type>ament_python</build_type></export>
+</package>
+'''
+
+
+def check_dependencies(reader: Any, package_xml: Optional[Path] = None) -> None:
+    """Check a learner's package.xml reader against catkin_pkg, ROS's own reader.
+
+    Introduced in ``02-create-a-package.ipynb``.
+
+    :param reader: the learner's function, ``reader(path) -> list[str]``.
+    :param package_xml: the file to read; default the course package's in the workspace.
+        The grader also feeds a package.xml of its own.
+    :raises CheckFailed: when the result differs from the file's ``<depend>`` tags.
+    """
+    files = [Path(package_xml) if package_xml else current_workspace() / course.PACKAGE_XML_FILE]
+    if not files[0].is_file():
+        raise CheckFailed(f'{files[0]} does not exist: run the pkg_create cell above first.')
+    if isinstance(reader, AnswerRef):
+        extra = current_judge().scratch / 'graded_reader' / 'package.xml'
+        extra.parent.mkdir(parents=True, exist_ok=True)
+        extra.write_text(_EXTRA_PACKAGE_XML)
+        files.append(extra)
+        outputs = answer_results(reader, [[{'path': str(f)}] for f in files])
+        results = [decoded(o, f'{reader.name}(package_xml)') for o in outputs]
+    else:
+        results = [call_learner(reader, f) for f in files]
+    for file, got in zip(files, results):
+        want = package_dependencies(file)
+        if not isinstance(got, list):
+            raise CheckFailed(f'{reader.__name__}() returned {type_name_of(got)}; return a list of '
+                              'names.')
+        if got != want:
+            raise CheckFailed(f'For {file.parent.name}/package.xml you returned {got}, but it '
+                              f'declares {want}: read the text of each <depend> element, in '
+                              'order, without spaces around it (test_depend is not a depend).')
+    passed(f'package.xml depends on {", ".join(package_dependencies(files[0]))}.')

@@ -1,0 +1,168 @@
+"""Checks of notebook 04, write the subscriber: the monitor's constructor, callback and main().
+
+Part of :mod:`ros2nb.checks`.  The judge creates the learner's ``TemperatureMonitor`` in a
+subject, publishes readings to it from its own node and reads its log lines on ``/rosout``.
+"""
+
+from __future__ import annotations
+
+import random
+import re
+
+from std_msgs.msg import Float32
+
+from .. import course
+from ..errors import CheckFailed
+from .base import ARRIVAL_TIMEOUT_S, Judge, judged, learner_error
+from .mains import run_main
+from .nodes import caught_up, new_node, started_log_verdict
+from .verdicts import endpoint_verdict, node_name_verdict
+
+#: Readings the monitor callback check sends: both boundaries and their neighbours (°C).
+BOUNDARY_READINGS_C = (19.99, 20.0, 23.0, 26.0, 26.01, 18.5, 27.5)
+
+
+def check_monitor_main() -> None:
+    """Check part 5 of ``temperature_subscriber.py``: ``main()`` and Ctrl+C.
+
+    As :func:`check_sensor_main`, for the monitor.
+
+    Introduced in ``04-write-the-subscriber.ipynb``.
+
+    :raises CheckFailed: with the process's last line.
+    """
+    judged('check_monitor_main', run_main, relative=course.SUBSCRIBER_FILE,
+           node_name=course.MONITOR_NODE)
+
+
+# ------------------------------------------------------------------ the monitor
+def _monitor_verdict(info: dict, found: list) -> None:
+    node_name_verdict(info, course.MONITOR_NODE)
+    endpoint_verdict(info['name'], found, 'subscription', '/' + course.TOPIC,
+                      course.MESSAGE_TYPE)
+
+
+def _monitor_constructor(judge: Judge) -> str:
+    mark = len(judge.observer.logs)
+    _subject, info = new_node(judge, course.SUBSCRIBER_FILE, course.MONITOR_CLASS,
+                               placeholders=('temperature_callback',))
+    _monitor_verdict(info, judge.observer.endpoints(info['name'], info['namespace'],
+                                                    info['endpoints']))
+    started_log_verdict(judge, info, mark, course.MONITOR_CLASS)
+    return f'{info["name"]} subscribes to /{course.TOPIC} [{course.MESSAGE_TYPE}].'
+
+
+def check_monitor_constructor() -> None:
+    """Check part 3 of ``temperature_subscriber.py``: the monitor's ``__init__``.
+
+    Creates your ``TemperatureMonitor`` and checks its name, its subscription (topic and
+    type, from the ROS graph) and its start-up log line.
+
+    Introduced in ``04-write-the-subscriber.ipynb``.
+
+    :raises CheckFailed: naming your value and the expected one.
+    """
+    judged('check_monitor_constructor', _monitor_constructor)
+
+
+def _feed_monitor(judge: Judge, readings: tuple[float, ...] | list[float]) -> list[list[str]]:
+    """Publish readings to the learner's monitor (from the judge); return its lines per reading."""
+    observer = judge.observer
+    mark = len(observer.logs)
+    subject, info = new_node(judge, course.SUBSCRIBER_FILE, course.MONITOR_CLASS)
+    _monitor_verdict(info, observer.endpoints(info['name'], info['namespace'], info['endpoints']))
+    caught_up(judge, info, mark, info['started_lines'])
+    publisher = judge.probe_publisher
+    if not observer.wait_until(lambda: publisher.get_subscription_count() >= 1,
+                               ARRIVAL_TIMEOUT_S):
+        raise CheckFailed(f'The grader\'s publisher on /{course.TOPIC} never reached your '
+                          'subscription: check its topic name and type.')
+    per_reading = []
+    before = subject.request('counts')
+    for value in readings:
+        mark = len(observer.logs)
+        publisher.publish(Float32(data=value))
+        reply = subject.request('wait_received', count=before['received'] + 1,
+                                seconds=ARRIVAL_TIMEOUT_S)
+        if reply['failure']:
+            failure = reply['failure']
+            raise learner_error(failure['callback'], failure, context=f' for {value} °C')
+        if not reply['ok']:
+            raise CheckFailed(f'The reading {value} °C never reached temperature_callback: is it '
+                              'the subscription\'s callback?')
+        per_reading.append(caught_up(judge, info, mark, reply['logged'] - before['logged']))
+        before = reply
+    return per_reading
+
+
+def _statuses_verdict(readings: tuple[float, ...] | list[float], lines: list[list[str]], *,
+                      with_value: bool) -> None:
+    words = re.compile(r'\b(High|Low|Normal)\b')
+    for value, said in zip(readings, lines):
+        want = course.monitor_status(value)
+        if not said:
+            raise CheckFailed(f'For a reading of {value} °C the monitor logged nothing: log one '
+                              'line with the reading and its status.')
+        if len(said) > 1:
+            raise CheckFailed(f'For a reading of {value} °C the monitor logged {len(said)} lines; '
+                              'log exactly one per message.')
+        found = words.findall(said[0])
+        if not found:
+            lower = re.search(r'\b(high|low|normal)\b', said[0], re.IGNORECASE)
+            if lower:
+                raise CheckFailed(f'For {value} °C the monitor logged "{said[0]}": write the '
+                                  f'status {lower.group(0).capitalize()}, with a capital letter, '
+                                  f'as High, Low and Normal are written.')
+            raise CheckFailed(f'For {value} °C the monitor logged "{said[0]}", without a status: '
+                              'add High, Low or Normal to the line.')
+        if found != [want]:
+            rule = (f'only readings strictly above {course.HIGH_ABOVE_C} °C are High and strictly '
+                    f'below {course.LOW_BELOW_C} °C Low')
+            raise CheckFailed(f'For {value} °C the monitor said {", ".join(found)}; it should say '
+                              f'{want}: {rule}.')
+        if with_value and f'{value:.2f}' not in said[0]:
+            raise CheckFailed(f'For {value} °C the monitor logged "{said[0]}": show the reading '
+                              'with two decimals, e.g. 23.00.')
+
+
+def _monitor_callback(judge: Judge) -> str:
+    lines = _feed_monitor(judge, BOUNDARY_READINGS_C)
+    _statuses_verdict(BOUNDARY_READINGS_C, lines, with_value=False)
+    return (f'one line with the right status for each of {len(BOUNDARY_READINGS_C)} readings, '
+            f'including {course.LOW_BELOW_C} and {course.HIGH_ABOVE_C} °C (both Normal).')
+
+
+def check_monitor_callback() -> None:
+    """Check part 4 of ``temperature_subscriber.py``: the callback and its statuses.
+
+    The judge publishes readings around both thresholds (19.99, 20.0, 26.0, 26.01 °C and
+    more) to your monitor over ROS and reads its log lines from ``/rosout``: exactly one
+    line per message, naming High, Low or Normal correctly.
+
+    Introduced in ``04-write-the-subscriber.ipynb``.
+
+    :raises CheckFailed: naming the reading, what your monitor said and the rule.
+    """
+    judged('check_monitor_callback', _monitor_callback)
+
+
+def _monitor_readings(judge: Judge) -> str:
+    chooser = random.Random(2024)
+    readings = [round(chooser.uniform(17.0, 29.0), 2) for _ in range(30)]
+    readings += [course.LOW_BELOW_C, course.HIGH_ABOVE_C, 19.995, 26.005]
+    lines = _feed_monitor(judge, readings)
+    _statuses_verdict(readings, lines, with_value=True)
+    return f'the right status and the reading in one line for each of {len(readings)} readings.'
+
+
+def check_monitor_readings() -> None:
+    """Hidden test of notebook 04: 34 readings from the grader's own publisher.
+
+    Random readings over the whole range and the boundaries; every one must give one line
+    with the reading (two decimals) and the right status.
+
+    Introduced in ``04-write-the-subscriber.ipynb``.
+
+    :raises CheckFailed: naming the first reading handled wrongly.
+    """
+    judged('check_monitor_readings', _monitor_readings)

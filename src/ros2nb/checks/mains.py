@@ -1,0 +1,138 @@
+"""The ``main()`` checks of notebooks 03 and 04: the file run as a program, then Ctrl+C.
+
+Part of :mod:`ros2nb.checks`.  The judge starts the learner's file as ``ros2 run`` would
+(a process of its own, sandboxed while grading), presses Ctrl+C once its node spins, and
+reads the exit code and the output; the learner's ``main()`` is read as text (``ast``).
+"""
+
+from __future__ import annotations
+
+import ast
+import re
+import subprocess
+import sys
+from typing import Optional
+
+from ..errors import CheckFailed
+from ..processes import interrupt, kill_process_group
+from .base import ARRIVAL_TIMEOUT_S, Judge
+
+#: Seconds a node process gets to exit after Ctrl+C (which comes once its node spins).
+EXIT_AFTER_CTRL_C_S = 10.0
+
+
+def _function(tree: ast.Module, name: str) -> Optional[ast.FunctionDef]:
+    return next((s for s in tree.body if isinstance(s, ast.FunctionDef) and s.name == name), None)
+
+
+def _calls(nodes: list[ast.stmt]) -> set[str]:
+    names = set()
+    for statement in nodes:
+        for node in ast.walk(statement):
+            if isinstance(node, ast.Call):
+                func = node.func
+                names.add(func.attr if isinstance(func, ast.Attribute) else
+                          func.id if isinstance(func, ast.Name) else '')
+    return names
+
+
+def _cleanup_verdict(main: ast.FunctionDef) -> None:
+    """main() must destroy its node and shut rclpy down, in a ``finally:`` block."""
+    in_finally = _calls([s for node in ast.walk(main) if isinstance(node, ast.Try)
+                         for s in node.finalbody])
+    anywhere = _calls(main.body)
+    if 'destroy_node' not in anywhere:
+        raise CheckFailed('main() never destroys its node: call node.destroy_node() when the '
+                          'spin ends (the tutorial\'s subscriber forgot it).')
+    if not anywhere & {'try_shutdown', 'shutdown'}:
+        raise CheckFailed('main() never shuts rclpy down: call rclpy.try_shutdown() when the '
+                          'spin ends.')
+    if 'destroy_node' not in in_finally or not in_finally & {'try_shutdown', 'shutdown'}:
+        raise CheckFailed('main() cleans up only when the spin ends normally: destroy the node '
+                          'and call rclpy.try_shutdown() in a finally: block.')
+
+
+def run_main(judge: Judge, relative: str, node_name: str) -> str:
+    """Run the learner's file, press Ctrl+C once its node spins; the verdict, or the sentence."""
+    path = judge.workspace / relative
+    if not path.is_file():
+        raise CheckFailed(f'{path.name} does not exist yet: run the %%part cells that write it.')
+    try:
+        tree = ast.parse(path.read_text())
+    except SyntaxError as error:
+        raise CheckFailed(f'{path.name} line {error.lineno}: SyntaxError: {error.msg}.') from None
+    main = _function(tree, 'main')
+    if main is None:
+        raise CheckFailed(f'{path.name} has no main() function yet: write part 5.')
+    observer = judge.observer
+    judge.drop(('file', relative))  # the node runs alone, as in a terminal: one of its name
+    proc, output = judge.start([sys.executable, str(path)], cwd=judge.workspace)
+    # Ctrl+C once the node spins (it answers a parameter call), as a learner presses it
+    # once the node runs: earlier, a busy machine would decide what the learner is told.
+    observer.wait_until(lambda: proc.poll() is not None or observer.has_node(node_name),
+                        ARRIVAL_TIMEOUT_S)
+    if proc.poll() is None:
+        observer.spins(node_name)
+    if proc.poll() is not None:
+        text = output.text()
+        if 'NotImplementedError' in text:
+            raise CheckFailed('main() still raises NotImplementedError: write part 5 where it '
+                              'says YOUR CODE HERE.')
+        if 'Traceback' in text:
+            raise CheckFailed(f'{path.name} crashed before Ctrl+C ({last_line(text)}): fix that '
+                              'first; the checks of the parts above show where.')
+        raise CheckFailed(f'{path.name} ended by itself before Ctrl+C (exit code '
+                          f'{proc.returncode}); main() should spin until Ctrl+C.')
+    interrupt(proc)
+    try:
+        code = proc.wait(EXIT_AFTER_CTRL_C_S)
+    except subprocess.TimeoutExpired:
+        kill_process_group(proc)
+        raise CheckFailed(f'{path.name} did not stop within {EXIT_AFTER_CTRL_C_S:g} s of Ctrl+C: '
+                          'let KeyboardInterrupt end the spin.') from None
+    text = output.text()
+    if code != 0 or 'Traceback' in text:
+        last = _error_line(text)
+        raise CheckFailed(f'{path.name} exited with code {code} after Ctrl+C ({last}): '
+                          f'{_ctrl_c_advice(main, last)}.')
+    _cleanup_verdict(main)
+    return (f'{path.name} stops cleanly on Ctrl+C (exit code 0, no traceback) and cleans up in '
+            'finally.')
+
+
+def _caught(main: ast.FunctionDef) -> set[str]:
+    """The exception names ``main()``'s ``except`` clauses catch."""
+    names: set[str] = set()
+    for node in ast.walk(main):
+        if isinstance(node, ast.ExceptHandler) and node.type is not None:
+            for part in ast.walk(node.type):
+                if isinstance(part, (ast.Name, ast.Attribute)):
+                    names.add(part.id if isinstance(part, ast.Name) else part.attr)
+    return names
+
+
+def _ctrl_c_advice(main: ast.FunctionDef, error: str) -> str:
+    """What to change in main(), from how it failed after Ctrl+C and what it catches."""
+    caught = _caught(main)
+    if 'rcl_shutdown already called' in error and \
+            {'KeyboardInterrupt', 'ExternalShutdownException'} <= caught:
+        return ('shut down with rclpy.try_shutdown() instead of rclpy.shutdown(): on Jazzy '
+                'Ctrl+C has already shut rclpy down')
+    missing = [name for name in ('KeyboardInterrupt', 'ExternalShutdownException')
+               if name not in caught]
+    if missing:
+        return (f'catch {" and ".join(missing)} around the spin (both end it on Jazzy), and shut '
+                'down with rclpy.try_shutdown()')
+    return 'clean up in a finally: block with node.destroy_node() and rclpy.try_shutdown()'
+
+
+def _error_line(text: str) -> str:
+    """The last line of a traceback, without module paths or rcl's C source location."""
+    line = last_line(text)
+    line = re.sub(r'^(?:[A-Za-z_][\w]*\.)+(?=\w+(?:Error|Exception)\b)', '', line)
+    return re.sub(r', at /\S+:\d+$', '', line)
+
+
+def last_line(text: str) -> str:
+    lines = [line.strip() for line in text.splitlines() if line.strip()]
+    return lines[-1][:200] if lines else 'no output'

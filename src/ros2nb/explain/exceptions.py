@@ -1,0 +1,184 @@
+"""One line for each mistake a beginner's code makes through rclpy or a message class.
+
+Introduced in ``00-setup-and-the-pubsub-idea.ipynb``; the whole list is in
+``docs/troubleshooting.md``.  :func:`explain_exception` turns an error that rclpy or a
+message class raised into one line naming what to do; :func:`learner_line` finds the
+learner's own line in a traceback.  The kernel shows that line instead of a traceback
+through rclpy (:mod:`ros2nb.kernel`); a failing callback is reported with it, in the
+kernel and in a check's subject alike.
+"""
+
+from __future__ import annotations
+
+import linecache
+import os
+import re
+import site
+import sysconfig
+from pathlib import Path
+from types import TracebackType
+from typing import Any, Optional
+
+from rclpy.exceptions import NotInitializedException
+
+from ..errors import SHUT_DOWN_MESSAGE
+
+#: The ros2nb package: its files are not the learner's.
+_HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def _library_dirs() -> tuple[str, ...]:
+    dirs = {_HERE, *site.getsitepackages(), site.getusersitepackages()}
+    for key in ('stdlib', 'platstdlib', 'purelib', 'platlib'):
+        dirs.add(sysconfig.get_paths()[key])
+    return tuple(sorted(os.path.abspath(d) + os.sep for d in dirs if d))
+
+
+_LIBRARY_DIRS = _library_dirs()
+
+
+def is_library_file(path: str) -> bool:
+    """True for files of Python, installed packages (rclpy, messages, IPython) and ros2nb."""
+    path = os.path.abspath(path)
+    return path.startswith(_LIBRARY_DIRS) or path.startswith('<frozen')
+
+
+def _learner_entry(exc: BaseException) -> Optional[TracebackType]:
+    """The innermost traceback entry in the learner's own code (a cell or their file)."""
+    found, tb = None, exc.__traceback__
+    while tb is not None:
+        if not is_library_file(tb.tb_frame.f_code.co_filename):
+            found = tb
+        tb = tb.tb_next
+    return found
+
+
+def learner_line(exc: BaseException) -> str:
+    """Return ``cell line N: source`` or ``FILE line N: source`` for the learner's innermost frame."""
+    entry = _learner_entry(exc)
+    if entry is None:
+        return ''
+    filename = entry.tb_frame.f_code.co_filename
+    path = Path(filename)
+    place = path.name if path.is_file() and 'ipykernel' not in filename else 'cell'
+    return f'{place} line {entry.tb_lineno}: {linecache.getline(filename, entry.tb_lineno).strip()}'
+
+
+def _frames(exc: BaseException):
+    tb = exc.__traceback__
+    while tb is not None:
+        yield tb.tb_frame
+        tb = tb.tb_next
+
+
+_FIELD_TYPE = re.compile(r"The '(\w+)' field must be of type '([\w.]+)'")
+_NUMBERS = {'float': 'a decimal number such as 22.0', 'int': 'a whole number such as 10',
+            'str': "text such as 'hello'", 'bool': 'True or False'}
+
+
+def _field_type(exc: AssertionError) -> Optional[str]:
+    match = _FIELD_TYPE.search(str(exc))
+    if not match:
+        return None
+    field, wanted = match.groups()
+    frame = list(_frames(exc))[-1]
+    message = frame.f_locals.get('self')
+    value = frame.f_locals.get('value')
+    owner = type(message).__name__ if message is not None else 'the message'
+    fix = _NUMBERS.get(wanted, f'a {wanted}')
+    if wanted == 'float' and isinstance(value, int) and not isinstance(value, bool):
+        fix = f'{value}.0 or float(...)'
+    return (f"{owner}'s field '{field}' takes {fix}, not {type(value).__name__} {value!r}: "
+            'convert the value before you put it into the message.')
+
+
+def _learner_frame(exc: BaseException) -> Any:
+    """The innermost frame of the learner's own code (a cell or their file), or None."""
+    entry = _learner_entry(exc)
+    return entry.tb_frame if entry is not None else None
+
+
+_NO_ATTRIBUTE = re.compile(r"^'(\w+)' object has no attribute '(\w+)'")
+
+
+def _missing_attribute(exc: AttributeError) -> Optional[str]:
+    """``self.TOPIC`` for a module constant, or a method written outside its class."""
+    match = _NO_ATTRIBUTE.match(str(exc))
+    frame = _learner_frame(exc)
+    if not match or frame is None:
+        return None
+    owner, name = match.groups()
+    found = frame.f_globals.get(name)
+    if found is None:
+        return None
+    if name.isupper():
+        return (f'{name} is a constant of the file, not of the node: write {name}, not '
+                f'self.{name}.')
+    if callable(found) and not isinstance(found, type):
+        return (f'{name} is written outside the class {owner}: indent its part by four spaces, '
+                'so that it becomes a method of the class.')
+    return None
+
+
+def _message_not_a_value(exc: TypeError) -> Optional[str]:
+    """A message used where its number is meant: ``msg > 26`` instead of ``msg.data > 26``."""
+    frame = _learner_frame(exc)
+    if frame is None:
+        return None
+    for value in frame.f_locals.values():
+        cls = type(value)
+        if hasattr(cls, 'get_fields_and_field_types') and \
+                re.search(rf'\b{cls.__name__}\b', str(exc)):
+            fields = ', '.join(cls.get_fields_and_field_types())
+            return (f'a {cls.__name__} message is not its value: use its field ({fields}), e.g. '
+                    'msg.data.')
+    return None
+
+
+def _node_without_init(exc: AttributeError) -> Optional[str]:
+    for frame in _frames(exc):
+        if not frame.f_code.co_filename.endswith(os.path.join('rclpy', 'node.py')):
+            continue
+        obj = frame.f_locals.get('self')
+        if obj is not None and not hasattr(obj, '_Node__node'):
+            name = type(obj).__name__
+            return (f"{name}.__init__ never calls super().__init__('node_name'): make that the "
+                    f'first line of {name}.__init__, before any publisher, timer or subscription.')
+    return None
+
+
+def explain_exception(exc: BaseException, *, ros_started: bool = False) -> Optional[str]:
+    """Return one line explaining a known beginner mistake behind ``exc``, or None.
+
+    :param exc: an exception raised by the learner's code, through rclpy or a message.
+    :param ros_started: True where ros2nb brought ROS up in this process (a kernel after
+        ``ros2nb.start()``): then "not initialised" means it was shut down since.
+    :return: what went wrong and what to do, or None for anything else (its normal
+        traceback is then the best explanation).
+    """
+    text = str(exc)
+    if isinstance(exc, NotInitializedException):
+        if ros_started:
+            return SHUT_DOWN_MESSAGE
+        return ('ROS 2 is not up in this kernel yet: run ros2nb.start() first (in a notebook it '
+                'takes the place of rclpy.init()), then create the node again.')
+    if isinstance(exc, RuntimeError) and 'must only be called once' in text:
+        return ('rclpy.init() was called, but ros2nb.start() already brought ROS 2 up in this '
+                'kernel: remove that call; to run a node here hand it to ros2nb.add(node) '
+                '(main() is for `ros2 run`, notebook 05).')
+    if isinstance(exc, AssertionError):
+        return _field_type(exc)
+    if isinstance(exc, AttributeError):
+        return _node_without_init(exc) or _missing_attribute(exc)
+    if type(exc).__name__ == 'RCLError' and 'context is invalid' in text:
+        return SHUT_DOWN_MESSAGE
+    if isinstance(exc, TypeError) and text.startswith('Expected <class'):
+        return ('publish() takes a message object, not a bare value: create the message '
+                '(msg = Float32()), set msg.data, then publish(msg).')
+    if isinstance(exc, TypeError) and text.startswith('Expected QoSProfile or int'):
+        return ('the arguments are in the wrong order: create_subscription takes the message '
+                'type, the topic, the callback and the queue depth (create_publisher: the type, '
+                'the topic and the depth); something else came where the depth belongs.')
+    if isinstance(exc, TypeError):
+        return _message_not_a_value(exc)
+    return None

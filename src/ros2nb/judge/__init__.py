@@ -1,0 +1,27 @@
+"""The judge: decides whether the learner's code does what a check asks, from outside it.
+
+Introduced in ``03-write-the-publisher.ipynb`` (every check of a node runs here).
+
+The judge is a process of its own, started for a check cell by the kernel, and once per
+notebook by the grader.  It never imports or executes the learner's code itself: that
+runs in subject processes (:mod:`ros2nb.subject`), which the judge watches over ROS with a
+node of its own (the graph, ``/temperature``, ``/rosout``) and asks for raw facts only.
+The verdict is computed here, so nothing a notebook does to its own kernel (replacing the
+checks, hooks, exceptions) changes it.  While grading, every subject also runs in a
+sandbox of its own (the grader passes the sandbox command in ``ROS2NB_SUBJECT_PREFIX``)
+and cannot see, signal or trace the judge.
+
+Modules: ``observer`` (its own ROS node), ``subjects`` (the processes that run the
+learner's code), ``session`` (what the checks get as their judge), ``grading`` (a whole
+notebook's graded cells), ``__main__`` (the command line).  It imports the checks it
+runs; the checks never import it (the kernel starts it by name).
+
+Command line (``python -m ros2nb.judge``):
+
+- ``check NAME KWARGS_JSON``: run ``ros2nb.checks.NAME(**kwargs)``; print one JSON line.
+- ``grade SOURCE.ipynb SUBMISSION.ipynb``: run every graded cell of the course's source
+  notebook (hidden tests included) against the learner's submission and workspace; print
+  one JSON object, ``{grade_id: result}``.
+
+Both take the learner's workspace from ``ROS2NB_WORKSPACE``.
+"""

@@ -1,0 +1,47 @@
+"""``python -m ros2nb.judge check NAME KWARGS_JSON`` or ``grade SOURCE SUBMISSION``.
+
+The judge's command line (see :mod:`ros2nb.judge`): it binds a :class:`Session` as the
+judge of this process's checks, runs them and prints one JSON line with the outcome.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+from pathlib import Path
+from typing import Any
+
+from .. import checks
+from ..checks.base import bind_judge
+from ..checks.dispatch import IN_JUDGE_ENV, captured
+from ..terminal.workspace import default_workspace
+from .grading import grade
+from .session import Session
+
+
+def main(argv: list[str]) -> int:
+    """Run one check, or grade one notebook; print the outcome as one JSON line."""
+    os.environ[IN_JUDGE_ENV] = '1'
+    if len(argv) != 3 or argv[0] not in ('check', 'grade'):
+        print('Usage: python -m ros2nb.judge check NAME KWARGS_JSON | grade SOURCE '
+              'SUBMISSION', file=sys.stderr)
+        return 2
+    session = Session(default_workspace())
+    bind_judge(session)
+    try:
+        if argv[0] == 'check':
+            function = getattr(checks, argv[1])
+            result: Any = captured(lambda: function(**json.loads(argv[2])))
+        else:
+            source, submission = (json.loads(Path(p).read_text()) for p in argv[1:])
+            result = grade(source, submission)
+    finally:
+        bind_judge(None)
+        session.close()
+    print(json.dumps(result))
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,102 @@
+"""Grading a notebook in the judge: every graded cell of the course, on what the learner wrote.
+
+Part of the judge (:mod:`ros2nb.judge`).  The graded cells come from the course's own
+source notebook (hidden tests included); of the learner's submission only the answer
+cells are read, as text: the names they define become :class:`AnswerRef` for the checks.
+"""
+
+from __future__ import annotations
+
+import ast
+from typing import Any, Optional
+
+from .. import checks, nbmeta
+from ..checks.base import AnswerRef
+from ..checks.dispatch import captured
+
+
+def _is_check_call(node: ast.AST) -> Optional[str]:
+    """``ros2nb.checks.NAME(...)`` -> NAME, else None."""
+    if not (isinstance(node, ast.Expr) and isinstance(node.value, ast.Call)):
+        return None
+    func = node.value.func
+    if (isinstance(func, ast.Attribute) and isinstance(func.value, ast.Attribute)
+            and isinstance(func.value.value, ast.Name) and func.value.value.id == 'ros2nb'
+            and func.value.attr == 'checks'):
+        return func.attr
+    return None
+
+
+def _value(node: ast.expr, names: dict[str, Any]) -> Any:
+    if isinstance(node, ast.Name):
+        if node.id not in names:
+            return AnswerRef(node.id, ())  # not defined in any answer cell
+        return names[node.id]
+    return ast.literal_eval(node)
+
+
+def graded_calls(source: str) -> list[tuple[str, list[ast.expr], list[ast.keyword]]]:
+    """The ``ros2nb.checks`` calls of a graded cell, the only statements the judge runs.
+
+    :raises ValueError: for any other statement (a mistake in the course, not the learner's).
+    """
+    lines = [line for line in source.splitlines() if not line.lstrip().startswith('###')]
+    calls = []
+    for statement in ast.parse('\n'.join(lines)).body:
+        name = _is_check_call(statement)
+        if name is None:
+            raise ValueError(f'a graded cell may only call ros2nb.checks functions: '
+                             f'{ast.unparse(statement)[:80]}')
+        call = statement.value  # type: ignore[attr-defined]
+        calls.append((name, call.args, call.keywords))
+    return calls
+
+
+def _defined_names(source: str) -> set[str]:
+    try:
+        tree = ast.parse(source)
+    except SyntaxError:
+        return set()
+    names = set()
+    for statement in tree.body:
+        if isinstance(statement, (ast.FunctionDef, ast.ClassDef, ast.AsyncFunctionDef)):
+            names.add(statement.name)
+        elif isinstance(statement, ast.Assign):
+            names.update(t.id for t in statement.targets if isinstance(t, ast.Name))
+    return names
+
+
+def grade(source: dict, submission: dict) -> dict[str, dict]:
+    """Run every graded cell of ``source`` (the course's notebook, hidden tests included).
+
+    Names in a graded call (``LoudListener``) are the learner's: the judge passes an
+    :class:`AnswerRef` with the course's context cells and every answer cell of the
+    submission, and the check runs it in a subject.
+
+    :param source: the course's source notebook (nbformat JSON).
+    :param submission: the learner's notebook (nbformat JSON); only its answer cells
+        (nbgrader ``solution: true``) are used.
+    :return: ``{grade_id: result}`` with ``passed``, ``lines``, ``type``, ``message``.
+    """
+    context = [nbmeta.text(c) for c in nbmeta.cells(source) if nbmeta.CONTEXT_TAG in
+               nbmeta.tags(c)]
+    answers = [nbmeta.text(c) for c in nbmeta.cells(submission) if nbmeta.nbgrader_metadata(c).get('solution')
+               and c.get('cell_type') == 'code']
+    sources = tuple(context + answers)
+    names = {name: AnswerRef(name, sources) for text in answers for name in _defined_names(text)}
+    results = {}
+    for cell in nbmeta.cells(source):
+        meta = nbmeta.nbgrader_metadata(cell)
+        if not meta.get('grade') or cell.get('cell_type') != 'code':
+            continue
+        results[meta['grade_id']] = result = {'passed': True, 'lines': []}
+        for name, args, keywords in graded_calls(nbmeta.text(cell)):
+            function = getattr(checks, name)
+            values = [_value(a, names) for a in args]
+            options = {k.arg: _value(k.value, names) for k in keywords}
+            outcome = captured(lambda: function(*values, **options))
+            result['lines'] += outcome.pop('lines')
+            if not outcome['passed']:
+                result.update(outcome)
+                break
+    return results

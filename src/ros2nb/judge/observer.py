@@ -1,0 +1,149 @@
+"""The judge's own ROS node: it sees the graph, hears the readings and the logs, asks nodes.
+
+Part of the judge (:mod:`ros2nb.judge`): every verdict comes from what this node observes
+itself over ROS, on the judge's own domain; a subject's word only says how long to wait.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import threading
+import time
+from typing import Any, Callable
+
+import rclpy
+from rcl_interfaces.msg import Log
+from rcl_interfaces.srv import ListParameters
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.signals import SignalHandlerOptions
+from std_msgs.msg import Float32
+
+from .. import domains
+from ..checks.base import ARRIVAL_TIMEOUT_S
+from ..errors import CheckFailed
+
+
+class Observer:
+    """The judge's own ROS node on the judge's domain: graph, readings, logs, probes."""
+
+    def __init__(self) -> None:
+        self.domain_id = domains.domain_id()
+        self.context = rclpy.Context()
+        rclpy.init(context=self.context, domain_id=self.domain_id,
+                   signal_handler_options=SignalHandlerOptions.NO)
+        self.node = Node('_ros2nb_judge', context=self.context)
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.node)
+        self.changed = threading.Condition()
+        self.readings: list[float] = []
+        self.logs: list[tuple[str, int, str]] = []
+        self._watching: set[str] = set()
+        self._stop = False
+        self._thread = threading.Thread(target=self._spin, name='ros2nb-judge', daemon=True)
+        self._thread.start()
+        self.watch_logs()
+
+    def _spin(self) -> None:
+        while not self._stop:
+            with contextlib.suppress(Exception):
+                self.executor.spin_once(timeout_sec=0.05)
+
+    def _note(self, store: list, item: Any) -> None:
+        with self.changed:
+            store.append(item)
+            self.changed.notify_all()
+
+    def watch_logs(self) -> None:
+        """Collect every /rosout line (as ``ros2 topic echo /rosout`` would see it)."""
+        qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE,
+                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        self.node.create_subscription(Log, '/rosout',
+                                      lambda m: self._note(self.logs, (m.name, m.level, m.msg)),
+                                      qos)
+
+    def watch_readings(self, topic: str) -> None:
+        """Collect every Float32 on ``topic``, reliably (a long queue, nothing dropped)."""
+        if topic in self._watching:
+            return
+        self._watching.add(topic)
+        self.node.create_subscription(
+            Float32, topic, lambda m: self._note(self.readings, float(m.data)),
+            QoSProfile(depth=10000, reliability=ReliabilityPolicy.RELIABLE))
+
+    def wait_until(self, condition: Callable[[], bool], seconds: float) -> bool:
+        """Wait until ``condition()`` holds (checked whenever something arrives)."""
+        deadline = time.monotonic() + seconds
+        with self.changed:
+            while not condition():
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    return False
+                self.changed.wait(min(left, 0.05))
+        return True
+
+    def lines_of(self, logger: str, start: int = 0) -> list[str]:
+        """Log lines of one logger received so far, from position ``start`` on."""
+        with self.changed:
+            return [text for name, _level, text in self.logs[start:] if name == logger]
+
+    def endpoints(self, name: str, namespace: str, expected: list[list[str]],
+                  seconds: float = ARRIVAL_TIMEOUT_S) -> list[tuple[str, str, str]]:
+        """The node's publishers and subscriptions as the ROS graph shows them.
+
+        Waits until the graph holds at least ``expected`` (what the subject said it made)
+        or ``seconds`` pass.
+        """
+        want = {tuple(e) for e in expected}
+        deadline = time.monotonic() + seconds
+        found: set[tuple[str, str, str]] = set()
+        while True:
+            try:
+                pubs = self.node.get_publisher_names_and_types_by_node(name, namespace)
+                subs = self.node.get_subscriber_names_and_types_by_node(name, namespace)
+                found = {('publisher', t, ty) for t, types in pubs for ty in types} | \
+                        {('subscription', t, ty) for t, types in subs for ty in types}
+            except Exception:  # the node is not discovered yet
+                found = set()
+            if want <= found:
+                return sorted(e for e in found if e[1] not in ('/rosout', '/parameter_events',
+                                                                '/clock'))
+            if time.monotonic() > deadline:  # not the learner's mistake: say what happened
+                missing = ', '.join(f'{kind} on {topic}' for kind, topic, _ in sorted(want - found))
+                raise CheckFailed(f'The grader could not see the {missing} of {name} in the ROS '
+                                  f'graph within {seconds:g} s (is the machine very busy?): run '
+                                  'this check again.')
+            time.sleep(0.02)
+
+    def spins(self, name: str, namespace: str = '/', seconds: float = ARRIVAL_TIMEOUT_S) -> bool:
+        """True once the node ``name`` answers a call of its ``list_parameters`` service.
+
+        Every rclpy node serves its parameters while it spins, and only then: an answer
+        proves that the process got past creating the node and into its spin.  False when no
+        answer came in ``seconds`` (or the node serves no parameters).
+        """
+        service = f'{namespace.rstrip("/")}/{name}/list_parameters'
+        client = self.node.create_client(ListParameters, service)
+        try:
+            deadline = time.monotonic() + seconds
+            while time.monotonic() < deadline:
+                # Ask again now and then: a request goes only to the servers discovered
+                # when it is sent (a node of that name that just ended may be one of them).
+                if client.wait_for_service(timeout_sec=0.1):
+                    answer = client.call_async(ListParameters.Request())
+                    if self.wait_until(answer.done, min(1.0, max(0.0, deadline - time.monotonic()))):
+                        return True
+            return False
+        finally:
+            self.node.destroy_client(client)
+
+    def has_node(self, name: str) -> bool:
+        return any(n == name for n, _ns in self.node.get_node_names_and_namespaces())
+
+    def close(self) -> None:
+        self._stop = True
+        self._thread.join()
+        self.executor.shutdown()
+        self.node.destroy_node()
+        rclpy.try_shutdown(context=self.context)

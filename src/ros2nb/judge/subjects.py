@@ -1,0 +1,135 @@
+"""The subject processes the judge starts to run the learner's code, and what it tells them.
+
+Part of the judge (:mod:`ros2nb.judge`).  A subject (:mod:`ros2nb.subject`) imports the
+learner's file or runs their answer cells; the judge sends it one JSON command at a time
+on a pipe and reads one JSON reply.  While grading, every subject runs under the grader's
+sandbox command (``ROS2NB_SUBJECT_PREFIX``) and cannot see, signal or trace the judge.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import select
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+from typing import Any, Optional
+
+from .. import domains
+from ..checks.dispatch import IN_JUDGE_ENV
+from ..errors import CheckFailed
+from ..processes import kill_process_group, stop_process_group
+
+#: JSON list put in front of every subject's command (the grader's sandbox).
+SUBJECT_PREFIX_ENV = 'ROS2NB_SUBJECT_PREFIX'
+#: Seconds a subject may take to answer one command before it counts as hanging.
+REPLY_TIMEOUT_S = 30.0
+#: Lines of a subject's own output kept for hints.
+KEPT_OUTPUT_LINES = 200
+
+
+def subject_prefix() -> list[str]:
+    """The sandbox command every subject runs under (empty outside grading)."""
+    value = os.environ.get(SUBJECT_PREFIX_ENV)
+    return json.loads(value) if value else []
+
+
+def subject_env(extra: Optional[dict[str, str]] = None) -> dict[str, str]:
+    """The environment of a subject: the judge's domain, field checks on, plain logs."""
+    env = {k: v for k, v in os.environ.items() if k not in (IN_JUDGE_ENV, SUBJECT_PREFIX_ENV)}
+    env.update({'ROS_DOMAIN_ID': str(domains.domain_id()), 'PYTHONUNBUFFERED': '1',
+                'ROS_PYTHON_CHECK_FIELDS': '1', 'RCUTILS_COLORIZED_OUTPUT': '0',
+                'RCUTILS_CONSOLE_OUTPUT_FORMAT': '[{severity}] [{name}]: {message}'})
+    env.update(extra or {})  # discovery range and transports: the judge's own
+    return env
+
+
+class Output:
+    """The last lines a process printed, read in a thread of their own."""
+
+    def __init__(self, stream: Any) -> None:
+        self.lines: list[str] = []
+        self._thread = threading.Thread(target=self._read, args=(stream,), daemon=True)
+        self._thread.start()
+
+    def _read(self, stream: Any) -> None:
+        for line in stream:
+            self.lines.append(line.rstrip('\n'))
+            del self.lines[:-KEPT_OUTPUT_LINES]
+
+    def text(self) -> str:
+        self._thread.join(0.5)
+        return '\n'.join(self.lines)
+
+
+class SubjectHung(CheckFailed):
+    """The learner's code did not answer in time."""
+
+
+class SubjectProcess:
+    """A running ``ros2nb.subject``: one JSON command, one JSON reply."""
+
+    def __init__(self, workspace: Path) -> None:
+        to_subject, self._commands = os.pipe()
+        self._replies, from_subject = os.pipe()
+        argv = [*subject_prefix(), sys.executable, '-m', 'ros2nb.subject',
+                str(to_subject), str(from_subject)]
+        self.proc = subprocess.Popen(argv, cwd=workspace, env=subject_env(), text=True,
+                                     stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                                     stderr=subprocess.STDOUT, start_new_session=True,
+                                     pass_fds=(to_subject, from_subject))
+        os.close(to_subject)
+        os.close(from_subject)
+        self.output = Output(self.proc.stdout)
+        self._buffer = b''
+
+    def request(self, op: str, *, timeout: float = REPLY_TIMEOUT_S, **arguments: Any) -> dict:
+        """Send one command and return its reply.
+
+        :raises SubjectHung: when no reply comes within ``timeout`` seconds, or the
+            process died (its last output line is in the message).
+        """
+        try:
+            os.write(self._commands, (json.dumps({'op': op, **arguments}) + '\n').encode())
+        except BrokenPipeError:
+            raise self._died() from None
+        deadline = time.monotonic() + timeout
+        while b'\n' not in self._buffer:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                kill_process_group(self.proc)
+                raise SubjectHung(f'Your code did not finish within {timeout:g} s (an endless '
+                                  'loop, or a call that waits for ever?): look for a loop that '
+                                  'never ends in the part you wrote.')
+            ready, _, _ = select.select([self._replies], [], [], min(left, 0.5))
+            if ready:
+                chunk = os.read(self._replies, 65536)
+                if not chunk:
+                    raise self._died()
+                self._buffer += chunk
+        line, self._buffer = self._buffer.split(b'\n', 1)
+        return json.loads(line)
+
+    def _died(self) -> CheckFailed:
+        code = self.proc.wait(5)
+        last = [line for line in self.output.text().splitlines() if line.strip()][-1:]
+        return CheckFailed(f'The process running your code ended (exit code {code})'
+                           + (f': {last[0].strip()}' if last else '') +
+                           ' (does your code call exit() or kill its own process?).')
+
+    def close(self) -> None:
+        with contextlib.suppress(OSError):
+            os.write(self._commands, b'{"op": "quit"}\n')
+        with contextlib.suppress(OSError):
+            os.close(self._commands)
+        try:
+            self.proc.wait(5)
+        except subprocess.TimeoutExpired:
+            pass
+        stop_process_group(self.proc)
+        with contextlib.suppress(OSError):
+            os.close(self._replies)

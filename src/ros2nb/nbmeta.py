@@ -1,0 +1,38 @@
+"""What the course reads of a notebook's JSON: its cells, their text, their nbgrader metadata.
+
+Plain JSON, no Jupyter import: the judge (in its sandbox) and the grader (on the
+instructor's host) read notebooks the same way, and neither trusts a cell to be well formed.
+"""
+
+from __future__ import annotations
+
+#: Tag of the course's cells a graded answer may rely on (imports, constants).
+CONTEXT_TAG = 'grading-context'
+
+
+def cells(notebook: dict) -> list[dict]:
+    """The notebook's cells that are JSON objects (a malformed cell is left out)."""
+    found = notebook.get('cells', []) if isinstance(notebook, dict) else []
+    return [c for c in found if isinstance(c, dict)] if isinstance(found, list) else []
+
+
+def text(cell: dict) -> str:
+    """A cell's source as one string (nbformat stores either a string or a list of lines)."""
+    source = cell.get('source', '')
+    if isinstance(source, list):
+        return ''.join(line for line in source if isinstance(line, str))
+    return source if isinstance(source, str) else ''
+
+
+def tags(cell: dict) -> list[str]:
+    """A cell's tags (none when its metadata holds none, or none that make sense)."""
+    meta = cell.get('metadata', {})
+    found = meta.get('tags', []) if isinstance(meta, dict) else []
+    return [t for t in found if isinstance(t, str)] if isinstance(found, list) else []
+
+
+def nbgrader_metadata(cell: dict) -> dict:
+    """A notebook cell's nbgrader metadata (empty when it has none, or none that makes sense)."""
+    meta = cell.get('metadata', {})
+    value = meta.get('nbgrader', {}) if isinstance(meta, dict) else {}
+    return value if isinstance(value, dict) else {}

@@ -1,0 +1,109 @@
+"""The kernel's ROS 2 runtime: one rclpy context, its hidden node, its executor thread.
+
+Introduced in ``00-setup-and-the-pubsub-idea.ipynb`` (through :func:`ros2nb.start`).
+:class:`Runtime` is made of four sides, each in a module of its own: its log lines
+(:mod:`.logs`), its executor thread (:mod:`.spinning`), its nodes (:mod:`.nodes`) and its
+clock (:mod:`.clock`).  The learner's notebook uses the verbs of :mod:`ros2nb.kernel`.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from typing import Optional
+
+import rclpy
+from rcl_interfaces.msg import Log
+from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.signals import SignalHandlerOptions
+from rosgraph_msgs.msg import Clock
+
+from ..errors import SHUT_DOWN_MESSAGE, Ros2nbError
+from .clock import SimulatedClock
+from .logs import LogLines
+from .nodes import NodeKeeping, destroy_stray_nodes
+from .spinning import Spinning
+
+#: Hidden name of the kernel's own node (names starting with ``_`` are hidden
+#: from ``ros2 node list``, as the ros2cli daemon's are).
+INTERNAL_NODE_NAME = '_ros2nb'
+#: For ros2nb's own subscriptions: no QoS event handlers (rclpy's default warns of
+#: incompatible QoS, which the kernel's own subscriptions choose to accept).
+QUIET_SUBSCRIPTION = SubscriptionEventCallbacks(use_default_callbacks=False)
+
+
+def enable_field_checks() -> None:
+    """Turn on rosidl's generated type/range checks, also for already imported messages."""
+    os.environ['ROS_PYTHON_CHECK_FIELDS'] = '1'
+    for module in list(sys.modules.values()):
+        if getattr(module, 'ros_python_check_fields', None) == '':
+            module.ros_python_check_fields = '1'
+
+
+class Runtime(LogLines, Spinning, NodeKeeping, SimulatedClock):
+    """The kernel's ROS 2 runtime: rclpy context, one executor, one spin thread.
+
+    Create it with :func:`ros2nb.start`; use the module-level functions, not this class.
+    A check's subject makes one of its own, without the background thread.
+
+    :param domain_id: the ROS domain.
+    :param sim_time: the kernel's clock: simulated (True) or wall-clock time.
+    :param background: spin in a background thread (False: only in :meth:`drain`).
+    """
+
+    def __init__(self, *, domain_id: int, sim_time: bool, background: bool = True) -> None:
+        LogLines.__init__(self)
+        Spinning.__init__(self, background)
+        NodeKeeping.__init__(self)
+        SimulatedClock.__init__(self, sim_time)
+        self._participant: Optional[bytes] = None
+        rclpy.init(args=['--ros-args', '--disable-stdout-logs', '--disable-external-lib-logs'],
+                   domain_id=domain_id, signal_handler_options=SignalHandlerOptions.NO)
+        self.context = rclpy.get_default_context()
+        self.domain_id = self.context.get_domain_id()
+        self.executor = SingleThreadedExecutor()
+        # The kernel's own node serves nothing and logs nothing: every entity a node has is
+        # one more in every wait of the executor, and it waits thousands of times a second.
+        self.node = Node(INTERNAL_NODE_NAME, start_parameter_services=False, enable_rosout=False,
+                         parameter_overrides=[Parameter('start_type_description_service',
+                                                        Parameter.Type.BOOL, False)])
+        self._clock_publisher = self.node.create_publisher(
+            Clock, '/clock', 10, event_callbacks=PublisherEventCallbacks(use_default_callbacks=False))
+        rosout_qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE,
+                                durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        self.node.create_subscription(Log, '/rosout', self._on_log, rosout_qos,
+                                      event_callbacks=QUIET_SUBSCRIPTION)
+        self.executor.add_node(self.node)
+        self.start_spinning()
+
+    @property
+    def alive(self) -> bool:
+        """False once ROS was shut down under ros2nb (e.g. by ``rclpy.shutdown()``)."""
+        return self.context.ok() and not self._stopping
+
+    def ensure_alive(self) -> None:
+        """:raises Ros2nbError: when ROS 2 was shut down under ros2nb."""
+        if not self.alive:
+            raise Ros2nbError(SHUT_DOWN_MESSAGE)
+
+    def participant_prefix(self) -> Optional[bytes]:
+        """This process's DDS participant: the first 12 bytes of its endpoints' GIDs."""
+        if self._participant is None:
+            for info in self.node.get_publishers_info_by_topic('/clock'):
+                if info.node_name == INTERNAL_NODE_NAME:
+                    self._participant = bytes(info.endpoint_gid[:12])
+        return self._participant
+
+    def shutdown(self) -> None:
+        """Stop every node, stop the executor, join its thread and shut rclpy down."""
+        self.stop_spinning()
+        self._destroy_all_nodes()
+        self.executor.remove_node(self.node)
+        self.node.destroy_node()
+        self.executor.shutdown()
+        destroy_stray_nodes(self.context)
+        rclpy.try_shutdown()

@@ -1,0 +1,122 @@
+"""The kernel's log lines: read back from ``/rosout``, printed in the cell that made them.
+
+Part of :class:`ros2nb.runtime.Runtime` (the :class:`LogLines` side of it).  The nodes'
+console output is off; their lines come back over ``/rosout`` (what rqt_console reads) and
+are printed, by the thread that asks, in the ROS console format without timestamps.
+"""
+
+from __future__ import annotations
+
+import collections
+import sys
+import threading
+from dataclasses import dataclass
+
+#: Log lines kept while no cell is reading them; older ones are counted, not kept.
+MAX_PENDING_LOG_LINES = 2000
+#: rcl_interfaces/msg/Log levels -> the console's severity names.
+SEVERITY_NAMES = {10: 'DEBUG', 20: 'INFO', 30: 'WARN', 40: 'ERROR', 50: 'FATAL'}
+
+
+@dataclass(frozen=True)
+class CallbackFailure:
+    """A callback that raised inside the executor.
+
+    :ivar node: fully qualified name of the node whose callback raised.
+    :ivar callback: qualified name of the callback, e.g. ``TemperatureMonitor.temperature_callback``.
+    :ivar error: ``ExceptionType: message``, or ros2nb's one-line explanation of it.
+    :ivar where: the learner's own line, ``FILE line N: source``; empty when none was found.
+    """
+
+    node: str
+    callback: str
+    error: str
+    where: str
+
+    def __str__(self) -> str:
+        text = (f'[ERROR] [{self.node.lstrip("/")}]: callback {self.callback} raised '
+                f'{self.error}')
+        if self.where:
+            text += f'\n    {self.where}'
+        return (text + f'\n    ros2nb stopped node {self.node}; the other nodes keep running. '
+                'Fix the callback, re-run the cell that creates the node and hand it over again.')
+
+
+class LogLines:
+    """The log lines of the nodes handed over, and the cell each belongs to."""
+
+    def __init__(self) -> None:
+        self._our_loggers: set[str] = set()
+        #: /rosout lines received so far, per logger name (the checks count with it).
+        self.log_counts: collections.Counter[str] = collections.Counter()
+        # (cell epoch, logger name | None for our own lines | CallbackFailure, level, text)
+        self._log_lines: collections.deque[tuple] = collections.deque()
+        self._overflow = 0
+        self._epoch = 0
+        self._lock = threading.Lock()
+
+    def own_logger(self, name: str) -> None:
+        """Show the lines of logger ``name`` (a node handed over) and of its children."""
+        self._our_loggers.add(name)
+
+    def begin_cell(self) -> None:
+        """A new cell starts: lines made before it are no longer news (IPython pre_run_cell)."""
+        self._epoch += 1
+
+    def _on_log(self, msg) -> None:
+        """Take one /rosout message (the subscription's callback)."""
+        with self._lock:
+            self.log_counts[msg.name] += 1
+            if len(self._log_lines) >= MAX_PENDING_LOG_LINES:
+                self._log_lines.popleft()
+                self._overflow += 1
+            self._log_lines.append((self._epoch, msg.name, msg.level, msg.msg))
+
+    def emit(self, text: str) -> None:
+        """Queue a line of our own (e.g. an echoed message) in order with the log lines."""
+        with self._lock:
+            self._log_lines.append((self._epoch, None, 0, text))
+
+    def _report_failure(self, failure: CallbackFailure) -> None:
+        """Queue a callback that raised, to be shown with the lines of its cell."""
+        with self._lock:
+            self._log_lines.append((self._epoch, CallbackFailure, 0, failure))
+
+    def is_ours(self, logger_name: str) -> bool:
+        """True for the loggers of nodes handed over (and their child loggers)."""
+        return any(logger_name == n or logger_name.startswith(n + '.')
+                   for n in self._our_loggers)
+
+    def print_pending(self, *, show_logs: bool = True) -> int:
+        """Print (from the calling thread) the log lines and callback failures of this cell.
+
+        Lines made while no cell was running (nodes on the wall clock keep running between
+        cells) are not shown as if they were new: one line says how many there were.
+
+        :param show_logs: ``False`` hides the log lines; failures are always shown.
+        :return: the number of log lines of this cell taken (printed or hidden).
+        """
+        with self._lock:
+            queued, self._log_lines = list(self._log_lines), collections.deque()
+            overflow, self._overflow = self._overflow, 0
+        earlier = overflow
+        taken = 0
+        lines: list[str] = []
+        for epoch, name, level, text in queued:
+            if name is CallbackFailure:
+                sys.stdout.flush()
+                print(text, file=sys.stderr)
+                sys.stderr.flush()
+            elif name is None or self.is_ours(name):
+                if epoch < self._epoch:
+                    earlier += 1
+                    continue
+                taken += 1
+                lines.append(text if name is None else
+                             f'[{SEVERITY_NAMES.get(level, level)}] [{name}]: {text}')
+        if earlier and show_logs:
+            print(f'({earlier} log lines made while no cell was running were not shown)')
+        if show_logs and lines:
+            print('\n'.join(lines))
+        sys.stdout.flush()
+        return taken

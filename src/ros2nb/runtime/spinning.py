@@ -1,0 +1,176 @@
+"""Spinning the kernel's nodes: one executor, one background thread, paused on demand.
+
+Part of :class:`ros2nb.runtime.Runtime` (the :class:`Spinning` side of it).  ONE
+``SingleThreadedExecutor`` runs every node handed over, in ONE background thread.  Any
+other thread may pause it (:meth:`Spinning.exclusive`) and spin the executor itself
+(:meth:`Spinning.drain`): that is how simulated time steps and how checks wait.
+"""
+
+from __future__ import annotations
+
+import collections
+import contextlib
+import threading
+from typing import Callable, Iterator, Optional
+
+from rclpy.executors import ExternalShutdownException, ShutdownException, TimeoutException
+
+from ..errors import Ros2nbError
+from ..explain.exceptions import explain_exception, learner_line
+from . import current
+from .logs import CallbackFailure
+
+#: How long the background thread waits for work before checking for a pause (s); a
+#: pause (every spin, add, stop) waits this long at most.
+BACKGROUND_WAIT_S = 0.02
+#: Callbacks one idle-wait may run before ros2nb calls it a loop that never ends (a burst
+#: of a few thousand messages to many subscriptions stays well below).
+MAX_CALLBACKS_PER_DRAIN = 10_000
+
+
+class Spinning:
+    """The executor, its background thread and the pause that lets another thread spin.
+
+    Needs, from the runtime it is part of: ``executor``, ``context``, ``node`` (ros2nb's
+    own), ``_nodes``, ``_report_failure`` and ``_discard``.
+    """
+
+    def __init__(self, background: bool) -> None:
+        self._pause_requested = threading.Event()
+        self._paused = threading.Event()
+        self._resume = threading.Event()
+        self._stopping = False
+        self._exclusive_depth = 0
+        #: Called with (node name, callback name, exception) when a callback raises.
+        self.on_failure: Optional[Callable[[str, str, BaseException], None]] = None
+        self._thread = threading.Thread(target=self._spin_in_background,
+                                        name='ros2nb-executor', daemon=True)
+        self._background = background  # without it, callbacks run only in drain()
+
+    def start_spinning(self) -> None:
+        """Start the background thread (a check's subject has none: it drains only)."""
+        if self._background:
+            self._thread.start()
+
+    def stop_spinning(self) -> None:
+        """End the background thread and wait for it (safe when it never ran)."""
+        self._stopping = True
+        self._pause_requested.clear()
+        self._resume.set()
+        with contextlib.suppress(Exception):  # a shut-down context cannot be woken
+            self.executor.wake()
+        if self._thread.is_alive():
+            self._thread.join()
+
+    def _run_one(self, timeout_sec: float) -> Optional[str]:
+        """Run one ready callback; return its name, or None when none became ready in time."""
+        try:
+            handler, entity, node = self.executor.wait_for_ready_callbacks(timeout_sec=timeout_sec)
+            handler()
+        except TimeoutException:
+            return None
+        except KeyboardInterrupt:  # the Stop button, while rclpy waited or ran a callback
+            self._recover_from_interrupt()
+            raise
+        callback = getattr(entity, 'callback', None)
+        label = getattr(callback, '__qualname__', repr(callback))
+        error = handler.exception()
+        if error is not None:
+            explained = explain_exception(error, ros_started=current.kernel_runtime() is self)
+            self._report_failure(CallbackFailure(
+                node=node.get_fully_qualified_name(), callback=label,
+                error=explained or f'{type(error).__name__}: {error}',
+                where=learner_line(error)))
+            if self.on_failure is not None:
+                self.on_failure(node.get_fully_qualified_name(), label, error)
+            if node is not self.node:
+                self._discard(node)
+        return label
+
+    def _recover_from_interrupt(self) -> None:
+        """Undo what an interrupted callback left half done in rclpy's executor.
+
+        rclpy marks an entity as taken and its callback group as busy before it calls the
+        callback, and clears both after; a KeyboardInterrupt in between (the Stop button)
+        leaves them set, and that node's timers and subscriptions never run again.  Only
+        this thread runs callbacks here, so after an interrupt none is running: every
+        entity is free again, and unfinished work is dropped (a message not taken stays in
+        its queue, a timer not called stays due, so the next wait finds them again).
+        """
+        with contextlib.suppress(AttributeError):
+            self.executor._tasks = []
+        for node in [self.node, *self._nodes.values()]:
+            for entity in (*node.timers, *node.subscriptions, *node.services, *node.clients,
+                           *node.guards, *node.waitables):
+                entity._executor_event = False
+                group = entity.callback_group
+                if getattr(group, '_active_entity', None) is not None:
+                    group._active_entity = None
+
+    def _spin_in_background(self) -> None:
+        """The background thread: run callbacks until stopped, pausing when asked."""
+        while not self._stopping:
+            if self._pause_requested.is_set():
+                self._paused.set()
+                self._resume.wait()
+                self._resume.clear()
+                continue
+            try:
+                self._run_one(BACKGROUND_WAIT_S)
+            except (ShutdownException, ExternalShutdownException):
+                break
+            except Exception:  # the context was shut down under us (rclpy.shutdown())
+                if self.context.ok():
+                    raise
+                break
+        self._paused.set()  # nobody waits for a pause of a thread that has ended
+
+    def _pause(self) -> None:
+        """Hold the background thread (re-entrant): this thread may then spin."""
+        if self._exclusive_depth == 0 and self._thread.is_alive():
+            self._paused.clear()
+            self._pause_requested.set()
+            self.executor.wake()
+            self._paused.wait()
+        self._exclusive_depth += 1
+
+    def _unpause(self) -> None:
+        """Let the background thread go on once the outermost pause ends."""
+        self._exclusive_depth -= 1
+        if self._exclusive_depth == 0:
+            self._pause_requested.clear()
+            self._resume.set()
+
+    def drain(self) -> int:
+        """Run ready callbacks from this thread until none is ready; return how many ran.
+
+        Only call while the background thread is paused (inside :meth:`exclusive`).
+
+        :raises Ros2nbError: when callbacks keep making work for each other without end
+            (e.g. a node that answers every message on its own topic).
+        """
+        counts: collections.Counter[str] = collections.Counter()
+        while True:
+            # With a zero timeout rclpy ends every wait round with TimeoutException, even
+            # one that ran callbacks, so "idle" is a round in which nothing ran.
+            in_round = 0
+            while (label := self._run_one(0.0)) is not None:
+                in_round += 1
+                counts[label] += 1
+                if sum(counts.values()) > MAX_CALLBACKS_PER_DRAIN:
+                    busiest, times = counts.most_common(1)[0]
+                    raise Ros2nbError(
+                        f'{busiest} ran {times} times without the clock moving: a callback keeps '
+                        'triggering itself (e.g. publishing on the topic it subscribes to); '
+                        'stop that node with ros2nb.stop() and fix it.')
+            if in_round == 0:
+                return sum(counts.values())
+
+    @contextlib.contextmanager
+    def exclusive(self) -> Iterator['Spinning']:
+        """Context manager: pause the spin thread so this thread may spin the executor."""
+        self._pause()
+        try:
+            yield self
+        finally:
+            self._unpause()

@@ -1,0 +1,170 @@
+"""Writing the learner's files: never over their own edits, ``%%part`` parts kept, fresh imports.
+
+Introduced in ``03-write-the-publisher.ipynb``.  No ROS import.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import importlib.util
+import json
+import shutil
+import sys
+from pathlib import Path
+from types import ModuleType
+from typing import Iterator, Optional
+
+from ..errors import FileProtectedError, Ros2nbError, UsageError
+from .workspace import PathLike, current_workspace, shown, workspace_file
+
+#: Where ros2nb records what it wrote, so it never overwrites a file you edited.
+WRITTEN_RECORD = '.ros2nb-written.json'
+#: Where ``%%part`` keeps the parts of each file, so a kernel restart loses none.
+PARTS_RECORD = '.ros2nb-parts.json'
+#: nbgrader's marker lines around an answer in the course's own notebooks; not part of a file.
+AUTHOR_MARKERS = ('### BEGIN SOLUTION', '### END SOLUTION')
+
+
+def _digest(text: str) -> str:
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _record_path(path: Path) -> Optional[Path]:
+    """The workspace's record file, or None for files outside the workspace (not recorded)."""
+    ws = current_workspace().resolve()
+    return ws / WRITTEN_RECORD if ws in path.resolve().parents else None
+
+
+def write_file(path: PathLike, text: str, *, overwrite: bool = False) -> Path:
+    """Write a source file, never overwriting changes you made to it yourself.
+
+    A file ros2nb wrote earlier and nobody changed since is replaced; a file you edited
+    (or that ros2nb did not write) is only replaced with ``overwrite=True``, and then
+    your version is kept beside it as ``<name>.bak``.
+
+    Introduced in ``03-write-the-publisher.ipynb``.
+
+    :param path: the file; relative paths are relative to the current workspace.
+    :param text: the new contents.
+    :param overwrite: replace the file even if you changed it.
+    :return: the file's absolute path.
+    :raises FileProtectedError: if the file has changes of yours and ``overwrite`` is false.
+    """
+    path = workspace_file(path)
+    if path.is_file():
+        current = path.read_text()
+        if current != text and _load_record(path).get(str(path.resolve())) != _digest(current):
+            if not overwrite:
+                raise FileProtectedError(
+                    f'{shown(path)} has changes that ros2nb did not write; to keep them do '
+                    'nothing, to replace them run again with overwrite=True, or add --overwrite to the %%part line (your version '
+                    'is then kept as .bak).')
+            shutil.copy2(path, path.with_name(path.name + '.bak'))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text)
+    remember_written(path)
+    return path.resolve()
+
+
+def _load_record(path: Path) -> dict[str, str]:
+    record_file = _record_path(path)
+    return json.loads(record_file.read_text()) if record_file and record_file.is_file() else {}
+
+
+def remember_written(path: PathLike) -> None:
+    """Record that ros2nb wrote ``path`` as it is now, so a later write may replace it.
+
+    Only files inside the current workspace are recorded; others are never replaced
+    without ``overwrite=True``.
+    """
+    path = Path(path).resolve()
+    record_file = _record_path(path)
+    if record_file is None:
+        return
+    record = _load_record(path)
+    record[str(path)] = _digest(path.read_text())
+    record_file.write_text(json.dumps(record, indent=1, sort_keys=True) + '\n')
+
+
+def import_file(path: PathLike, module_name: Optional[str] = None) -> ModuleType:
+    """Import a Python file afresh (re-running the cell picks up your latest edits).
+
+    Introduced in ``03-write-the-publisher.ipynb``.
+
+    :param path: the ``.py`` file; relative paths are relative to the current workspace.
+    :param module_name: name to register in ``sys.modules``; default the file's stem.
+    :return: the module.
+    :raises Ros2nbError: if the file does not exist.
+    :raises SyntaxError: (and anything the file raises at import) unchanged, with its line.
+    """
+    path = workspace_file(path)
+    if not path.is_file():
+        raise Ros2nbError(f'{shown(path)} does not exist: run the cells that write it first.')
+    name = module_name or path.stem
+    spec = importlib.util.spec_from_file_location(name, path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+_parts_outside: dict[str, dict[int, str]] = {}  # files outside the workspace: this kernel only
+
+
+@contextlib.contextmanager
+def _parts_of(path: Path) -> Iterator[dict[int, str]]:
+    """The stored parts of ``path`` (kept in the workspace, so a kernel restart loses none).
+
+    Changes made inside the block are saved when it ends without an error.
+    """
+    ws = current_workspace().resolve()
+    resolved = path.resolve()
+    if ws not in resolved.parents:
+        yield _parts_outside.setdefault(str(resolved), {})
+        return
+    record_file = ws / PARTS_RECORD
+    record = json.loads(record_file.read_text()) if record_file.is_file() else {}
+    key = str(resolved.relative_to(ws))
+    parts = {int(n): text for n, text in record.get(key, {}).items()}
+    yield parts
+    record[key] = {str(n): parts[n] for n in sorted(parts)}
+    record_file.write_text(json.dumps(record, indent=1, sort_keys=True) + '\n')
+
+
+def write_part(path: PathLike, number: int, text: str, *, overwrite: bool = False) -> Path:
+    """Set part ``number`` of a source file and write the file from all its parts.
+
+    Parts are joined in number order with one blank line between them, so cells can be
+    re-run in any order.  nbgrader's answer markers (``### BEGIN SOLUTION``) are left out.  The parts are kept in the workspace (``.ros2nb-parts.json``),
+    so after a kernel restart re-running one part keeps all the others.  Like
+    :func:`write_file`, it never overwrites a file you changed in an editor.  Used by the
+    ``%%part FILE N`` cell magic (``%load_ext ros2nb``).
+
+    Introduced in ``03-write-the-publisher.ipynb``.
+
+    :param path: the file, as for :func:`write_file`.
+    :param number: the part's position (1, 2, ...).
+    :param text: the part's source code.
+    :param overwrite: as for :func:`write_file`.
+    :return: the file's absolute path.
+    :raises FileProtectedError: as :func:`write_file`.
+    """
+    if isinstance(number, bool) or not isinstance(number, int) or number < 1:
+        raise UsageError(f'A part number is a whole number from 1 up (got {number!r}).')
+    text = '\n'.join(line for line in text.split('\n') if line.strip() not in AUTHOR_MARKERS)
+    resolved = workspace_file(path)
+    with _parts_of(resolved) as parts:
+        replaces = resolved.is_file() and not parts
+        new_parts = {**parts, number: text.rstrip('\n') + '\n'}
+        written = write_file(resolved, '\n\n'.join(new_parts[n].rstrip('\n')
+                                                   for n in sorted(new_parts)) + '\n',
+                             overwrite=overwrite)
+        parts.clear()
+        parts.update(new_parts)
+    lines = written.read_text().count('\n')
+    print(f'{shown(written)}: part {number} saved (parts {", ".join(map(str, sorted(parts)))}; '
+          f'{lines} lines)' + (' (it replaces the file ros2nb wrote there before)' if replaces
+                               else ''))
+    return written
