@@ -53,11 +53,11 @@ test: $(STAMP) sandbox-tool
 
 # Re-run solutions/ in place so their stored outputs are fresh (then make learner-notebooks).
 solutions: $(STAMP)
-	$(PY) tools/execute_solutions.py
+	$(VENV)/bin/ros2nb-solutions
 
 # Regenerate notebooks/ from solutions/ with nbgrader (never edit notebooks/ by hand).
 learner-notebooks: $(STAMP)
-	$(PY) tools/generate_learner_notebooks.py
+	$(VENV)/bin/ros2nb-learner-notebooks
 
 # ros2nb against bare rclpy, and grading seconds per notebook (benchmarks/bench.py).
 bench: $(STAMP) sandbox-tool
@@ -67,7 +67,7 @@ bench: $(STAMP) sandbox-tool
 # Output goes to grading/ (git-ignored); FORCE=1 replaces an earlier grading/.
 grade: $(STAMP) sandbox-tool
 	@test -n "$(SUBMISSIONS)" || { echo "Usage: make grade SUBMISSIONS=DIR (DIR/<learner>/NN-title.ipynb) or SUBMISSIONS=class.zip [FORCE=1] [NO_SANDBOX=1]"; exit 2; }
-	$(PY) tools/grade.py "$(SUBMISSIONS)" $(if $(FORCE),--force) $(if $(NO_SANDBOX),--no-sandbox)
+	$(VENV)/bin/ros2nb-grade "$(SUBMISSIONS)" $(if $(FORCE),--force) $(if $(NO_SANDBOX),--no-sandbox)
 
 clean:
 	rm -rf $(VENV) .cache .jupyter
@@ -97,10 +97,10 @@ hub-proxy-if-possible:
 test: hub-proxy-if-possible
 
 hub: $(STAMP) $(CHP_STAMP)
-	@$(PY) tools/hub_singleuser.py --check
+	@$(VENV)/bin/ros2nb-hub-singleuser --check
 	$(VENV)/bin/jupyterhub -f environment/jupyterhub_config.py
 
 hub-collect: $(STAMP)
 	@test -n "$(CLASS)" || { echo "Usage: make hub-collect CLASS=DIR, then make grade SUBMISSIONS=DIR"; exit 2; }
-	$(PY) tools/hub_collect.py "$(CLASS)"
+	$(VENV)/bin/ros2nb-hub-collect "$(CLASS)"
 # ---- end of the classroom-server block ----------------------------------------------------

@@ -2,7 +2,7 @@
 
 Learners log in with their Unix account and password (PAM). Each gets a Jupyter server of
 their own, started as that Unix user by ``LocalProcessSpawner`` from the course's venv, so
-every learner has the course's kernel, ros2nb and ROS 2 Jazzy. ``tools/hub_singleuser.py``
+every learner has the course's kernel, ros2nb and ROS 2 Jazzy. ``ros2nb_instructor.hub.singleuser``
 runs first, as the learner: it copies the learner notebooks that are missing into
 ``~/ros2-course/notebooks/`` and gives the learner the ROS workspace
 ``~/ros2-course/workspace/ROS2_and_RL_Tutorials``.
@@ -83,7 +83,7 @@ c.JupyterHub.cookie_secret_file = str(STATE / 'jupyterhub_cookie_secret')
 
 # --- each learner's server: their own Unix user, the course's venv, their own course folder
 c.JupyterHub.spawner_class = 'localprocess'
-c.Spawner.cmd = [str(COURSE_PYTHON), str(COURSE / 'tools' / 'hub_singleuser.py')]
+c.Spawner.cmd = [str(COURSE_PYTHON), '-m', 'ros2nb_instructor.hub.singleuser']
 c.Spawner.notebook_dir = LEARNER_FOLDER
 c.Spawner.default_url = '/lab/tree/notebooks'
 c.Spawner.env_keep = KEPT_VARIABLES

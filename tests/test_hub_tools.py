@@ -2,30 +2,20 @@
 
 from __future__ import annotations
 
-import importlib.util
 import os
 import shutil
 import stat
-import sys
 import tempfile
 from pathlib import Path
-from types import ModuleType
 
 import pytest
+
+from ros2nb_instructor.hub import collect as collector
+from ros2nb_instructor.hub import singleuser as launcher
 
 ROOT = Path(__file__).resolve().parent.parent
 
 
-def load_tool(name: str) -> ModuleType:
-    spec = importlib.util.spec_from_file_location(name, ROOT / 'tools' / f'{name}.py')
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module  # dataclasses look their module up there
-    spec.loader.exec_module(module)
-    return module
-
-
-launcher = load_tool('hub_singleuser')
-collector = load_tool('hub_collect')
 SHIPPED = sorted(p.name for p in (ROOT / 'notebooks').glob('*.ipynb'))
 
 

@@ -3,7 +3,7 @@
 Everything here is real, nothing is mocked: JupyterHub from the course's venv, loaded with
 the course's ``environment/jupyterhub_config.py``; configurable-http-proxy as ``make
 hub-proxy`` installs it; two single-user servers started through the Hub's REST API, each
-through the course's launcher ``tools/hub_singleuser.py``; and one kernel on each server,
+through the course's launcher ``ros2nb_instructor.hub.singleuser``; and one kernel on each server,
 created with the server's REST API and driven over its kernel websocket with the learner's
 own token. The hub lives in a temporary folder and listens on free ports of 127.0.0.1.
 

@@ -1,4 +1,4 @@
-"""tools/sandbox.py with real processes: every protection next to the failure it prevents.
+"""ros2nb_instructor.grading.sandbox with real processes: every protection next to the failure it prevents.
 
 Each probe also runs without the sandbox (or with the protection off) and must succeed
 there, so a sandbox that protects nothing fails these tests.  ROS runs outside a network
@@ -20,10 +20,9 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT / 'tools'))
-import sandbox  # noqa: E402
-from sandbox import Limits, Sandbox  # noqa: E402
-from waiting import PATIENCE_S  # noqa: E402
+from ros2nb_instructor.grading import sandbox
+from ros2nb_instructor.grading.sandbox import Limits, Sandbox
+from waiting import PATIENCE_S
 
 PROBLEM = sandbox.problem()
 pytestmark = pytest.mark.skipif(PROBLEM is not None, reason=str(PROBLEM))
@@ -206,7 +205,7 @@ def test_files_hidden_read_only_and_scratch(tmp_path):
               'course append': ('append', course / 'notebooks' / 'a.ipynb'),
               'course create': ('create', course / 'new.txt'),
               'hidden read': ('read', course / 'solutions' / 'a.ipynb'),
-              'repository read': ('read', ROOT / 'tools' / 'sandbox.py'),
+              'repository read': ('read', Path(sandbox.__file__)),
               'shadow read': ('read', '/etc/shadow'),
               'home list': ('list', Path.home()),
               'sysctl write': ('open-for-write', '/proc/sys/vm/swappiness'),

@@ -1,5 +1,6 @@
-#!/usr/bin/env python3
-"""Collect the learners' notebooks from the course's JupyterHub: ``make hub-collect CLASS=DIR``.
+"""``ros2nb-hub-collect``: collect the learners' notebooks from the course's JupyterHub.
+
+Runs on the classroom server (``make hub-collect CLASS=DIR``), as root or an instructor.
 
 On the hub of ``make hub`` a learner, say ``alice``, works in
 ``~alice/ros2-course/notebooks/``. For every member of the hub's Unix group
@@ -25,16 +26,18 @@ import stat
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Optional
 
-ROOT = Path(__file__).resolve().parent.parent
+from ..paths import NOTEBOOKS
+
 #: Each learner's notebooks, relative to their home (see environment/jupyterhub_config.py).
 LEARNER_NOTEBOOKS = Path('ros2-course') / 'notebooks'
 #: The notebooks' names, as shipped in notebooks/.
-COURSE_NOTEBOOKS = ROOT / 'notebooks'
+COURSE_NOTEBOOKS = NOTEBOOKS
 DEFAULT_GROUP = 'ros2-course'
 #: A course notebook with outputs is well under 1 MB; anything far larger is not one.
 MAX_NOTEBOOK_BYTES = 20 * 1024 * 1024
-#: The learner ids tools/grade.py accepts (they become folder names).
+#: The learner ids ros2nb-grade accepts (they become folder names).
 LEARNER_ID = re.compile(r'^[A-Za-z0-9][A-Za-z0-9_.-]*$')
 
 
@@ -144,7 +147,8 @@ def summary(name: str, done: Collected) -> str:
     return line + (f'; refused {", ".join(done.refused)}' if done.refused else '')
 
 
-def main(argv: list[str]) -> int:
+def main(argv: Optional[list[str]] = None) -> int:
+    """Collect every learner's notebooks into the destination folder; say what was missing."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('destination', type=Path, help='new folder for DIR/<learner>/NN-*.ipynb')
     parser.add_argument('--group', default=os.environ.get('ROS2_COURSE_HUB_GROUP', DEFAULT_GROUP),
@@ -163,4 +167,4 @@ def main(argv: list[str]) -> int:
 
 
 if __name__ == '__main__':
-    sys.exit(main(sys.argv[1:]))
+    sys.exit(main())

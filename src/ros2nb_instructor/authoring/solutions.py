@@ -1,11 +1,10 @@
-#!/usr/bin/env python3
-"""Run solutions/*.ipynb in place, in order, so their stored outputs are fresh (``make solutions``).
+"""``ros2nb-solutions``: run solutions/*.ipynb in place, in order, so their stored outputs are fresh.
 
 The notebooks run as nbval runs them in ``make test``: one kernel each, in order, sharing
 one temporary workspace (``ros2nb-test-*``, which tests/sanitize.cfg masks), each kernel
 on a ROS domain of its own.  Then ``make learner-notebooks`` regenerates notebooks/.
 
-Usage: execute_solutions.py [NOTEBOOK ...]   (default: every solution notebook)
+Usage: ros2nb-solutions [NOTEBOOK ...]   (default: every solution notebook; ``make solutions``)
 """
 
 from __future__ import annotations
@@ -15,11 +14,14 @@ import shutil
 import sys
 import tempfile
 from pathlib import Path
+from typing import Optional
 
 import nbformat
 from nbclient import NotebookClient
+from ros2nb.terminal.workspace import WORKSPACE_NAME
 
-ROOT = Path(__file__).resolve().parent.parent
+from ..paths import ROOT, SOLUTIONS
+
 #: Seconds one cell may take (an hour of simulated time and the judge's checks included).
 CELL_TIMEOUT_S = 600
 
@@ -46,16 +48,18 @@ def execute(path: Path, workspace: Path) -> None:
     print(f'executed {path.relative_to(ROOT)}')
 
 
-def main(argv: list[str]) -> int:
-    paths = [Path(a).resolve() for a in argv] or sorted((ROOT / 'solutions').glob('*.ipynb'))
+def main(argv: Optional[list[str]] = None) -> int:
+    """Execute the given solution notebooks (default all), in order, in place."""
+    argv = sys.argv[1:] if argv is None else argv
+    paths = [Path(a).resolve() for a in argv] or sorted(SOLUTIONS.glob('*.ipynb'))
     scratch = Path(tempfile.mkdtemp(prefix='ros2nb-test-'))
     try:
         for path in paths:
-            execute(path, scratch / 'ROS2_and_RL_Tutorials')
+            execute(path, scratch / WORKSPACE_NAME)
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
     return 0
 
 
 if __name__ == '__main__':
-    sys.exit(main(sys.argv[1:]))
+    sys.exit(main())

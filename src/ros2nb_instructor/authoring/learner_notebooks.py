@@ -1,11 +1,10 @@
-#!/usr/bin/env python3
-"""Generate the learner notebooks in notebooks/ from solutions/ with nbgrader.
+"""``ros2nb-learner-notebooks``: the learner notebooks in notebooks/, made from solutions/ by nbgrader.
 
 solutions/ is the single source.  ``nbgrader generate_assignment`` replaces every
 ``### BEGIN SOLUTION`` ... ``### END SOLUTION`` region with a placeholder, removes hidden
 tests and clears all outputs.  Never edit notebooks/ by hand: run ``make learner-notebooks``.
 
-Usage: generate_learner_notebooks.py [--check] [--out DIR]
+Usage: ros2nb-learner-notebooks [--check] [--out DIR]
   --check  exit 1 (naming the notebooks) if notebooks/ differs from freshly generated ones.
 """
 
@@ -19,15 +18,10 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+from typing import Optional
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from nbgrader_cli import nbgrader_argv  # noqa: E402
-
-ROOT = Path(__file__).resolve().parent.parent
-SOLUTIONS = ROOT / 'solutions'
-NOTEBOOKS = ROOT / 'notebooks'
-#: nbgrader's name for the set of notebooks a learner submits.
-ASSIGNMENT = 'ros2-pubsub'
+from ..nbgrader_cli import nbgrader_argv
+from ..paths import ASSIGNMENT, NOTEBOOKS, ROOT, SOLUTIONS
 
 
 def generate(out: Path) -> list[Path]:
@@ -57,11 +51,11 @@ def generate(out: Path) -> list[Path]:
         return written
 
 
-def main() -> int:
+def main(argv: Optional[list[str]] = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--check', action='store_true')
     parser.add_argument('--out', type=Path, default=NOTEBOOKS)
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     if not args.check:
         for path in generate(args.out):
             print(f'wrote {path.relative_to(ROOT) if ROOT in path.parents else path}')

@@ -1,5 +1,7 @@
-#!/usr/bin/env python3
-"""Start one learner's Jupyter server on the course's JupyterHub (``make hub``).
+"""``ros2nb-hub-singleuser``: start one learner's Jupyter server on the course's JupyterHub.
+
+Runs on the classroom server, as the learner (JupyterHub's spawner starts it), never as
+root; ``make hub`` runs its ``--check`` as root first.
 
 JupyterHub's spawner runs this as the learner, with ``HOME`` set to the learner's home and
 ``JUPYTERHUB_ROOT_DIR`` set to their course folder (``~/ros2-course``). It
@@ -13,7 +15,7 @@ JupyterHub's spawner runs this as the learner, with ``HOME`` set to the learner'
 3. puts the course's venv first on ``PATH`` and becomes ``jupyterhub-singleuser`` with the
    arguments the hub passed.
 
-``make hub`` first runs it as ``hub_singleuser.py --check``: when the hub runs as root (so
+``make hub`` first runs it as ``ros2nb-hub-singleuser --check``: when the hub runs as root (so
 that learners' servers run as the learners), every learner must be able to run the venv's
 Python and read the course. A venv built on a Python under ``/root`` (pyenv) fails that.
 """
@@ -27,12 +29,14 @@ import sys
 from pathlib import Path
 from typing import Mapping, MutableMapping, NoReturn, Optional
 
-#: The course repository (this file is tools/hub_singleuser.py inside it).
-COURSE = Path(__file__).resolve().parent.parent
+from ros2nb.terminal.workspace import WORKSPACE_NAME
+
+from ..paths import NOTEBOOKS, ROOT
+
+#: The course repository.
+COURSE = ROOT
 #: The learner's course folder when the hub does not say (JupyterHub's notebook_dir).
 DEFAULT_FOLDER = '~/ros2-course'
-#: The tutorial's workspace name; ros2nb shows paths relative to it.
-WORKSPACE_NAME = 'ROS2_and_RL_Tutorials'
 
 
 def learner_folder(env: Mapping[str, str]) -> Path:
@@ -82,8 +86,8 @@ def closed_to_others(path: Path, *, need: int) -> Optional[Path]:
 
 def check_learners_can_use_course(python: Path) -> Optional[str]:
     """Return why learners could not start the course's server as themselves, or ``None``."""
-    needs = ((python, stat.S_IXOTH), (COURSE / 'tools' / 'hub_singleuser.py', stat.S_IROTH),
-             (COURSE / 'notebooks', stat.S_IROTH | stat.S_IXOTH))
+    needs = ((python, stat.S_IXOTH), (Path(__file__).resolve(), stat.S_IROTH),
+             (NOTEBOOKS, stat.S_IROTH | stat.S_IXOTH))
     for path, need in needs:
         blocked = closed_to_others(path, need=need)
         if blocked is not None:
@@ -93,8 +97,9 @@ def check_learners_can_use_course(python: Path) -> Optional[str]:
     return None
 
 
-def main(argv: list[str]) -> NoReturn:
+def main(argv: Optional[list[str]] = None) -> NoReturn:
     """Prepare the learner's folder, then replace this process with jupyterhub-singleuser."""
+    argv = sys.argv[1:] if argv is None else argv
     venv_bin = Path(sys.executable).parent
     if argv == ['--check']:
         problem = check_learners_can_use_course(Path(sys.executable)) if os.geteuid() == 0 else None
@@ -103,7 +108,7 @@ def main(argv: list[str]) -> NoReturn:
     if not server.exists():
         sys.exit(f'{server} is missing: run `make setup` in {COURSE} (it installs jupyterhub).')
     folder = learner_folder(os.environ)
-    copied = copy_missing_notebooks(COURSE / 'notebooks', folder)
+    copied = copy_missing_notebooks(NOTEBOOKS, folder)
     if copied:
         print(f'ros2-course: copied {", ".join(copied)} to {folder / "notebooks"}', file=sys.stderr)
     learner_environment(os.environ, folder, venv_bin)
@@ -111,4 +116,4 @@ def main(argv: list[str]) -> NoReturn:
 
 
 if __name__ == '__main__':
-    main(sys.argv[1:])
+    main()
