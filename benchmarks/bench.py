@@ -12,7 +12,7 @@ else the machine does falls on both alike.
    separate processes (what ``ros2 run`` starts).
 3. Grading, in seconds per notebook: one learner who handed in the six notebooks complete
    (every cell runs, every check passes) and one who handed them in untouched, each graded
-   alone with tools/grade.py in its sandboxes, nbgrader's set-up and feedback included.
+   alone with ``ros2nb-grade`` in its sandboxes, nbgrader's set-up and feedback included.
 
 Targets (issue "Fast and steady"): simulated hour >= 0.9 x bare rclpy and >= 1000x real
 time; grading <= 10 s per notebook for a complete learner.
@@ -40,6 +40,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 PEERS = Path(__file__).resolve().parent / 'peers.py'
 SIMULATED_S = 3600
+#: The instructor's grading command, as the course's venv installs it.
+GRADE = str(Path(sys.executable).with_name('ros2nb-grade'))
 
 
 def peer(what: str, key: str = 'seconds') -> float:
@@ -70,8 +72,7 @@ def grading_seconds_per_notebook(folder: str) -> float:
         for notebook in notebooks:
             shutil.copy2(notebook, learner / notebook.name)
         started = time.perf_counter()
-        done = subprocess.run([sys.executable, str(ROOT / 'tools' / 'grade.py'),
-                               str(learner.parent), '--out', str(Path(tmp) / 'grading')],
+        done = subprocess.run([GRADE, str(learner.parent), '--out', str(Path(tmp) / 'grading')],
                               capture_output=True, text=True, timeout=1800)
         elapsed = time.perf_counter() - started
     if done.returncode != 0:
@@ -92,8 +93,8 @@ def grade_class(learners: int) -> tuple[float, int, str]:
             for notebook in notebooks:
                 shutil.copy2(notebook, learner / notebook.name)
         started = time.perf_counter()
-        subprocess.run([sys.executable, str(ROOT / 'tools' / 'grade.py'), str(Path(tmp) / 'class'),
-                        '--out', str(Path(tmp) / 'grading')], capture_output=True, timeout=7200)
+        subprocess.run([GRADE, str(Path(tmp) / 'class'), '--out', str(Path(tmp) / 'grading')],
+                       capture_output=True, timeout=7200)
         elapsed = time.perf_counter() - started
         with open(Path(tmp) / 'grading' / 'grades.csv', newline='') as stream:
             totals = [r for r in csv.DictReader(stream) if r['notebook'] == 'TOTAL']
