@@ -17,7 +17,7 @@ export ROS_HOME            := $(HERE)/.cache/ros
 export ROS_LOG_DIR         := $(HERE)/.cache/ros/log
 export PIP_DISABLE_PIP_VERSION_CHECK := 1
 
-.PHONY: lab test setup sandbox-tool solutions learner-notebooks bench grade clean
+.PHONY: lab test setup sandbox-tool browser-tool solutions learner-notebooks bench grade clean
 
 setup: $(STAMP)
 
@@ -43,12 +43,18 @@ sandbox-tool:
 	  || { apt-get update -q >/dev/null 2>&1 && apt-get install -y -q bubblewrap >/dev/null 2>&1; } || true
 	@command -v bwrap >/dev/null || echo "bubblewrap is not installed (sudo apt-get install bubblewrap): grading refuses to run and its tests skip."
 
+# Browser tests (Playwright) drive Debian's chromium; Playwright's own download is unreachable.
+browser-tool:
+	@command -v chromium >/dev/null || [ "$$(id -u)" != 0 ] || apt-get install -y -q chromium >/dev/null 2>&1 \
+	  || { apt-get update -q >/dev/null 2>&1 && apt-get install -y -q chromium >/dev/null 2>&1; } || true
+	@command -v chromium >/dev/null || echo "chromium is not installed (sudo apt-get install chromium): the browser tests skip."
+
 # Three steps, always all three (tests/run_steps.sh): tests/ with pytest-xdist, and nbval
 # over solutions/ and notebooks/ alongside it; one failure never hides the others, the
 # results come together at the end, and make fails if any step failed.
 TEST_WORKERS ?= 3
 
-test: $(STAMP) sandbox-tool
+test: $(STAMP) sandbox-tool browser-tool
 	@tests/run_steps.sh $(PY) $(TEST_WORKERS)
 
 # Re-run solutions/ in place so their stored outputs are fresh (then make learner-notebooks).
