@@ -17,11 +17,17 @@ from __future__ import annotations
 
 import os
 import shutil
+import signal
 import tempfile
 from pathlib import Path
 
 import pytest
 
+# A shell's background job (`make test &` in a script) starts with Ctrl+C ignored, and every
+# process started from it inherits that: the tests that press Ctrl+C (for a node process, for
+# a spin) would then see it ignored. A person at a terminal never runs with it ignored.
+if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 os.environ.pop('ROS_DOMAIN_ID', None)
 os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
 _SCRATCH = Path(tempfile.mkdtemp(prefix='ros2nb-test-'))
