@@ -20,6 +20,8 @@ from ros2nb.checks.dispatch import IN_JUDGE_ENV
 from ros2nb.judge.session import Session
 from ros2nb.errors import CheckFailed, LearnerCodeError
 
+from waiting import wait_for
+
 pytestmark = pytest.mark.timeout(300)
 
 PUB, SUB = course.PUBLISHER_FILE, course.SUBSCRIBER_FILE
@@ -53,6 +55,21 @@ def session(tmp_path_factory):
     ws_module._current = None
 
 
+def strangers(session) -> list[str]:
+    """Nodes on the judge's domain other than its own (the judge's graph, now)."""
+    own = session.observer.node.get_name()
+    return sorted(f'{ns.rstrip("/")}/{n}'
+                  for n, ns in session.observer.node.get_node_names_and_namespaces() if n != own)
+
+
+def alone(session) -> None:
+    """Wait until the judge's graph holds no node of an earlier subject: a subject that was
+    dropped leaves the graph at once when it ends cleanly, and within the DDS lease (20 s)
+    when it had to be killed. The next check must not meet its node under the same name."""
+    wait_for(lambda: not strangers(session), "the judge's domain free of earlier subjects' nodes",
+             seen=lambda: strangers(session))
+
+
 def mutated(session, relative: str, old, new) -> None:
     """Write the reference file with ``old`` replaced by ``new`` (or each of several pairs)."""
     path = session.workspace / relative
@@ -62,11 +79,13 @@ def mutated(session, relative: str, old, new) -> None:
         text = text.replace(before, after)
     path.write_text(text)
     session.drop(('file', relative))
+    alone(session)
 
 
 def restore(session, relative: str) -> None:
     (session.workspace / relative).write_text(course.reference_source(Path(relative).name))
     session.drop(('file', relative))
+    alone(session)
 
 
 def fails(check, pattern: str) -> str:

@@ -110,11 +110,22 @@ class Observer:
                 return sorted(e for e in found if e[1] not in ('/rosout', '/parameter_events',
                                                                 '/clock'))
             if time.monotonic() > deadline:  # not the learner's mistake: say what happened
-                missing = ', '.join(f'{kind} on {topic}' for kind, topic, _ in sorted(want - found))
-                raise CheckFailed(f'The grader could not see the {missing} of {name} in the ROS '
-                                  f'graph within {seconds:g} s (is the machine very busy?): run '
-                                  'this check again.')
+                raise CheckFailed(self._unseen(name, namespace, want, found, seconds))
             time.sleep(0.02)
+
+    def _unseen(self, name: str, namespace: str, want: set, found: set, seconds: float) -> str:
+        """Why the graph never showed what a subject said its node made, in one line."""
+        same = [n for n, ns in self.node.get_node_names_and_namespaces()
+                if n == name and ns == namespace]
+        if len(same) > 1:
+            return (f'{len(same)} nodes named {name} are on the grader\'s ROS domain '
+                    f'{self.domain_id}, so the grader cannot tell yours apart: run this check '
+                    'again (another program on this machine uses that domain).')
+        missing = ', '.join(f'{kind} on {topic}' for kind, topic, _ in sorted(want - found))
+        shown = ', '.join(f'{kind} on {topic}' for kind, topic, _ in sorted(found)) or 'nothing'
+        return (f'The grader could not see the {missing} of {name} in the ROS graph within '
+                f'{seconds:g} s (it saw {shown}; is the machine very busy?): run this check '
+                'again.')
 
     def spins(self, name: str, namespace: str = '/', seconds: float = ARRIVAL_TIMEOUT_S) -> bool:
         """True once the node ``name`` answers a call of its ``list_parameters`` service.
