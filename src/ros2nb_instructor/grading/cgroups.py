@@ -1,0 +1,98 @@
+"""Cgroups for a sandbox: a fresh group per sandbox limits its tasks and its memory.
+
+Part of :mod:`.sandbox` (runs on the instructor's host, as root while grading).  cgroup v1
+``pids`` and ``memory`` when the host has them, else cgroup v2 with both controllers
+delegated; none when neither can be made (then :mod:`.sandbox` falls back to rlimits).
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+import signal
+import time
+from pathlib import Path
+
+_CGROUP_PREFIX = 'ros2nb-sandbox-'
+_counter = itertools.count()
+
+
+def _own_cgroup(controller: str) -> Path | None:
+    """This process's cgroup folder for a v1 controller, or for cgroup v2 when ``''``."""
+    mount = None
+    for line in _read(Path('/proc/self/mountinfo')).splitlines():
+        before, after = line.split(' - ', 1)
+        fstype, _, options = after.split()[:3]
+        if (fstype == 'cgroup2' and not controller
+                or fstype == 'cgroup' and controller in options.split(',')):
+            mount = Path(before.split()[4])
+    for line in _read(Path('/proc/self/cgroup')).splitlines():
+        _, names, path = line.split(':', 2)
+        if mount and (controller in names.split(',') if controller else names == ''):
+            return mount / path.lstrip('/')
+    return None
+
+
+def make_cgroups(pids: int, memory_bytes: int) -> tuple[list[Path], list[str]]:
+    """Fresh cgroups limiting tasks and memory: v1 pids+memory, else v2; [] when impossible."""
+    name = f'{_CGROUP_PREFIX}{os.getpid()}-{next(_counter)}'
+    v1 = {'pids': {'pids.max': pids},
+          'memory': {'memory.limit_in_bytes': memory_bytes,
+                     'memory.memsw.limit_in_bytes': memory_bytes}}
+    made, enforced = [], []
+    for controller, files in v1.items():
+        parent = _own_cgroup(controller)
+        if parent and _try_cgroup(parent / name, files):
+            made.append(parent / name)
+            enforced.append(f'{controller}(cgroup)')
+    parent = _own_cgroup('')
+    if not made and parent and {'pids', 'memory'} <= set(
+            _read(parent / 'cgroup.subtree_control').split()):
+        files = {'pids.max': pids, 'memory.max': memory_bytes, 'memory.swap.max': 0}
+        if _try_cgroup(parent / name, files):
+            made, enforced = [parent / name], ['pids(cgroup)', 'memory(cgroup)']
+    return made, enforced
+
+
+def _read(path: Path) -> str:
+    try:
+        return path.read_text()
+    except OSError:
+        return ''
+
+
+def _try_cgroup(path: Path, files: dict[str, int]) -> bool:
+    try:
+        path.mkdir()
+    except OSError:
+        return False
+    try:
+        for name, value in files.items():
+            if (path / name).exists():
+                (path / name).write_text(str(value))
+        return True
+    except OSError:
+        path.rmdir()
+        return False
+
+
+def remove(cgroups: list[Path]) -> None:
+    """Kill whatever is left in the cgroups (nothing, normally) and remove them."""
+    deadline = time.monotonic() + 10
+    for cgroup in cgroups:
+        while cgroup.exists():
+            for pid in _read(cgroup / 'cgroup.procs').split():
+                _kill(int(pid))
+            try:
+                cgroup.rmdir()
+            except OSError:
+                if time.monotonic() > deadline:
+                    raise
+                time.sleep(0.02)
+
+
+def _kill(pid: int) -> None:
+    try:
+        os.kill(pid, signal.SIGKILL)
+    except ProcessLookupError:
+        pass

@@ -1,0 +1,143 @@
+"""``ros2nb-grade``: grade learners' notebooks (``make grade SUBMISSIONS=DIR`` or a platform's .zip).
+
+DIR/<learner>/ holds a learner's copies of notebooks/NN-*.ipynb (any subset).  nbgrader
+keeps the gradebook, scores the notebooks and writes the feedback; this script decides
+nothing by itself.  Per notebook, three steps, none of which the notebook can reach:
+
+1. The learner's notebook runs in a sandbox of its own (:mod:`.sandbox`: its own PID and
+   network namespaces, only its own scratch folder writable, the course, the gradebook,
+   other learners, solutions and hidden tests invisible; time, memory, task, file-size
+   and output limits), on a workspace shared only with that learner's other notebooks.
+2. The judge (``python -m ros2nb.judge grade``) runs every graded cell of the course's
+   source notebook, hidden tests included, on what the learner wrote (their files, the
+   source of their answer cells), in a second sandbox; the learner's code runs there in
+   subject processes with a sandbox of their own, and the verdicts come from the judge.
+3. The judge's results become the outputs of the graded cells of the executed notebook,
+   which nbgrader then scores (without executing anything) and turns into feedback.
+
+Without a sandbox (no bubblewrap, no user namespaces) grading refuses to start; with
+``--no-sandbox`` (``NO_SANDBOX=1``) it grades trusted work unsandboxed.
+
+Output (``grading/``): ``grades.csv`` (learner, notebook, score, max_score, then a TOTAL
+row per learner), ``feedback/<learner>/<notebook>.html``, ``notes.json`` and ``nbgrader/``,
+an nbgrader course folder with its gradebook.  Exit code 0 when grading itself worked,
+whatever the learners scored.
+"""
+
+from __future__ import annotations
+
+import argparse
+import concurrent.futures
+import json
+import shutil
+import sys
+import tempfile
+import time
+import zipfile
+from pathlib import Path
+from typing import Optional
+
+from ..paths import ROOT
+from . import sandbox
+from .gradebook import collect_zip, score_and_feedback, set_up_course, write_results
+from .judging import Judges
+from .learners import grade_learner
+from .settings import CELL_TIMEOUT_S, JOBS, NOTEBOOK_TIMEOUT_S, Settings
+from .submissions import Learner, find_learners
+
+
+def _options(argv: Optional[list[str]]) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('submissions', type=Path, help='folder of learner folders, or a .zip')
+    parser.add_argument('--out', type=Path, default=ROOT / 'grading')
+    parser.add_argument('--cell-timeout', type=int, default=CELL_TIMEOUT_S)
+    parser.add_argument('--notebook-timeout', type=int, default=NOTEBOOK_TIMEOUT_S)
+    parser.add_argument('--jobs', type=int, default=JOBS)
+    parser.add_argument('--force', action='store_true',
+                        help='replace an earlier grading/ (and any manual grades in it)')
+    parser.add_argument('--no-sandbox', action='store_true',
+                        help='grade without a sandbox: only for work you trust')
+    return parser.parse_args(argv)
+
+
+def _refusal(submissions: Path, out: Path, args: argparse.Namespace) -> Optional[str]:
+    """Why grading cannot start, in one line saying what to do; None when it can."""
+    if not submissions.exists():
+        return f'{submissions} does not exist: pass SUBMISSIONS=folder-of-learner-folders or a .zip'
+    why = None if args.no_sandbox else sandbox.problem()
+    if why:
+        return (f'No sandbox can be made here ({why}); grading runs learners\' code, so it stops. '
+                'For work you trust, run again with NO_SANDBOX=1 (--no-sandbox).')
+    if out.exists() and any(out.iterdir()) and not args.force:
+        return (f'{out} holds an earlier grading (maybe with manual grades): move it away, '
+                'or run again with FORCE=1 to replace it.')
+    if submissions.suffix == '.zip' and not zipfile.is_zipfile(submissions):
+        return f'{submissions} is not a zip file: download the submissions again.'
+    return None
+
+
+def _grade_all(course: Path, learners: list[Learner], notebooks: list[str],
+               settings: Settings, jobs: int) -> None:
+    """Grade every learner, ``jobs`` at a time, each notebook's judge beside the next run."""
+    with tempfile.TemporaryDirectory(prefix='ros2nb-grading-') as scratch_root:
+        Path(scratch_root).chmod(0o711)
+        judges = Judges(jobs)
+        try:
+            with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
+                # Most notebooks first, so the longest learner does not start last.
+                ordered = sorted(learners, key=lambda learner: -len(learner.files))
+                for job in [pool.submit(grade_learner, course, Path(scratch_root), learner,
+                                        notebooks, settings, judges) for learner in ordered]:
+                    job.result()
+        finally:
+            judges.close()
+
+
+def _report(out: Path, learners: list[Learner], rows: list[list[str]],
+            refused: list[str]) -> None:
+    """notes.json, and one line per learner: their total and what happened."""
+    (out / 'notes.json').write_text(json.dumps(
+        {'learners': {l.name: l.notes for l in learners}, 'not graded': refused},
+        indent=1, sort_keys=True, ensure_ascii=False) + '\n')
+    totals = {row[0]: f'{row[2]}/{row[3]}' for row in rows if row[1] == 'TOTAL'}
+    for learner in learners:
+        notes = '; '.join(f'{k}: {v}' for k, v in sorted(learner.notes.items()))
+        print(f'{learner.name}: {totals[learner.name]}' + (f'  ({notes})' if notes else ''))
+
+
+def main(argv: Optional[list[str]] = None) -> int:
+    """``ros2nb-grade SUBMISSIONS [--out DIR] ...``: grade a class; 0 when grading worked."""
+    args = _options(argv)
+    started = time.monotonic()
+    submissions, out = args.submissions.resolve(), args.out.resolve()
+    refusal = _refusal(submissions, out, args)
+    if refusal:
+        print(refusal)
+        return 2
+    if out.exists():
+        shutil.rmtree(out)
+    out.mkdir(parents=True)
+    course = out / 'nbgrader'
+    course.mkdir()
+    notebooks = set_up_course(course)
+    refused: list[str] = []
+    if submissions.suffix == '.zip':
+        submissions, refused = collect_zip(submissions, course)
+    learners, not_learners = find_learners(submissions, notebooks)
+    refused += not_learners
+    for line in refused:
+        print(f'not graded: {line}')
+    if not learners:
+        print(f'{submissions} has no learner folders (<learner>/NN-title.ipynb).')
+        return 2
+    settings = Settings(args.cell_timeout, args.notebook_timeout, not args.no_sandbox)
+    _grade_all(course, learners, notebooks, settings, args.jobs)
+    if any(learner.files for learner in learners):
+        score_and_feedback(course)
+    _report(out, learners, write_results(course, out, learners, notebooks), refused)
+    print(f'wrote {out / "grades.csv"} and {out / "feedback"} in {time.monotonic() - started:.0f} s')
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

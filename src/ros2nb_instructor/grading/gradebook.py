@@ -1,0 +1,173 @@
+"""The nbgrader course under ``grading/``: its gradebook, scores and feedback, and grades.csv.
+
+Runs on the instructor's host.  nbgrader keeps the gradebook, scores the notebooks and
+writes the feedback; it executes nothing of the learners' here (its Execute step is off
+for the scoring run: every notebook was run in a sandbox and judged before).
+"""
+
+from __future__ import annotations
+
+import csv
+import hashlib
+import html
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+from importlib import metadata
+from pathlib import Path
+
+from nbgrader.api import Gradebook, MissingEntry
+
+from ..nbgrader_cli import nbgrader_argv
+from ..paths import ASSIGNMENT, ROOT, SOLUTIONS
+from .submissions import Learner, screen_zip
+
+#: Where the course's set-up is kept per version of the solutions (git-ignored).
+SET_UP_CACHE = ROOT / '.cache' / 'grading-courses'
+#: nbgrader settings of the course under grading/: feedback shows learners' content as text.
+COURSE_CONFIG = 'c = get_config()  # noqa: F821\n'
+SCORE_ONLY_CONFIG = '''\
+# Score notebooks that were already run and judged: execute nothing, keep the outputs.
+from nbgrader.converters.autograde import Autograde
+from nbgrader.preprocessors import ClearOutput, Execute
+
+defaults = Autograde.class_traits()
+c.Autograde.sanitize_preprocessors = [
+    p for p in defaults['sanitize_preprocessors'].default() if p is not ClearOutput]
+c.Autograde.autograde_preprocessors = [
+    p for p in defaults['autograde_preprocessors'].default() if p is not Execute]
+'''
+
+
+def nbgrader(course: Path, *args: str, log: Path) -> int:
+    """Run ``nbgrader ARGS`` for the course folder (trusted: it executes nothing of learners')."""
+    argv = [*nbgrader_argv(*args), f'--CourseDirectory.root={course}',
+            f'--CourseDirectory.db_url=sqlite:///{course / "gradebook.db"}', '--log-level=INFO']
+    env = dict(os.environ, JUPYTER_CONFIG_DIR=str(course / '.jupyter'),
+               PATH=os.pathsep.join([str(Path(sys.executable).parent), os.environ['PATH']]))
+    with open(log, 'a') as out:
+        return subprocess.run(argv, cwd=course, env=env, stdout=out, stderr=subprocess.STDOUT,
+                              stdin=subprocess.DEVNULL).returncode
+
+
+def set_up_course(course: Path) -> list[str]:
+    """Create the nbgrader course (source with hidden tests, release, gradebook).
+
+    nbgrader's ``generate_assignment`` runs once per version of the solutions: its result
+    is kept in ``.cache/grading-courses/<digest>/`` and copied from there (the gradebook
+    then holds the assignment and its cells, and no learner yet).
+
+    :return: the notebooks' names (``NN-title``), in course order.
+    """
+    digest = _solutions_digest()
+    kept = SET_UP_CACHE / digest
+    if not (kept / 'gradebook.db').is_file():
+        _generate_course(kept)
+    shutil.copytree(kept, course, dirs_exist_ok=True)
+    return sorted(p.stem for p in (course / 'source' / ASSIGNMENT).glob('*.ipynb'))
+
+
+def _solutions_digest() -> str:
+    """A digest of what the course's set-up depends on: the solutions and nbgrader's version."""
+    parts = [f'nbgrader {metadata.version("nbgrader")}', COURSE_CONFIG]
+    for notebook in sorted(SOLUTIONS.glob('*.ipynb')):
+        parts += [notebook.name, hashlib.sha256(notebook.read_bytes()).hexdigest()]
+    return hashlib.sha256('\n'.join(parts).encode()).hexdigest()[:16]
+
+
+def _generate_course(kept: Path) -> None:
+    """nbgrader's ``generate_assignment`` in a fresh folder, then in place at ``kept``."""
+    kept.parent.mkdir(parents=True, exist_ok=True)
+    fresh = Path(tempfile.mkdtemp(prefix='.making-', dir=kept.parent))
+    source = fresh / 'source' / ASSIGNMENT
+    source.mkdir(parents=True)
+    for notebook in sorted(SOLUTIONS.glob('*.ipynb')):
+        shutil.copy2(notebook, source / notebook.name)
+    (fresh / 'nbgrader_config.py').write_text(COURSE_CONFIG)
+    if nbgrader(fresh, 'generate_assignment', ASSIGNMENT, '--force',
+                log=fresh / 'grading.log') != 0:
+        sys.exit(f'nbgrader generate_assignment failed: see {fresh / "grading.log"}')
+    (fresh / 'grading.log').unlink()
+    try:
+        fresh.rename(kept)  # another grading may have made it meanwhile: then keep that one
+    except OSError:
+        shutil.rmtree(fresh, ignore_errors=True)
+
+
+def collect_zip(archive: Path, course: Path) -> tuple[Path, list[str]]:
+    """nbgrader's ``zip_collect`` on a screened copy of a platform download.
+
+    :return: the folder of learner folders, and one line per member refused.
+    """
+    downloaded = course / 'downloaded' / ASSIGNMENT / 'archive'
+    downloaded.mkdir(parents=True)
+    refused = screen_zip(archive, downloaded / archive.name)
+    regexp = r'.*/extracted/(?:.*/)?(?P<student_id>[^/]+)/(?P<file_id>[^/]+\.ipynb)$'
+    code = nbgrader(course, 'zip_collect', ASSIGNMENT, '--force',
+                    f'--FileNameCollectorPlugin.named_regexp={regexp}', log=course / 'grading.log')
+    collected = course / 'collected'
+    collected.mkdir()
+    if code != 0:
+        refused.append(f'nbgrader zip_collect failed (see {course / "grading.log"}); nothing '
+                       'from the archive was graded')
+        return collected, refused
+    for learner in (course / 'submitted').iterdir() if (course / 'submitted').is_dir() else ():
+        target = collected / learner.name
+        target.mkdir()
+        for notebook in (learner / ASSIGNMENT).glob('*.ipynb'):
+            shutil.move(notebook, target / notebook.name)
+    shutil.rmtree(course / 'submitted', ignore_errors=True)
+    return collected, refused
+
+
+def _not_submitted_page(learner: Learner, notebook: str, points: float) -> str:
+    return (f'<!DOCTYPE html><html><head><meta charset="utf-8"><title>{notebook}</title></head>'
+            f'<body><h1>{html.escape(learner.name)}: {notebook}</h1><p>Not submitted: 0 of '
+            f'{points:g} points.</p></body></html>\n')
+
+
+def write_results(course: Path, out: Path, learners: list[Learner],
+                  notebooks: list[str]) -> list[list[str]]:
+    """grades.csv from nbgrader's gradebook, and the feedback files; return the CSV rows."""
+    rows = []
+    with Gradebook(f'sqlite:///{course / "gradebook.db"}') as gb:
+        maxima = {nb.name: nb.max_score for nb in gb.find_assignment(ASSIGNMENT).notebooks}
+        for learner in learners:
+            total = 0.0
+            folder = out / 'feedback' / learner.name
+            folder.mkdir(parents=True, exist_ok=True)
+            for notebook in notebooks:
+                try:
+                    score = gb.find_submission_notebook(notebook, ASSIGNMENT, learner.id).score
+                except MissingEntry:
+                    score = 0.0
+                total += score
+                rows.append([learner.name, notebook, f'{score:g}', f'{maxima[notebook]:g}'])
+                made = course / 'feedback' / learner.id / ASSIGNMENT / f'{notebook}.html'
+                page = folder / f'{notebook}.html'
+                if notebook in learner.files and made.is_file():
+                    shutil.copy2(made, page)
+                else:
+                    page.write_text(_not_submitted_page(learner, notebook, maxima[notebook]))
+            rows.append([learner.name, 'TOTAL', f'{total:g}', f'{sum(maxima.values()):g}'])
+    with open(out / 'grades.csv', 'w', newline='') as stream:
+        writer = csv.writer(stream)
+        writer.writerow(['learner', 'notebook', 'score', 'max_score'])
+        writer.writerows(rows)
+    return rows
+
+
+def score_and_feedback(course: Path) -> None:
+    """nbgrader scores what was filed (executing nothing), then writes the feedback."""
+    log = course / 'grading.log'
+    config = course / 'nbgrader_config.py'
+    # nbgrader reads the course's nbgrader_config.py (its command line has no --config);
+    # the score-only settings are there only for this one run.
+    config.write_text(COURSE_CONFIG + SCORE_ONLY_CONFIG)
+    try:
+        nbgrader(course, 'autograde', ASSIGNMENT, '--force', log=log)
+    finally:
+        config.write_text(COURSE_CONFIG)
+    nbgrader(course, 'generate_feedback', ASSIGNMENT, '--force', log=log)

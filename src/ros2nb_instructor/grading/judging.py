@@ -1,0 +1,95 @@
+"""Judging one learner notebook: ros2nb's judge in a sandbox, its subjects sandboxed again.
+
+Runs on the instructor's host.  The judge (``python -m ros2nb.judge grade``) runs every
+graded cell of the course's source notebook on what the learner wrote, in a second
+sandbox; a notebook's judge works beside the learner's next notebook.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+from typing import Optional
+
+from ..paths import ROOT, SOLUTIONS
+from . import sandbox
+from .scratch import Scratch, sandbox_env
+from .settings import Settings
+
+#: Seconds the judge may take for one notebook.
+JUDGE_TIMEOUT_S = 600
+
+
+def judge_notebook(scratch: Scratch, notebook: str, submitted: Path, settings: Settings,
+                   workspace: Path) -> tuple[dict, Optional[str]]:
+    """Run the judge on what the learner wrote; return ``{grade_id: result}`` or a problem.
+
+    :param workspace: the snapshot of the learner's workspace this notebook left
+        (:meth:`Scratch.snapshot`).
+    """
+    given, folder = scratch.judge_folders(notebook)
+    source = given / 'source.ipynb'
+    shutil.copy2(SOLUTIONS / f'{notebook}.ipynb', source)
+    shutil.copy2(submitted, given / 'submission.ipynb')
+    for path in (source, given / 'submission.ipynb'):
+        path.chmod(0o644)
+    home = folder / 'home'
+    home.mkdir()
+    tmp = folder / 'tmp'
+    tmp.mkdir()
+    argv = [sys.executable, '-m', 'ros2nb.judge', 'grade', str(source),
+            str(given / 'submission.ipynb')]
+    env = sandbox_env(home, ROS2NB_WORKSPACE=str(workspace), ROS2NB_JUDGE='1', TMPDIR=str(tmp))
+    limits = sandbox.Limits(wall_s=JUDGE_TIMEOUT_S)
+    if settings.sandboxed:
+        env['FASTDDS_BUILTIN_TRANSPORTS'] = 'UDPv4'  # judge and subjects: own /dev/shm each
+        env['ROS2NB_SUBJECT_PREFIX'] = json.dumps(sandbox.inner_prefix(  # the course may be
+            readable=[workspace, ROOT / 'src'], writable=[folder],  # under /tmp too
+            hidden=[ROOT / 'src' / 'ros2nb' / 'reference']))
+        box = sandbox.Sandbox(writable=[folder], env=env, cwd=folder, nested=True,
+                              readable=[ROOT / 'src', workspace, given],
+                              hidden=[ROOT / 'src' / 'ros2nb' / 'reference'])
+        try:
+            result = box.run(argv, limits, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                             text=True)
+        except OSError as error:  # e.g. the notebook made its workspace unreadable
+            return {}, f'the grader could not check it: {error}'
+        out, err, code, timed_out = result.stdout, result.stderr, result.returncode, \
+            result.timed_out
+    else:
+        try:
+            done = subprocess.run(argv, env={**os.environ, **env}, cwd=folder, text=True,
+                                  capture_output=True, timeout=JUDGE_TIMEOUT_S)
+            out, err, code, timed_out = done.stdout, done.stderr, done.returncode, False
+        except subprocess.TimeoutExpired:
+            out, err, code, timed_out = '', '', -9, True
+    if timed_out:
+        return {}, f'checking it took longer than {JUDGE_TIMEOUT_S} s'
+    try:
+        return json.loads(out.strip().splitlines()[-1]), None
+    except (IndexError, ValueError):
+        last = (err or '').strip().splitlines()[-1:] or ['no message']
+        return {}, f'the grader could not check it (judge exit code {code}: {last[0][:200]})'
+
+
+class Judges:
+    """The judges of a class, working while the learners' next notebooks run.
+
+    A notebook's judge needs only what that notebook left (a snapshot of the workspace
+    and the submitted file), so it runs beside the learner's next notebook.
+    """
+
+    def __init__(self, jobs: int) -> None:
+        self._pool = concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs),
+                                                           thread_name_prefix='judge')
+
+    def submit(self, *arguments: object) -> concurrent.futures.Future:
+        return self._pool.submit(judge_notebook, *arguments)
+
+    def close(self) -> None:
+        self._pool.shutdown(wait=True)

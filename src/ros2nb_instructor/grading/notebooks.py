@@ -1,0 +1,165 @@
+"""The notebooks around a learner's run: what the sandbox executes, and what nbgrader scores.
+
+Part of the grading (:mod:`ros2nb_instructor.grading`), on the instructor's host.  The learner's kernel never runs a check whose result counts: the
+graded cells it executes are only a comment, and their outputs in the notebook nbgrader
+scores are the judge's (ros2nb.judge), who ran the checks on the learner's files in a
+process of its own.  Whatever the learner wrote into markdown or outputs is shown in the
+feedback as text, never as HTML or script.
+"""
+
+from __future__ import annotations
+
+import copy
+import html
+from typing import Any, Optional
+
+import nbformat
+from ros2nb.nbmeta import nbgrader_metadata as nbgrader
+
+#: What the learner's kernel runs in place of a graded cell.
+CHECKED_OUTSIDE = '# Checked by the grader, outside this notebook (ros2nb.judge).'
+#: Output types shown in feedback as they are; others (HTML, JavaScript, SVG) are dropped.
+SAFE_MIME_TYPES = ('text/plain', 'image/png', 'image/jpeg')
+
+
+def graded_ids(release: nbformat.NotebookNode) -> list[str]:
+    """The grade ids of the course's graded cells, in notebook order."""
+    return [nbgrader(c)['grade_id'] for c in release.cells if nbgrader(c).get('grade')]
+
+
+def _by_grade_id(nb: nbformat.NotebookNode) -> dict[str, Any]:
+    return {nbgrader(c)['grade_id']: c for c in nb.cells if nbgrader(c).get('grade_id')}
+
+
+def _clean(cell: Any) -> None:
+    if cell.cell_type == 'code':
+        cell.outputs, cell.execution_count = [], None
+
+
+def _course_cells(nb: nbformat.NotebookNode, course: dict[str, Any]) -> list[Any]:
+    """The cells of ``nb`` that are the course's (graded or answer) cells, first of each id.
+
+    Metadata claiming a grade id the course does not have, or one already claimed by an
+    earlier cell, is removed; the course's own metadata is put back on the others.
+    """
+    found, seen = [], set()
+    for cell in nb.cells:
+        grade_id = nbgrader(cell).get('grade_id')
+        if grade_id is None:
+            cell.metadata.pop('nbgrader', None)
+            continue
+        if grade_id not in course or grade_id in seen:
+            cell.metadata.pop('nbgrader', None)
+            continue
+        seen.add(grade_id)
+        cell.metadata['nbgrader'] = copy.deepcopy(course[grade_id].metadata['nbgrader'])
+        found.append(cell)
+    return found
+
+
+def for_the_run(release: nbformat.NotebookNode,
+                submitted: nbformat.NotebookNode) -> nbformat.NotebookNode:
+    """The learner's notebook as the sandbox runs it.
+
+    The learner's own cells as they are; every locked cell of the course as the course
+    released it; graded cells reduced to a comment; outputs cleared.  Metadata that
+    claims a grade id the course does not have (or claims one twice) is removed.
+    """
+    nb = copy.deepcopy(submitted)
+    course = _by_grade_id(release)
+    for cell in _course_cells(nb, course):
+        grade_id = nbgrader(cell)['grade_id']
+        original = course[grade_id]
+        if nbgrader(original).get('locked'):
+            cell.source, cell.cell_type = original.source, original.cell_type
+        if nbgrader(original).get('grade'):
+            cell.source = CHECKED_OUTSIDE
+    for cell in nb.cells:
+        _clean(cell)
+    return nb
+
+
+def result_outputs(result: Optional[dict], problem: Optional[str]) -> list:
+    """The outputs of a graded cell: the judge's lines, and its verdict when it failed."""
+    if result is None:
+        reason = problem or 'the grader could not check this cell'
+        return [nbformat.v4.new_output('error', ename='GradingError', evalue=reason,
+                                       traceback=[f'GradingError: {reason}'])]
+    outputs = []
+    if result.get('lines'):
+        outputs.append(nbformat.v4.new_output('stream', name='stdout',
+                                              text='\n'.join(result['lines']) + '\n'))
+    if not result['passed']:
+        name, message = result['type'], result['message']
+        outputs.append(nbformat.v4.new_output(
+            'error', ename=name, evalue=message,
+            traceback=[*result.get('traceback', []), f'{name}: {message}']))
+    return outputs
+
+
+def _escape_markdown(source: str) -> str:
+    """Markdown whose HTML shows as text: ``<`` and ``&`` escaped, markdown itself kept."""
+    return source.replace('&', '&amp;').replace('<', '&lt;')
+
+
+def _safe_outputs(outputs: list) -> list:
+    kept = []
+    for output in outputs:
+        if output.get('output_type') in ('display_data', 'execute_result'):
+            output['data'] = {k: v for k, v in output.get('data', {}).items()
+                              if k in SAFE_MIME_TYPES}
+            if not output['data']:
+                continue
+        kept.append(output)
+    return kept
+
+
+def for_scoring(release: nbformat.NotebookNode, executed: nbformat.NotebookNode,
+                results: dict[str, dict], problem: Optional[str] = None) -> nbformat.NotebookNode:
+    """The notebook nbgrader scores and turns into feedback.
+
+    Every graded cell of the course is there exactly once (a deleted one is put back
+    where it belongs), with the judge's result as its outputs; the learner's markdown
+    and outputs are made safe to show as HTML.
+
+    :param release: the course's released notebook (its graded cells, their metadata).
+    :param executed: the learner's notebook as the sandbox ran it.
+    :param results: ``{grade_id: result}`` from ros2nb.judge.
+    :param problem: why nothing could be checked, if so (every graded cell shows it).
+    """
+    nb = copy.deepcopy(executed)
+    course_cells = {c.get('id'): c for c in release.cells}
+    present = {nbgrader(c)['grade_id']: c for c in _course_cells(nb, _by_grade_id(release))}
+    previous = None
+    for original in release.cells:
+        grade_id = nbgrader(original).get('grade_id')
+        if grade_id is None:
+            continue
+        cell = present.get(grade_id)
+        if cell is None:  # deleted: put the course's cell back after its predecessor
+            cell = copy.deepcopy(original)
+            _clean(cell)
+            index = nb.cells.index(previous) + 1 if previous is not None else 0
+            nb.cells.insert(index, cell)
+        if nbgrader(original).get('grade'):
+            cell.source = original.source
+            cell.outputs = result_outputs(results.get(grade_id), problem)
+            cell.execution_count = 1
+        previous = cell
+    for cell in nb.cells:
+        if cell.cell_type == 'markdown':
+            original = course_cells.get(cell.get('id'))
+            if original is None or original.source != cell.source:
+                cell.source = _escape_markdown(cell.source)
+            cell.pop('attachments', None)
+        elif cell.cell_type == 'code' and not nbgrader(cell).get('grade'):
+            cell.outputs = _safe_outputs(cell.get('outputs', []))
+    return nb
+
+
+def note_notebook(release: nbformat.NotebookNode, reason: str) -> nbformat.NotebookNode:
+    """The released notebook with ``reason`` in every graded cell: 0 points, and why."""
+    nb = copy.deepcopy(release)
+    nb.cells.insert(0, nbformat.v4.new_markdown_cell(
+        f'**Grading note:** {html.escape(reason)}'))
+    return for_scoring(release, nb, {}, reason)

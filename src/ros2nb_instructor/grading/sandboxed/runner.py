@@ -1,0 +1,130 @@
+#!/usr/bin/env python3
+"""Execute one learner notebook for grading, with limits: ``python -m ros2nb_instructor.grading.sandboxed.runner IN OUT``.
+
+Runs inside the learner's sandbox (:mod:`ros2nb_instructor.grading.sandbox`), as the
+sandbox's user, beside the learner's kernel: nothing it writes is trusted beyond the two
+files the grader reads back.  nbclient does the executing.  What
+it adds: every cell has a time limit after which its kernel is interrupted and the next
+cell runs; a cell's output is cut at a size limit, with a note; the notebook is saved
+after every cell, so whatever ran is kept even if the sandbox is stopped from outside;
+and ``OUT.status.json`` says what happened: cells that ran too long, a kernel that died, output
+that was cut.  Nothing here decides a grade (ros2nb.judge does, nbgrader scores).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+from pathlib import Path
+from typing import Any, Optional
+
+# jsonschema, which nbformat imports, would import rfc3987_syntax if it can: that builds a
+# parser for IRIs and costs a second of CPU in every sandbox, for a format no notebook uses.
+sys.modules.setdefault('rfc3987_syntax', None)  # its absence is an ImportError jsonschema expects
+
+import nbformat  # noqa: E402
+from nbclient import NotebookClient  # noqa: E402
+from nbclient.exceptions import DeadKernelError  # noqa: E402
+
+#: Characters of text output one cell may keep (printed text, tracebacks, text/plain).
+MAX_CELL_OUTPUT_BYTES = 100_000
+#: Bytes of images (base64) one cell may keep besides: a plot or two.
+MAX_CELL_IMAGE_BYTES = 2_000_000
+IMAGE_TYPES = ('image/png', 'image/jpeg', 'image/svg+xml')
+
+
+def _size(output: Any) -> int:
+    """Text characters of an output (images are counted apart, by :func:`_image_size`)."""
+    if output.get('output_type') == 'stream':
+        return len(output.get('text', ''))
+    return sum(len(str(v)) for k, v in output.get('data', {}).items() if k not in IMAGE_TYPES) \
+        + len(str(output.get('traceback', '')))
+
+
+def _image_size(output: Any) -> int:
+    return sum(len(str(v)) for k, v in output.get('data', {}).items() if k in IMAGE_TYPES)
+
+
+class LimitedClient(NotebookClient):
+    """nbclient with a size limit per cell and a save after every cell."""
+
+    def __init__(self, nb: nbformat.NotebookNode, out: Path, status: dict, **kwargs: Any) -> None:
+        super().__init__(nb, **kwargs)
+        self.out_path, self.status = out, status
+        self._notes: dict[int, Any] = {}
+        self.on_cell_executed = self._saved
+
+    def output(self, outs: list, msg: dict, display_id: Optional[str], cell_index: int) -> Any:
+        out = super().output(outs, msg, display_id, cell_index)
+        if out is None:
+            return None
+        note = self._notes.get(cell_index)
+        kept = sum(_size(o) for o in outs if o is not note)
+        images = sum(_image_size(o) for o in outs)
+        if kept > MAX_CELL_OUTPUT_BYTES or images > MAX_CELL_IMAGE_BYTES:
+            outs.remove(out)
+            if out.get('output_type') == 'stream':  # keep the first part of the text
+                room = MAX_CELL_OUTPUT_BYTES - (kept - _size(out))
+                if room > 0:
+                    out['text'] = out['text'][:room]
+                    outs.insert(len(outs) - (note is not None), out)
+            if note is None:
+                self.status['output_cut'].append(cell_index)
+                note = self._notes[cell_index] = nbformat.v4.new_output(
+                    'stream', name='stderr', text=(
+                        f'\n[The grader cut this cell\'s output at {MAX_CELL_OUTPUT_BYTES // 1000} '
+                        f'kB of text and {MAX_CELL_IMAGE_BYTES // 1_000_000} MB of images; what '
+                        'it showed beyond that is not kept.]\n'))
+                outs.append(note)
+        return out
+
+    def _saved(self, cell: Any, cell_index: int, execute_reply: dict) -> None:
+        error = execute_reply.get('content', {})
+        if error.get('ename') == 'CellTimeoutError':
+            self.status['timed_out'].append(cell_index)
+        self.status['ran'] = cell_index + 1
+        save(self.nb, self.out_path, self.status)
+
+
+def save(nb: nbformat.NotebookNode, out: Path, status: dict) -> None:
+    """Write the notebook and its status atomically (a kill never leaves half a file)."""
+    for path, text in ((out, nbformat.writes(nb)),
+                       (Path(str(out) + '.status.json'), json.dumps(status))):
+        partial = path.with_name(path.name + '.partial')
+        partial.write_text(text)
+        os.replace(partial, path)
+
+
+def main(argv: list[str]) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument('notebook', type=Path)
+    parser.add_argument('out', type=Path)
+    parser.add_argument('--cell-timeout', type=int, default=120)
+    args = parser.parse_args(argv)
+    nb = nbformat.read(args.notebook, as_version=4)
+    status: dict = {'ran': 0, 'cells': len(nb.cells), 'timed_out': [], 'output_cut': [],
+                    'kernel_died_at': None, 'finished': False}
+    timeout_error = {'ename': 'CellTimeoutError',
+                     'evalue': f'the grader stopped this cell after {args.cell_timeout} s',
+                     'traceback': [f'CellTimeoutError: the grader stopped this cell after '
+                                   f'{args.cell_timeout} s; the cells after it still ran.']}
+    client = LimitedClient(nb, args.out, status, timeout=args.cell_timeout,
+                           kernel_name='python3', allow_errors=True, interrupt_on_timeout=True,
+                           error_on_timeout=timeout_error, record_timing=False,
+                           resources={'metadata': {'path': str(args.notebook.parent)}})
+    save(nb, args.out, status)
+    try:
+        client.execute()
+        status['finished'] = True
+    except DeadKernelError:
+        status['kernel_died_at'] = status['ran']
+    except Exception as error:  # nbclient could not go on: say why, keep what ran
+        status['runner_error'] = f'{type(error).__name__}: {str(error)[:300]}'
+    save(nb, args.out, status)
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,28 @@
+"""How to grade: the limits and whether to sandbox (``ros2nb-grade``'s options).
+
+Runs on the instructor's host.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+#: Seconds one cell may run before its kernel is interrupted (the next cell still runs).
+CELL_TIMEOUT_S = 120
+#: Seconds one notebook may take in all; then its sandbox is stopped.
+NOTEBOOK_TIMEOUT_S = 600
+#: Seconds the judge may take for one notebook.
+JUDGE_TIMEOUT_S = 600
+#: Notebooks graded at the same time: one more than the CPUs (a notebook often waits).
+JOBS = (os.cpu_count() or 1) + 1
+#: Largest executed notebook read back (the runner cuts each cell's output at 100 kB).
+
+
+@dataclass(frozen=True)
+class Settings:
+    """How to grade: the limits and whether to sandbox."""
+
+    cell_timeout: int
+    notebook_timeout: int
+    sandboxed: bool
