@@ -70,7 +70,25 @@ EXPECTED = {
     # ---- the course's graded cells cannot be removed or re-weighted
     'deletes-the-check': Case({NB01: 1}, {NB01: 'Check passed'}),
     'claims-100-points': Case({NB01: 0}),
+    # ---- the grader never follows a learner's path (honest twins: complete, untouched)
+    'links-notebooks-to-solutions': Case({NB01: 1, NB02: 0}),
+    'links-to-classmates': Case({}, {}, {'_folder': 'is a link (links are not followed'}),
+    # ---- one learner, one learner's problem (honest twin: complete's 01)
+    'malformed-metadata': Case({NB01: 1}),
+    'rewrites-its-status': Case({NB01: 1}, {}, {NB01: 'the runner\'s status'}),
+    'fills-the-disk': Case({NB01: 1}, {}, {NB01: 'ran out of scratch space'}),
+    # ---- feedback that cannot run code (honest twin: complete's 01)
+    'feedback-attacks': Case({NB01: 1}, {NB01: 'Score: 1.0 / 1.0 (drawn by me)'}),
+    # ---- honest work kept (honest twin: complete's 01)
+    'nbformat-3': Case({NB01: 1}, {NB01: 'Check passed'}, {NB01: ''}),
+    'pasted-image': Case({NB01: 1}, {NB01: 'Check passed'}, {NB01: ''}),
+    'attaches-200-mb': Case({NB01: 1}, {NB01: 'Check passed'},
+                            {NB01: 'an attachment of 200 MB'}),
 }
+#: Learners whose feedback pages the browser test opens (a learner script must not run there).
+FEEDBACK_ATTACKERS = ('feedback-attacks', 'script-in-feedback', 'pasted-image')
+#: What a learner script in a feedback page would set (page title and a window flag).
+PWNED = 'pwned-by-a-learner'
 
 
 def _with_cells(source: Path, cells: dict[int, str], markdown: bool = False
@@ -220,6 +238,62 @@ from IPython.display import HTML, Javascript, display
 display(HTML('<b>bold</b><script>alert("pwned-html")</script>'))
 display(Javascript('alert("pwned-js")'))
 '''
+LINK_TO_SOLUTIONS = '''
+import os, shutil
+here = os.getcwd()  # the folder the grader gave this notebook
+os.chdir('..')
+shutil.rmtree(here)
+os.symlink({solutions!r}, here)
+print('linked', here)
+'''
+REWRITE_THE_STATUS = '''
+import json, os, signal
+for pid in os.listdir('/proc'):
+    try:
+        argv = open(f'/proc/{pid}/cmdline', 'rb').read().decode().split('\\0')
+    except (OSError, ValueError):
+        continue
+    if any(part.endswith('sandboxed.runner') for part in argv):
+        out = argv[argv.index(next(p for p in argv if p.endswith('sandboxed.runner'))) + 2]
+        with open(out + '.status.json', 'w') as stream:
+            json.dump({'ran': 'all', 'cells': None, 'timed_out': 7, 'output_cut': {'a': 1},
+                       'kernel_died_at': [1], 'finished': 'yes'}, stream)
+        os.kill(int(pid), signal.SIGKILL)
+'''
+FILL_THE_DISK = '''
+import os, pathlib
+written = 0
+chunk = b'x' * (16 << 20)
+for folder in (pathlib.Path.home(), pathlib.Path('/tmp'), pathlib.Path('/dev/shm')):
+    for number in range(400):  # up to 6.4 GB each; files stay under the 256 MB size limit
+        try:
+            with open(folder / f'filler-{number}', 'wb') as stream:
+                for _ in range(8):
+                    stream.write(chunk)
+                    written += len(chunk)
+        except OSError as error:
+            print(folder, error.strerror)
+            break
+print('wrote', written >> 20, 'MB')
+'''
+FEEDBACK_IMAGE = '''
+import base64
+from IPython.display import display
+PNG = base64.b64encode(bytes.fromhex(
+    '89504e470d0a1a0a0000000d4948445200000001000000010806000000'
+    '1f15c4890000000d49444154789c6360f8cfc0f01f0005000201e1a8a5'
+    '0c0000000049454e44ae426082')).decode()
+attack = "x onerror=document.title='{pwned}';window.pwned=1 "
+display({{'image/png': PNG}}, raw=True,
+        metadata={{'image/png': {{'width': attack, 'height': attack}}}})
+'''
+FEEDBACK_MARKDOWN = '''[a link](javascript:document.title='{pwned}') and
+[another](data:text/html;base64,PHNjcmlwdD5hbGVydCgxKTwvc2NyaXB0Pg==) and
+![remote](http://127.0.0.1:9/tracker.png) and <a href="javascript:window.pwned=1">raw</a>'''
+FEEDBACK_RAW = '''<div class="panel panel-default"><div class="panel-heading">
+Score: 1.0 / 1.0 (drawn by me)</div></div>
+<script>document.title = '{pwned}'; window.pwned = 1;</script>
+<img src="http://127.0.0.1:9/raw.png" onerror="document.title='{pwned}'">'''
 HANG_IN_CALLBACK = '''
 from rclpy.node import Node
 
@@ -313,4 +387,42 @@ def build(folder: Path, *, grading_out: Path, submissions: Path, decoy_gradebook
         'nbgrader': {'grade': True, 'grade_id': 'my-own-points', 'locked': True, 'points': 50,
                      'solution': False, 'schema_version': 3, 'task': False}}))
     put('claims-100-points', NB01, claims)
+    _hostile_class_two(folder, put)
     return folder
+
+
+def _hostile_class_two(folder: Path, put) -> None:
+    """The second hostile class (issue 14): links, malformed files, feedback, honest oddities."""
+    put('links-notebooks-to-solutions', NB01, _with_cells(
+        SOLUTION[NB01], {99: LINK_TO_SOLUTIONS.format(solutions=str(ROOT / 'solutions'))}))
+    put('links-notebooks-to-solutions', NB02, LEARNER[NB02])
+    (folder / 'links-to-classmates').mkdir()
+    (folder / 'links-to-classmates' / f'{NB01}.ipynb').symlink_to(
+        folder / 'complete' / f'{NB01}.ipynb')
+    (folder / 'links-to-classmates' / f'{NB02}.ipynb').symlink_to(SOLUTION[NB02])
+    (folder / 'links-to-the-solutions').symlink_to(ROOT / 'solutions')
+    malformed = _with_cells(SOLUTION[NB01], {3: 'print("my own cell")'})
+    malformed.cells[3].metadata['nbgrader'] = {'grade': True, 'grade_id': ['a', 'list'],
+                                               'points': 'ten', 'solution': False}
+    put('malformed-metadata', NB01, malformed)
+    put('rewrites-its-status', NB01, _with_cells(SOLUTION[NB01], {99: REWRITE_THE_STATUS}))
+    put('fills-the-disk', NB01, _with_cells(SOLUTION[NB01], {99: FILL_THE_DISK}))
+    attacks = _with_cells(SOLUTION[NB01], {3: FEEDBACK_IMAGE.format(pwned=PWNED)})
+    attacks.cells.insert(3, nbformat.v4.new_markdown_cell(FEEDBACK_MARKDOWN.format(pwned=PWNED)))
+    attacks.cells.insert(3, nbformat.v4.new_raw_cell(FEEDBACK_RAW.format(pwned=PWNED),
+                                                     metadata={'format': 'text/html'}))
+    put('feedback-attacks', NB01, attacks)
+    old = nbformat.read(SOLUTION[NB01], as_version=4)
+    put('nbformat-3', NB01, nbformat.writes(nbformat.convert(old, 3), version=3))
+    put('pasted-image', NB01, _with_attachment(SOLUTION[NB01], b'\x89PNG\r\n\x1a\n' + b'0' * 64))
+    put('attaches-200-mb', NB01, _with_attachment(SOLUTION[NB01], b'\x00' * 150_000_000))
+
+
+def _with_attachment(source: Path, data: bytes) -> nbformat.NotebookNode:
+    """The notebook with a markdown cell showing a pasted image (``data``, base64 in the file)."""
+    import base64
+    nb = nbformat.read(source, as_version=4)
+    cell = nbformat.v4.new_markdown_cell('My screenshot: ![image.png](attachment:image.png)')
+    cell['attachments'] = {'image.png': {'image/png': base64.b64encode(data).decode()}}
+    nb.cells.insert(3, cell)
+    return nb

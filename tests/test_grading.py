@@ -19,7 +19,8 @@ from pathlib import Path
 
 import pytest
 
-from grading_samples import EXPECTED, MARK, NB01, ROOT, SOLUTION, build
+from browser import page  # noqa: F401 - the fixture
+from grading_samples import EXPECTED, FEEDBACK_ATTACKERS, MARK, NB01, PWNED, ROOT, SOLUTION, build
 
 from ros2nb_instructor.grading import sandbox
 
@@ -166,3 +167,55 @@ def test_the_gradebook_holds_only_what_nbgrader_scored(graded):
     with sqlite3.connect(course / 'gradebook.db') as db:
         assert db.execute('SELECT COUNT(*) FROM grade WHERE manual_score IS NOT NULL'
                           ).fetchone()[0] == 0
+
+
+def test_links_are_never_followed(graded):
+    """Links in the submissions folder are named, never graded as their targets."""
+    out, done, *_ = graded
+    notes = json.loads((out / 'notes.json').read_text())
+    assert any(line.startswith("'links-to-the-solutions': a link") for line in notes['not graded'])
+    assert "'links-to-the-solutions': a link" in done.stdout
+    assert (f'{NB01}.ipynb is a link (links are not followed'
+            in notes['learners']['links-to-classmates']['_folder'])
+
+
+def test_feedback_pages_forbid_scripts_and_show_learners_html_as_text(graded):
+    """Every page carries the CSP; the raw cell's fake score box is text, not a box."""
+    out, *_ = graded
+    for page in (out / 'feedback').rglob('*.html'):
+        text = page.read_text()
+        assert "Content-Security-Policy\" content=\"default-src 'none'" in text, page
+        assert not re.search(r'<script|<[^>]*(?:javascript:|onerror=|src="http)[^>]*>', text,
+                             re.I), page  # learners' HTML is in the page as text only
+    text = (out / 'feedback' / 'feedback-attacks' / f'{NB01}.html').read_text()
+    assert 'panel-heading">\nScore: 1.0 / 1.0 (drawn by me)' not in text  # no box of its own
+    assert '&lt;div class="panel panel-default"&gt;' in text
+    pasted = (out / 'feedback' / 'pasted-image' / f'{NB01}.html').read_text()
+    assert re.search(r'<img [^>]*src="data:image/png;base64,', pasted)  # the pasted image shows
+
+
+def _opened(page, path: Path) -> tuple[str, object, list[str]]:
+    """Open ``path`` in the browser: its title, the learner's window flag, requests that left."""
+    left = []
+    page.on('request', lambda request: left.append(request.url)
+            if not request.url.startswith(('file://', 'data:')) else None)
+    page.goto(path.as_uri())
+    page.wait_for_load_state('load')
+    return page.title(), page.evaluate('window.pwned'), left
+
+
+def test_no_learner_script_runs_in_a_browser(graded, page, tmp_path):
+    """Every feedback page of the hostile learners in chromium: no script ran, nothing loaded.
+
+    A planted page (the same payloads, unsanitised) shows the check sees a script that runs.
+    """
+    out, *_ = graded
+    planted = tmp_path / 'planted.html'
+    planted.write_text(f'<html><head><title>planted</title></head><body><img src="x" '
+                       f"onerror=\"document.title='{PWNED}';window.pwned=1\"></body></html>")
+    title, flag, _ = _opened(page, planted)
+    assert title == PWNED and flag == 1  # the hole, planted: the check sees it
+    for learner in FEEDBACK_ATTACKERS:
+        for notebook in NOTEBOOKS:
+            title, flag, left = _opened(page, out / 'feedback' / learner / f'{notebook}.html')
+            assert (title, flag, left) == (notebook, None, []), (learner, notebook)

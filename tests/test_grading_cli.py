@@ -25,31 +25,62 @@ pytestmark = [pytest.mark.timeout(1200),
 
 
 def test_zip_from_a_learning_platform(tmp_path):
-    """nbgrader's zip_collect grades the rest; nested archives and duplicates are refused."""
+    """A learner is a folder at the archive's top (below one export folder); nested archives
+    are refused, and nothing below a learner's folder names another learner.
+
+    mallory's folder holds alice/, extracted/bob/ and carol/: all three are mallory's files
+    (graded as one notebook of hers, the other copies named), never alice's, bob's or a
+    carol's (before, alice and bob were refused as "in 2 places" and carol was graded from
+    mallory's file).
+    """
     solved, unsolved = SOLUTION[NB01], LEARNER[NB01]
     inner = tmp_path / 'inner.zip'
     with zipfile.ZipFile(inner, 'w') as zipped:
-        zipped.write(solved, f'mallory/{NB01}.ipynb')  # would decide who is graded if unpacked
+        zipped.write(solved, f'dan/{NB01}.ipynb')  # would decide who is graded if unpacked
     archive = tmp_path / 'class.zip'
     with zipfile.ZipFile(archive, 'w') as zipped:
         zipped.write(solved, f'course-export/ada/{NB01}.ipynb')
         zipped.write(unsolved, f'course-export/bo/{NB01}.ipynb')
         zipped.write(inner, 'course-export/eve/extra.zip')
         zipped.write(solved, f'course-export/eve/{NB01}.ipynb')
-        zipped.write(solved, f'course-export/dup/{NB01}.ipynb')
-        zipped.write(unsolved, f'late-export/dup/{NB01}.ipynb')
+        zipped.write(unsolved, f'course-export/alice/{NB01}.ipynb')
+        zipped.write(unsolved, f'course-export/bob/{NB01}.ipynb')
+        zipped.write(solved, f'course-export/mallory/alice/{NB01}.ipynb')
+        zipped.write(solved, f'course-export/mallory/extracted/bob/{NB01}.ipynb')
+        zipped.write(solved, f'course-export/mallory/carol/{NB01}.ipynb')
     done = subprocess.run([GRADE, str(archive),
                            '--out', str(tmp_path / 'grading'), '--cell-timeout=60'],
                           capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stdout + done.stderr
     rows = {(r['learner'], r['notebook']): r['score']
             for r in csv.DictReader(open(tmp_path / 'grading' / 'grades.csv'))}
-    assert rows['ada', 'TOTAL'] == '1' and rows['bo', 'TOTAL'] == '0' and rows['eve', 'TOTAL'] == '1'
-    assert not any(learner in ('mallory', 'dup') for learner, _ in rows)
+    totals = {learner: score for (learner, notebook), score in rows.items()
+              if notebook == 'TOTAL'}
+    assert totals == {'ada': '1', 'bo': '0', 'eve': '1', 'alice': '0', 'bob': '0',
+                      'mallory': '1'}, done.stdout
     assert ('not graded: course-export/eve/extra.zip: an archive inside the archive is not '
             'unpacked') in done.stdout
-    assert ('not graded: dup: appears in 2 places of the archive (course-export/dup, '
-            'late-export/dup); not graded, send one copy') in done.stdout
+    assert (f'not graded: course-export/mallory/carol/{NB01}.ipynb: another copy of '
+            f'{NB01}.ipynb in mallory\'s folder; graded course-export/mallory/alice/'
+            f'{NB01}.ipynb') in done.stdout
+    assert 'appears in' not in done.stdout
+
+
+def test_force_replaces_an_earlier_grading_only_once_complete(tmp_path):
+    """FORCE=1 with a grading that cannot finish (here: no learner) keeps the earlier one.
+
+    Before, the earlier grading/ was deleted first and the failed run left nothing.
+    """
+    earlier = tmp_path / 'grading'
+    earlier.mkdir()
+    (earlier / 'grades.csv').write_text('manual work\n')
+    (tmp_path / 'class' / 'not-a-notebook.txt').parent.mkdir()
+    (tmp_path / 'class' / 'not-a-notebook.txt').write_text('hello\n')
+    done = subprocess.run([GRADE, str(tmp_path / 'class'), '--out', str(earlier), '--force'],
+                          capture_output=True, text=True, timeout=600)
+    assert done.returncode == 2 and 'has no learner folders' in done.stdout, done.stdout
+    assert (earlier / 'grades.csv').read_text() == 'manual work\n'
+    assert sorted(p.name for p in tmp_path.iterdir()) == ['class', 'grading']  # nothing left
 
 
 def test_bad_input_gets_one_line(tmp_path):

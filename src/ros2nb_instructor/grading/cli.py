@@ -29,6 +29,7 @@ from __future__ import annotations
 import argparse
 import concurrent.futures
 import json
+import os
 import shutil
 import sys
 import tempfile
@@ -86,9 +87,14 @@ def _grade_all(course: Path, learners: list[Learner], notebooks: list[str],
             with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
                 # Most notebooks first, so the longest learner does not start last.
                 ordered = sorted(learners, key=lambda learner: -len(learner.files))
-                for job in [pool.submit(grade_learner, course, Path(scratch_root), learner,
-                                        notebooks, settings, judges) for learner in ordered]:
-                    job.result()
+                jobs_of = {pool.submit(grade_learner, course, Path(scratch_root), learner,
+                                       notebooks, settings, judges): learner for learner in ordered}
+                for job, learner in jobs_of.items():
+                    try:
+                        job.result()
+                    except Exception as error:  # noqa: BLE001 - that learner's, in a note
+                        learner.note('_folder', f'the grader could not grade this learner '
+                                                f'({type(error).__name__}: {str(error)[:200]})')
         finally:
             judges.close()
 
@@ -114,9 +120,33 @@ def main(argv: Optional[list[str]] = None) -> int:
     if refusal:
         print(refusal)
         return 2
-    if out.exists():
-        shutil.rmtree(out)
-    out.mkdir(parents=True)
+    # A new grading is made beside the old one and replaces it only once complete: a
+    # grading that stops half-way leaves an earlier grading/ (FORCE=1) as it was.
+    out.parent.mkdir(parents=True, exist_ok=True)
+    final, out = out, Path(tempfile.mkdtemp(prefix=f'.{out.name}-new-', dir=out.parent))
+    try:
+        code = _grade(args, submissions, out, started)
+        if code == 0:
+            _replace(final, out)
+        return code
+    finally:
+        shutil.rmtree(out, ignore_errors=True)
+
+
+def _replace(final: Path, new: Path) -> None:
+    """Put the complete grading ``new`` at ``final`` (an earlier one there goes only now)."""
+    new.chmod(0o755)
+    old = None
+    if final.exists() or final.is_symlink():
+        old = Path(tempfile.mkdtemp(prefix=f'.{final.name}-old-', dir=final.parent))
+        os.replace(final, old / final.name)
+    os.replace(new, final)
+    if old:
+        shutil.rmtree(old, ignore_errors=True)
+
+
+def _grade(args: argparse.Namespace, submissions: Path, out: Path, started: float) -> int:
+    """Grade into the empty folder ``out``; 0 when grading worked."""
     course = out / 'nbgrader'
     course.mkdir()
     notebooks = set_up_course(course)
@@ -135,7 +165,8 @@ def main(argv: Optional[list[str]] = None) -> int:
     if any(learner.files for learner in learners):
         score_and_feedback(course)
     _report(out, learners, write_results(course, out, learners, notebooks), refused)
-    print(f'wrote {out / "grades.csv"} and {out / "feedback"} in {time.monotonic() - started:.0f} s')
+    print(f'wrote {args.out.resolve() / "grades.csv"} and {args.out.resolve() / "feedback"} in '
+          f'{time.monotonic() - started:.0f} s')
     return 0
 
 

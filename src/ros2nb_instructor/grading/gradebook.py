@@ -22,6 +22,7 @@ from nbgrader.api import Gradebook, MissingEntry
 
 from ..nbgrader_cli import nbgrader_argv
 from ..paths import ASSIGNMENT, ROOT, SOLUTIONS
+from . import feedback
 from .submissions import Learner, screen_zip
 
 #: Where the course's set-up is kept per version of the solutions (git-ignored).
@@ -123,9 +124,8 @@ def collect_zip(archive: Path, course: Path) -> tuple[Path, list[str]]:
 
 
 def _not_submitted_page(learner: Learner, notebook: str, points: float) -> str:
-    return (f'<!DOCTYPE html><html><head><meta charset="utf-8"><title>{notebook}</title></head>'
-            f'<body><h1>{html.escape(learner.name)}: {notebook}</h1><p>Not submitted: 0 of '
-            f'{points:g} points.</p></body></html>\n')
+    return feedback.page(notebook, f'<h1>{html.escape(learner.name)}: {notebook}</h1><p>Not '
+                                   f'submitted: 0 of {points:g} points.</p>')
 
 
 def write_results(course: Path, out: Path, learners: list[Learner],
@@ -148,7 +148,7 @@ def write_results(course: Path, out: Path, learners: list[Learner],
                 made = course / 'feedback' / learner.id / ASSIGNMENT / f'{notebook}.html'
                 page = folder / f'{notebook}.html'
                 if notebook in learner.files and made.is_file():
-                    shutil.copy2(made, page)
+                    page.write_text(feedback.safe_feedback(made.read_text(), notebook))
                 else:
                     page.write_text(_not_submitted_page(learner, notebook, maxima[notebook]))
             rows.append([learner.name, 'TOTAL', f'{total:g}', f'{sum(maxima.values()):g}'])

@@ -16,6 +16,8 @@ import sys
 from pathlib import Path
 from typing import Optional
 
+import nbformat
+
 from ..paths import ROOT, SOLUTIONS
 from . import sandbox
 from .scratch import Scratch, sandbox_env
@@ -25,17 +27,19 @@ from .settings import Settings
 JUDGE_TIMEOUT_S = 600
 
 
-def judge_notebook(scratch: Scratch, notebook: str, submitted: Path, settings: Settings,
-                   workspace: Path) -> tuple[dict, Optional[str]]:
+def judge_notebook(scratch: Scratch, notebook: str, submitted: nbformat.NotebookNode,
+                   settings: Settings, workspace: Path) -> tuple[dict, Optional[str]]:
     """Run the judge on what the learner wrote; return ``{grade_id: result}`` or a problem.
 
+    :param submitted: the learner's notebook as the grader read it (nbformat 4, whatever
+        version was handed in; attachments too large to keep already dropped).
     :param workspace: the snapshot of the learner's workspace this notebook left
         (:meth:`Scratch.snapshot`).
     """
     given, folder = scratch.judge_folders(notebook)
     source = given / 'source.ipynb'
-    shutil.copy2(SOLUTIONS / f'{notebook}.ipynb', source)
-    shutil.copy2(submitted, given / 'submission.ipynb')
+    shutil.copyfile(SOLUTIONS / f'{notebook}.ipynb', source)
+    (given / 'submission.ipynb').write_text(nbformat.writes(submitted))
     for path in (source, given / 'submission.ipynb'):
         path.chmod(0o644)
     home = folder / 'home'

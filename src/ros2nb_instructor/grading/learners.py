@@ -6,7 +6,7 @@ Runs on the instructor's host.
 from __future__ import annotations
 
 import concurrent.futures
-import shutil
+import errno
 from pathlib import Path
 
 import nbformat
@@ -15,7 +15,7 @@ from ..paths import ASSIGNMENT
 from . import notebooks as notebooks_of
 from .judging import Judges
 from .runs import run_note, run_notebook
-from .scratch import Scratch
+from .scratch import HOME_BYTES, OUT_OF_SPACE, Scratch
 from .settings import Settings
 from .submissions import Learner, readable
 
@@ -25,7 +25,10 @@ def grade_learner(course: Path, scratch_root: Path, learner: Learner, notebooks:
     """Grade a learner's notebooks in course order; file them in the nbgrader course.
 
     The notebooks run one after the other (each on the workspace the previous ones left);
-    each one's judge starts as soon as it has run.
+    each one's judge starts as soon as it has run.  Whatever goes wrong with one notebook
+    (a malformed file, a dead runner, a full disk) is a note for that notebook, which
+    scores 0 unless what was judged stands; the learner's other notebooks and the rest of
+    the class are graded all the same.
     """
     scratch = Scratch(scratch_root, learner)
     target = course / 'submitted' / learner.id / ASSIGNMENT
@@ -35,28 +38,61 @@ def grade_learner(course: Path, scratch_root: Path, learner: Learner, notebooks:
         for notebook in (n for n in notebooks if n in learner.files):
             release = nbformat.read(course / 'release' / ASSIGNMENT / f'{notebook}.ipynb',
                                     as_version=4)
-            problem = readable(learner.files[notebook])
-            if problem:
-                learner.note(notebook, f'{problem}; 0 points')
-                nbformat.write(notebooks_of.note_notebook(release, f'{problem}; 0 points.'),
+            try:
+                verdict = _run_and_judge(scratch, learner, notebook, release, settings, judges)
+            except Exception as error:  # noqa: BLE001 - one learner's problem, said in a note
+                verdict = _not_gradable(learner, notebook, error)
+            if isinstance(verdict, tuple):
+                judged.append((notebook, release, *verdict))
+            else:
+                nbformat.write(notebooks_of.note_notebook(release, verdict),
                                target / f'{notebook}.ipynb')
-                continue
-            submitted = nbformat.read(learner.files[notebook], as_version=4)
-            prepared = notebooks_of.for_the_run(release, submitted)
-            executed, status, stopped = run_notebook(scratch, notebook, prepared, settings)
-            happened = run_note(status, stopped)
-            if happened:
-                learner.note(notebook, happened)
-            verdict = judges.submit(scratch, notebook, learner.files[notebook], settings,
-                                    scratch.snapshot(notebook))
-            judged.append((notebook, release, executed, verdict))
         for notebook, release, executed, verdict in judged:
-            results, problem = verdict.result()
-            if problem:
-                learner.note(notebook, problem)
-            nbformat.write(notebooks_of.for_scoring(release, executed, results, problem),
-                           target / f'{notebook}.ipynb')
+            _file(target, learner, notebook, release, executed, verdict)
     finally:
         for _notebook, _release, _executed, verdict in judged:
             concurrent.futures.wait([verdict])  # nothing of the scratch is removed in use
-        shutil.rmtree(scratch.top, ignore_errors=True)
+        scratch.remove()
+
+
+def _run_and_judge(scratch: Scratch, learner: Learner, notebook: str,
+                   release: nbformat.NotebookNode, settings: Settings, judges: Judges):
+    """Run one notebook and submit it to its judge: ``(executed, future)``, or why not (str)."""
+    submitted, problem = readable(learner.files[notebook])
+    if problem:
+        learner.note(notebook, f'{problem}; 0 points')
+        return f'{problem}; 0 points.'
+    for dropped in notebooks_of.drop_large_attachments(submitted):
+        learner.note(notebook, dropped)
+    prepared = notebooks_of.for_the_run(release, submitted)
+    executed, status, stopped = run_notebook(scratch, notebook, prepared, settings)
+    happened = run_note(status, stopped)
+    if scratch.home_full():
+        happened = '; '.join(filter(None, [OUT_OF_SPACE.format(HOME_BYTES >> 20), happened]))
+    if happened:
+        learner.note(notebook, happened)
+    return executed, judges.submit(scratch, notebook, submitted, settings,
+                                   scratch.snapshot(notebook))
+
+
+def _not_gradable(learner: Learner, notebook: str, error: Exception) -> str:
+    """The note for a notebook the grader could not take through (its text for the feedback)."""
+    if isinstance(error, OSError) and error.errno == errno.ENOSPC:
+        why = OUT_OF_SPACE.format(HOME_BYTES >> 20)
+    else:
+        why = f'the grader could not grade it ({type(error).__name__}: {str(error)[:200]})'
+    learner.note(notebook, f'{why}; 0 points')
+    return f'{why}; 0 points.'
+
+
+def _file(target: Path, learner: Learner, notebook: str, release: nbformat.NotebookNode,
+          executed: nbformat.NotebookNode, verdict: concurrent.futures.Future) -> None:
+    """Put the judged notebook where nbgrader scores it (or a note why it could not be)."""
+    try:
+        results, problem = verdict.result()
+        if problem:
+            learner.note(notebook, problem)
+        scored = notebooks_of.for_scoring(release, executed, results, problem)
+    except Exception as error:  # noqa: BLE001 - one learner's problem, said in a note
+        scored = notebooks_of.note_notebook(release, _not_gradable(learner, notebook, error))
+    nbformat.write(scored, target / f'{notebook}.ipynb')

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import copy
 import html
+import json
+import re
 from typing import Any, Optional
 
 import nbformat
@@ -22,13 +24,25 @@ CHECKED_OUTSIDE = '# Checked by the grader, outside this notebook (ros2nb.judge)
 SAFE_MIME_TYPES = ('text/plain', 'image/png', 'image/jpeg')
 
 
+#: Largest attachment (a pasted image) kept in a markdown cell.
+MAX_ATTACHMENT_BYTES = 5_000_000
+#: Attachment types shown in the feedback (as images); others are dropped.
+SAFE_ATTACHMENT_TYPES = ('image/png', 'image/jpeg')
+
+
+def _grade_id(cell: Any) -> Optional[str]:
+    """A cell's grade id when it is one (a string); a list or a number is none."""
+    grade_id = nbgrader(cell).get('grade_id')
+    return grade_id if isinstance(grade_id, str) and grade_id else None
+
+
 def graded_ids(release: nbformat.NotebookNode) -> list[str]:
     """The grade ids of the course's graded cells, in notebook order."""
-    return [nbgrader(c)['grade_id'] for c in release.cells if nbgrader(c).get('grade')]
+    return [_grade_id(c) for c in release.cells if nbgrader(c).get('grade') and _grade_id(c)]
 
 
 def _by_grade_id(nb: nbformat.NotebookNode) -> dict[str, Any]:
-    return {nbgrader(c)['grade_id']: c for c in nb.cells if nbgrader(c).get('grade_id')}
+    return {_grade_id(c): c for c in nb.cells if _grade_id(c)}
 
 
 def _clean(cell: Any) -> None:
@@ -44,7 +58,7 @@ def _course_cells(nb: nbformat.NotebookNode, course: dict[str, Any]) -> list[Any
     """
     found, seen = [], set()
     for cell in nb.cells:
-        grade_id = nbgrader(cell).get('grade_id')
+        grade_id = _grade_id(cell)
         if grade_id is None:
             cell.metadata.pop('nbgrader', None)
             continue
@@ -68,7 +82,7 @@ def for_the_run(release: nbformat.NotebookNode,
     nb = copy.deepcopy(submitted)
     course = _by_grade_id(release)
     for cell in _course_cells(nb, course):
-        grade_id = nbgrader(cell)['grade_id']
+        grade_id = _grade_id(cell)
         original = course[grade_id]
         if nbgrader(original).get('locked'):
             cell.source, cell.cell_type = original.source, original.cell_type
@@ -103,15 +117,52 @@ def _escape_markdown(source: str) -> str:
 
 
 def _safe_outputs(outputs: list) -> list:
+    """Outputs of the safe types only, without their metadata (nbconvert writes an image's
+    width and height into the page unquoted: metadata could add an attribute)."""
     kept = []
     for output in outputs:
         if output.get('output_type') in ('display_data', 'execute_result'):
             output['data'] = {k: v for k, v in output.get('data', {}).items()
                               if k in SAFE_MIME_TYPES}
+            output['metadata'] = {}
             if not output['data']:
                 continue
         kept.append(output)
     return kept
+
+
+def _safe_attachments(cell: Any) -> None:
+    """Keep a markdown cell's pasted PNG and JPEG images; a reference to any other
+    attachment becomes a link to nowhere (nbconvert stops at a missing attachment)."""
+    kept = {}
+    found = cell.get('attachments')
+    for name, bundle in (found.items() if isinstance(found, dict) else ()):
+        data = {k: v for k, v in bundle.items() if k in SAFE_ATTACHMENT_TYPES
+                and isinstance(v, str)} if isinstance(bundle, dict) else {}
+        if data and isinstance(name, str):
+            kept[name] = data
+    cell.pop('attachments', None)
+    if kept:
+        cell['attachments'] = kept
+    cell.source = re.sub(r'attachment:([^\s)"\'>]*)', lambda m: m.group(0) if m.group(1) in kept
+                         else '#attachment-not-kept', cell.source)
+
+
+def drop_large_attachments(nb: nbformat.NotebookNode) -> list[str]:
+    """Drop attachments over :data:`MAX_ATTACHMENT_BYTES` from ``nb``; one note for each."""
+    notes = []
+    for number, cell in enumerate(nb.cells, start=1):
+        attachments = cell.get('attachments')
+        if not isinstance(attachments, dict):
+            continue
+        for name, bundle in list(attachments.items()):
+            size = len(json.dumps(bundle))
+            if size > MAX_ATTACHMENT_BYTES:
+                del attachments[name]
+                notes.append(f'an attachment of {size // 1_000_000} MB ({str(name)[:60]} in '
+                             f'cell {number}) was not kept: attachments over '
+                             f'{MAX_ATTACHMENT_BYTES // 1_000_000} MB are dropped')
+    return notes
 
 
 def for_scoring(release: nbformat.NotebookNode, executed: nbformat.NotebookNode,
@@ -129,10 +180,10 @@ def for_scoring(release: nbformat.NotebookNode, executed: nbformat.NotebookNode,
     """
     nb = copy.deepcopy(executed)
     course_cells = {c.get('id'): c for c in release.cells}
-    present = {nbgrader(c)['grade_id']: c for c in _course_cells(nb, _by_grade_id(release))}
+    present = {_grade_id(c): c for c in _course_cells(nb, _by_grade_id(release))}
     previous = None
     for original in release.cells:
-        grade_id = nbgrader(original).get('grade_id')
+        grade_id = _grade_id(original)
         if grade_id is None:
             continue
         cell = present.get(grade_id)
@@ -146,12 +197,14 @@ def for_scoring(release: nbformat.NotebookNode, executed: nbformat.NotebookNode,
             cell.outputs = result_outputs(results.get(grade_id), problem)
             cell.execution_count = 1
         previous = cell
-    for cell in nb.cells:
+    for index, cell in enumerate(nb.cells):
+        if cell.cell_type == 'raw':  # shown as text, never as the HTML it may claim to be
+            cell = nb.cells[index] = nbformat.v4.new_markdown_cell(cell.source)
         if cell.cell_type == 'markdown':
             original = course_cells.get(cell.get('id'))
             if original is None or original.source != cell.source:
                 cell.source = _escape_markdown(cell.source)
-            cell.pop('attachments', None)
+            _safe_attachments(cell)
         elif cell.cell_type == 'code' and not nbgrader(cell).get('grade'):
             cell.outputs = _safe_outputs(cell.get('outputs', []))
     return nb

@@ -7,6 +7,7 @@ the two files the runner was asked to write.
 
 from __future__ import annotations
 
+import errno
 import json
 import subprocess
 import sys
@@ -17,6 +18,7 @@ import nbformat
 
 from ..paths import ROOT
 from . import sandbox
+from .paths_of_learners import NotARegularFile, read_regular
 from .scratch import Scratch, sandbox_env
 from .settings import Settings
 
@@ -30,42 +32,87 @@ def run_notebook(scratch: Scratch, notebook: str, prepared: nbformat.NotebookNod
                  settings: Settings) -> tuple[nbformat.NotebookNode, dict, Optional[str]]:
     """Execute the prepared notebook in the learner's sandbox.
 
-    :return: the executed notebook (what ran of it), the runner's status, and a note when
-        the sandbox had to be stopped.
+    The notebook goes in through a folder of the grader's (read-only inside); the runner
+    writes into an output folder of its own; the grader reads the two files back by file
+    descriptor, never through a link, after the sandbox ended.  It writes nothing in the
+    learner's home, whatever the learner's code put there.
+
+    :return: the executed notebook (what ran of it), the runner's status (checked: every
+        field of the right type), and a note when the sandbox had to be stopped.
     """
-    folder = scratch.home / 'notebooks'
-    folder.mkdir(exist_ok=True)
-    given, done = folder / f'{notebook}.ipynb', folder / f'{notebook}.run.ipynb'
-    nbformat.write(prepared, given)
-    argv = [sys.executable, '-m', RUNNER, str(given), str(done),
-            f'--cell-timeout={settings.cell_timeout}']
+    given, out = scratch.run_folders(notebook)
+    (given / f'{notebook}.ipynb').write_text(nbformat.writes(prepared))
+    (given / f'{notebook}.ipynb').chmod(0o644)
+    argv = [sys.executable, '-m', RUNNER, str(given / f'{notebook}.ipynb'),
+            str(out / f'{notebook}.run.ipynb'), f'--cell-timeout={settings.cell_timeout}',
+            f'--folder={scratch.home / "notebooks"}']
     env = sandbox_env(scratch.home, ROS2NB_WORKSPACE=str(scratch.workspace))
     limits = sandbox.Limits(wall_s=settings.notebook_timeout)
     stopped = None
     if settings.sandboxed:
-        box = sandbox.Sandbox(writable=[scratch.home], env=env, cwd=folder,
-                              readable=[ROOT / 'src'],
+        box = sandbox.Sandbox(writable=[scratch.home, out], env=env, cwd=scratch.home,
+                              readable=[ROOT / 'src', given],
                               hidden=[ROOT / 'src' / 'ros2nb' / 'reference'])
         result = box.run(argv, limits, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        if result.timed_out:
-            stopped = (f'it ran longer than the {settings.notebook_timeout} s limit for a '
-                       'notebook and was stopped')
+        timed_out = result.timed_out
     else:
         try:
-            subprocess.run(argv, env=env, cwd=folder, timeout=settings.notebook_timeout,
+            subprocess.run(argv, env=env, cwd=scratch.home, timeout=settings.notebook_timeout,
                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            timed_out = False
         except subprocess.TimeoutExpired:
-            stopped = (f'it ran longer than the {settings.notebook_timeout} s limit for a '
-                       'notebook and was stopped')
+            timed_out = True
+    if timed_out:
+        stopped = (f'it ran longer than the {settings.notebook_timeout} s limit for a '
+                   'notebook and was stopped')
+    return (*_read_back(out, notebook, prepared), stopped)
+
+
+def _read_back(out: Path, notebook: str, prepared: nbformat.NotebookNode
+               ) -> tuple[nbformat.NotebookNode, dict]:
+    """The executed notebook and the runner's status, or the prepared one and why not."""
     try:
-        if done.stat().st_size > MAX_NOTEBOOK_BYTES:
-            raise ValueError('too large')
-        executed = nbformat.read(done, as_version=4)
-        status = json.loads(Path(str(done) + '.status.json').read_text())
-    except (OSError, ValueError):  # it deleted, broke or bloated what the runner wrote
-        return prepared, {'ran': 0, 'timed_out': [], 'output_cut': [], 'kernel_died_at': None,
-                          'runner_error': 'its run left no readable notebook'}, stopped
-    return executed, status, stopped
+        executed = nbformat.reads(read_regular(out, f'{notebook}.run.ipynb', MAX_NOTEBOOK_BYTES)
+                                  .decode('utf-8'), as_version=4)
+    except (OSError, ValueError) as error:  # deleted, broken, linked or bloated
+        why = ('it left a link where its executed notebook belongs'
+               if isinstance(error, NotARegularFile) and error.errno == errno.ELOOP
+               else 'its run left no readable notebook')
+        return prepared, {**NO_STATUS, 'runner_error': why}
+    try:
+        status = json.loads(read_regular(out, f'{notebook}.run.ipynb.status.json', 1_000_000))
+    except (OSError, ValueError):
+        status = None
+    status = checked_status(status)
+    if status is None:
+        return executed, {**NO_STATUS, 'runner_error': (
+            "the runner's status was unreadable or rewritten (its kernel or the runner was "
+            "killed, or the notebook changed it); what ran of the notebook is graded")}
+    return executed, status
+
+
+#: A status of a run that said nothing readable.
+NO_STATUS = {'ran': 0, 'cells': 0, 'timed_out': [], 'output_cut': [], 'kernel_died_at': None,
+             'finished': False}
+
+
+def checked_status(status: object) -> Optional[dict]:
+    """The runner's status when every field has its type (ints, lists of ints), else None."""
+    def whole(value: object) -> bool:
+        return isinstance(value, int) and not isinstance(value, bool) and 0 <= value < 1_000_000
+
+    if not isinstance(status, dict):
+        return None
+    died = status.get('kernel_died_at')
+    lists = (status.get('timed_out'), status.get('output_cut'))
+    error = status.get('runner_error')
+    ok = (whole(status.get('ran')) and whole(status.get('cells'))
+          and isinstance(status.get('finished'), bool) and (died is None or whole(died))
+          and all(isinstance(v, list) and all(whole(i) for i in v) for v in lists)
+          and (error is None or isinstance(error, str)))
+    if not ok:
+        return None
+    return {key: status.get(key) for key in (*NO_STATUS, 'runner_error')}
 
 
 def run_note(status: dict, stopped: Optional[str]) -> Optional[str]:
@@ -82,7 +129,7 @@ def run_note(status: dict, stopped: Optional[str]) -> Optional[str]:
         cells = ', '.join(str(i + 1) for i in status['output_cut'])
         notes.append(f'the output of cell(s) {cells} was cut (too large to keep)')
     if status.get('runner_error'):
-        notes.append(f'running it stopped early: {status["runner_error"]}')
+        notes.append(f'running it stopped early: {status["runner_error"][:300]}')
     if not notes and not status.get('finished'):
         notes.append(f'its run ended at cell {status["ran"] + 1} of {status["cells"]}: the '
                      'notebook stopped or killed the processes running it')

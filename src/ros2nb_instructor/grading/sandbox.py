@@ -36,7 +36,9 @@ Use (``limits_enforced`` of the result says which limits applied)::
 What it does not cover: the kernel is shared (a kernel exploit escapes, and unprivileged
 user namespaces widen the kernel's attack surface); CPU time is not limited, only wall
 time (a busy sandbox slows the others); disk space in ``writable`` folders is limited per
-file, not in total; a sandbox with ``share_network=True`` reaches every port its network
+file here, in total only where the caller mounted a size-capped tmpfs there (the grader
+does, :mod:`.scratch`), while ``/tmp`` and ``/dev/shm`` hold :data:`TMPFS_BYTES` each; a
+sandbox with ``share_network=True`` reaches every port its network
 namespace offers (a judge's subjects reach the judge's ports); timing and host-wide
 information such as ``/proc/meminfo`` stay visible.  A caller killed with SIGKILL takes its
 sandboxes along but leaves empty ``ros2nb-sandbox-*`` cgroups and ``/tmp/ros2nb-stage-*``.
@@ -66,6 +68,9 @@ MiB = 1 << 20
 INNER_UID = 1000
 #: Host uid and gid of sandboxes started by root: no user, file or process has it.
 HOST_UID = 2_000_000_000
+#: Bytes a sandbox's own /tmp and /dev/shm may each hold (memory, gone when it ends).
+TMPFS_BYTES = 512 * MiB
+_SIZE = ['--size', str(TMPFS_BYTES)]
 ETC_FILES = ('ld.so.cache', 'ld.so.conf', 'ld.so.conf.d', 'passwd', 'group', 'nsswitch.conf',
              'hosts', 'localtime')
 
@@ -179,9 +184,9 @@ def inner_prefix(*, readable: Sequence[Path] = (), writable: Sequence[Path] = ()
     :param share_shm: give the subject the judge's ``/dev/shm`` instead of an empty one.
     :return: a JSON-serialisable list of strings ending in ``--``.
     """
-    shm = ['--bind', '/dev/shm', '/dev/shm'] if share_shm else ['--tmpfs', '/dev/shm']
+    shm = ['--bind', '/dev/shm', '/dev/shm'] if share_shm else [*_SIZE, '--tmpfs', '/dev/shm']
     return ['bwrap', *_namespace_args(True, False, 'subject'), '--ro-bind', '/', '/',
-            '--proc', '/proc', '--dev', '/dev', '--tmpfs', '/tmp', *shm,
+            '--proc', '/proc', '--dev', '/dev', *_SIZE, '--tmpfs', '/tmp', *shm,
             *_path_args([*_python_paths(), *readable], writable, hidden), '--']
 
 
@@ -221,8 +226,9 @@ class Sandbox:
         readable = [*(_python_paths() if self.python else ()), *self.readable]
         hidden = [p for p in self.hidden if Path(p).exists()]  # nothing to hide otherwise
         args = ['bwrap', *_namespace_args(self.share_network, self.nested, 'sandbox'),
-                *_system_args(source), '--proc', '/proc', '--dev', '/dev', '--tmpfs', '/tmp',
-                '--tmpfs', '/dev/shm', *_path_args(readable, self.writable, hidden, source),
+                *_system_args(source), '--proc', '/proc', '--dev', '/dev', *_SIZE, '--tmpfs',
+                '/tmp', *_SIZE, '--tmpfs', '/dev/shm',
+                *_path_args(readable, self.writable, hidden, source),
                 '--remount-ro', '/', '--clearenv']
         for key, value in self.env.items():
             args += ['--setenv', key, value]

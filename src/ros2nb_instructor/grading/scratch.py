@@ -1,7 +1,10 @@
 """A learner's folders while grading: outside the repository, shared by their notebooks in order.
 
 Runs on the instructor's host.  Each notebook's judge gets a snapshot of the workspace as
-that notebook left it, copied without following a link.
+that notebook left it, copied without following a link.  The folders a sandbox may write
+(the learner's home, a run's output folder, a judge's folder) are each a size-capped tmpfs
+when the grader is root, so one learner filling the disk fills only their own space.  The
+grader writes only in folders of its own, which no sandbox can write.
 """
 
 from __future__ import annotations
@@ -15,7 +18,19 @@ from pathlib import Path
 
 from ros2nb.terminal.workspace import WORKSPACE_NAME
 
+from .paths_of_learners import mount_capped, nearly_full, real_folder_below, unmount
 from .submissions import Learner
+
+MiB = 1 << 20
+#: Bytes a learner's home (their workspace and everything their notebooks write) may hold.
+HOME_BYTES = 1024 * MiB
+#: Bytes a notebook's run may leave in its output folder (the executed notebook, its status).
+RUN_OUT_BYTES = 64 * MiB
+#: Bytes a judge and its subjects may write in the judge's folder.
+JUDGE_BYTES = 256 * MiB
+#: What a note says when a learner filled their space.
+OUT_OF_SPACE = ('it ran out of scratch space ({} MB for a learner\'s files); what it wrote '
+                'after that was lost')
 
 
 class Scratch:
@@ -25,8 +40,35 @@ class Scratch:
         self.top = Path(tempfile.mkdtemp(prefix='learner-', dir=root))
         self.home = self.top / 'home'
         self.workspace = self.home / 'workspace' / WORKSPACE_NAME
-        self.home.mkdir()
+        self._mounts: list[Path] = []
         self.top.chmod(0o711)  # the sandboxes' own user may pass, nobody may list
+        self.home = self._capped('home', HOME_BYTES)
+
+    def _capped(self, name: str, size_bytes: int) -> Path:
+        """A fresh folder of the grader's in ``top``: a tmpfs of ``size_bytes`` when root."""
+        folder = self.top / name
+        folder.mkdir()
+        if mount_capped(folder, size_bytes):
+            self._mounts.append(folder)
+        return folder
+
+    def home_full(self) -> bool:
+        """True when the learner's home has (almost) no space left."""
+        return nearly_full(self.home)
+
+    def run_folders(self, notebook: str) -> tuple[Path, Path]:
+        """A folder with the notebook to run (the grader's, read-only inside) and its output folder."""
+        given = self.top / f'run-in-{notebook}'
+        given.mkdir()
+        given.chmod(0o755)
+        return given, self._capped(f'run-out-{notebook}', RUN_OUT_BYTES)
+
+    def remove(self) -> None:
+        """Remove every folder of the learner's, unmounting what was mounted, never following a link."""
+        for folder in reversed(self._mounts):
+            unmount(folder)
+        self._mounts = []
+        shutil.rmtree(self.top, ignore_errors=True)
 
     def snapshot(self, notebook: str) -> Path:
         """A copy of the workspace as ``notebook``'s run left it, for that notebook's judge.
@@ -39,7 +81,9 @@ class Scratch:
         target = self.top / f'workspace-{notebook}' / WORKSPACE_NAME
         target.parent.mkdir()
         target.parent.chmod(0o755)
-        if self.workspace.is_dir() and not self.workspace.is_symlink():
+        # No part of the path below the home may be a link: a home/workspace linked to the
+        # host would hand the judge (and so the learner's code in it) the host's files.
+        if real_folder_below(self.home, self.workspace):
             shutil.copytree(self.workspace, target, symlinks=True, ignore=_not_for_the_judge(
                 self.workspace))
         else:
@@ -49,10 +93,11 @@ class Scratch:
 
     def judge_folders(self, notebook: str) -> tuple[Path, Path]:
         """A fresh judge folder (writable by the judge and its subjects) and its inputs."""
-        given, scratch = self.top / f'judge-in-{notebook}', self.top / f'judge-{notebook}'
-        for folder, mode in ((given, 0o755), (scratch, 0o711)):
-            folder.mkdir()
-            folder.chmod(mode)  # the judge's sandbox user reads the given files
+        given = self.top / f'judge-in-{notebook}'
+        given.mkdir()
+        given.chmod(0o755)  # the judge's sandbox user reads the given files
+        scratch = self._capped(f'judge-{notebook}', JUDGE_BYTES)
+        scratch.chmod(0o711)
         return given, scratch
 
 

@@ -6,7 +6,9 @@ the reason; every file is graded or named in a note; nothing is skipped without 
 
 from __future__ import annotations
 
+import os
 import re
+import stat
 import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
@@ -83,7 +85,11 @@ def find_learners(folder: Path, notebooks: list[str]) -> tuple[list[Learner], li
     """
     learners, refused, taken = [], [], set()
     for number, entry in enumerate(sorted(folder.iterdir(), key=lambda p: p.name), start=1):
-        if not entry.is_dir() or entry.is_symlink():
+        if entry.is_symlink():
+            refused.append(f'{entry.name!r}: a link, not a learner folder (links are not '
+                           'followed: put the learner\'s folder itself there)')
+            continue
+        if not entry.is_dir():
             refused.append(f'{entry.name!r}: not a learner folder (only folders of notebooks '
                            'are graded)')
             continue
@@ -97,6 +103,10 @@ def find_learners(folder: Path, notebooks: list[str]) -> tuple[list[Learner], li
                                     'the folder name itself)')
         candidates: dict[str, list[Path]] = {}
         for path in sorted(entry.iterdir()):
+            if path.is_symlink():
+                learner.note('_folder', f'{path.name} is a link (links are not followed: hand '
+                                        'in the notebook itself); not graded')
+                continue
             notebook = notebook_for(path.name, notebooks) if path.is_file() else None
             if notebook is None:
                 learner.note('_folder', f'{path.name} is not one of the course notebooks')
@@ -104,7 +114,7 @@ def find_learners(folder: Path, notebooks: list[str]) -> tuple[list[Learner], li
                 candidates.setdefault(notebook, []).append(path)
         for notebook, paths in candidates.items():
             exact = [p for p in paths if p.stem == notebook]
-            chosen = exact[0] if exact else max(paths, key=lambda p: p.stat().st_mtime)
+            chosen = exact[0] if exact else max(paths, key=lambda p: p.lstat().st_mtime)
             learner.files[notebook] = chosen
             if chosen.stem != notebook:
                 learner.note(notebook, f'graded {chosen.name} as {notebook}.ipynb')
@@ -120,50 +130,84 @@ def _is_archive(name: str, head: bytes) -> bool:
     return name.lower().endswith(ARCHIVE_SUFFIXES) or head.startswith(ARCHIVE_MAGIC)
 
 
+def _learner_paths(members: list[zipfile.ZipInfo]) -> list[tuple[zipfile.ZipInfo, tuple]]:
+    """Each member with its path's parts below the archive's top level.
+
+    One folder around everything that holds no file itself (a platform's export folder) is
+    not a learner: it is left out.  Then the first part of a path names the learner, and
+    nothing below it ever names another.
+    """
+    paths = [(m, PurePosixPath(m.filename).parts) for m in members]
+    tops = {parts[0] for _m, parts in paths}
+    if len(tops) == 1 and all(len(parts) >= 3 for _m, parts in paths):
+        paths = [(m, parts[1:]) for m, parts in paths]
+    return paths
+
+
 def screen_zip(archive: Path, cleaned: Path) -> list[str]:
     """Copy the members of a platform's .zip that may be graded into ``cleaned``.
 
-    Refused, one line each: archives inside the archive (they are never unpacked, so
-    nothing inside one can claim to be another learner), and learners who appear in two
-    different places of the archive (which copy is theirs cannot be told); everything
-    else is copied as it is, for nbgrader's ``zip_collect``.
+    A learner is a folder at the archive's top level (below one export folder, if all is
+    in one); their notebooks may be anywhere under it, and go to ``LEARNER/NAME`` in
+    ``cleaned`` for nbgrader's ``zip_collect``: a folder deeper down (``mallory/alice/``,
+    ``mallory/extracted/bob/``) is mallory's, never alice's or bob's.  Refused, one line
+    each: archives inside the archive (never unpacked), files outside any learner's folder,
+    and a second copy of a notebook in one learner's folder (the shallowest is graded).
 
     :return: one line per refusal.
     :raises zipfile.BadZipFile: when ``archive`` is not a zip file.
     """
     lines = []
-    with zipfile.ZipFile(archive) as source:
+    with zipfile.ZipFile(archive) as source, zipfile.ZipFile(cleaned, 'w') as out:
         members = [m for m in source.infolist() if not m.is_dir()]
-        places: dict[str, set[str]] = {}
-        for member in members:
-            path = PurePosixPath(member.filename)
-            if path.suffix == '.ipynb' and len(path.parts) >= 2:
-                places.setdefault(path.parts[-2], set()).add(str(path.parent))
-        twice = {learner for learner, where in places.items() if len(where) > 1}
-        for learner in sorted(twice):
-            lines.append(f'{learner}: appears in {len(places[learner])} places of the archive '
-                         f'({", ".join(sorted(places[learner]))}); not graded, send one copy')
-        with zipfile.ZipFile(cleaned, 'w') as out:
-            for member in members:
-                path = PurePosixPath(member.filename)
-                with source.open(member) as stream:
-                    head = stream.read(8)
-                if _is_archive(path.name, head):
-                    lines.append(f'{member.filename}: an archive inside the archive is not '
-                                 'unpacked; hand in the notebooks themselves')
-                    continue
-                if len(path.parts) >= 2 and path.parts[-2] in twice:
-                    continue
-                out.writestr(member, source.read(member))
+        chosen: dict[tuple[str, str], zipfile.ZipInfo] = {}
+        for member, parts in sorted(_learner_paths(members),
+                                    key=lambda mp: (len(mp[1]), mp[1])):
+            with source.open(member) as stream:
+                head = stream.read(8)
+            if _is_archive(parts[-1], head):
+                lines.append(f'{member.filename}: an archive inside the archive is not '
+                             'unpacked; hand in the notebooks themselves')
+            elif len(parts) < 2 or legal_name(parts[0]):
+                lines.append(f'{member.filename}: not in a learner\'s folder at the top of '
+                             'the archive')
+            elif (parts[0], parts[-1]) in chosen:
+                lines.append(f'{member.filename}: another copy of {parts[-1]} in '
+                             f'{parts[0]}\'s folder; graded '
+                             f'{chosen[parts[0], parts[-1]].filename}')
+            else:
+                chosen[parts[0], parts[-1]] = member
+                out.writestr(f'{parts[0]}/{parts[-1]}', source.read(member))
     return lines
 
 
-def readable(path: Path) -> Optional[str]:
-    """Why a handed-in file cannot be graded, or None when it is a valid notebook."""
-    if path.stat().st_size == 0:
-        return 'the file is empty'
+#: Largest notebook file read (a notebook with a few plots is a few MB).
+MAX_SUBMISSION_BYTES = 400_000_000
+
+
+def readable(path: Path) -> tuple[Optional[nbformat.NotebookNode], Optional[str]]:
+    """A handed-in file as an nbformat 4 notebook, or None and why it cannot be graded.
+
+    Read without following a link; an nbformat 3 notebook is converted (by nbformat).
+    """
     try:
-        nbformat.validate(nbformat.read(path, as_version=4))
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+    except OSError as error:
+        return None, f'the file could not be read ({os.strerror(error.errno)})'
+    with os.fdopen(fd, 'rb') as stream:
+        size = os.fstat(stream.fileno()).st_size
+        if not stat.S_ISREG(os.fstat(stream.fileno()).st_mode):
+            return None, 'not a regular file'
+        if size == 0:
+            return None, 'the file is empty'
+        if size > MAX_SUBMISSION_BYTES:
+            return None, (f'the file is {size >> 20} MB, more than the '
+                          f'{MAX_SUBMISSION_BYTES // 1_000_000} MB a notebook may be: remove '
+                          'large pasted images or outputs and hand it in again')
+        data = stream.read(MAX_SUBMISSION_BYTES + 1)
+    try:
+        nb = nbformat.reads(data.decode('utf-8'), as_version=4)
+        nbformat.validate(nb)
     except Exception as error:  # json, schema or encoding errors alike
-        return f'the file is not a valid notebook ({type(error).__name__})'
-    return None
+        return None, f'the file is not a valid notebook ({type(error).__name__})'
+    return nb, None

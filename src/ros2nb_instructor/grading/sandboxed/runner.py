@@ -97,12 +97,27 @@ def save(nb: nbformat.NotebookNode, out: Path, status: dict) -> None:
         os.replace(partial, path)
 
 
+def _working_folder(folder: Path) -> Path:
+    """``folder`` as a real folder: whatever an earlier notebook left there (a link) goes.
+
+    Inside the sandbox a link resolves only to what the sandbox sees; the folder is the
+    learner's, made anew when their last notebook replaced it.
+    """
+    if folder.is_symlink() or (folder.exists() and not folder.is_dir()):
+        folder.unlink()
+    folder.mkdir(parents=True, exist_ok=True)
+    return folder
+
+
 def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('notebook', type=Path)
     parser.add_argument('out', type=Path)
     parser.add_argument('--cell-timeout', type=int, default=120)
+    parser.add_argument('--folder', type=Path, default=None,
+                        help="the kernel's working folder (made here, inside the sandbox)")
     args = parser.parse_args(argv)
+    folder = _working_folder(args.folder or args.notebook.parent)
     nb = nbformat.read(args.notebook, as_version=4)
     status: dict = {'ran': 0, 'cells': len(nb.cells), 'timed_out': [], 'output_cut': [],
                     'kernel_died_at': None, 'finished': False}
@@ -113,7 +128,7 @@ def main(argv: list[str]) -> int:
     client = LimitedClient(nb, args.out, status, timeout=args.cell_timeout,
                            kernel_name='python3', allow_errors=True, interrupt_on_timeout=True,
                            error_on_timeout=timeout_error, record_timing=False,
-                           resources={'metadata': {'path': str(args.notebook.parent)}})
+                           resources={'metadata': {'path': str(folder)}})
     save(nb, args.out, status)
     try:
         client.execute()

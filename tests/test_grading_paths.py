@@ -1,0 +1,108 @@
+"""The grader's own handling of what a learner's code left: links, odd files, full disks.
+
+Fast checks of the pieces ``tests/test_grading.py`` shows working on a whole class: each
+plants the learner's move and shows what the grader makes of it (root, as when grading).
+"""
+
+import json
+import os
+
+import nbformat
+import pytest
+
+from grading_samples import NB01, SOLUTION
+
+from ros2nb.terminal.workspace import WORKSPACE_NAME
+from ros2nb_instructor.grading import notebooks
+from ros2nb_instructor.grading.paths_of_learners import NotARegularFile, read_regular
+from ros2nb_instructor.grading.runs import checked_status
+from ros2nb_instructor.grading.scratch import HOME_BYTES, Scratch
+from ros2nb_instructor.grading.submissions import Learner
+
+
+@pytest.fixture
+def scratch(tmp_path):
+    made = Scratch(tmp_path, Learner('ada', 'ada'))
+    yield made
+    made.remove()
+
+
+@pytest.fixture
+def host(tmp_path):
+    """A folder of the host's that holds a workspace of someone else's, with a secret."""
+    folder = tmp_path / 'host'
+    (folder / WORKSPACE_NAME / 'src').mkdir(parents=True)
+    (folder / WORKSPACE_NAME / 'src' / 'secret.txt').write_text('the hidden tests\n')
+    return folder
+
+
+def test_a_linked_workspace_is_never_copied_for_the_judge(scratch, host):
+    """home/workspace replaced by a link to a host folder: the judge gets an empty workspace.
+
+    Before, the snapshot checked only the workspace's last part and copied the host's
+    folder through the link (so the judge, and the learner's code it runs, saw it).
+    """
+    (scratch.home / 'workspace').symlink_to(host)
+    snapshot = scratch.snapshot(NB01)
+    assert list(snapshot.iterdir()) == []
+    (scratch.home / 'workspace').unlink()
+    (scratch.home / 'workspace').mkdir()
+    (scratch.home / 'workspace' / WORKSPACE_NAME).symlink_to(host / WORKSPACE_NAME)
+    assert list(scratch.snapshot('again').iterdir()) == []
+
+
+def test_a_real_workspace_is_copied_with_its_links_as_links(scratch, host):
+    """The honest twin: a real workspace is copied; a link inside stays a link, unfollowed."""
+    workspace = scratch.home / 'workspace' / WORKSPACE_NAME
+    (workspace / 'src').mkdir(parents=True)
+    (workspace / 'src' / 'setup.py').write_text('# mine\n')
+    (workspace / 'src' / 'elsewhere').symlink_to(host)
+    snapshot = scratch.snapshot(NB01)
+    assert (snapshot / 'src' / 'setup.py').read_text() == '# mine\n'
+    assert (snapshot / 'src' / 'elsewhere').is_symlink()
+
+
+def test_results_are_read_without_following_a_link(tmp_path, host):
+    (tmp_path / 'out').mkdir()
+    (tmp_path / 'out' / 'nb.run.ipynb').symlink_to(host / WORKSPACE_NAME / 'src' / 'secret.txt')
+    with pytest.raises(NotARegularFile):
+        read_regular(tmp_path / 'out', 'nb.run.ipynb', 1000)
+    (tmp_path / 'out' / 'big').write_bytes(b'x' * 2000)
+    with pytest.raises(NotARegularFile):
+        read_regular(tmp_path / 'out', 'big', 1000)
+    (tmp_path / 'out' / 'fine').write_bytes(b'{}')
+    assert read_regular(tmp_path / 'out', 'fine', 1000) == b'{}'
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason='a size-capped scratch needs root (the grader is)')
+def test_a_learners_home_holds_a_bounded_total(scratch):
+    """Files each under the size limit still stop at the home's total: the learner's own
+    disk is full, nobody else's (before, one learner wrote 3 GB in 24 s)."""
+    chunk = b'x' * (64 << 20)
+    with pytest.raises(OSError, match='No space left'):
+        for number in range(HOME_BYTES // len(chunk) + 2):
+            (scratch.home / f'filler-{number}').write_bytes(chunk)
+    assert scratch.home_full()
+
+
+def test_a_rewritten_status_is_not_trusted():
+    good = {'ran': 3, 'cells': 9, 'timed_out': [1], 'output_cut': [], 'kernel_died_at': None,
+            'finished': False}
+    assert checked_status(good) == {**good, 'runner_error': None}
+    forged = {'ran': 'all', 'cells': None, 'timed_out': 7, 'output_cut': {'a': 1},
+              'kernel_died_at': [1], 'finished': 'yes'}
+    assert checked_status(forged) is None
+    assert checked_status({**good, 'timed_out': [True]}) is None
+    assert checked_status([good]) is None
+
+
+def test_malformed_nbgrader_metadata_is_removed_not_fatal():
+    """A grade_id that is a list (a TypeError in the grader before) counts as no grade id."""
+    release = nbformat.read(SOLUTION[NB01], as_version=4)
+    submitted = nbformat.read(SOLUTION[NB01], as_version=4)
+    submitted.cells.insert(3, nbformat.v4.new_code_cell('print(1)', metadata={'nbgrader': {
+        'grade': True, 'grade_id': ['a', 'list'], 'points': 'ten', 'solution': False}}))
+    prepared = notebooks.for_the_run(release, submitted)
+    assert 'nbgrader' not in prepared.cells[3].metadata
+    scored = notebooks.for_scoring(release, prepared, {})
+    assert json.dumps(scored)  # nothing unserialisable left
