@@ -17,6 +17,7 @@ from .runtime import current_runtime
 from .terminal.colcon import colcon_build, source_workspace
 from .terminal.echo import message_type, record, topic_echo, topic_hz
 from .terminal.files import import_file, write_file, write_part
+from .terminal.param import param_describe, param_dump, param_get, param_list, param_set
 from .terminal.pkg_create import pkg_create
 from .terminal.run import find_executable, ros2_run, run_and_interrupt
 from .terminal.topic import node_list, topic_info, topic_list, unmatched_topics
@@ -32,7 +33,8 @@ __all__ = [
     'CheckFailed', 'ColconBuildError', 'DomainsExhaustedError', 'FileProtectedError',
     'LearnerCodeError', 'PkgCreateError', 'Ros2nbError', 'UsageError', 'add', 'checks',
     'colcon_build', 'course', 'create_workspace', 'current_runtime', 'current_workspace',
-    'domains', 'find_executable', 'import_file', 'message_type', 'node_list', 'pkg_create',
+    'domains', 'find_executable', 'import_file', 'message_type', 'node_list', 'param_describe',
+    'param_dump', 'param_get', 'param_list', 'param_set', 'pkg_create',
     'record', 'ros2_run', 'run_and_interrupt', 'shutdown', 'source_workspace', 'spin', 'start',
     'stop', 'topic_echo', 'topic_hz', 'topic_info', 'topic_list', 'tree', 'unmatched_topics',
     'write_file', 'write_part',

@@ -53,12 +53,22 @@ HIGH_ABOVE_C = 26.0           # strictly above: High
 LOW_BELOW_C = 20.0            # strictly below: Low
 STATUSES = ('Low', 'Normal', 'High')
 
+# ------------------------------------------------------------------ parameters (notebook 08)
+#: The monitor's thresholds as parameters: name -> default (°C); both may be set from
+#: MIN_TEMPERATURE_C to MAX_TEMPERATURE_C (the sensor's clamp range) while the node runs.
+HIGH_PARAMETER, LOW_PARAMETER = 'high_above_c', 'low_below_c'
+THRESHOLD_DEFAULTS_C = {HIGH_PARAMETER: HIGH_ABOVE_C, LOW_PARAMETER: LOW_BELOW_C}
+#: The sensor's parameters: its period (read-only: the timer is made once) and start value.
+PERIOD_PARAMETER, START_PARAMETER = 'publish_period_s', 'start_temperature_c'
+MIN_PERIOD_S, MAX_PERIOD_S = 0.1, 10.0
+
 #: Environment variable the grader sets: the course's reference code never stands in.
 GRADING_ENV = 'ROS2NB_GRADING'
 #: Notebook number -> what must exist before it starts.
 STEPS = {1: (), 2: ('workspace',), 3: ('workspace', 'package'),
          4: ('workspace', 'package', 'publisher'),
-         5: ('workspace', 'package', 'publisher', 'subscriber')}
+         5: ('workspace', 'package', 'publisher', 'subscriber'),
+         8: ('workspace', 'package', 'publisher', 'subscriber', 'entry_points')}
 
 
 def monitor_status(temperature_c: float) -> str:
@@ -97,6 +107,24 @@ def package_path(workspace: Path) -> Path:
     return workspace / 'src' / PACKAGE
 
 
+def _entry_points_missing(package: Path) -> bool:
+    setup_py = package / 'setup.py'
+    text = setup_py.read_text() if setup_py.is_file() else ''
+    return not all(f'{name} =' in text or f'{name}=' in text
+                   for name in (PUBLISHER_EXECUTABLE, SUBSCRIBER_EXECUTABLE))
+
+
+def _write_entry_points(package: Path) -> None:
+    """Notebook 05's two entry points in setup.py, as the course writes them (never over
+    a setup.py you edited yourself: write_file refuses)."""
+    setup_py = package / 'setup.py'
+    entries = ''.join(f"            '{name} = {PACKAGE}.{name}:main',\n"
+                      for name in (PUBLISHER_EXECUTABLE, SUBSCRIBER_EXECUTABLE))
+    text = setup_py.read_text().replace("'console_scripts': [\n", "'console_scripts': [\n" + entries,
+                                        1)
+    write_file(setup_py, text)
+
+
 def catch_up(notebook: int) -> Path:
     """Create whatever earlier notebooks would have made, if it is missing.
 
@@ -106,7 +134,7 @@ def catch_up(notebook: int) -> Path:
 
     Introduced in ``01-create-a-workspace.ipynb``.
 
-    :param notebook: the number of the notebook about to run (1-5).
+    :param notebook: the number of the notebook about to run (1-5, 8).
     :return: the workspace path.
     :raises ValueError: for a notebook number without steps.
     """
@@ -134,6 +162,12 @@ def catch_up(notebook: int) -> Path:
         write_file(target, text)
         target.chmod(0o755)
         done.append(shown(target))
+    if 'entry_points' in steps and _entry_points_missing(package):
+        if reference_source(PUBLISHER_FILE.rsplit('/', 1)[1]) is None:
+            missing.append('the entry points in setup.py')
+        else:
+            _write_entry_points(package)
+            done.append(shown(package / 'setup.py'))
     if done:
         print('Caught up: created ' + ', '.join(done))
     elif not missing:

@@ -52,6 +52,13 @@ class Spinning:
         if self._background:
             self._thread.start()
 
+    def spin_in_background(self) -> None:
+        """Start the background thread now, if it is not running (a subject that must answer
+        service calls while the judge waits, e.g. the parameter services of notebook 08)."""
+        if not self._thread.is_alive():
+            self._background = True
+            self._thread.start()
+
     def stop_spinning(self) -> None:
         """End the background thread and wait for it (safe when it never ran)."""
         self._stopping = True

@@ -256,6 +256,12 @@ class Subject:
     def counts(self) -> dict:
         return {'ok': True, **self._counts()}
 
+    def serve(self) -> dict:
+        """Spin the node in the background from now on: it answers service calls (its
+        parameters) whenever the judge makes them."""
+        self._runtime().spin_in_background()
+        return {'ok': True, **self._counts()}
+
     def advance(self, seconds: float, seed: Optional[int] = None) -> dict:
         if seed is not None:
             random.seed(seed)
@@ -283,7 +289,7 @@ def serve(commands: Any, replies: Any) -> None:
         'call': subject.call, 'new_node': subject.new_node,
         'set_attribute': subject.set_attribute, 'wait_matched': subject.wait_matched,
         'advance': subject.advance, 'wait_received': subject.wait_received,
-        'counts': subject.counts,
+        'counts': subject.counts, 'serve': subject.serve,
     }
     for line in commands:
         request = json.loads(line)

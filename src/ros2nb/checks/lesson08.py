@@ -1,0 +1,227 @@
+"""Checks of notebook 08, parameters: the monitor's declared thresholds and its on-set callback.
+
+Part of :mod:`ros2nb.checks`.  The judge creates the learner's ``TemperatureMonitor`` in a
+subject that spins it in the background, and talks to the node's real parameter services
+from its own node with rclpy's ``AsyncParameterClient`` (what ``ros2 param`` does): it lists,
+gets and describes the parameters, and sets values the callback must accept or refuse.
+The source text is never read.
+"""
+
+from __future__ import annotations
+
+import re
+import time
+from typing import Any
+
+from rcl_interfaces.msg import ParameterType
+from rclpy.parameter import Parameter, parameter_value_to_python
+from rclpy.parameter_client import AsyncParameterClient
+
+from .. import course
+from ..errors import CheckFailed
+from .base import ARRIVAL_TIMEOUT_S, Judge, judged, learner_error
+from .nodes import new_node
+
+#: The on-set callback the learner writes (part 4); the constructor registers it.
+CALLBACK = 'on_set_thresholds'
+THRESHOLDS = (course.HIGH_PARAMETER, course.LOW_PARAMETER)
+#: rclpy's reason when an on-set callback returns anything but a SetParametersResult.
+INVALID_RETURN = 'Callback returned an invalid type'
+
+
+class _Parameters:
+    """The learner's monitor in a fresh subject, and a parameter client of the judge's."""
+
+    def __init__(self, judge: Judge) -> None:
+        # A fresh process each time: one node of this name, ever, so that the judge's client
+        # reaches no services of an earlier node (they linger in the graph).
+        judge.drop(('file', course.SUBSCRIBER_FILE))
+        try:
+            self.subject, info = new_node(judge, course.SUBSCRIBER_FILE, course.MONITOR_CLASS,
+                                          placeholders=('temperature_callback', CALLBACK))
+        except CheckFailed as error:
+            undeclared = re.search(r"undeclared parameter\(s\)\W*(\w+)", str(error))
+            if undeclared is None:
+                raise
+            raise CheckFailed(f'{course.MONITOR_CLASS}() reads the parameter '
+                              f'{undeclared.group(1)}, which it never declares: declare it in '
+                              '__init__ with self.declare_parameter() (names must match '
+                              'exactly).') from None
+        self.name = info['name']
+        self.full = info['namespace'].rstrip('/') + '/' + info['name']
+        self.subject.request('serve')
+        self.observer = judge.observer
+        self.client = AsyncParameterClient(self.observer.node, self.full)
+        if not self.client.wait_for_services(ARRIVAL_TIMEOUT_S):
+            raise CheckFailed(f'The grader could not reach the parameter services of {self.full} '
+                              f'within {ARRIVAL_TIMEOUT_S:g} s (is the machine very busy?): run '
+                              'this check again.')
+
+    def answer(self, future: Any, what: str) -> Any:
+        """Wait for the node's answer; a callback of the learner's that raised is named."""
+        deadline = time.monotonic() + ARRIVAL_TIMEOUT_S
+        while not self.observer.wait_until(future.done, 0.5):
+            failure = self.subject.request('counts')['failure']
+            if failure:
+                _callback_failure(failure, what)
+            if time.monotonic() > deadline:
+                raise CheckFailed(f'{self.name} did not answer {what} within '
+                                  f'{ARRIVAL_TIMEOUT_S:g} s: does your callback wait for '
+                                  'something?')
+        return future.result()
+
+    def names(self) -> list[str]:
+        return sorted(self.answer(self.client.list_parameters(), 'ros2 param list').result.names)
+
+    def values(self, names: list[str]) -> list[Any]:
+        return list(self.answer(self.client.get_parameters(names), 'ros2 param get').values)
+
+    def descriptors(self, names: list[str]) -> list[Any]:
+        return list(self.answer(self.client.describe_parameters(names),
+                                'ros2 param describe').descriptors)
+
+    def set(self, name: str, value: float) -> Any:
+        future = self.client.set_parameters([Parameter(name, value=value)])
+        return self.answer(future, f'ros2 param set {name} {value}').results[0]
+
+
+def _callback_failure(failure: dict, what: str) -> None:
+    """Raise for the learner's on-set callback raising inside the node's parameter service."""
+    if failure.get('type') == 'AttributeError' and "'successful'" in failure.get('message', ''):
+        returned = failure['message'].split("'")[1]
+        raise CheckFailed(f'{CALLBACK} returned a {returned}, not a SetParametersResult: return '
+                          'SetParametersResult(successful=..., reason=...).')
+    raise learner_error(f'{course.MONITOR_CLASS}.{CALLBACK}', failure, context=f' for {what}')
+
+
+def _declared_verdict(node: _Parameters) -> None:
+    names = node.names()
+    for name in THRESHOLDS:
+        if name not in names:
+            mine = ', '.join(n for n in names if n not in ('use_sim_time',
+                                                           'start_type_description_service'))
+            raise CheckFailed(f'{node.name} declares no parameter {name} (it has: '
+                              f'{mine or "none of its own"}): declare it in __init__ with '
+                              'self.declare_parameter().')
+    for name, value in zip(THRESHOLDS, node.values(list(THRESHOLDS))):
+        default = course.THRESHOLD_DEFAULTS_C[name]
+        python = parameter_value_to_python(value)
+        if value.type == ParameterType.PARAMETER_INTEGER:
+            raise CheckFailed(f'{name} is an integer parameter ({python}): give it the float '
+                              f'default {default}, or 25.5 can never be set.')
+        if value.type != ParameterType.PARAMETER_DOUBLE:
+            raise CheckFailed(f'{name} is not a number ({python!r}): its default is the '
+                              f'constant {default}.')
+        if python != default:
+            raise CheckFailed(f'{name} starts at {python}; its default is {default}, the '
+                              'constant of part 2.')
+
+
+def _descriptor_verdict(node: _Parameters) -> None:
+    low, high = course.MIN_TEMPERATURE_C, course.MAX_TEMPERATURE_C
+    for descriptor in node.descriptors(list(THRESHOLDS)):
+        name = descriptor.name
+        if not descriptor.description.strip():
+            raise CheckFailed(f'{name} has no description: give its ParameterDescriptor a '
+                              'description (ros2 param describe shows it).')
+        if descriptor.read_only:
+            raise CheckFailed(f'{name} is read-only, so nobody can change it while the node runs: '
+                              'leave read_only out for the thresholds.')
+        ranges = list(descriptor.floating_point_range)
+        if not ranges:
+            raise CheckFailed(f'{name} has no floating-point range: give its descriptor '
+                              f'floating_point_range=[FloatingPointRange(...)] from {low} to '
+                              f'{high} °C.')
+        found = (ranges[0].from_value, ranges[0].to_value)
+        if found != (low, high):
+            raise CheckFailed(f'The range of {name} is [{found[0]}, {found[1]}] °C; thresholds '
+                              f'may go from {low} to {high} °C, the sensor\'s clamp range.')
+
+
+def _monitor_parameters(judge: Judge) -> str:
+    node = _Parameters(judge)
+    _declared_verdict(node)
+    _descriptor_verdict(node)
+    high, low = course.HIGH_PARAMETER, course.LOW_PARAMETER
+    return (f'{node.name} declares {high} = {course.HIGH_ABOVE_C} and {low} = '
+            f'{course.LOW_BELOW_C}, described, in [{course.MIN_TEMPERATURE_C}, '
+            f'{course.MAX_TEMPERATURE_C}] °C.')
+
+
+def check_monitor_parameters() -> None:
+    """Check part 3 of notebook 08: the monitor declares its two thresholds as parameters.
+
+    Creates your ``TemperatureMonitor`` and asks its parameter services, as ``ros2 param
+    list/get/describe`` do: both thresholds declared, doubles with their defaults, each
+    with a description and a floating-point range of [18.0, 28.0] °C, not read-only.
+
+    Introduced in ``08-parameters.ipynb``.
+
+    :raises CheckFailed: naming the parameter and what its declaration lacks.
+    """
+    judged('check_monitor_parameters', _monitor_parameters)
+
+
+#: (name, value, must succeed, the current other threshold) in the order the check sets them.
+STEPS = ((course.HIGH_PARAMETER, 25.0, True), (course.LOW_PARAMETER, 25.5, False),
+         (course.LOW_PARAMETER, 25.0, False), (course.LOW_PARAMETER, 21.0, True),
+         (course.HIGH_PARAMETER, 20.5, False))
+
+
+def _refusal_hint(name: str) -> str:
+    if name == course.HIGH_PARAMETER:
+        return (f'your callback gets only the parameters being set: compare with the current '
+                f'value of {course.LOW_PARAMETER} (self.get_parameter(...).value).')
+    return f'refuse unless {course.LOW_PARAMETER} stays strictly below {course.HIGH_PARAMETER}.'
+
+
+def _threshold_callback(judge: Judge) -> str:
+    node = _Parameters(judge)
+    _declared_verdict(node)
+    current = dict(course.THRESHOLD_DEFAULTS_C)
+    for name, value, valid in STEPS:
+        other = course.LOW_PARAMETER if name == course.HIGH_PARAMETER else course.HIGH_PARAMETER
+        result = node.set(name, value)
+        if result is None or not hasattr(result, 'successful'):
+            raise CheckFailed(f'Setting {name} got no answer: {CALLBACK} must return a '
+                              'SetParametersResult.')
+        if not result.successful and result.reason == INVALID_RETURN:
+            raise CheckFailed(f'{CALLBACK} returned something else than a SetParametersResult '
+                              f'(rclpy: "{INVALID_RETURN}"): return '
+                              'SetParametersResult(successful=..., reason=...).')
+        if valid and not result.successful:
+            raise CheckFailed(f'Setting {name} to {value} while {other} is {current[other]} was '
+                              f'refused ({result.reason or "no reason"}): that pair is valid, '
+                              'return SetParametersResult(successful=True) for it.')
+        if not valid and result.successful:
+            raise CheckFailed(f'Setting {name} to {value} while {other} is {current[other]} was '
+                              f'accepted: {_refusal_hint(name)}')
+        if not valid and not result.reason.strip():
+            raise CheckFailed(f'Setting {name} to {value} was refused without a reason: give the '
+                              'SetParametersResult a reason that says why (ros2 param set shows '
+                              'it).')
+        if valid:
+            current[name] = value
+    got = [parameter_value_to_python(v) for v in node.values([course.HIGH_PARAMETER,
+                                                                course.LOW_PARAMETER])]
+    if got != [current[course.HIGH_PARAMETER], current[course.LOW_PARAMETER]]:
+        raise CheckFailed(f'After the accepted changes the thresholds are {got}, expected '
+                          f'{[current[course.HIGH_PARAMETER], current[course.LOW_PARAMETER]]}: '
+                          'do not change parameters inside the callback.')
+    return (f'{CALLBACK} accepts valid thresholds and refuses, with a reason, '
+            f'{len([s for s in STEPS if not s[2]])} changes that would put '
+            f'{course.LOW_PARAMETER} at or above {course.HIGH_PARAMETER}.')
+
+
+def check_threshold_callback() -> None:
+    """Check part 4 of notebook 08: the on-set callback refuses inverted thresholds.
+
+    Sets the thresholds of your running monitor through its ``set_parameters`` service, as
+    ``ros2 param set`` does: valid pairs must be accepted, and every change that leaves
+    ``low_below_c`` at or above ``high_above_c`` refused with a reason.
+
+    Introduced in ``08-parameters.ipynb``.
+
+    :raises CheckFailed: naming the change and what the node answered.
+    """
+    judged('check_threshold_callback', _threshold_callback)

@@ -1,0 +1,143 @@
+"""The checks of notebook 08 (parameters) against the mistakes learners make: one line each.
+
+As tests/test_checks.py: this process is the judge, the learner's monitor runs in real
+subject processes, and the verdicts come from the judge's own parameter client talking to
+the monitor's real parameter services. The monitor is the solution notebook's (its
+``%%part`` cells), so it never goes stale; it passes both checks, so every failure below is
+the planted mistake's.
+"""
+
+import os
+import re
+
+import nbformat
+import pytest
+
+from ros2nb import checks, course
+from ros2nb.checks.base import bind_judge
+from ros2nb.checks.dispatch import IN_JUDGE_ENV
+from ros2nb.errors import CheckFailed
+from ros2nb.judge.session import Session
+
+pytestmark = pytest.mark.timeout(300)
+
+SOLUTION = os.path.join(os.path.dirname(__file__), '..', 'solutions', '08-parameters.ipynb')
+SUB = course.SUBSCRIBER_FILE
+
+
+def solution_monitor() -> str:
+    """The monitor file that notebook 08's %%part cells write (parts 1 to 4)."""
+    parts = {}
+    for cell in nbformat.read(SOLUTION, as_version=4).cells:
+        first, _, body = cell.source.partition('\n')
+        if cell.cell_type == 'code' and first.startswith('%%part {SUBSCRIBER}'):
+            lines = [line for line in body.splitlines() if not line.strip().startswith('###')]
+            parts[int(first.split()[-1])] = '\n'.join(lines).rstrip('\n')
+    return '\n\n'.join(parts[n] for n in sorted(parts)) + '\n'
+
+
+REFERENCE = solution_monitor()
+
+
+@pytest.fixture(scope='module')
+def session(tmp_path_factory):
+    """A judge session (this process is the judge) on a workspace with the course's package."""
+    import ros2nb
+    from ros2nb.terminal import workspace as ws_module
+    root = tmp_path_factory.mktemp('checks08')
+    saved = {k: os.environ.get(k) for k in ('ROS2NB_WORKSPACE', IN_JUDGE_ENV)}
+    os.environ['ROS2NB_WORKSPACE'] = str(root / 'ws')
+    os.environ[IN_JUDGE_ENV] = '1'
+    ws_module._current = None
+    ros2nb.course.catch_up(5)
+    session = Session(root / 'ws')
+    bind_judge(session)
+    yield session
+    bind_judge(None)
+    session.close()
+    for key, value in saved.items():
+        if value is None:
+            os.environ.pop(key, None)
+        else:
+            os.environ[key] = value
+    ws_module._current = None
+
+
+def write_monitor(session, text: str) -> None:
+    (session.workspace / SUB).write_text(text)
+
+
+def test_the_solution_passes_both_checks(session, capsys):
+    write_monitor(session, REFERENCE)
+    checks.check_monitor_parameters()
+    checks.check_threshold_callback()
+    out = capsys.readouterr().out
+    assert out.count('Check passed:') == 2, out
+
+
+DECLARE = ("        self.declare_parameter('low_below_c', LOW_BELOW_C, ParameterDescriptor(\n"
+           "            description='Readings strictly below this are Low (°C)',\n"
+           "            floating_point_range=in_clamp_range))\n")
+REFUSE = ('low_c >= high_c', "reason=f'low_below_c ({low_c}) must stay below high_above_c "
+          "({high_c})')")
+DECLARATION_MISTAKES = [
+    ('placeholder', 'in_clamp_range = [', 'raise NotImplementedError()\n        in_clamp_range = [',
+     r'TemperatureMonitor\(\) still raises NotImplementedError: write your code where it says'),
+    ('one not declared', DECLARE, '',
+     r'TemperatureMonitor\(\) reads the parameter low_below_c, which it never declares: declare it'),
+    ('name typo', "declare_parameter('high_above_c'", "declare_parameter('high_above'",
+     r'TemperatureMonitor\(\) reads the parameter high_above_c, which it never declares'),
+    ('integer default', "'high_above_c', HIGH_ABOVE_C,", "'high_above_c', 26,",
+     r'high_above_c is an integer parameter \(26\): give it the float default 26.0'),
+    ('wrong default', "'low_below_c', LOW_BELOW_C,", "'low_below_c', 18.0,",
+     r'low_below_c starts at 18.0; its default is 20.0'),
+    ('no description', "description='Readings strictly above this are High (°C)',", '',
+     r'high_above_c has no description: give its ParameterDescriptor a description'),
+    ('read-only', "description='Readings strictly above this are High (°C)',",
+     "description='Readings strictly above this are High (°C)', read_only=True,",
+     r'high_above_c is read-only, so nobody can change it while the node runs'),
+    ('no range', 'floating_point_range=in_clamp_range))\n        self.declare_parameter(',
+     '))\n        self.declare_parameter(',
+     r'high_above_c has no floating-point range: give its descriptor floating_point_range='),
+    ('wrong range', "to_value=MAX_THRESHOLD_C)]\n        self.declare_parameter('high",
+     "to_value=30.0)]\n        self.declare_parameter('high",
+     r'The range of high_above_c is \[18.0, 30.0\] °C; thresholds may go from 18.0 to 28.0 °C'),
+]
+CALLBACK_MISTAKES = [
+    ('placeholder', 'new = {parameter.name', 'raise NotImplementedError()\n        new = {parameter.name',
+     r'still raises NotImplementedError: write your code where it says YOUR CODE HERE'),
+    ('only the parameters being set', "self.get_parameter('high_above_c').value)\n        low_c",
+     "HIGH_ABOVE_C)\n        low_c",
+     r'Setting low_below_c to 25.5 while high_above_c is 25.0 was accepted: refuse unless'),
+    ('the other one forgotten', "new.get('low_below_c', self.get_parameter('low_below_c').value)",
+     "new.get('low_below_c', LOW_BELOW_C)",
+     r'Setting high_above_c to 20.5 while low_below_c is 21.0 was accepted: your callback gets '
+     r'only the parameters being set'),
+    ('equal allowed', 'low_c >= high_c', 'low_c > high_c',
+     r'Setting low_below_c to 25.0 while high_above_c is 25.0 was accepted'),
+    ('no reason', REFUSE[1], "reason='')",
+     r'Setting low_below_c to 25.5 was refused without a reason'),
+    ('refuses everything', 'return SetParametersResult(successful=True)',
+     "return SetParametersResult(successful=False, reason='no')",
+     r'Setting high_above_c to 25.0 while low_below_c is 20.0 was refused \(no\): that pair is '
+     r'valid'),
+    ('returns a bool', 'return SetParametersResult(successful=True)', 'return True',
+     r'on_set_thresholds returned something else than a SetParametersResult'),
+]
+MISTAKES = ([(checks.check_monitor_parameters, *m) for m in DECLARATION_MISTAKES]
+            + [(checks.check_threshold_callback, *m) for m in CALLBACK_MISTAKES])
+
+
+@pytest.mark.parametrize('check, label, old, new, pattern', MISTAKES,
+                         ids=[f'{m[0].__name__}: {m[1]}' for m in MISTAKES])
+def test_a_mistake_gets_one_line(session, check, label, old, new, pattern):
+    assert old in REFERENCE, old
+    write_monitor(session, REFERENCE.replace(old, new, 1))
+    with pytest.raises(CheckFailed) as caught:
+        check()
+    message = str(caught.value).splitlines()[0] if type(caught.value) is not CheckFailed \
+        else str(caught.value)
+    assert re.search(pattern, message), message
+    assert '\n' not in message
+    assert "declare_parameter('" not in message and 'SetParametersResult(successful=False' \
+        not in message
