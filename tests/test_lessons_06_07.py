@@ -1,4 +1,4 @@
-"""The checks of notebook 06 (the five promises) against real mistakes: one line each.
+"""The checks of notebooks 06 (the five promises) and 07 (a live plot) against real mistakes.
 
 As tests/test_checks.py: this process is the judge, the learner's files run in real subject
 processes, verdicts come from the judge's own ROS node.  The course's reference files pass
@@ -19,7 +19,7 @@ from ros2nb.judge.session import Session
 
 pytestmark = pytest.mark.timeout(300)
 
-FAN, PROMISES = course.FAN_FILE, course.PROMISES_FILE
+FAN, PROMISES, PLOT = course.FAN_FILE, course.PROMISES_FILE, course.LIVE_PLOT_FILE
 
 
 @pytest.fixture(scope='module')
@@ -31,9 +31,9 @@ def session(tmp_path_factory):
     os.environ['ROS2NB_WORKSPACE'] = str(root / 'ws')
     os.environ[IN_JUDGE_ENV] = '1'
     ws_module._current = None
-    course.catch_up(6)
+    course.catch_up(7)
     session = Session(root / 'ws')
-    for relative in (FAN, PROMISES):
+    for relative in (FAN, PROMISES, PLOT):
         restore(session, relative)
     bind_judge(session)
     yield session
@@ -62,10 +62,10 @@ def mutated(session, relative: str, old: str, new: str) -> None:
 def test_reference_files_pass(session, capsys):
     for check in (checks.check_fan_controller, checks.check_fan_main,
                   checks.check_counting_monitor, checks.check_responsive_worker,
-                  checks.check_room_arguments):
+                  checks.check_room_arguments, checks.check_plot_callback):
         check()
     out = capsys.readouterr().out
-    assert out.count('Check passed:') == 5, out
+    assert out.count('Check passed:') == 6, out
     found = re.search(r'heartbeat still ran (\d+) times', out)
     print(f'heartbeat runs in 2 s with the fix: {found.group(1)}')
 
@@ -115,6 +115,13 @@ MISTAKES = [
     ('rooms: placeholder', PROMISES, "    return ['--ros-args', '-r', f'__ns:=/{room}']",
      '    raise NotImplementedError()', checks.check_room_arguments,
      r"room_arguments\('kitchen'\) still raises NotImplementedError"),
+    ('plot: wall-clock time', PLOT, 'self.get_clock().now().nanoseconds / 1e9', "__import__('time').time()",
+     checks.check_plot_callback, r"got the time \d+\.\d+: use the node's clock in seconds"),
+    ('plot: no redraw', PLOT, '        self.redraw()\n', '',
+     checks.check_plot_callback, r'After 4 readings the plot was redrawn 0 times: call '
+                                 r'self.redraw\(\) once per message'),
+    ('plot: the message, not its data', PLOT, 'self.temps_c.append(msg.data)',
+     'self.temps_c.append(msg)', checks.check_plot_callback, r'temps_c holds .* append msg.data'),
 ]
 
 

@@ -34,7 +34,7 @@ def text(cell: dict) -> str:
 
 def test_names_are_numbered_kebab_case_and_consecutive():
     names = [p.name for p in SOLUTIONS]
-    assert len(names) >= 7
+    assert len(names) >= 8
     assert all(NAME.match(n) for n in names), names
     assert [int(n[:2]) for n in names] == list(range(len(names)))
     assert [p.name for p in LEARNER] == names
@@ -120,6 +120,7 @@ def _file_from_parts(path: Path, variable: str) -> str:
     ('04-write-the-subscriber.ipynb', 'SUBSCRIBER', 'temperature_subscriber.py'),
     ('06-five-promises.ipynb', 'FAN', 'fan_controller.py'),
     ('06-five-promises.ipynb', 'PROMISES', 'promises.py'),
+    ('07-live-plot.ipynb', 'LIVE_PLOT', 'live_plot.py'),
 ])
 def test_solution_parts_are_the_reference_nodes(notebook, variable, reference):
     from ros2nb import course

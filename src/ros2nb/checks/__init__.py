@@ -30,12 +30,13 @@ from .lesson04 import (check_monitor_callback, check_monitor_constructor, check_
 from .lesson05 import check_entry_points, check_package_runs, check_setup_cfg
 from .lesson06 import (check_counting_monitor, check_fan_controller, check_fan_main,
                        check_responsive_worker, check_room_arguments)
+from .lesson07 import check_plot_callback
 
 __all__ = [
     'CheckFailed', 'check_counting_monitor', 'check_dependencies', 'check_endpoint',
     'check_entry_points', 'check_expanded_path', 'check_fan_controller', 'check_fan_main',
     'check_monitor_callback', 'check_monitor_constructor',
-    'check_monitor_main', 'check_monitor_readings', 'check_package_runs',
+    'check_monitor_main', 'check_monitor_readings', 'check_package_runs', 'check_plot_callback',
     'check_publisher_samples', 'check_responsive_worker', 'check_room_arguments',
     'check_sensor_callback', 'check_sensor_constructor',
     'check_sensor_hour', 'check_sensor_main', 'check_setup_cfg', 'package_dependencies',

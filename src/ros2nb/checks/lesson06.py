@@ -14,7 +14,7 @@ from .. import course
 from ..errors import CheckFailed
 from .base import ARRIVAL_TIMEOUT_S, Judge, judged, learner_error
 from .mains import run_main
-from .nodes import new_node
+from .nodes import new_node, reach
 from .verdicts import endpoint_verdict, node_name_verdict
 
 #: Readings the fan check sends (°C): both sides of the High threshold.
@@ -24,15 +24,6 @@ COUNTED_READINGS = 5
 #: Wall-clock seconds the worker is spun, and the share of its heartbeats that must run.
 WORKER_SPIN_S = 2.0
 HEARTBEAT_SHARE = 0.6
-
-
-def _reach(judge: Judge, node: str) -> None:
-    """Wait until the judge's publisher on /temperature reaches a subscription."""
-    publisher = judge.probe_publisher
-    if not judge.observer.wait_until(lambda: publisher.get_subscription_count() >= 1,
-                                     ARRIVAL_TIMEOUT_S):
-        raise CheckFailed(f"The grader's publisher on /{course.TOPIC} never reached {node}: "
-                          'check its subscription\'s topic name and type.')
 
 
 def _send(judge: Judge, subject, value: float, received: int, callback: str) -> dict:
@@ -63,7 +54,7 @@ def _fan_controller(judge: Judge) -> str:
         raise CheckFailed(f'The fan controller\'s publisher never reached the grader\'s '
                           f'subscription on /{course.FAN_TOPIC}: is the machine very busy? '
                           'Run this check again.')
-    _reach(judge, info['name'])
+    reach(judge, subject, info['name'])
     received = info['received']
     for value in FAN_READINGS_C:
         before = len(commands)
@@ -131,7 +122,7 @@ def _counting_monitor(judge: Judge) -> str:
     if start['value']['value'] != 0:
         raise CheckFailed(f'A new {course.COUNTING_CLASS} starts with received = '
                           f"{start['value']['value']}; start counting at 0.")
-    _reach(judge, name)
+    reach(judge, subject, name)
     received = info['received']
     for index in range(COUNTED_READINGS):
         received = _send(judge, subject, 21.0 + index, received, 'its callback')['received']

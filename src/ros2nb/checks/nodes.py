@@ -8,6 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Optional
 
+from .. import course
 from ..errors import CheckFailed
 from .base import ARRIVAL_TIMEOUT_S, Judge, learner_error
 
@@ -45,3 +46,16 @@ def caught_up(judge: Judge, info: dict, mark: int, lines: int) -> list[str]:
     observer.wait_until(lambda: len(observer.lines_of(info['name'], mark)) >= lines,
                         ARRIVAL_TIMEOUT_S)
     return observer.lines_of(info['name'], mark)
+
+
+def reach(judge: Judge, subject, node: str) -> None:
+    """Wait until the learner's node (in ``subject``) has discovered the judge's publisher.
+
+    Counted from the subject's side: a subscription of an earlier subject that just ended
+    may still count on the judge's side for a moment.
+    """
+    _ = judge.probe_publisher  # created before the subject looks for it
+    if not subject.request('wait_publishers', topic='/' + course.TOPIC,
+                           seconds=ARRIVAL_TIMEOUT_S, timeout=ARRIVAL_TIMEOUT_S + 10)['ok']:
+        raise CheckFailed(f"The grader's publisher on /{course.TOPIC} never reached {node}: "
+                          'check its subscription\'s topic name and type.')

@@ -260,6 +260,15 @@ class Subject:
     def counts(self) -> dict:
         return {'ok': True, **self._counts()}
 
+    def wait_publishers(self, topic: str, seconds: float) -> dict:
+        """Wait until the node's graph shows a publisher on ``topic`` (the judge's, discovered)."""
+        deadline = time.monotonic() + seconds
+        while self.node is not None and time.monotonic() < deadline:
+            if self.node.count_publishers(topic) >= 1:
+                return {'ok': True}
+            time.sleep(0.01)
+        return {'ok': False}
+
     def attribute(self, name: str) -> dict:
         """The running node's attribute ``name`` (encoded), or ``missing``."""
         if self.node is None or not hasattr(self.node, name):
@@ -341,6 +350,7 @@ def serve(commands: Any, replies: Any) -> None:
         'advance': subject.advance, 'wait_received': subject.wait_received,
         'counts': subject.counts, 'attribute': subject.attribute,
         'timer_runs': subject.timer_runs, 'room_nodes': subject.room_nodes,
+        'wait_publishers': subject.wait_publishers,
     }
     for line in commands:
         request = json.loads(line)
