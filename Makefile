@@ -17,7 +17,7 @@ export ROS_HOME            := $(HERE)/.cache/ros
 export ROS_LOG_DIR         := $(HERE)/.cache/ros/log
 export PIP_DISABLE_PIP_VERSION_CHECK := 1
 
-.PHONY: lab test setup sandbox-tool browser-tool solutions learner-notebooks bench grade clean
+.PHONY: lab test setup sandbox-tool browser-tool graph-tool solutions learner-notebooks bench grade clean
 
 setup: $(STAMP)
 
@@ -32,7 +32,7 @@ $(STAMP): environment/requirements.txt pyproject.toml
 	@touch $(STAMP)
 
 # Localhost only, token authentication on; --allow-root only where you are root (containers).
-lab: $(STAMP)
+lab: $(STAMP) graph-tool
 	$(VENV)/bin/jupyter lab --ServerApp.ip=127.0.0.1 --ServerApp.root_dir=$(HERE) \
 	  --LabApp.default_url=/lab/tree/notebooks $(if $(filter 0,$(shell id -u)),--allow-root)
 
@@ -49,12 +49,18 @@ browser-tool:
 	  || { apt-get update -q >/dev/null 2>&1 && apt-get install -y -q chromium >/dev/null 2>&1; } || true
 	@command -v chromium >/dev/null || echo "chromium is not installed (sudo apt-get install chromium): the browser tests skip."
 
+# Notebook 06 draws the ROS graph with Graphviz's dot layout (as rqt_graph does): Debian's graphviz.
+graph-tool:
+	@command -v dot >/dev/null || [ "$$(id -u)" != 0 ] || apt-get install -y -q graphviz >/dev/null 2>&1 \
+	  || { apt-get update -q >/dev/null 2>&1 && apt-get install -y -q graphviz >/dev/null 2>&1; } || true
+	@command -v dot >/dev/null || echo "graphviz is not installed (sudo apt-get install graphviz): notebook 06 lists the graph as text instead of drawing it."
+
 # Three steps, always all three (tests/run_steps.sh): tests/ with pytest-xdist, and nbval
 # over solutions/ and notebooks/ alongside it; one failure never hides the others, the
 # results come together at the end, and make fails if any step failed.
 TEST_WORKERS ?= 3
 
-test: $(STAMP) sandbox-tool browser-tool
+test: $(STAMP) sandbox-tool browser-tool graph-tool
 	@tests/run_steps.sh $(PY) $(TEST_WORKERS)
 
 # Re-run solutions/ in place so their stored outputs are fresh (then make learner-notebooks).

@@ -19,9 +19,9 @@ SOLUTION = {p.stem: p for p in (ROOT / 'solutions').glob('*.ipynb')}
 LEARNER = {p.stem: p for p in (ROOT / 'notebooks').glob('*.ipynb')}
 NB = sorted(SOLUTION)
 NB00, NB01, NB02, NB03, NB04, NB05 = NB[:6]
-#: Points of each notebook, by its number (a complete learner's score).
-POINTS = {'00': 1, '01': 1, '02': 1, '03': 6, '04': 5, '05': 4, '08': 4}
-FULL = {n: POINTS[n[:2]] for n in NB}
+#: Points of each notebook, by its number: what a complete learner scores.
+POINTS = {'00': 1, '01': 1, '02': 1, '03': 6, '04': 5, '05': 4, '06': 7, '07': 2, '08': 4}
+FULL = {notebook: POINTS[notebook[:2]] for notebook in NB}
 #: Marks the hostile processes, so the test can look for survivors.
 MARK = 'ros2nb-hostile-sample'
 

@@ -20,7 +20,8 @@ from pathlib import Path
 import pytest
 
 from browser import page  # noqa: F401 - the fixture
-from grading_samples import EXPECTED, FEEDBACK_ATTACKERS, MARK, NB01, PWNED, ROOT, SOLUTION, build
+from grading_samples import (EXPECTED, FEEDBACK_ATTACKERS, FULL, MARK, NB01, PWNED, ROOT, SOLUTION,
+                             build)
 
 from ros2nb_instructor.grading import sandbox
 
@@ -96,7 +97,7 @@ def test_every_score_and_csv_row(graded):
         for notebook in NOTEBOOKS:
             assert got[learner, notebook] == case.scores.get(notebook, 0), (learner, notebook)
         assert got[learner, 'TOTAL'] == sum(case.scores.values()), learner
-    assert maxima == {**dict(zip(NOTEBOOKS, (1.0, 1.0, 1.0, 6.0, 5.0, 4.0))), 'TOTAL': 18.0}
+    assert maxima == {**{n: float(p) for n, p in FULL.items()}, 'TOTAL': float(sum(FULL.values()))}
 
 
 def shown(page: Path) -> str:
@@ -162,7 +163,7 @@ def test_the_gradebook_holds_only_what_nbgrader_scored(graded):
     assert done.returncode == 0, done.stderr
     rows = list(csv.DictReader(open(export)))
     totals = {r['student_id']: float(r['score']) for r in rows}
-    assert totals['complete'] == 18.0 and totals['forges-the-gradebook'] == 0.0
+    assert totals['complete'] == sum(FULL.values()) and totals['forges-the-gradebook'] == 0.0
     import sqlite3
     with sqlite3.connect(course / 'gradebook.db') as db:
         assert db.execute('SELECT COUNT(*) FROM grade WHERE manual_score IS NOT NULL'

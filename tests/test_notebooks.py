@@ -34,6 +34,7 @@ def text(cell: dict) -> str:
 
 def test_names_are_numbered_kebab_case_and_consecutive():
     names = [p.name for p in SOLUTIONS]
+    assert len(names) >= 8
     assert all(NAME.match(n) for n in names), names
     assert [int(n[:2]) for n in names] == list(range(len(names)))
     assert [p.name for p in LEARNER] == names
@@ -117,6 +118,9 @@ def _file_from_parts(path: Path, variable: str) -> str:
 @pytest.mark.parametrize('notebook, variable, reference', [
     ('03-write-the-publisher.ipynb', 'PUBLISHER', 'temperature_publisher.py'),
     ('04-write-the-subscriber.ipynb', 'SUBSCRIBER', 'temperature_subscriber.py'),
+    ('06-five-promises.ipynb', 'FAN', 'fan_controller.py'),
+    ('06-five-promises.ipynb', 'PROMISES', 'promises.py'),
+    ('07-live-plot.ipynb', 'LIVE_PLOT', 'live_plot.py'),
 ])
 def test_solution_parts_are_the_reference_nodes(notebook, variable, reference):
     from ros2nb import course
@@ -128,7 +132,8 @@ def test_the_node_files_carry_the_course_constants():
     """The standalone node files spell the numbers out; they must be ros2nb.course's."""
     import ast
     from ros2nb import course
-    for reference in ('temperature_publisher.py', 'temperature_subscriber.py'):
+    for reference in ('temperature_publisher.py', 'temperature_subscriber.py',
+                      'fan_controller.py', 'promises.py'):
         tree = ast.parse(course.reference_source(reference))
         constants = {t.id: ast.literal_eval(n.value) for n in tree.body
                      if isinstance(n, ast.Assign) for t in n.targets if t.id.isupper()}

@@ -14,8 +14,11 @@ from .errors import (CheckFailed, ColconBuildError, DomainsExhaustedError, FileP
                      LearnerCodeError, PkgCreateError, Ros2nbError, UsageError)
 from .kernel import add, install, shutdown, spin, start, stop
 from .runtime import current_runtime
+from .runtime.rates import callback_groups, timer_runs
+from .terminal.background import NodeProcess, ros2_start, stop_all
 from .terminal.colcon import colcon_build, source_workspace
 from .terminal.echo import message_type, record, topic_echo, topic_hz
+from .terminal.graph import graph_edges, graph_picture
 from .terminal.files import import_file, write_file, write_part
 from .terminal.param import param_describe, param_dump, param_get, param_list, param_set
 from .terminal.pkg_create import pkg_create
@@ -31,11 +34,12 @@ def load_ipython_extension(ipython) -> None:
 
 __all__ = [
     'CheckFailed', 'ColconBuildError', 'DomainsExhaustedError', 'FileProtectedError',
-    'LearnerCodeError', 'PkgCreateError', 'Ros2nbError', 'UsageError', 'add', 'checks',
-    'colcon_build', 'course', 'create_workspace', 'current_runtime', 'current_workspace',
-    'domains', 'find_executable', 'import_file', 'message_type', 'node_list', 'param_describe',
-    'param_dump', 'param_get', 'param_list', 'param_set', 'pkg_create',
-    'record', 'ros2_run', 'run_and_interrupt', 'shutdown', 'source_workspace', 'spin', 'start',
-    'stop', 'topic_echo', 'topic_hz', 'topic_info', 'topic_list', 'tree', 'unmatched_topics',
-    'write_file', 'write_part',
+    'LearnerCodeError', 'NodeProcess', 'PkgCreateError', 'Ros2nbError', 'UsageError', 'add',
+    'callback_groups', 'checks', 'colcon_build', 'course', 'create_workspace',
+    'current_runtime', 'current_workspace', 'domains', 'find_executable', 'graph_edges',
+    'graph_picture', 'import_file', 'message_type', 'node_list', 'param_describe',
+    'param_dump', 'param_get', 'param_list', 'param_set', 'pkg_create', 'record', 'ros2_run',
+    'ros2_start', 'run_and_interrupt', 'shutdown', 'source_workspace', 'spin', 'start', 'stop',
+    'stop_all', 'timer_runs', 'topic_echo', 'topic_hz', 'topic_info', 'topic_list', 'tree',
+    'unmatched_topics', 'write_file', 'write_part',
 ]

@@ -53,6 +53,23 @@ HIGH_ABOVE_C = 26.0           # strictly above: High
 LOW_BELOW_C = 20.0            # strictly below: Low
 STATUSES = ('Low', 'Normal', 'High')
 
+# ------------------------------------------------------------------ notebook 06: the promises
+FAN_FILE = f'src/{PACKAGE}/{PACKAGE}/fan_controller.py'
+FAN_EXECUTABLE = 'fan_controller'
+FAN_CLASS, FAN_NODE = 'FanController', 'fan_controller'
+FAN_TOPIC, FAN_MESSAGE_TYPE = 'fan_command', 'std_msgs/msg/Bool'   # True: fan on (High)
+PROMISES_FILE = f'src/{PACKAGE}/{PACKAGE}/promises.py'
+COUNTING_CLASS = 'CountingMonitor'
+WORKER_FUNCTION, ROOMS_FUNCTION = 'responsive_worker', 'room_arguments'
+HEARTBEAT_PERIOD_S = 0.1      # the worker's quick timer: 10 Hz
+SLOW_PERIOD_S = 0.5           # the worker's slow timer ...
+SLOW_WORK_S = 0.45            # ... whose callback works (sleeps) this long
+ROOMS = ('kitchen', 'attic')
+
+# ------------------------------------------------------------------ notebook 07: a live plot
+LIVE_PLOT_FILE = f'src/{PACKAGE}/{PACKAGE}/live_plot.py'
+PLOT_CLASS, PLOT_NODE = 'PlotFeeder', 'plot_feeder'
+
 # ------------------------------------------------------------------ parameters (notebook 08)
 #: The monitor's thresholds as parameters: name -> default (°C); both may be set from
 #: MIN_TEMPERATURE_C to MAX_TEMPERATURE_C (the sensor's clamp range) while the node runs.
@@ -68,6 +85,8 @@ GRADING_ENV = 'ROS2NB_GRADING'
 STEPS = {1: (), 2: ('workspace',), 3: ('workspace', 'package'),
          4: ('workspace', 'package', 'publisher'),
          5: ('workspace', 'package', 'publisher', 'subscriber'),
+         6: ('workspace', 'package', 'publisher', 'subscriber'),
+         7: ('workspace', 'package', 'publisher', 'subscriber'),
          8: ('workspace', 'package', 'publisher', 'subscriber', 'entry_points')}
 
 
@@ -134,7 +153,7 @@ def catch_up(notebook: int) -> Path:
 
     Introduced in ``01-create-a-workspace.ipynb``.
 
-    :param notebook: the number of the notebook about to run (1-5, 8).
+    :param notebook: the number of the notebook about to run (1-8).
     :return: the workspace path.
     :raises ValueError: for a notebook number without steps.
     """

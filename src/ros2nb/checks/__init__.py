@@ -6,14 +6,14 @@ raised, you see its traceback (your lines only) instead.  Checks test behaviour 
 node publishes and logs, what a function returns, how a process exits on Ctrl+C); they
 never print the answer's code.
 
-Checks of your files (notebooks 03-05) run in a judge process of their own
+Checks of your files (notebooks 03-07) run in a judge process of their own
 (:mod:`ros2nb.judge`, started by name), on a ROS domain of their own, so the nodes
 running in your kernel neither disturb them nor are disturbed.  The grader runs the very same functions, in the
 same way, on your submitted work; the points come from there, never from your kernel.
 Checks of a function or class you defined in a cell (notebooks 00-02) call it right here
 in the kernel; the grader runs those from the source of your answer cell.
 
-One module per lesson (``lesson00`` ... ``lesson05``, ``lesson08``) on a small shared vocabulary:
+One module per lesson (``lesson00`` ... ``lesson08``) on a small shared vocabulary:
 ``base`` (a check's parts and the judge it asks), ``dispatch`` (kernel to judge and back),
 ``verdicts``, ``answers`` (answer cells), ``nodes`` (a node from a file), ``mains``
 (``main()`` and Ctrl+C).  A new lesson adds a module and its names here.
@@ -28,13 +28,18 @@ from .lesson03 import (check_publisher_samples, check_sensor_callback, check_sen
 from .lesson04 import (check_monitor_callback, check_monitor_constructor, check_monitor_main,
                        check_monitor_readings)
 from .lesson05 import check_entry_points, check_package_runs, check_setup_cfg
+from .lesson06 import (check_counting_monitor, check_fan_controller, check_fan_main,
+                       check_responsive_worker, check_room_arguments)
+from .lesson07 import check_plot_callback
 from .lesson08 import check_monitor_parameters, check_threshold_callback
 
 __all__ = [
-    'CheckFailed', 'check_dependencies', 'check_endpoint', 'check_entry_points',
-    'check_expanded_path', 'check_monitor_callback', 'check_monitor_constructor',
-    'check_monitor_main', 'check_monitor_parameters', 'check_monitor_readings', 'check_package_runs',
-    'check_publisher_samples', 'check_sensor_callback', 'check_sensor_constructor',
+    'CheckFailed', 'check_counting_monitor', 'check_dependencies', 'check_endpoint',
+    'check_entry_points', 'check_expanded_path', 'check_fan_controller', 'check_fan_main',
+    'check_monitor_callback', 'check_monitor_constructor', 'check_monitor_main',
+    'check_monitor_parameters', 'check_monitor_readings', 'check_package_runs',
+    'check_plot_callback', 'check_publisher_samples', 'check_responsive_worker',
+    'check_room_arguments', 'check_sensor_callback', 'check_sensor_constructor',
     'check_sensor_hour', 'check_sensor_main', 'check_setup_cfg', 'check_threshold_callback',
     'package_dependencies',
 ]

@@ -56,7 +56,7 @@ def _cleanup_verdict(main: ast.FunctionDef) -> None:
                           'and call rclpy.try_shutdown() in a finally: block.')
 
 
-def run_main(judge: Judge, relative: str, node_name: str) -> str:
+def run_main(judge: Judge, relative: str, node_name: str, part: int = 5) -> str:
     """Run the learner's file, press Ctrl+C once its node spins; the verdict, or the sentence."""
     path = judge.workspace / relative
     if not path.is_file():
@@ -67,7 +67,7 @@ def run_main(judge: Judge, relative: str, node_name: str) -> str:
         raise CheckFailed(f'{path.name} line {error.lineno}: SyntaxError: {error.msg}.') from None
     main = _function(tree, 'main')
     if main is None:
-        raise CheckFailed(f'{path.name} has no main() function yet: write part 5.')
+        raise CheckFailed(f'{path.name} has no main() function yet: write part {part}.')
     observer = judge.observer
     judge.drop(('file', relative))  # the node runs alone, as in a terminal: one of its name
     proc, output = judge.start([sys.executable, str(path)], cwd=judge.workspace)
@@ -80,8 +80,8 @@ def run_main(judge: Judge, relative: str, node_name: str) -> str:
     if proc.poll() is not None:
         text = output.text()
         if 'NotImplementedError' in text:
-            raise CheckFailed('main() still raises NotImplementedError: write part 5 where it '
-                              'says YOUR CODE HERE.')
+            raise CheckFailed(f'main() still raises NotImplementedError: write part {part} where '
+                              'it says YOUR CODE HERE.')
         if 'Traceback' in text:
             raise CheckFailed(f'{path.name} crashed before Ctrl+C ({last_line(text)}): fix that '
                               'first; the checks of the parts above show where.')

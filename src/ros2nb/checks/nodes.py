@@ -1,6 +1,6 @@
 """A node from the learner's file, created in a subject and watched by the judge.
 
-Part of :mod:`ros2nb.checks`: what the checks of notebooks 03 and 04 share.
+Part of :mod:`ros2nb.checks`: what the checks of notebooks 03, 04 and 06 share.
 """
 
 from __future__ import annotations
@@ -8,16 +8,18 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Optional
 
+from .. import course
 from ..errors import CheckFailed
 from .base import ARRIVAL_TIMEOUT_S, Judge, learner_error
 
 
 def new_node(judge: Judge, relative: str, cls: str, *, placeholders: tuple[str, ...] = (),
-              attributes: tuple[str, ...] = (), seed: Optional[int] = None) -> tuple[Any, dict]:
-    """Create the learner's node from their file in a subject; raise for what went wrong."""
+              attributes: tuple[str, ...] = (), seed: Optional[int] = None,
+              args: tuple = ()) -> tuple[Any, dict]:
+    """Create the learner's node ``cls(*args)`` from their file in a subject; raise for what went wrong."""
     subject = judge.file_subject(relative)
     reply = subject.request('new_node', cls=cls, placeholders=list(placeholders),
-                            attributes=list(attributes), seed=seed)
+                            attributes=list(attributes), seed=seed, args=list(args))
     file = Path(relative).name
     if reply.get('no_class'):
         others = reply['classes']
@@ -27,7 +29,8 @@ def new_node(judge: Judge, relative: str, cls: str, *, placeholders: tuple[str, 
     if reply.get('refused'):
         raise CheckFailed(reply['refused'])
     if not reply['ok']:
-        raise learner_error(f'{cls}()', reply['error'])
+        shown = ', '.join(repr(a) for a in args)
+        raise learner_error(f'{cls}({shown})', reply['error'])
     return subject, reply
 
 
@@ -43,3 +46,16 @@ def caught_up(judge: Judge, info: dict, mark: int, lines: int) -> list[str]:
     observer.wait_until(lambda: len(observer.lines_of(info['name'], mark)) >= lines,
                         ARRIVAL_TIMEOUT_S)
     return observer.lines_of(info['name'], mark)
+
+
+def reach(judge: Judge, subject, node: str) -> None:
+    """Wait until the learner's node (in ``subject``) has discovered the judge's publisher.
+
+    Counted from the subject's side: a subscription of an earlier subject that just ended
+    may still count on the judge's side for a moment.
+    """
+    _ = judge.probe_publisher  # created before the subject looks for it
+    if not subject.request('wait_publishers', topic='/' + course.TOPIC,
+                           seconds=ARRIVAL_TIMEOUT_S, timeout=ARRIVAL_TIMEOUT_S + 10)['ok']:
+        raise CheckFailed(f"The grader's publisher on /{course.TOPIC} never reached {node}: "
+                          'check its subscription\'s topic name and type.')

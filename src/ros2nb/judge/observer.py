@@ -40,6 +40,7 @@ class Observer:
         self.readings: list[float] = []
         self.logs: list[tuple[str, int, str]] = []
         self._watching: set[str] = set()
+        self.messages: dict[str, list] = {}
         self._stop = False
         self._thread = threading.Thread(target=self._spin, name='ros2nb-judge', daemon=True)
         self._thread.start()
@@ -71,6 +72,18 @@ class Observer:
         self.node.create_subscription(
             Float32, topic, lambda m: self._note(self.readings, float(m.data)),
             QoSProfile(depth=10000, reliability=ReliabilityPolicy.RELIABLE))
+
+    def watch_messages(self, topic: str, msg_type: Any) -> list:
+        """Collect the ``data`` of every ``msg_type`` message on ``topic``; return the list.
+
+        Reliable, with a long queue; watching a topic twice returns the same list.
+        """
+        if topic not in self.messages:
+            self.messages[topic] = store = []
+            self.node.create_subscription(
+                msg_type, topic, lambda m: self._note(store, m.data),
+                QoSProfile(depth=10000, reliability=ReliabilityPolicy.RELIABLE))
+        return self.messages[topic]
 
     def wait_until(self, condition: Callable[[], bool], seconds: float) -> bool:
         """Wait until ``condition()`` holds (checked whenever something arrives)."""

@@ -133,6 +133,10 @@ def add(node: Node) -> Node:
 def stop(node: Optional[NodeOrName] = None) -> list[str]:
     """Stop and destroy one running node, or all of them; ROS itself stays up.
 
+    Their log lines are no longer shown here afterwards (a process started with
+    :func:`ros2nb.ros2_start` may run a node of the same name: its lines are not this
+    kernel's).
+
     Introduced in ``00-setup-and-the-pubsub-idea.ipynb``.
 
     :param node: the node or its name (``'temperature_sensor'``); ``None`` stops all nodes.
@@ -142,6 +146,7 @@ def stop(node: Optional[NodeOrName] = None) -> list[str]:
     rt = current_runtime()
     names = rt.stop(node)
     rt.print_pending()
+    rt.disown_loggers_except({n.get_logger().name for n in rt.nodes.values()})
     return names
 
 

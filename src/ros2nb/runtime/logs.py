@@ -59,6 +59,15 @@ class LogLines:
         """Show the lines of logger ``name`` (a node handed over) and of its children."""
         self._our_loggers.add(name)
 
+    def disown_loggers_except(self, running: set[str]) -> None:
+        """Stop showing the lines of loggers whose nodes were stopped (``running``: those kept).
+
+        A process on this domain may run a node of the same name (``ros2nb.ros2_start``); its
+        lines reach this kernel's /rosout too, and are not this kernel's to print.
+        """
+        with self._lock:
+            self._our_loggers &= running
+
     def begin_cell(self) -> None:
         """A new cell starts: lines made before it are no longer news (IPython pre_run_cell)."""
         self._epoch += 1

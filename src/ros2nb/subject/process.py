@@ -24,13 +24,16 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any, Callable, Optional
 
+from rclpy.executors import Executor
 from rclpy.node import Node
+from std_msgs.msg import Float32
 
 from .. import domains
 from ..endpoints import node_endpoints
 from ..errors import Ros2nbError
 from ..explain.exceptions import explain_exception, is_library_file, learner_line
 from ..runtime import Runtime, enable_field_checks
+from ..runtime.rates import callback_groups, timer_runs
 
 #: Exit code when a command could not even be read.
 PROTOCOL_ERROR = 3
@@ -99,6 +102,7 @@ class Subject:
         self.received = 0
         self.fired = 0
         self.failure: Optional[dict] = None
+        self.rooms: list[Node] = []  # stand-in nodes of the reusability check (notebook 06)
 
     # -------------------------------------------------------------- loading
     def exec_cells(self, sources: list[str]) -> dict:
@@ -182,7 +186,7 @@ class Subject:
         timer.callback = counted
 
     def new_node(self, cls: str, placeholders: list[str], attributes: list[str],
-                 seed: Optional[int]) -> dict:
+                 seed: Optional[int], args: Optional[list] = None) -> dict:
         rt = self._runtime()
         if self.node is not None:
             if self.node.get_fully_qualified_name() in rt.nodes:
@@ -202,7 +206,7 @@ class Subject:
         self.published, self.received, self.fired, self.failure = {}, 0, 0, None
         logged_before = dict(rt.log_counts)
         try:
-            node = node_class()
+            node = node_class(*(args or []))
         except BaseException as error:
             return {'ok': False, 'error': describe_error(error)}
         try:
@@ -262,6 +266,67 @@ class Subject:
         self._runtime().spin_in_background()
         return {'ok': True, **self._counts()}
 
+    def wait_publishers(self, topic: str, seconds: float) -> dict:
+        """Wait until the node's graph shows a publisher on ``topic`` (the judge's, discovered)."""
+        deadline = time.monotonic() + seconds
+        while self.node is not None and time.monotonic() < deadline:
+            if self.node.count_publishers(topic) >= 1:
+                return {'ok': True}
+            time.sleep(0.01)
+        return {'ok': False}
+
+    def attribute(self, name: str) -> dict:
+        """The running node's attribute ``name`` (encoded), or ``missing``."""
+        if self.node is None or not hasattr(self.node, name):
+            return {'ok': True, 'missing': True}
+        return {'ok': True, 'value': encode(getattr(self.node, name))}
+
+    def timer_runs(self, name: str, seconds: float) -> dict:
+        """Call the learner's ``name()`` for ``(node, executor)``; spin them on the wall clock."""
+        function = self.namespace.get(name)
+        if not callable(function):
+            return {'ok': False, 'undefined': True}
+        self._runtime()
+        try:
+            made = function()
+        except BaseException as error:
+            return {'ok': False, 'error': describe_error(error)}
+        if not (isinstance(made, tuple) and len(made) == 2 and isinstance(made[0], Node)
+                and isinstance(made[1], Executor)):
+            return {'ok': False, 'returned': encode(made)}
+        node, executor = made
+        groups = callback_groups(node)
+        try:
+            runs = timer_runs(node, executor, seconds)
+        except BaseException as error:
+            return {'ok': False, 'error': describe_error(error)}
+        finally:
+            node.destroy_node()
+        return {'ok': True, 'executor': type(executor).__name__, 'groups': groups,
+                'runs': runs}
+
+    def room_nodes(self, arguments: list) -> dict:
+        """A stand-in sensor and monitor, each started with ``arguments`` (as ``--ros-args``)."""
+        rt = self._runtime()
+        made = []
+        try:
+            for name, kind in (('temperature_sensor', 'publisher'),
+                               ('temperature_monitor', 'subscription')):
+                node = Node(name, cli_args=[str(a) for a in arguments],
+                            use_global_arguments=False, start_parameter_services=False)
+                if kind == 'publisher':
+                    node.create_publisher(Float32, 'temperature', 10)
+                else:
+                    node.create_subscription(Float32, 'temperature', lambda msg: None, 10)
+                made.append(node)
+        except BaseException as error:
+            for node in made:
+                node.destroy_node()
+            return {'ok': False, 'error': describe_error(error)}
+        self.rooms.extend(made)
+        return {'ok': True, 'nodes': [[n.get_name(), n.get_namespace(), node_endpoints(n)]
+                                      for n in made]}
+
     def advance(self, seconds: float, seed: Optional[int] = None) -> dict:
         if seed is not None:
             random.seed(seed)
@@ -289,7 +354,9 @@ def serve(commands: Any, replies: Any) -> None:
         'call': subject.call, 'new_node': subject.new_node,
         'set_attribute': subject.set_attribute, 'wait_matched': subject.wait_matched,
         'advance': subject.advance, 'wait_received': subject.wait_received,
-        'counts': subject.counts, 'serve': subject.serve,
+        'counts': subject.counts, 'serve': subject.serve, 'attribute': subject.attribute,
+        'timer_runs': subject.timer_runs, 'room_nodes': subject.room_nodes,
+        'wait_publishers': subject.wait_publishers,
     }
     for line in commands:
         request = json.loads(line)

@@ -1,0 +1,102 @@
+"""How often each timer of a node runs on a given executor, on the wall clock.
+
+Introduced in ``06-five-promises.ipynb`` (concurrency).  A slow callback only blocks the
+others on the wall clock (``time.sleep`` does not wait for ``/clock``), so this is the one
+place in the course that spins a node on the wall clock on an executor the learner chose,
+apart from the kernel's own.  The kernel and the judge's subjects call the same function.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from typing import Any
+
+from rclpy.executors import Executor
+from rclpy.node import Node
+
+#: Seconds one ``spin_once`` of the measured executor may wait.
+SPIN_WAIT_S = 0.02
+#: Seconds to wait, after the measurement, for callbacks still running in other threads.
+FINISH_WAIT_S = 30.0
+
+
+class _Running:
+    """How many counted callbacks are running now (in any of the executor's threads)."""
+
+    def __init__(self) -> None:
+        self.count = 0
+        self.changed = threading.Condition()
+
+    def __enter__(self) -> None:
+        with self.changed:
+            self.count += 1
+
+    def __exit__(self, *exc: Any) -> None:
+        with self.changed:
+            self.count -= 1
+            self.changed.notify_all()
+
+
+def _counted(timer: Any, counts: dict[str, int], running: _Running) -> None:
+    original = timer.callback
+    name = getattr(original, '__name__', repr(original))
+    counts[name] = 0
+
+    def counted() -> Any:
+        with running:
+            counts[name] += 1
+            return original()
+
+    counted.__name__ = counted.__qualname__ = name
+    timer.callback = counted
+
+
+def timer_runs(node: Node, executor: Executor, seconds: float) -> dict[str, int]:
+    """Spin ``node`` alone on ``executor`` for ``seconds`` of wall-clock time; count its timers.
+
+    The node is added to the executor, spun, then removed, once the callbacks still running
+    in the executor's threads have returned; the executor is shut down at the end, so hand
+    over a fresh one each time.  The node itself is left to the caller.
+
+    Introduced in ``06-five-promises.ipynb``.
+
+    :param node: a node on the wall clock (not handed to :func:`ros2nb.add`).
+    :param executor: e.g. ``SingleThreadedExecutor()`` or ``MultiThreadedExecutor()``.
+    :param seconds: wall-clock seconds to spin.
+    :return: ``{callback name: times it ran}`` for each timer of the node.
+    """
+    counts: dict[str, int] = {}
+    running = _Running()
+    for timer in node.timers:
+        _counted(timer, counts, running)
+    executor.add_node(node)
+    try:
+        deadline = time.monotonic() + seconds
+        while time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=SPIN_WAIT_S)
+        measured = dict(counts)
+    finally:
+        executor.remove_node(node)
+        with running.changed:  # rclpy's shutdown() does not wait for them in Jazzy
+            running.changed.wait_for(lambda: running.count == 0, FINISH_WAIT_S)
+        executor.shutdown()
+    return measured
+
+
+def callback_groups(node: Node) -> list[tuple[str, str, int]]:
+    """Each timer's callback name, its callback group's type and the group's identity.
+
+    Introduced in ``06-five-promises.ipynb``.
+
+    :return: ``(callback name, group class name, group number)``, groups numbered from 0
+        in order of first use (two timers with the same number share a group).
+    """
+    numbers: dict[int, int] = {}
+    found = []
+    for timer in node.timers:
+        group = timer.callback_group
+        number = numbers.setdefault(id(group), len(numbers))
+        found.append((getattr(timer.callback, '__name__', repr(timer.callback)),
+                      type(group).__name__, number))
+    return found

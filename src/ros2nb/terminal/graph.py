@@ -1,0 +1,101 @@
+"""``rqt_graph`` in a notebook: the running ROS graph, nodes and topics, as a picture.
+
+Introduced in ``06-five-promises.ipynb``.  The facts come from the kernel's graph (as
+:func:`ros2nb.node_list` reads it): every node, in this kernel or in any process on the
+kernel's domain, and the topics it publishes or subscribes to.  The picture is laid out
+by Graphviz's ``dot``, the layout rqt_graph itself uses: publishers left of their
+topics, subscribers right of them, no edge drawn across another when it can be helped.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any, Iterable, Optional
+
+from ..errors import Ros2nbError
+from ..runtime import current_runtime
+from .topic import INFRASTRUCTURE_TOPICS, hidden
+
+#: Seconds :func:`graph_edges` waits for the nodes it is told to expect.
+GRAPH_WAIT_S = 60.0
+
+
+def _endpoints_now() -> set[tuple[str, str, str]]:
+    node = current_runtime().node
+    found = set()
+    for name, namespace in node.get_node_names_and_namespaces():
+        full = namespace.rstrip('/') + '/' + name
+        if hidden(full):
+            continue
+        try:
+            pubs = node.get_publisher_names_and_types_by_node(name, namespace)
+            subs = node.get_subscriber_names_and_types_by_node(name, namespace)
+        except Exception:  # the node left the graph between the two calls
+            continue
+        for kind, entries in (('publisher', pubs), ('subscription', subs)):
+            found |= {(full, kind, topic) for topic, _ in entries
+                      if topic not in INFRASTRUCTURE_TOPICS and not hidden(topic)}
+    return found
+
+
+def graph_edges(*, expect: Iterable[str] = (),
+                timeout: float = GRAPH_WAIT_S) -> list[tuple[str, str, str]]:
+    """The graph's endpoints: ``(node, 'publisher' or 'subscription', topic)``, sorted.
+
+    Hidden nodes and topics (``/_ros2nb``, ``/rosout``, ``/parameter_events``, ``/clock``)
+    are left out.  Discovery takes a moment: name the nodes you expect and it waits until
+    the graph shows each of them with its publishers and subscriptions.
+
+    Introduced in ``06-five-promises.ipynb``.
+
+    :param expect: full node names to wait for, e.g. ``['/temperature_sensor']``.
+    :param timeout: wall-clock seconds to wait for them at most.
+    :raises Ros2nbError: if ROS is not up, or an expected node did not appear in time.
+    """
+    want = set(expect)
+    deadline = time.monotonic() + timeout
+    while True:
+        found = _endpoints_now()
+        missing = want - {node for node, _, _ in found}
+        if not missing:
+            return sorted(found)
+        if time.monotonic() > deadline:
+            raise Ros2nbError(f'The graph shows no node {sorted(missing)[0]} with a topic after '
+                              f'{timeout:g} s: is it running?')
+        time.sleep(0.05)
+
+
+def graph_picture(edges: Optional[Iterable[tuple[str, str, str]]] = None, *,
+                  title: str = '') -> Any:
+    """Draw the graph as rqt_graph does: nodes as ellipses, topics as boxes, arrows for data.
+
+    Introduced in ``06-five-promises.ipynb``.
+
+    :param edges: from :func:`graph_edges` (``None`` reads the graph now).
+    :param title: a caption under the picture.
+    :return: an SVG picture the notebook displays (``IPython.display.SVG``).
+    :raises Ros2nbError: when Graphviz's ``dot`` is not installed (``make graph-tool``).
+    """
+    import graphviz
+    from IPython.display import SVG
+
+    edges = sorted(_endpoints_now() if edges is None else edges)
+    graph = graphviz.Digraph(graph_attr={'rankdir': 'LR', 'label': title, 'fontsize': '11',
+                                         'fontname': 'Helvetica', 'bgcolor': 'white'},
+                             node_attr={'fontname': 'Helvetica', 'fontsize': '11',
+                                        'style': 'filled'})
+    for name in sorted({node for node, _, _ in edges}):
+        graph.node('node ' + name, label=name, shape='ellipse', fillcolor='#cfe3f7')
+    for topic in sorted({topic for _, _, topic in edges}):
+        graph.node('topic ' + topic, label=topic, shape='box', fillcolor='#f3e5c0')
+    for node, kind, topic in edges:
+        if kind == 'publisher':
+            graph.edge('node ' + node, 'topic ' + topic)
+        else:
+            graph.edge('topic ' + topic, 'node ' + node)
+    try:
+        return SVG(graph.pipe(format='svg'))
+    except graphviz.ExecutableNotFound:
+        raise Ros2nbError("Graphviz's dot is not installed: run make graph-tool (or sudo "
+                          'apt-get install graphviz); graph_edges() lists the same graph as '
+                          'text.') from None

@@ -1,0 +1,139 @@
+"""The checks of notebooks 06 (the five promises) and 07 (a live plot) against real mistakes.
+
+As tests/test_checks.py: this process is the judge, the learner's files run in real subject
+processes, verdicts come from the judge's own ROS node.  The course's reference files pass
+first, so every failure below is its mistake's.
+"""
+
+import os
+import re
+from pathlib import Path
+
+import pytest
+
+from ros2nb import checks, course
+from ros2nb.checks.base import bind_judge
+from ros2nb.checks.dispatch import IN_JUDGE_ENV
+from ros2nb.errors import CheckFailed
+from ros2nb.judge.session import Session
+
+pytestmark = pytest.mark.timeout(300)
+
+FAN, PROMISES, PLOT = course.FAN_FILE, course.PROMISES_FILE, course.LIVE_PLOT_FILE
+
+
+@pytest.fixture(scope='module')
+def session(tmp_path_factory):
+    """A judge session on a workspace with the course's package and its 06 files."""
+    from ros2nb.terminal import workspace as ws_module
+    root = tmp_path_factory.mktemp('lesson06')
+    saved = {k: os.environ.get(k) for k in ('ROS2NB_WORKSPACE', IN_JUDGE_ENV)}
+    os.environ['ROS2NB_WORKSPACE'] = str(root / 'ws')
+    os.environ[IN_JUDGE_ENV] = '1'
+    ws_module._current = None
+    course.catch_up(7)
+    session = Session(root / 'ws')
+    for relative in (FAN, PROMISES, PLOT):
+        restore(session, relative)
+    bind_judge(session)
+    yield session
+    bind_judge(None)
+    session.close()
+    for key, value in saved.items():
+        if value is None:
+            os.environ.pop(key, None)
+        else:
+            os.environ[key] = value
+    ws_module._current = None
+
+
+def restore(session, relative: str) -> None:
+    (session.workspace / relative).write_text(course.reference_source(Path(relative).name))
+    session.drop(('file', relative))
+
+
+def mutated(session, relative: str, old: str, new: str) -> None:
+    text = course.reference_source(Path(relative).name)
+    assert old in text, old
+    (session.workspace / relative).write_text(text.replace(old, new))
+    session.drop(('file', relative))
+
+
+def test_reference_files_pass(session, capsys):
+    for check in (checks.check_fan_controller, checks.check_fan_main,
+                  checks.check_counting_monitor, checks.check_responsive_worker,
+                  checks.check_room_arguments, checks.check_plot_callback):
+        check()
+    out = capsys.readouterr().out
+    assert out.count('Check passed:') == 6, out
+    found = re.search(r'heartbeat still ran (\d+) times', out)
+    print(f'heartbeat runs in 2 s with the fix: {found.group(1)}')
+
+
+MISTAKES = [
+    ('fan: >=', FAN, 'msg.data > HIGH_ABOVE_C', 'msg.data >= HIGH_ABOVE_C',
+     checks.check_fan_controller, r'For 26.0 °C the fan controller published True; it should be '
+                                  r'False: the fan is on only when the reading is High'),
+    ('fan: no publish', FAN, '        self.publisher_.publish(command)\n', '',
+     checks.check_fan_controller, r'published nothing on /fan_command: publish one Bool'),
+    ('fan: topic typo', FAN, "FAN_TOPIC = 'fan_command'", "FAN_TOPIC = 'fan_comand'",
+     checks.check_fan_controller, r'no publisher on /fan_command \(it has: /fan_comand'),
+    ('fan: node name', FAN, "super().__init__('fan_controller')", "super().__init__('fan')",
+     checks.check_fan_controller, r'The node is called fan; name it fan_controller'),
+    ('fan main: no finally', FAN, '''    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()''', '''    node.destroy_node()
+    rclpy.try_shutdown()''',
+     checks.check_fan_main, r'cleans up only when the spin ends normally'),
+    ('counting: name ignored', PROMISES, 'super().__init__(name)',
+     "super().__init__('counting_monitor')", checks.check_counting_monitor,
+     r"CountingMonitor\('monitor_7'\) made a node called counting_monitor: pass the name"),
+    ('counting: never counts', PROMISES, 'self.received += 1', 'pass',
+     checks.check_counting_monitor, r'After 5 readings self.received is 0: add one'),
+    ('counting: no attribute', PROMISES, '        self.received = 0\n', '',
+     checks.check_counting_monitor, r'has no attribute received: set self.received = 0'),
+    ('worker: single-threaded', PROMISES, 'executor = MultiThreadedExecutor(num_threads=2)',
+     'from rclpy.executors import SingleThreadedExecutor\n    executor = SingleThreadedExecutor()',
+     checks.check_responsive_worker, r'heartbeat ran \d+ times in 2 s \(20 expected\): a '
+                                     r'SingleThreadedExecutor runs one callback at a time'),
+    ('worker: one group', PROMISES, '''slow_group=MutuallyExclusiveCallbackGroup(),
+                  heartbeat_group=MutuallyExclusiveCallbackGroup())''', ')',
+     checks.check_responsive_worker, r'both timers are in one MutuallyExclusiveCallbackGroup'),
+    ('worker: returns the node only', PROMISES, 'return node, executor', 'return node',
+     checks.check_responsive_worker, r'returned <.*Worker object.*; return two things'),
+    ('rooms: no --ros-args', PROMISES, "['--ros-args', '-r', f'__ns:=/{room}']",
+     "['-r', f'__ns:=/{room}']", checks.check_room_arguments,
+     r"only the arguments after '--ros-args'"),
+    ('rooms: topic only', PROMISES, "f'__ns:=/{room}'", "f'temperature:=/{room}/temperature'",
+     checks.check_room_arguments, r"room_arguments\('kitchen'\) the node runs as "
+                                  r'/temperature_sensor; put it in the namespace /kitchen'),
+    ('rooms: room ignored', PROMISES, "f'__ns:=/{room}'", "'__ns:=/kitchen'",
+     checks.check_room_arguments, r"room_arguments\('attic'\) the node runs as "
+                                  r'/kitchen/temperature_sensor'),
+    ('rooms: bad remap', PROMISES, "f'__ns:=/{room}'", "f'__ns:={room}'",
+     checks.check_room_arguments, r'rclpy refused the arguments'),
+    ('rooms: placeholder', PROMISES, "    return ['--ros-args', '-r', f'__ns:=/{room}']",
+     '    raise NotImplementedError()', checks.check_room_arguments,
+     r"room_arguments\('kitchen'\) still raises NotImplementedError"),
+    ('plot: wall-clock time', PLOT, 'self.get_clock().now().nanoseconds / 1e9', "__import__('time').time()",
+     checks.check_plot_callback, r"got the time \d+\.\d+: use the node's clock in seconds"),
+    ('plot: no redraw', PLOT, '        self.redraw()\n', '',
+     checks.check_plot_callback, r'After 4 readings the plot was redrawn 0 times: call '
+                                 r'self.redraw\(\) once per message'),
+    ('plot: the message, not its data', PLOT, 'self.temps_c.append(msg.data)',
+     'self.temps_c.append(msg)', checks.check_plot_callback, r'temps_c holds .* append msg.data'),
+]
+
+
+@pytest.mark.parametrize('label, file, old, new, check, pattern', MISTAKES,
+                         ids=[m[0] for m in MISTAKES])
+def test_a_mistake_gets_one_line(session, label, file, old, new, check, pattern):
+    mutated(session, file, old, new)
+    try:
+        with pytest.raises(CheckFailed) as caught:
+            check()
+    finally:
+        restore(session, file)
+    message = str(caught.value)
+    assert re.search(pattern, message), message
+    assert '\n' not in message
