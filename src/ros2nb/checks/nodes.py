@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any, Optional
 
 from ..errors import CheckFailed
+from ..terminal.files import missing_parts
 from .base import ARRIVAL_TIMEOUT_S, Judge, learner_error
 
 
@@ -19,6 +20,12 @@ def new_node(judge: Judge, relative: str, cls: str, *, placeholders: tuple[str, 
     reply = subject.request('new_node', cls=cls, placeholders=list(placeholders),
                             attributes=list(attributes), seed=seed)
     file = Path(relative).name
+    gaps = missing_parts(judge.workspace, relative)
+    if gaps and (reply.get('no_class') or not reply.get('ok')):
+        raise CheckFailed(f'{file} is missing part{"s" if len(gaps) > 1 else ""} '
+                          f'{", ".join(map(str, gaps))}: run the %%part '
+                          f'cell{"s" if len(gaps) > 1 else ""} for {"them" if len(gaps) > 1 else "it"} '
+                          '(parts go into the file in number order), then this check again.')
     if reply.get('no_class'):
         others = reply['classes']
         hint = (f' (it defines {", ".join(others)}: names must match exactly; the tutorial '
