@@ -116,12 +116,21 @@ def _run_sensor(judge: Judge, subject: Any, info: dict, seconds: int, *,
 
 
 def _log_format_verdict(readings: list[float], lines: list[str]) -> None:
-    """Each reading's log line shows the reading (two decimals, as 'Publishing: 22.31C')."""
-    for reading, line in zip(readings, lines):
-        numbers = [float(n) for n in re.findall(r'-?\d+(?:\.\d+)?', line)]
-        if not any(abs(n - reading) <= LOGGED_READING_TOLERANCE_C for n in numbers):
-            raise CheckFailed(f'publish_temperature logged "{line}" for a reading of {reading:.2f} '
-                              f"°C: show the reading in its line, e.g. 'Publishing: {reading:.2f}C'.")
+    """Each reading has a log line that shows it (two decimals, as 'Publishing: 22.31C').
+
+    The start-up line may arrive among them (over /rosout): lines are matched to readings
+    by the number they show, not by position.
+    """
+    def shows(line: str, reading: float) -> bool:
+        return any(abs(float(n) - reading) <= LOGGED_READING_TOLERANCE_C
+                   for n in re.findall(r'-?\d+(?:\.\d+)?', line))
+
+    unshown = [r for r in readings if not any(shows(line, r) for line in lines)]
+    if unshown:
+        odd = [line for line in lines if not any(shows(line, r) for r in readings)]
+        said = f'"{odd[-1]}"' if odd else 'lines without it'
+        raise CheckFailed(f'publish_temperature logged {said} for a reading of {unshown[0]:.2f} '
+                          f"°C: show the reading in its line, e.g. 'Publishing: {unshown[0]:.2f}C'.")
 
 
 def _samples_verdict(samples: list[float], *, seconds: float,

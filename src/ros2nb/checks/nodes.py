@@ -13,6 +13,17 @@ from ..terminal.files import missing_parts
 from .base import ARRIVAL_TIMEOUT_S, Judge, learner_error
 
 
+def parts_verdict(workspace: Path, relative: str) -> None:
+    """Raise CheckFailed naming the ``%%part`` cells of ``relative`` never run, if any."""
+    gaps = missing_parts(workspace, relative)
+    if gaps:
+        many = len(gaps) > 1
+        raise CheckFailed(f'{Path(relative).name} is missing part{"s" if many else ""} '
+                          f'{", ".join(map(str, gaps))}: run the %%part cell{"s" if many else ""} '
+                          f'for {"them" if many else "it"} (parts go into the file in number '
+                          'order), then this check again.')
+
+
 def new_node(judge: Judge, relative: str, cls: str, *, placeholders: tuple[str, ...] = (),
               attributes: tuple[str, ...] = (), seed: Optional[int] = None) -> tuple[Any, dict]:
     """Create the learner's node from their file in a subject; raise for what went wrong."""
@@ -20,12 +31,8 @@ def new_node(judge: Judge, relative: str, cls: str, *, placeholders: tuple[str, 
     reply = subject.request('new_node', cls=cls, placeholders=list(placeholders),
                             attributes=list(attributes), seed=seed)
     file = Path(relative).name
-    gaps = missing_parts(judge.workspace, relative)
-    if gaps and (reply.get('no_class') or not reply.get('ok')):
-        raise CheckFailed(f'{file} is missing part{"s" if len(gaps) > 1 else ""} '
-                          f'{", ".join(map(str, gaps))}: run the %%part '
-                          f'cell{"s" if len(gaps) > 1 else ""} for {"them" if len(gaps) > 1 else "it"} '
-                          '(parts go into the file in number order), then this check again.')
+    if reply.get('no_class') or not reply.get('ok'):
+        parts_verdict(judge.workspace, relative)
     if reply.get('no_class'):
         others = reply['classes']
         hint = (f' (it defines {", ".join(others)}: names must match exactly; the tutorial '

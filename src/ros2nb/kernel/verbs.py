@@ -10,6 +10,7 @@ import atexit
 import contextlib
 import difflib
 import io
+import itertools
 import math
 import sys
 import os
@@ -155,15 +156,13 @@ class _HeldOutput:
         :return: the number of lines of standard output left out.
         """
         writes, self.writes[:] = list(self.writes), []
-        dropped = []
-        for name, text in writes:
-            if errors_only and name == 'stdout':
-                dropped.append(text)
-                continue
+        dropped = ''.join(text for name, text in writes if name == 'stdout') if errors_only else ''
+        kept = [(name, text) for name, text in writes if not (errors_only and name == 'stdout')]
+        for name, group in itertools.groupby(kept, key=lambda write: write[0]):
             stream = getattr(sys, name)
-            stream.write(text)
+            stream.write(''.join(text for _name, text in group))  # one output per run of lines
             stream.flush()
-        return len(''.join(dropped).splitlines())
+        return len(dropped.splitlines())
 
 
 class _HeldStream(io.TextIOBase):
