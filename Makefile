@@ -17,7 +17,7 @@ export ROS_HOME            := $(HERE)/.cache/ros
 export ROS_LOG_DIR         := $(HERE)/.cache/ros/log
 export PIP_DISABLE_PIP_VERSION_CHECK := 1
 
-.PHONY: lab test setup sandbox-tool browser-tool graph-tool solutions learner-notebooks bench grade clean
+.PHONY: lab lab-instructor test setup sandbox-tool browser-tool graph-tool solutions learner-notebooks bench grade clean
 
 setup: $(STAMP)
 
@@ -31,10 +31,16 @@ $(STAMP): environment/requirements.txt pyproject.toml
 	$(PY) -m pip install --quiet --no-deps --editable .
 	@touch $(STAMP)
 
-# Localhost only, token authentication on; --allow-root only where you are root (containers).
+# The learner's lab: the course's notebooks copied into work/ (git ignores it; a course update
+# never overwrites a notebook there, it puts the new version beside it), nbgrader's instructor
+# tools, the news pop-up and the Extension Manager off (environment/jupyter-learner/).
+# Localhost only, token authentication on (src/ros2nb_instructor/lab.py).
 lab: $(STAMP) graph-tool
-	$(VENV)/bin/jupyter lab --ServerApp.ip=127.0.0.1 --ServerApp.root_dir=$(HERE) \
-	  --LabApp.default_url=/lab/tree/notebooks $(if $(filter 0,$(shell id -u)),--allow-root)
+	$(VENV)/bin/ros2nb-lab
+
+# The instructor's lab: the course folder itself, nbgrader's Formgrader and Create Assignment on.
+lab-instructor: $(STAMP) graph-tool
+	$(VENV)/bin/ros2nb-lab --instructor
 
 # Unit tests of ros2nb, the notebook checks, then nbval over both notebook folders.
 # Grading runs learners' code in bubblewrap sandboxes (Debian's bubblewrap package).

@@ -7,6 +7,7 @@ so every failure below is the mistake's, and the test could not pass with a chec
 says nothing.
 """
 
+import json
 import os
 import re
 import shutil
@@ -141,6 +142,11 @@ SENSOR_MISTAKES = [
      checks.check_sensor_constructor, r'TemperatureSensor\(\) raised: TOPIC is a constant of the file, not of the node: write TOPIC, not self.TOPIC'),
     ('part 4 not indented', '    def publish_temperature(self):', 'def publish_temperature(self):',
      checks.check_sensor_callback, r'publish_temperature is written outside the class TemperatureSensor: indent its part by four spaces'),
+    ('log line without the reading', "self.get_logger().info(f'Publishing: {self.temperature:.2f}C')",
+     "self.get_logger().info('Publishing a reading')",
+     checks.check_sensor_callback, r'publish_temperature logged "Publishing a reading" for a reading of \d+\.\d\d °C: show the reading in its line'),
+    ('main() crashes before its spin', '    rclpy.init(args=args)\n', '',
+     checks.check_sensor_main, r"crashed before Ctrl\+C at line \d+ \(super\(\).__init__\('temperature_sensor'\)\) \(NotInitializedException: .*\): fix that line"),
     ('shutdown instead of try_shutdown', 'rclpy.try_shutdown()  # rclpy.shutdown() would raise', 'rclpy.shutdown()  # rclpy.shutdown() would raise',
      checks.check_sensor_main, r'exited with code 1 after Ctrl\+C \(Ctrl\+C had already shut rclpy down\): shut down with rclpy.try_shutdown\(\) instead of rclpy.shutdown\(\)'),
     ("the tutorial's main", '''    except (KeyboardInterrupt, ExternalShutdownException):
@@ -180,6 +186,8 @@ MONITOR_MISTAKES = [
      checks.check_monitor_constructor, r'TemperatureMonitor\(\) raised: the arguments are in the wrong order: create_subscription takes the message type, the topic, the callback and the queue depth'),
     ('the message for its value', 'temperature_c = msg.data', 'temperature_c = msg',
      checks.check_monitor_callback, r'temperature_callback raised for 19.99 °C: a Float32 message is not its value: use its field \(data\), e.g. msg.data'),
+    ('callback left unwritten', '        temperature_c = msg.data\n', '        raise NotImplementedError()\n',
+     checks.check_monitor_callback, r'temperature_callback still raises NotImplementedError: write your code'),
     ('two lines', "        self.get_logger().info(f'Temperature: {temperature_c:.2f}C - Status: {status}')",
      "        self.get_logger().info(f'Temperature: {temperature_c:.2f}C')\n        self.get_logger().info(f'Status: {status}')",
      checks.check_monitor_callback, r'logged 2 lines; log exactly one per message'),
@@ -203,6 +211,22 @@ def test_a_mistake_gets_one_line(session, file, label, old, new, check, pattern)
         fails(check, pattern)
     finally:
         restore(session, file)
+
+
+def test_a_part_run_out_of_order_is_named_by_the_check(session):
+    """Part 3 (the class) saved, parts 1-2 (imports, constants) never run: the check names them."""
+    record = session.workspace / '.ros2nb-parts.json'
+    text = course.reference_source(Path(PUB).name)
+    part3 = text[text.index('class TemperatureSensor'):]
+    record.write_text(json.dumps({PUB: {'3': part3}}))
+    (session.workspace / PUB).write_text(part3)
+    session.drop(('file', PUB))
+    try:
+        fails(checks.check_sensor_constructor, r'temperature_publisher.py is missing parts 1, 2: run '
+                                               r'the %%part cells for them')
+    finally:
+        record.unlink()
+        restore(session, PUB)
 
 
 def test_package_checks(session, capsys):
@@ -300,6 +324,10 @@ def test_cell_answers_in_the_kernel(tmp_path):
     checks.check_dependencies(lambda p: ['rclpy', 'std_msgs'], xml)
     with pytest.raises(CheckFailed, match='test_depend is not a depend'):
         checks.check_dependencies(lambda p: ['rclpy', 'x', 'std_msgs'], xml)
+    import xml.etree.ElementTree as ElementTree  # the elements, not their text
+    with pytest.raises(CheckFailed, match=r"returned a list of Element objects, not of names: return "
+                                          r"each <depend> element's text, e\.g\. \[element\.text"):
+        checks.check_dependencies(lambda p: list(ElementTree.parse(p).getroot().iter('depend')), xml)
 
 
 def test_endpoint_in_the_kernel():

@@ -21,12 +21,14 @@ SHIPPED = sorted(p.name for p in (ROOT / 'notebooks').glob('*.ipynb'))
 
 def test_launcher_copies_missing_notebooks_and_never_replaces_work(tmp_path):
     folder = tmp_path / 'ros2-course'
-    assert launcher.copy_missing_notebooks(ROOT / 'notebooks', folder) == SHIPPED
+    copied = launcher.copy_missing_notebooks(ROOT / 'notebooks', folder)
+    assert [Path(line.split(':')[0]).name for line in copied] == SHIPPED
     assert (folder.stat().st_mode & 0o777) == 0o700
     work = folder / 'notebooks' / SHIPPED[3]
     work.write_text('my own work')
     (folder / 'notebooks' / SHIPPED[0]).unlink()
-    assert launcher.copy_missing_notebooks(ROOT / 'notebooks', folder) == [SHIPPED[0]]
+    assert launcher.copy_missing_notebooks(ROOT / 'notebooks', folder) == [
+        f'{folder / "notebooks" / SHIPPED[0]}: new notebook from the course.']
     assert work.read_text() == 'my own work'
 
 
@@ -37,6 +39,7 @@ def test_launcher_gives_each_learner_a_workspace_in_their_folder(tmp_path):
                                           'ROS2_and_RL_Tutorials')
     assert env['PATH'].split(os.pathsep) == ['/course/.venv/bin', '/usr/bin']
     assert 'ROS_DOMAIN_ID' not in env
+    assert env['JUPYTER_CONFIG_PATH'] == str(ROOT / 'environment' / 'jupyter-learner')
     assert launcher.learner_folder({'HOME': str(tmp_path)}) == Path('~/ros2-course').expanduser()
 
 

@@ -432,3 +432,17 @@ def test_two_learners_at_once_each_get_the_stored_outputs(class_run):
                                    + difference(want, have))
     print(f'hub, two servers and notebook 04 twice at once: {class_run.seconds:.0f} s')
     assert not differences, '\n'.join(differences)
+
+
+def test_each_learner_gets_the_learners_lab_without_instructor_tools(class_run):
+    hub = class_run.hub
+    for learner in LEARNERS:
+        token = learner_token(hub, learner)
+        base = f'{hub.url}/user/{learner}'
+        headers = {'Authorization': f'token {token}'}
+        assert requests.get(f'{base}/formgrader', headers=headers, timeout=API_S).status_code == 404
+        page = requests.get(f'{base}/lab', headers=headers, timeout=API_S).text
+        config = json.loads(re.search(r'<script id="jupyter-config-data" type="application/json">'
+                                      r'(.*?)</script>', page, re.S).group(1))
+        assert '@jupyter/nbgrader:create-assignment' in config['disabledExtensions'], learner
+        assert config['news'] == {'disabled': True}, learner

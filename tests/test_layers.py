@@ -37,7 +37,8 @@ LAYERS: list[tuple[str, ...]] = [
     # ros2nb_instructor: the instructor's host (and, for the runner, the learner's sandbox).
     ('ros2nb_instructor.paths', 'ros2nb_instructor.nbgrader_cli'),
     ('ros2nb_instructor.grading.sandboxed',),
-    ('ros2nb_instructor.grading', 'ros2nb_instructor.authoring', 'ros2nb_instructor.hub'),
+    ('ros2nb_instructor.grading', 'ros2nb_instructor.authoring', 'ros2nb_instructor.hub',
+     'ros2nb_instructor.lab'),
     ('ros2nb_instructor',),
 ]
 #: Largest module and function, in lines (docstrings included).

@@ -208,3 +208,104 @@ def test_a_check_that_fails_is_one_line(ros):
                      'ros2nb.checks.check_expanded_path(lambda: "/Documents/W", ends_with="W")')
     assert result['error']['traceback'] == [
         "CheckFailed: <lambda>() returned str '/Documents/W'; return a pathlib.Path."]
+
+
+# ---------------------------------------------------------------- rclpy's own exceptions
+SENSOR_WITH = ("class Sensor(Node):\n    def __init__(self):\n        super().__init__('s')\n"
+               "        {line}\n\n    def tick(self):\n        pass\n\nSensor()")
+
+
+@pytest.mark.parametrize('line, fragments', [
+    ("self.create_publisher(Float32, 'temp-erature', 10)",
+     ("'temp-erature' is not a valid ROS topic name", "write it as 'temp_erature'")),
+    ('self.create_timer(-1.0, self.tick)',
+     ('create_timer got a negative period: give the period in seconds as a positive number',)),
+    ("self.create_publisher(Float32, 'temperature')",
+     ('the queue depth (QoS) is missing after the topic',)),
+    ("self.create_publisher(Float32, 'temperature', -1)",
+     ('the queue depth must be 0 or more (10 is usual)',)),
+    ("self.create_publisher(Float32, 'temperature', qos_profile=10, depth=10)",
+     ("got an unexpected keyword argument 'depth': the calls are create_publisher(Float32,",)),
+    ("self.create_publisher(Float32, 'temperature', rclpy.qos.QoSProfile())",
+     ('a QoSProfile needs its history depth: QoSProfile(depth=10)',)),
+])
+def test_rclpy_refuses_an_argument_in_one_line_at_the_learners_line(ros, line, fragments):
+    ros.one_line(SENSOR_WITH.format(line=line), *fragments, f'cell line 4: {line}')
+
+
+def test_a_node_name_with_a_space(ros):
+    ros.one_line("sensor = Node('temp sensor')",
+                 "'temp sensor' is not a valid ROS node name: node name must not contain "
+                 "characters other than alphanumerics or '_'; write it as 'temp_sensor'",
+                 "cell line 1: sensor = Node('temp sensor')")
+
+
+def test_a_subscription_callback_without_the_message(ros):
+    ros.one_line("class Monitor(Node):\n    def __init__(self):\n        super().__init__('m')\n"
+                 "        self.create_subscription(Float32, 'reading', self.on_reading, 10)\n\n"
+                 "    def on_reading(self):\n        pass\n\nMonitor()",
+                 "the subscription's callback Monitor.on_reading() must take the message ROS hands "
+                 'it: define it as def on_reading(self, msg)',
+                 "cell line 4: self.create_subscription(Float32, 'reading', self.on_reading, 10)")
+
+
+def test_a_timer_callback_that_asks_for_a_message(ros):
+    ros.run("class Ticker(Node):\n    def __init__(self):\n        super().__init__('t')\n"
+            "        self.create_timer(1.0, self.tick)\n\n"
+            "    def tick(self, msg):\n        pass\n\nticker = ros2nb.add(Ticker())")
+    stderr = ros.run('_ = ros2nb.spin(2)')['stderr']
+    assert ('callback Ticker.tick raised ROS calls Ticker.tick() with no arguments (a timer '
+            'callback): define it as def tick(self) and keep what it needs on self.') in stderr, stderr
+    assert 'cell line 6: def tick(self, msg):' in stderr, stderr
+    assert 'Traceback' not in stderr
+
+
+# ---------------------------------------------------------------- silent cases speak
+def test_a_misspelt_topic_in_a_subscription_is_named_after_the_spin(ros):
+    ros.run("class Sensor(Node):\n    def __init__(self):\n        super().__init__('sensor')\n"
+            "        self.pub = self.create_publisher(Float32, 'temperature', 10)\n\n"
+            'sensor = ros2nb.add(Sensor())')
+    ros.run("class Monitor(Node):\n    def __init__(self):\n        super().__init__('monitor')\n"
+            "        self.create_subscription(Float32, 'temprature', print, 10)\n\n"
+            'monitor = ros2nb.add(Monitor())')
+    out = ros.run('_ = ros2nb.spin(2)')['stdout']
+    assert ('monitor subscribes to /temprature, which has no publisher, but /temperature has one: '
+            'check the topic name in create_subscription.') in out, out
+
+
+# ---------------------------------------------------------------- misleading messages fixed
+def test_plain_rclpy_spin_without_ros2nb_start_says_what_to_use(kernel):
+    kernel.run('ros2nb.shutdown()')
+    line = kernel.one_line("rclpy.init()\nnode = Node('plain')\nrclpy.spin(node)",
+                           'rclpy.spin(node) never returns in a notebook cell (it would block the '
+                           'kernel until you press Stop): run ros2nb.start() instead of rclpy.init()')
+    assert line.startswith('Ros2nbError: ')
+    kernel.run('node.destroy_node(); rclpy.try_shutdown()')
+
+
+def test_the_deliberate_mkdir_error_of_01_is_one_line(kernel, tmp_path):
+    kernel.run(f'from pathlib import Path\nws = Path({str(tmp_path)!r})')
+    kernel.one_line('ws.mkdir()', f'{tmp_path} already exists, and mkdir() without exist_ok refuses',
+                    'mkdir(parents=True, exist_ok=True) is mkdir -p', 'cell line 1: ws.mkdir()')
+
+
+def test_a_long_simulated_spin_interrupted_is_one_line_not_its_log_lines(ros):
+    ros.run("import os, signal\n"
+            "class Sensor(Node):\n    def __init__(self):\n        super().__init__('loud')\n"
+            "        self.ticks = 0\n"
+            "        self.create_timer(1.0, self.tick)\n\n"
+            "    def tick(self):\n        self.ticks += 1\n"
+            "        self.get_logger().info(f'tick {self.ticks}')\n"
+            "        if self.ticks == 600:\n            os.kill(os.getpid(), signal.SIGINT)\n\n"
+            "sensor = ros2nb.add(Sensor())")
+    result = ros.run('_ = ros2nb.spin(10 ** 7)')
+    lines = result['stdout'].strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith('Interrupted after 600.0 of 1e+07 simulated s '
+                                                   '(its log lines are not shown)'), lines[:3]
+
+
+def test_a_part_run_out_of_order_says_which_part_is_missing(kernel, tmp_path):
+    kernel.run(f"ros2nb.create_workspace({str(tmp_path / 'ws')!r}, allow_outside_course=True)")
+    out = kernel.run('%%part scripts/order.py 3\nc = 3\n')['stdout']
+    assert out.strip().endswith('part 3 saved (parts 3; 1 lines; parts 1, 2 not saved yet: run '
+                                'their cells too)'), out

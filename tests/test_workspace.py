@@ -10,6 +10,7 @@ import pytest
 
 import ros2nb
 from ros2nb import course
+from ros2nb.terminal.workspace import shown
 
 ws_module = importlib.import_module('ros2nb.terminal.workspace')
 
@@ -257,3 +258,32 @@ def test_catch_up_never_writes_course_nodes_while_grading(tmp_path, monkeypatch,
     assert capsys.readouterr().out.splitlines()[-1] == (
         'Not created: temperature_publisher.py, temperature_subscriber.py (only your own nodes '
         'count here); the cells that use them will fail until you write them.')
+
+
+def test_notebook_05s_unwritten_answers_never_replace_the_working_package_files(tmp_path, capsys):
+    """05's answer cells run unedited keep 02's setup.py and setup.cfg; --overwrite replaces them."""
+    import nbformat
+    ros2nb.create_workspace(tmp_path / 'ws', allow_outside_course=True)
+    ros2nb.pkg_create(course.PACKAGE, destination=tmp_path / 'ws' / 'src',
+                      dependencies=list(course.DEPENDENCIES))
+    files = {'{SETUP_PY}': course.SETUP_PY_FILE, '{SETUP_CFG}': course.SETUP_CFG_FILE}
+    notebook = nbformat.read(os.path.join(os.path.dirname(__file__), '..', 'notebooks',
+                                          '05-entry-points-and-run.ipynb'), as_version=4)
+    answers = [c.source for c in notebook.cells if c.source.startswith('%%part ')]
+    assert len(answers) == 2
+    working = {name: (tmp_path / 'ws' / name).read_text() for name in files.values()}
+    capsys.readouterr()
+    for answer in answers:
+        first, _, body = answer.partition('\n')
+        _, name, number = first.split()
+        ros2nb.write_part(files[name], int(number), body)
+        assert (tmp_path / 'ws' / files[name]).read_text() == working[files[name]]
+    said = capsys.readouterr().out.splitlines()
+    assert said == [f'{shown(tmp_path / "ws" / name)} was not changed: this cell still holds '
+                    'the placeholder "raise NotImplementedError()", which would replace the working '
+                    'version; write your answer in its place and run the cell again (to replace it '
+                    'on purpose, add --overwrite to the %%part line).' for name in files.values()]
+    # the failure it prevents: the same write on purpose puts the placeholder in
+    first, _, body = answers[1].partition('\n')
+    ros2nb.write_part(files['{SETUP_CFG}'], 1, body, overwrite=True)
+    assert 'raise NotImplementedError()' in (tmp_path / 'ws' / course.SETUP_CFG_FILE).read_text()

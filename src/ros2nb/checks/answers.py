@@ -23,6 +23,9 @@ def answer_results(ref: AnswerRef, inputs: list[list[Any]]) -> list[dict]:
     return reply['outputs']
 
 
+_PLAIN = ('str', 'float', 'int', 'bool', 'NoneType')
+
+
 def decoded(output: dict, label: str) -> Any:
     """One output of :func:`answer_results` as a Python value; a raised error is raised."""
     if 'error' in output:
@@ -31,8 +34,9 @@ def decoded(output: dict, label: str) -> Any:
     if result['type'] == 'Path':
         return Path(result['value'])
     if result['type'] in ('list', 'tuple'):
-        return [item['value'] for item in result['value']]
-    if result['type'] in ('str', 'float', 'int', 'bool', 'NoneType'):
+        return [item['value'] if item.get('type') in _PLAIN else Opaque(item['type'], item['value'])
+                for item in result['value']]
+    if result['type'] in _PLAIN:
         return result['value']
     return Opaque(result['type'], result['value'])
 

@@ -115,8 +115,8 @@ def learner_error(what: str, error: dict, *, context: str = '') -> CheckFailed:
     :param error: the subject's description of the exception.
     :param context: what it was doing, e.g. `` for 19.99 °C``.
     """
-    if error.get('type') == 'NotImplementedError':
-        return CheckFailed(f'{what} still raises NotImplementedError{context}: write your code '
+    if error.get('type') == 'NotImplementedError':  # for any input: the input is no clue
+        return CheckFailed(f'{what} still raises NotImplementedError: write your code '
                            'where it says YOUR CODE HERE and run that cell again.')
     if error.get('explanation'):
         where = error.get('where')

@@ -82,6 +82,11 @@ def check_dependencies(reader: Any, package_xml: Optional[Path] = None) -> None:
         if not isinstance(got, list):
             raise CheckFailed(f'{reader.__name__}() returned {type_name_of(got)}; return a list of '
                               'names.')
+        odd = [type_name_of(item) for item in got if not isinstance(item, str)]
+        if odd:
+            raise CheckFailed(f'{reader.__name__}() returned a list of {odd[0]} objects, not of '
+                              "names: return each <depend> element's text, e.g. "
+                              '[element.text.strip() for element in ...].')
         if got != want:
             raise CheckFailed(f'For {file.parent.name}/package.xml you returned {got}, but it '
                               f'declares {want}: read the text of each <depend> element, in '

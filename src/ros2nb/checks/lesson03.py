@@ -7,6 +7,7 @@ subject, runs it on simulated time and decides from what reaches its own node ov
 from __future__ import annotations
 
 import math
+import re
 from typing import Any, Optional
 
 from .. import course
@@ -18,6 +19,8 @@ from .verdicts import endpoint_verdict, node_name_verdict
 
 #: Tolerance for values that went through a 32-bit float (°C).
 FLOAT32_TOLERANCE_C = 1e-4
+#: How far a logged number may be from its reading (°C): two decimals, rounded either way.
+LOGGED_READING_TOLERANCE_C = 0.011
 #: Simulated seconds the callback check runs the sensor, then each clamp probe.
 CALLBACK_RUN_S, CLAMP_RUN_S = 20, 40
 #: Seeds of ``random`` for the sensor checks (a clamp-less walk crosses both limits).
@@ -82,7 +85,7 @@ def check_sensor_constructor() -> None:
 
 
 def _run_sensor(judge: Judge, subject: Any, info: dict, seconds: int, *,
-                step_s: float = 1.0, seed: Optional[int] = None) -> tuple[list[float], int, int]:
+                step_s: float = 1.0, seed: Optional[int] = None) -> tuple[list[float], list[str], int]:
     """Run the sensor ``seconds`` simulated seconds; return readings, log lines, firings.
 
     The readings and log lines are what arrived at the judge's own subscriptions, over
@@ -109,7 +112,25 @@ def _run_sensor(judge: Judge, subject: Any, info: dict, seconds: int, *,
                               f'{len(observer.readings) - first} arrived: is something else '
                               'wrong with the publisher (its queue depth)?')
     lines = caught_up(judge, info, log_mark, reply['logged'] - base['logged'])
-    return observer.readings[first:], len(lines), reply['fired'] - base['fired']
+    return observer.readings[first:], lines, reply['fired'] - base['fired']
+
+
+def _log_format_verdict(readings: list[float], lines: list[str]) -> None:
+    """Each reading has a log line that shows it (two decimals, as 'Publishing: 22.31C').
+
+    The start-up line may arrive among them (over /rosout): lines are matched to readings
+    by the number they show, not by position.
+    """
+    def shows(line: str, reading: float) -> bool:
+        return any(abs(float(n) - reading) <= LOGGED_READING_TOLERANCE_C
+                   for n in re.findall(r'-?\d+(?:\.\d+)?', line))
+
+    unshown = [r for r in readings if not any(shows(line, r) for line in lines)]
+    if unshown:
+        odd = [line for line in lines if not any(shows(line, r) for r in readings)]
+        said = f'"{odd[-1]}"' if odd else 'lines without it'
+        raise CheckFailed(f'publish_temperature logged {said} for a reading of {unshown[0]:.2f} '
+                          f"°C: show the reading in its line, e.g. 'Publishing: {unshown[0]:.2f}C'.")
 
 
 def _samples_verdict(samples: list[float], *, seconds: float,
@@ -167,9 +188,10 @@ def _sensor_callback(judge: Judge) -> str:
                           'new reading into a Float32 message and publish it with the publisher '
                           'from __init__.' if fired else
                           'The timer never called publish_temperature: check the timer in part 3.')
-    if logged < len(readings):
-        raise CheckFailed(f'{len(readings)} readings were published but {logged} logged: log each '
-                          "reading with the node's logger, e.g. 'Publishing: 22.31C'.")
+    if len(logged) < len(readings):
+        raise CheckFailed(f'{len(readings)} readings were published but {len(logged)} logged: log '
+                          "each reading with the node's logger, e.g. 'Publishing: 22.31C'.")
+    _log_format_verdict(readings, logged)
     _samples_verdict(readings, seconds=CALLBACK_RUN_S)
     for start_c, seed in zip(CLAMP_PROBES_C, (CEILING_SEED, FLOOR_SEED)):
         subject.request('set_attribute', name='temperature', value=start_c)

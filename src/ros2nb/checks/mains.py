@@ -75,16 +75,15 @@ def run_main(judge: Judge, relative: str, node_name: str, part: int = 5) -> str:
     # once the node runs: earlier, a busy machine would decide what the learner is told.
     observer.wait_until(lambda: proc.poll() is not None or observer.has_node(node_name),
                         ARRIVAL_TIMEOUT_S)
-    if proc.poll() is None:
-        observer.spins(node_name)
+    spinning = proc.poll() is None and observer.spins(node_name)
     if proc.poll() is not None:
         text = output.text()
         if 'NotImplementedError' in text:
             raise CheckFailed(f'main() still raises NotImplementedError: write part {part} where '
                               'it says YOUR CODE HERE.')
         if 'Traceback' in text:
-            raise CheckFailed(f'{path.name} crashed before Ctrl+C ({last_line(text)}): fix that '
-                              'first; the checks of the parts above show where.')
+            raise CheckFailed(f'{path.name} crashed before Ctrl+C{_crash_place(text, path)} '
+                              f'({_error_line(text)}): fix that line, then run this check again.')
         raise CheckFailed(f'{path.name} ended by itself before Ctrl+C (exit code '
                           f'{proc.returncode}); main() should spin until Ctrl+C.')
     interrupt(proc)
@@ -95,6 +94,11 @@ def run_main(judge: Judge, relative: str, node_name: str, part: int = 5) -> str:
         raise CheckFailed(f'{path.name} did not stop within {EXIT_AFTER_CTRL_C_S:g} s of Ctrl+C: '
                           'let KeyboardInterrupt end the spin.') from None
     text = output.text()
+    stuck = _last_frame(text, path)
+    if not spinning and stuck is not None and stuck[1] != 'main':
+        raise CheckFailed(f'{path.name} never reached its spin: line {stuck[0]} in {stuck[1]} '
+                          f'({stuck[2]}) was still running at Ctrl+C; no loop in a constructor or '
+                          'callback: repeat work with a timer (create_timer) and let main() spin.')
     if code != 0 or 'Traceback' in text:
         last = _error_line(text)
         already = any(mark in last for mark in ALREADY_SHUT_DOWN_MARKS)
@@ -136,6 +140,22 @@ def _error_line(text: str) -> str:
     line = last_line(text)
     line = re.sub(r'^(?:[A-Za-z_][\w]*\.)+(?=\w+(?:Error|Exception)\b)', '', line)
     return re.sub(r', at /\S+:\d+$', '', line)
+
+
+def _last_frame(text: str, path) -> Optional[tuple[int, str, str]]:
+    """(line, function, source) of the learner's file's last frame in a traceback, or None."""
+    frames = re.findall(rf'File "{re.escape(str(path))}", line (\d+), in (\w+)', text)
+    if not frames:
+        return None
+    number, function = int(frames[-1][0]), frames[-1][1]
+    lines = path.read_text().splitlines()
+    return number, function, lines[number - 1].strip() if 0 < number <= len(lines) else ''
+
+
+def _crash_place(text: str, path) -> str:
+    """`` at line N (source)`` for the learner's file's last frame in a traceback, or ''."""
+    frame = _last_frame(text, path)
+    return '' if frame is None else f' at line {frame[0]} ({frame[2]})'
 
 
 def last_line(text: str) -> str:

@@ -10,7 +10,19 @@ from typing import Any, Optional
 
 from .. import course
 from ..errors import CheckFailed
+from ..terminal.files import missing_parts
 from .base import ARRIVAL_TIMEOUT_S, Judge, learner_error
+
+
+def parts_verdict(workspace: Path, relative: str) -> None:
+    """Raise CheckFailed naming the ``%%part`` cells of ``relative`` never run, if any."""
+    gaps = missing_parts(workspace, relative)
+    if gaps:
+        many = len(gaps) > 1
+        raise CheckFailed(f'{Path(relative).name} is missing part{"s" if many else ""} '
+                          f'{", ".join(map(str, gaps))}: run the %%part cell{"s" if many else ""} '
+                          f'for {"them" if many else "it"} (parts go into the file in number '
+                          'order), then this check again.')
 
 
 def new_node(judge: Judge, relative: str, cls: str, *, placeholders: tuple[str, ...] = (),
@@ -21,6 +33,8 @@ def new_node(judge: Judge, relative: str, cls: str, *, placeholders: tuple[str, 
     reply = subject.request('new_node', cls=cls, placeholders=list(placeholders),
                             attributes=list(attributes), seed=seed, args=list(args))
     file = Path(relative).name
+    if reply.get('no_class') or not reply.get('ok'):
+        parts_verdict(judge.workspace, relative)
     if reply.get('no_class'):
         others = reply['classes']
         hint = (f' (it defines {", ".join(others)}: names must match exactly; the tutorial '

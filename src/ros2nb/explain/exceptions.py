@@ -19,7 +19,7 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any, Optional
 
-from rclpy.exceptions import NotInitializedException
+from rclpy.exceptions import NameValidationException, NotInitializedException
 
 from ..errors import SHUT_DOWN_MESSAGE
 
@@ -56,12 +56,35 @@ def _learner_entry(exc: BaseException) -> Optional[TracebackType]:
 def learner_line(exc: BaseException) -> str:
     """Return ``cell line N: source`` or ``FILE line N: source`` for the learner's innermost frame."""
     entry = _learner_entry(exc)
-    if entry is None:
-        return ''
-    filename = entry.tb_frame.f_code.co_filename
+    if entry is not None:
+        filename, number = entry.tb_frame.f_code.co_filename, entry.tb_lineno
+    else:  # ROS called a function of the learner's wrongly (a callback's signature)
+        code = _called_code(exc)
+        if code is None:
+            return ''
+        filename, number = code.co_filename, code.co_firstlineno
     path = Path(filename)
     place = path.name if path.is_file() and 'ipykernel' not in filename else 'cell'
-    return f'{place} line {entry.tb_lineno}: {linecache.getline(filename, entry.tb_lineno).strip()}'
+    return f'{place} line {number}: {linecache.getline(filename, number).strip()}'
+
+
+_SIGNATURE = re.compile(r'^(?P<name>[\w.]+)\(\) (?:takes (?P<takes>\d+) positional arguments? '
+                        r'but (?P<given>\d+) (?:was|were) given|missing \d+ required positional)')
+
+
+def _called_code(exc: BaseException) -> Any:
+    """The code of the learner's function that rclpy called with the wrong arguments, or None."""
+    match = _SIGNATURE.match(str(exc)) if isinstance(exc, TypeError) else None
+    frames = list(_frames(exc))
+    if match is None or not frames or not is_library_file(frames[-1].f_code.co_filename):
+        return None
+    for value in frames[-1].f_locals.values():
+        function = getattr(value, '__func__', value)
+        code = getattr(function, '__code__', None)
+        if code is not None and getattr(function, '__qualname__', '') == match['name'] \
+                and not is_library_file(code.co_filename):
+            return code
+    return None
 
 
 def _frames(exc: BaseException):
@@ -69,6 +92,13 @@ def _frames(exc: BaseException):
     while tb is not None:
         yield tb.tb_frame
         tb = tb.tb_next
+
+
+def _raised_in(exc: BaseException, function: str) -> bool:
+    """True when the innermost frame of ``exc`` is a library function named ``function``."""
+    frames = list(_frames(exc))
+    return bool(frames) and frames[-1].f_code.co_name == function and \
+        is_library_file(frames[-1].f_code.co_filename)
 
 
 _FIELD_TYPE = re.compile(r"The '(\w+)' field must be of type '([\w.]+)'")
@@ -157,6 +187,20 @@ def explain_exception(exc: BaseException, *, ros_started: bool = False) -> Optio
         traceback is then the best explanation).
     """
     text = str(exc)
+    if isinstance(exc, NameValidationException):
+        return _invalid_name(exc)
+    if _called_code(exc) is not None:
+        return _callback_signature(exc)
+    if isinstance(exc, RuntimeError) and 'callback should be either be callable with one' in text:
+        return _subscription_callback(exc)
+    if type(exc).__name__ == 'RCLError' and 'timer period must be non-negative' in text:
+        return ('create_timer got a negative period: give the period in seconds as a positive '
+                'number, e.g. self.create_timer(1.0, self.publish_temperature).')
+    if isinstance(exc, (TypeError, ValueError)) and _is_qos_mistake(exc):
+        return _qos_advice(exc)
+    if isinstance(exc, FileExistsError) and _raised_in(exc, 'mkdir'):
+        return (f'{exc.filename} already exists, and mkdir() without exist_ok refuses an existing '
+                'folder, like mkdir without -p: mkdir(parents=True, exist_ok=True) is mkdir -p.')
     if isinstance(exc, NotInitializedException):
         if ros_started:
             return SHUT_DOWN_MESSAGE
@@ -166,6 +210,9 @@ def explain_exception(exc: BaseException, *, ros_started: bool = False) -> Optio
         return ('rclpy.init() was called, but ros2nb.start() already brought ROS 2 up in this '
                 'kernel: remove that call; to run a node here hand it to ros2nb.add(node) '
                 '(main() is for `ros2 run`, notebook 05).')
+    if type(exc).__name__ == 'InvalidQoSProfileException':
+        return ('a QoSProfile needs its history depth: QoSProfile(depth=10), or pass just the '
+                'depth, 10.')
     if isinstance(exc, AssertionError):
         return _field_type(exc)
     if isinstance(exc, AttributeError):
@@ -182,3 +229,59 @@ def explain_exception(exc: BaseException, *, ros_started: bool = False) -> Optio
     if isinstance(exc, TypeError):
         return _message_not_a_value(exc)
     return None
+
+
+def _invalid_name(exc: BaseException) -> str:
+    """A node, topic or namespace name with a character ROS forbids."""
+    first, _, rest = str(exc).partition('\n')
+    kind, _, reason = first.partition(': ')
+    kind = kind.replace('Invalid ', '')
+    name_line = rest.strip().splitlines()[0] if rest.strip() else ''
+    name = name_line.strip().strip("'")
+    allowed = r'[^A-Za-z0-9_]' if kind == 'node name' else r'[^A-Za-z0-9_/~{}]'
+    fixed = re.sub(allowed, '_', name)
+    if fixed[:1].isdigit():
+        fixed = '_' + fixed
+    return (f"'{name}' is not a valid ROS {kind}: {reason.rstrip(':')}; write it as "
+            f"'{fixed}' (letters, digits and _).")
+
+
+def _callback_signature(exc: BaseException) -> str:
+    """ROS called a callback with other arguments than it takes."""
+    match = _SIGNATURE.match(str(exc))
+    assert match is not None
+    name = match['name']
+    short, me = name.rpartition('.')[2], ('self, ' if '.' in name else '')
+    given = list(_frames(exc))[-1].f_locals.get('args', ())
+    if given:
+        return (f'ROS calls {name}() with the message it received (a subscription callback): '
+                f'define it as def {short}({me}msg) and read msg.data.')
+    return (f'ROS calls {name}() with no arguments (a timer callback): define it as '
+            f'def {short}({me.rstrip(", ")}) and keep what it needs on self.')
+
+
+def _subscription_callback(exc: BaseException) -> str:
+    """rclpy refused a subscription callback that cannot take the message."""
+    callback = list(_frames(exc))[-1].f_locals.get('value')
+    name = getattr(callback, '__qualname__', 'the callback')
+    short, me = name.rpartition('.')[2], ('self, ' if '.' in name else '')
+    return (f'the subscription\'s callback {name}() must take the message ROS hands it: define '
+            f'it as def {short}({me}msg) and read msg.data.')
+
+
+def _is_qos_mistake(exc: BaseException) -> bool:
+    text = str(exc)
+    return ("'qos_profile'" in text or 'history depth must be' in text
+            or text.startswith("Node.create_publisher()") or text.startswith('Node.create_subscription()'))
+
+
+def _qos_advice(exc: BaseException) -> str:
+    """The queue depth (QoS) of create_publisher / create_subscription given wrongly."""
+    usage = ("create_publisher(Float32, 'temperature', 10) and create_subscription(Float32, "
+             "'temperature', self.callback, 10)")
+    text = str(exc)
+    if 'history depth must be' in text:
+        return f'the queue depth must be 0 or more (10 is usual): {usage}.'
+    if "missing 1 required positional argument: 'qos_profile'" in text:
+        return f'the queue depth (QoS) is missing after the topic: {usage}.'
+    return f'{text.split(": ", 1)[-1]}: the calls are {usage}.'

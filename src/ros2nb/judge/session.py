@@ -17,6 +17,7 @@ from std_msgs.msg import Float32
 
 from .. import course
 from ..checks.base import AnswerRef, learner_error
+from ..checks.nodes import parts_verdict
 from ..errors import CheckFailed
 from ..processes import kill_process_group
 from .observer import Observer
@@ -81,6 +82,7 @@ class Session:
                 raise CheckFailed(f'{path.name} does not exist yet: run the %%part cells that '
                                   'write it, from part 1 on.')
             if not reply['ok']:
+                parts_verdict(self.workspace, relative)  # a part never run explains it best
                 raise learner_error(path.name, reply['error'], context=' on import')
 
         return self.subject(('file', relative), load)

@@ -4,6 +4,7 @@ Introduced in ``00-setup-and-the-pubsub-idea.ipynb``.  :func:`ros2nb.start` inst
 a notebook; ``%load_ext ros2nb`` does too (notebook 05 runs no ROS in the kernel).
 Runs in the learner's kernel.
 
+- ``rclpy.spin(node)`` in a cell says what to use instead of blocking the kernel.
 - ``%%part FILE N [--overwrite]`` saves the cell as part N of FILE (:func:`ros2nb.write_part`).
 - Known beginner mistakes raised through rclpy or a message class show as one line
   naming the learner's own line (:mod:`ros2nb.explain`); other errors keep their normal
@@ -20,14 +21,29 @@ from __future__ import annotations
 import re
 import shlex
 import sys
+import threading
 from typing import Any, Optional
 
-from ..errors import UsageError
+import rclpy
+
+from ..errors import Ros2nbError, UsageError
 from ..explain.exceptions import explain_exception, learner_line
 from ..runtime import kernel_runtime
 from ..terminal.files import write_part
 
 _INSTALLED = '_ros2nb_installed'
+_original_spin = rclpy.spin
+
+
+def _spin_in_a_cell(node: Any, executor: Any = None) -> None:
+    """``rclpy.spin`` in a kernel: from a cell it explains instead of blocking the kernel."""
+    if threading.current_thread() is threading.main_thread():
+        first = ('' if kernel_runtime() is not None else
+                 'run ros2nb.start() instead of rclpy.init(), then ')
+        raise Ros2nbError('rclpy.spin(node) never returns in a notebook cell (it would block the '
+                          f'kernel until you press Stop): {first}hand the node over with '
+                          'ros2nb.add(node) and let it run with ros2nb.spin(seconds).')
+    return _original_spin(node, executor)
 
 
 def part(line: str, cell: str) -> None:
@@ -93,5 +109,6 @@ def install(ip: Any = None) -> bool:
     ip.events.register('pre_run_cell', _before_cell)
     ip.events.register('post_run_cell', _after_cell)
     ip.set_custom_exc((Exception,), _explain)
+    rclpy.spin = _spin_in_a_cell
     setattr(ip, _INSTALLED, True)
     return True

@@ -7,7 +7,12 @@ Introduced in ``00-setup-and-the-pubsub-idea.ipynb``.  They run the kernel's one
 from __future__ import annotations
 
 import atexit
+import contextlib
+import difflib
+import io
+import itertools
 import math
+import sys
 import os
 import threading
 import time
@@ -22,18 +27,6 @@ from ..explain.guards import guard_endpoint_types
 from ..runtime import NodeOrName, Runtime, current_runtime, enable_field_checks, kernel_runtime
 from ..runtime.current import participant_prefix, set_kernel_runtime
 from . import ipython
-
-_original_spin = rclpy.spin
-
-
-def _spin_in_a_cell(node, executor=None) -> None:
-    """``rclpy.spin`` as ros2nb installs it in a kernel: from a cell it explains instead of blocking."""
-    if kernel_runtime() is not None and threading.current_thread() is threading.main_thread():
-        raise Ros2nbError('rclpy.spin(node) never returns in a notebook cell (it spins until '
-                          'Ctrl+C): hand the node over with ros2nb.add(node) and let it run with '
-                          'ros2nb.spin(seconds).')
-    return _original_spin(node, executor)
-
 
 def _describe(rt: Runtime) -> str:
     clock = 'simulated time' if rt.sim_time else 'wall-clock time'
@@ -88,8 +81,7 @@ def start(*, domain_id: Optional[int] = None, sim_time: Optional[bool] = None) -
     set_kernel_runtime(rt)
     atexit.register(shutdown)
     guard_endpoint_types(participant_prefix)
-    if ipython.install():  # inside IPython: cell hooks, one-line errors, %%part
-        rclpy.spin = _spin_in_a_cell
+    ipython.install()  # inside IPython: cell hooks, one-line errors, %%part, rclpy.spin explained
     print(f'ROS 2 is up in this kernel: {_describe(rt)}.')
     return rt
 
@@ -156,6 +148,58 @@ def _check_seconds(seconds: float) -> None:
         raise UsageError(f'seconds must be a number of seconds, zero or more (got {seconds!r}).')
 
 
+class _HeldOutput:
+    """What a simulated spin prints, held in order until the spin ends."""
+
+    def __init__(self) -> None:
+        self.writes: list[tuple[str, str]] = []
+        self.stdout, self.stderr = _HeldStream(self.writes, 'stdout'), _HeldStream(self.writes, 'stderr')
+
+    def replay(self, *, errors_only: bool = False) -> int:
+        """Write what was held, in order (only callback failures if ``errors_only``).
+
+        :return: the number of lines of standard output left out.
+        """
+        writes, self.writes[:] = list(self.writes), []
+        dropped = ''.join(text for name, text in writes if name == 'stdout') if errors_only else ''
+        kept = [(name, text) for name, text in writes if not (errors_only and name == 'stdout')]
+        for name, group in itertools.groupby(kept, key=lambda write: write[0]):
+            stream = getattr(sys, name)
+            stream.write(''.join(text for _name, text in group))  # one output per run of lines
+            stream.flush()
+        return len(dropped.splitlines())
+
+
+class _HeldStream(io.TextIOBase):
+    def __init__(self, writes: list[tuple[str, str]], name: str) -> None:
+        super().__init__()
+        self._writes, self._name = writes, name
+
+    def write(self, text: str) -> int:
+        if text:
+            self._writes.append((self._name, text))
+        return len(text)
+
+
+def _unheard_subscriptions(rt: Runtime) -> list[str]:
+    """One line per subscription of the kernel's nodes whose topic has no publisher while a
+    topic of a similar name (a misspelling) has one."""
+    graph = rt.node
+    published = [name for name, _types in graph.get_topic_names_and_types()
+                 if graph.count_publishers(name)]
+    lines = []
+    for node in rt.nodes.values():
+        for subscription in node.subscriptions:
+            topic = subscription.topic_name
+            if topic in published:
+                continue
+            close = difflib.get_close_matches(topic, published, n=1, cutoff=0.8)
+            if close:
+                lines.append(f'{node.get_name()} subscribes to {topic}, which has no publisher, '
+                             f'but {close[0]} has one: check the topic name in create_subscription.')
+    return lines
+
+
 def spin(seconds: float, *, sim_time: Optional[bool] = None, show_logs: bool = True) -> float:
     """Let the nodes run for ``seconds`` and print their log lines in this cell.
 
@@ -183,19 +227,23 @@ def spin(seconds: float, *, sim_time: Optional[bool] = None, show_logs: bool = T
         print('No nodes are running in this kernel: hand yours over with ros2nb.add(node), '
               'then spin.')
         return 0.0
-    taken = 0
+    taken, held = 0, _HeldOutput()  # a simulated spin shows its lines when it ends
 
     def flush() -> None:
         nonlocal taken
         taken += rt.print_pending(show_logs=show_logs)
 
+    def flush_held() -> None:
+        with contextlib.redirect_stdout(held.stdout), contextlib.redirect_stderr(held.stderr):
+            flush()
+
     flush()
-    ran = 0.0
-    started_ns, started_wall = rt.sim_now_ns, time.monotonic()
+    ran, started_ns, started_wall = 0.0, rt.sim_now_ns, time.monotonic()
     try:
         with rt.clock(use_sim):
             if use_sim:
-                ran = rt.advance_sim_time(seconds, on_step=flush)
+                ran = rt.advance_sim_time(seconds, on_step=flush_held)
+                held.replay()
             else:
                 deadline = time.monotonic() + seconds
                 while (left := deadline - time.monotonic()) > 0:
@@ -205,16 +253,32 @@ def spin(seconds: float, *, sim_time: Optional[bool] = None, show_logs: bool = T
     except KeyboardInterrupt:
         ran = ((rt.sim_now_ns - started_ns) / 1e9 if use_sim
                else time.monotonic() - started_wall)
-        flush()
-        print(f'Interrupted after {ran:.1f} of {seconds:g} {"simulated " if use_sim else ""}'
-              's; the nodes wait until the next spin (ros2nb.stop() stops them).')
+        flush_held()
+        _say_interrupted(rt, held, ran, seconds, use_sim)
         return ran
     flush()
+    _say_done(rt, taken, seconds, show_logs)
+    return ran
+
+
+def _say_interrupted(rt: Runtime, held: '_HeldOutput', ran: float, seconds: float,
+                     use_sim: bool) -> None:
+    """The one line of a spin ended by the Stop button (a simulated spin's log lines dropped)."""
+    hidden = ' (its log lines are not shown)' if held.replay(errors_only=True) else ''
+    if use_sim:
+        rt.mute_cell()  # lines still on their way over /rosout would follow the line below
+    print(f'Interrupted after {ran:.1f} of {seconds:g} {"simulated " if use_sim else ""}'
+          f's{hidden}; the nodes wait until the next spin (ros2nb.stop() stops them).')
+
+
+def _say_done(rt: Runtime, taken: int, seconds: float, show_logs: bool) -> None:
+    """What a spin that ran its time adds: unheard subscriptions, hidden or missing log lines."""
+    for line in _unheard_subscriptions(rt):
+        print(line)
     if not show_logs:
         print(f'({taken} log lines hidden)')
     elif taken == 0:
         print(f'(no log lines in {seconds:g} s; running: {", ".join(sorted(rt.nodes))})')
-    return ran
 
 
 def shutdown() -> None:

@@ -53,6 +53,7 @@ class LogLines:
         self._log_lines: collections.deque[tuple] = collections.deque()
         self._overflow = 0
         self._epoch = 0
+        self._muted_epoch = -1
         self._lock = threading.Lock()
 
     def own_logger(self, name: str) -> None:
@@ -67,6 +68,10 @@ class LogLines:
         """
         with self._lock:
             self._our_loggers &= running
+
+    def mute_cell(self) -> None:
+        """Show no more log lines of the running cell (an interrupted simulated spin)."""
+        self._muted_epoch = self._epoch
 
     def begin_cell(self) -> None:
         """A new cell starts: lines made before it are no longer news (IPython pre_run_cell)."""
@@ -119,6 +124,8 @@ class LogLines:
             elif name is None or self.is_ours(name):
                 if epoch < self._epoch:
                     earlier += 1
+                    continue
+                if epoch == self._muted_epoch:
                     continue
                 taken += 1
                 lines.append(text if name is None else

@@ -136,6 +136,7 @@ def destroy_stray_nodes(context: rclpy.context.Context) -> None:
     the new node's log lines would stop reaching the cell part-way through a spin.
     """
     for candidate in gc.get_objects():
-        if isinstance(candidate, Node) and candidate.context is context:
+        # a half-built node (its __init__ never called super().__init__) has no context
+        if isinstance(candidate, Node) and getattr(candidate, '_context', None) is context:
             with contextlib.suppress(Exception):  # already destroyed, or half-built
                 candidate.destroy_node()

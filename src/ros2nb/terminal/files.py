@@ -24,6 +24,8 @@ WRITTEN_RECORD = '.ros2nb-written.json'
 PARTS_RECORD = '.ros2nb-parts.json'
 #: nbgrader's marker lines around an answer in the course's own notebooks; not part of a file.
 AUTHOR_MARKERS = ('### BEGIN SOLUTION', '### END SOLUTION')
+#: What nbgrader leaves in an answer cell the learner has not written yet.
+PLACEHOLDER = 'raise NotImplementedError'
 
 
 def _digest(text: str) -> str:
@@ -133,6 +135,21 @@ def _parts_of(path: Path) -> Iterator[dict[int, str]]:
     record_file.write_text(json.dumps(record, indent=1, sort_keys=True) + '\n')
 
 
+def missing_parts(workspace: Path, relative: str) -> list[int]:
+    """The part numbers below the highest saved part of ``relative`` that were never saved.
+
+    Read from the workspace's ``.ros2nb-parts.json`` (what ``%%part`` cells saved).
+    Introduced in ``03-write-the-publisher.ipynb`` (checks name a part run out of order).
+    """
+    record_file = workspace / PARTS_RECORD
+    try:
+        record = json.loads(record_file.read_text()) if record_file.is_file() else {}
+    except ValueError:
+        return []
+    saved = {int(n) for n in record.get(relative, {})}
+    return [n for n in range(1, max(saved, default=0)) if n not in saved]
+
+
 def write_part(path: PathLike, number: int, text: str, *, overwrite: bool = False) -> Path:
     """Set part ``number`` of a source file and write the file from all its parts.
 
@@ -150,6 +167,10 @@ def write_part(path: PathLike, number: int, text: str, *, overwrite: bool = Fals
     :param overwrite: as for :func:`write_file`.
     :return: the file's absolute path.
     :raises FileProtectedError: as :func:`write_file`.
+
+    A part that still holds nbgrader's placeholder (``raise NotImplementedError()``) never
+    replaces working content (a file written before, or the same part without it) unless
+    ``overwrite`` is true: one line says so, and nothing is written.
     """
     if isinstance(number, bool) or not isinstance(number, int) or number < 1:
         raise UsageError(f'A part number is a whole number from 1 up (got {number!r}).')
@@ -157,6 +178,14 @@ def write_part(path: PathLike, number: int, text: str, *, overwrite: bool = Fals
     resolved = workspace_file(path)
     with _parts_of(resolved) as parts:
         replaces = resolved.is_file() and not parts
+        working = resolved.read_text() if replaces else parts.get(number)
+        if PLACEHOLDER in text and working is not None and PLACEHOLDER not in working \
+                and not overwrite:
+            print(f'{shown(resolved)} was not changed: this cell still holds the placeholder '
+                  f'"{PLACEHOLDER}()", which would replace the working version; write your '
+                  'answer in its place and run the cell again (to replace it on purpose, add '
+                  '--overwrite to the %%part line).')
+            return resolved.resolve()
         new_parts = {**parts, number: text.rstrip('\n') + '\n'}
         written = write_file(resolved, '\n\n'.join(new_parts[n].rstrip('\n')
                                                    for n in sorted(new_parts)) + '\n',
@@ -164,7 +193,10 @@ def write_part(path: PathLike, number: int, text: str, *, overwrite: bool = Fals
         parts.clear()
         parts.update(new_parts)
     lines = written.read_text().count('\n')
+    gaps = [n for n in range(1, max(parts)) if n not in parts]
+    gap = (f'; part{"s" if len(gaps) > 1 else ""} {", ".join(map(str, gaps))} not saved yet: '
+           f'run {"its cell" if len(gaps) == 1 else "their cells"} too' if gaps else '')
     print(f'{shown(written)}: part {number} saved (parts {", ".join(map(str, sorted(parts)))}; '
-          f'{lines} lines)' + (' (it replaces the file ros2nb wrote there before)' if replaces
-                               else ''))
+          f'{lines} lines{gap})' + (' (it replaces the file ros2nb wrote there before)'
+                                    if replaces else ''))
     return written

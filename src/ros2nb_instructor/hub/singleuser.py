@@ -8,11 +8,14 @@ JupyterHub's spawner runs this as the learner, with ``HOME`` set to the learner'
 
 1. creates that folder (readable by the learner only) and copies every learner notebook of
    the course (``notebooks/*.ipynb``) that is not there yet into its ``notebooks/``. It never
-   replaces a notebook, so the learner's work survives restarts, and a course update only
-   adds the notebooks that are new;
+   replaces a notebook the learner has, so their work survives restarts; a changed course
+   notebook goes beside theirs as ``NN-title (course update).ipynb`` (as ``make lab`` does,
+   :mod:`ros2nb_instructor.lab`);
 2. gives the learner their own ROS workspace, ``<course folder>/workspace/ROS2_and_RL_Tutorials``
    (``ROS2NB_WORKSPACE``, which ros2nb reads);
-3. puts the course's venv first on ``PATH`` and becomes ``jupyterhub-singleuser`` with the
+3. gives the server the learner's Jupyter configuration (no nbgrader instructor tools, no
+   news pop-up, no Extension Manager: ``environment/jupyter-learner``);
+4. puts the course's venv first on ``PATH`` and becomes ``jupyterhub-singleuser`` with the
    arguments the hub passed.
 
 ``make hub`` first runs it as ``ros2nb-hub-singleuser --check``: when the hub runs as root (so
@@ -31,6 +34,8 @@ from typing import Mapping, MutableMapping, NoReturn, Optional
 
 from ros2nb.terminal.workspace import WORKSPACE_NAME
 
+from .. import lab
+from ..lab import update_work_folder
 from ..paths import NOTEBOOKS, ROOT
 
 #: The course repository.
@@ -45,29 +50,25 @@ def learner_folder(env: Mapping[str, str]) -> Path:
 
 
 def copy_missing_notebooks(source: Path, folder: Path) -> list[str]:
-    """Copy each ``*.ipynb`` of ``source`` that ``folder/notebooks`` lacks; never overwrite.
+    """Bring the course's notebooks into ``folder/notebooks`` as ``make lab`` does; never overwrite.
+
+    A notebook the learner has is kept; a changed course version goes beside it
+    (:func:`ros2nb_instructor.lab.update_work_folder`).
 
     :param source: the course's ``notebooks/``.
     :param folder: the learner's course folder; created readable by its owner only.
-    :return: the names of the notebooks copied.
+    :return: one line per notebook copied, updated or offered beside the learner's.
     """
     folder.mkdir(mode=0o700, parents=True, exist_ok=True)
-    target = folder / 'notebooks'
-    target.mkdir(exist_ok=True)
-    copied = []
-    for notebook in sorted(source.glob('*.ipynb')):
-        destination = target / notebook.name
-        if not destination.exists() and not destination.is_symlink():
-            shutil.copyfile(notebook, destination)
-            copied.append(notebook.name)
-    return copied
+    return update_work_folder(source, folder / 'notebooks')
 
 
 def learner_environment(env: MutableMapping[str, str], folder: Path, venv_bin: Path) -> None:
-    """Give the learner their own ROS workspace and the course's venv first on ``PATH``."""
+    """Give the learner their own ROS workspace, the course's venv first on ``PATH``, the learner's lab."""
     env.setdefault('ROS2NB_WORKSPACE', str(folder / 'workspace' / WORKSPACE_NAME))
     env['PATH'] = os.pathsep.join([str(venv_bin), env.get('PATH', os.defpath)])
     env['VIRTUAL_ENV'] = str(venv_bin.parent)
+    lab.learner_environment(env)  # nbgrader's instructor tools, news and Extension Manager off
 
 
 def closed_to_others(path: Path, *, need: int) -> Optional[Path]:
@@ -108,9 +109,8 @@ def main(argv: Optional[list[str]] = None) -> NoReturn:
     if not server.exists():
         sys.exit(f'{server} is missing: run `make setup` in {COURSE} (it installs jupyterhub).')
     folder = learner_folder(os.environ)
-    copied = copy_missing_notebooks(NOTEBOOKS, folder)
-    if copied:
-        print(f'ros2-course: copied {", ".join(copied)} to {folder / "notebooks"}', file=sys.stderr)
+    for line in copy_missing_notebooks(NOTEBOOKS, folder):
+        print(f'ros2-course: {line}', file=sys.stderr)
     learner_environment(os.environ, folder, venv_bin)
     os.execv(server, [str(server), *argv])
 

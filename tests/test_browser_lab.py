@@ -1,0 +1,184 @@
+"""The learner's lab in a real browser: what ``make lab`` starts, driven as a learner would.
+
+One JupyterLab server, started by ``ros2nb-lab`` as ``make lab`` starts it (the learner's
+configuration, a working folder of its own, a token), and one headless chromium, shared
+by the tests of this module in file order:
+
+1. a learner notebook shows no instructor tool (no Nbgrader menu, no Create Assignment
+   panel, no Validate button) and no news pop-up;
+2. a finished notebook (01, the cheapest) runs to the end with Run All Cells, its check
+   passing in its own cell;
+3. Interrupt stops a running spin within 1 s, with one line.
+
+Screenshots go to a temporary folder whose name the tests print (``-s`` shows it).
+"""
+
+from __future__ import annotations
+
+import os
+import secrets
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+from pathlib import Path
+
+import nbformat
+import pytest
+
+import browser
+from waiting import PATIENCE_S, wait_for
+
+pytestmark = pytest.mark.timeout(600)
+
+ROOT = Path(__file__).resolve().parent.parent
+NOTEBOOK = '01-create-a-workspace.ipynb'
+#: How fast Interrupt must stop a spin (s), from the click to the cell's end.
+INTERRUPT_WITHIN_S = 1.0
+#: A cell that spins a ticking node for longer than any test waits, announcing the spin first.
+SPIN_CELL = ("from rclpy.node import Node\n"
+             "class Ticker(Node):\n"
+             "    def __init__(self):\n"
+             "        super().__init__('ticker')\n"
+             "        self.create_timer(1.0, lambda: self.get_logger().info('tick'))\n"
+             "ticker = ros2nb.add(Ticker())\n"
+             "print('spinning')\n"
+             "_ = ros2nb.spin(10 ** 7)\n")
+#: The notebook's cells are all there and its kernel is idle (the status bar says so).
+NOTEBOOK_READY = ("n => document.querySelectorAll('.jp-Notebook .jp-CodeCell').length === n && "
+                  "(document.querySelector('#jp-main-statusbar') || {innerText: ''})"
+                  ".innerText.includes('| Idle')")
+CELL_DONE = ("i => !document.querySelectorAll('.jp-Notebook .jp-CodeCell .jp-InputPrompt')[i]"
+             ".textContent.includes('*')")
+INSTRUCTOR_TEXTS = ('Nbgrader', 'Create Assignment', 'Formgrader', 'Course List',
+                    'Assignment List', 'Validate', 'Extension Manager')
+NEWS_TEXT = 'official Jupyter news'
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(('127.0.0.1', 0))
+        return s.getsockname()[1]
+
+
+def answers(url: str) -> bool:
+    try:
+        with urllib.request.urlopen(url, timeout=2) as response:
+            return response.status == 200
+    except OSError:
+        return False
+
+
+@pytest.fixture(scope='module')
+def lab(tmp_path_factory):
+    """A learner's lab (``ros2nb-lab``) on a free port with a token, and a page on notebook 01."""
+    why = browser.problem()
+    if why:
+        pytest.skip(why)
+    home = tmp_path_factory.mktemp('learners-lab')
+    work = home / 'work'
+    work.mkdir()
+    shutil.copyfile(ROOT / 'solutions' / NOTEBOOK, work / NOTEBOOK)  # a learner who finished 01
+    env = {k: v for k, v in os.environ.items()
+           if k not in ('ROS_DOMAIN_ID', 'JUPYTER_CONFIG_PATH', 'PYTEST_CURRENT_TEST')}
+    env.update(JUPYTER_CONFIG_DIR=str(home / 'config'), JUPYTER_DATA_DIR=str(home / 'data'),
+               JUPYTER_RUNTIME_DIR=str(home / 'runtime'), IPYTHONDIR=str(home / 'ipython'),
+               ROS2NB_WORK=str(work), ROS2NB_WORKSPACE=str(home / 'ws'))
+    port, token = free_port(), secrets.token_hex(16)
+    server = subprocess.Popen(
+        [str(Path(sys.executable).parent / 'ros2nb-lab'), f'--ServerApp.port={port}',
+         '--ServerApp.port_retries=0', '--ServerApp.open_browser=False',
+         f'--IdentityProvider.token={token}'],
+        env=env, stdout=subprocess.DEVNULL, stderr=open(home / 'server.log', 'w'),
+        start_new_session=True)
+    base = f'http://127.0.0.1:{port}'
+    try:
+        wait_for(lambda: server.poll() is not None or answers(f'{base}/api/status?token={token}'),
+                 'the learner\'s lab answering', seen=lambda: (home / 'server.log').read_text()[-800:])
+        assert server.poll() is None, (home / 'server.log').read_text()
+        shots = Path(tmp_path_factory.mktemp('lab-screenshots'))
+        print(f'\nscreenshots: {shots}')
+        with browser.chromium() as chromium:
+            context = chromium.new_context(viewport={'width': 1400, 'height': 900})
+            page = context.new_page()
+            page.goto(f'{base}/lab/tree/{NOTEBOOK}?token={token}')
+            code_cells = sum(c.cell_type == 'code' for c in nbformat.read(work / NOTEBOOK, 4).cells)
+            page.wait_for_function(NOTEBOOK_READY, arg=code_cells, timeout=1000 * PATIENCE_S)
+            yield page, shots, work
+            context.close()
+    finally:
+        os.killpg(server.pid, signal.SIGTERM)
+        try:
+            server.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            os.killpg(server.pid, signal.SIGKILL)
+            server.wait()
+
+
+def menu(page, top: str, item: str) -> None:
+    """Choose ``top`` > ``item`` in JupyterLab's menu bar."""
+    page.click(f'.lm-MenuBar-itemLabel:text-is("{top}")')
+    page.click(f'.lm-Menu-itemLabel:text-is("{item}")')
+
+
+def prompts(page) -> list[str]:
+    return page.eval_on_selector_all('.jp-Notebook .jp-CodeCell .jp-InputPrompt',
+                                     'els => els.map(e => e.textContent.trim())')
+
+
+def test_no_instructor_tool_and_no_news_popup(lab):
+    page, shots, work = lab
+    labels = page.eval_on_selector_all('.lm-MenuBar-itemLabel', 'els => els.map(e => e.textContent)')
+    assert {'File', 'Run', 'Kernel'} <= set(labels), labels  # the menu bar is there, and read
+    assert 'Nbgrader' not in labels, labels
+    shown = page.inner_text('body')
+    for text in INSTRUCTOR_TEXTS:
+        assert text not in shown, text
+    assert page.locator('button:has-text("Validate"), jp-button:has-text("Validate")').count() == 0
+    news = page.evaluate("JSON.parse(document.getElementById('jupyter-config-data').textContent).news")
+    assert news == {'disabled': True}
+    assert NEWS_TEXT not in shown
+    assert (work / '00-setup-and-the-pubsub-idea.ipynb').is_file()  # the course's, copied in
+    page.screenshot(path=str(shots / 'learner-lab-01-opened.png'))
+
+
+def test_a_finished_notebook_runs_to_the_end_with_its_check_passing(lab):
+    page, shots, _ = lab
+    menu(page, 'Edit', 'Clear Outputs of All Cells')
+    wait_for(lambda: all(p in ('[ ]:', '') for p in prompts(page)), 'outputs cleared',
+             seen=lambda: prompts(page))
+    menu(page, 'Run', 'Run All Cells')
+    wait_for(lambda: all(p[1:-2].isdigit() for p in prompts(page)), 'every cell run',
+             seen=lambda: prompts(page))
+    checks = page.locator('.jp-CodeCell:has(.jp-InputArea:has-text("ros2nb.checks."))')
+    assert checks.count() >= 1
+    for index in range(checks.count()):
+        output = checks.nth(index).locator('.jp-OutputArea').inner_text()
+        assert output.strip().startswith('Check passed:') and '\n' not in output.strip(), output
+    page.screenshot(path=str(shots / 'learner-lab-01-run-all.png'), full_page=True)
+
+
+def test_interrupt_stops_a_spin_within_a_second_with_one_line(lab):
+    page, shots, _ = lab
+    index = page.locator('.jp-Notebook .jp-CodeCell').count()  # the new cell's, at the end
+    page.locator('.jp-Notebook .jp-Cell').last.click()
+    page.keyboard.press('Escape')
+    page.keyboard.press('b')
+    page.keyboard.press('Enter')
+    page.keyboard.insert_text(SPIN_CELL)
+    page.keyboard.press('Shift+Enter')
+    cell = page.locator('.jp-Notebook .jp-CodeCell').nth(index)  # Shift+Enter added one below
+    wait_for(lambda: 'spinning' in cell.locator('.jp-OutputArea').inner_text(), 'the spin running',
+             seen=lambda: cell.inner_text())
+    began = time.monotonic()
+    page.click('.jp-NotebookPanel-toolbar [data-command="notebook:interrupt-kernel"]')
+    page.wait_for_function(CELL_DONE, arg=index, polling=10, timeout=1000 * 30)
+    took = time.monotonic() - began
+    print(f'\nInterrupt stopped the spin in {took:.2f} s')
+    lines = cell.locator('.jp-OutputArea').inner_text().strip().splitlines()
+    page.screenshot(path=str(shots / 'learner-lab-01-interrupted.png'))
+    assert lines[0] == 'spinning' and len(lines) == 2 and lines[1].startswith('Interrupted after '), lines
+    assert took < INTERRUPT_WITHIN_S, f'Interrupt took {took:.2f} s'
