@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import itertools
 import os
+import threading
 import time
 from dataclasses import dataclass, field
 from typing import Any, Callable, Optional
@@ -262,6 +263,10 @@ def pair(publisher_qos: QoSProfile, subscription_qos: QoSProfile, *,
         trial.subscription(subscription_qos)
         matched = trial.wait_matched(publisher)
         graph = trial.nodes[1]
+        deadline = time.monotonic() + MATCH_TIMEOUT_S  # both endpoints in the graph
+        while (min(graph.count_publishers(trial.topic), graph.count_subscribers(trial.topic)) < 1
+               and time.monotonic() < deadline):
+            trial.executor.spin_once(timeout_sec=0.01)
         for label, infos in (('Publisher', graph.get_publishers_info_by_topic(trial.topic)),
                              ('Subscription', graph.get_subscriptions_info_by_topic(trial.topic))):
             trial.out.endpoints += [f'{label} count: {len(infos)}', '']
@@ -275,6 +280,51 @@ def pair(publisher_qos: QoSProfile, subscription_qos: QoSProfile, *,
             deadline = time.monotonic() + IDLE_S * 4
             while number not in trial.out.received and time.monotonic() < deadline:
                 trial.executor.spin_once(timeout_sec=IDLE_S)
+
+    return _trial(body)
+
+
+def burst_while_spinning(subscription_qos: QoSProfile, *, count: int = 30,
+                         callback_s: float = 0.002, gap_s: float = 0.001) -> Deliveries:
+    """Publish ``count`` numbers, one every ``gap_s`` s, while a callback taking
+    ``callback_s`` s spins in another thread: the subscription takes some while others arrive.
+
+    What is lost depends on how the operating system schedules the two threads: the numbers
+    change from run to run (a wall-clock demonstration, never a check).
+
+    Introduced in ``09-qos.ipynb``.
+
+    :raises Ros2nbError: when the profile is not a QoSProfile.
+    """
+    _require_profile(subscription_qos, 'The subscription\'s profile')
+
+    def body(trial: _Trial) -> None:
+        publisher = trial.publisher(QoSProfile(depth=count))
+        subscription = trial.subscription(subscription_qos)
+        keep = subscription.callback
+
+        def slow(msg: Any) -> None:
+            time.sleep(callback_s)
+            keep(msg)
+
+        subscription.callback = slow
+        if not trial.wait_matched(publisher):
+            return
+        done = threading.Event()
+
+        def spin() -> None:
+            while not done.is_set():
+                trial.executor.spin_once(timeout_sec=IDLE_S)
+
+        spinner = threading.Thread(target=spin, daemon=True)
+        spinner.start()
+        for number in range(count):
+            publisher.publish(Int32(data=number))
+            time.sleep(gap_s)
+        publisher.wait_for_all_acked()
+        done.set()
+        spinner.join()
+        trial.drain()
 
     return _trial(body)
 
