@@ -38,8 +38,6 @@ from .errors import Ros2nbError
 MATCH_TIMEOUT_S = 30.0
 #: Seconds one spin waits for a message; a drain ends after one such empty wait.
 IDLE_S = 0.05
-#: The policies a trial's profile is made of, as ``ros2 topic info --verbose`` names them.
-POLICIES = ('history', 'depth', 'reliability', 'durability')
 _topics = itertools.count()
 
 
@@ -354,7 +352,6 @@ def _duration(value: Any) -> str:
         f'{nanoseconds} nanoseconds'
 
 
-#: The policy rclpy's event names, for messages (``QoSPolicyKind.RELIABILITY`` -> Reliability).
 def policy_name(kind: Any) -> str:
     """``QoSPolicyKind.RELIABILITY`` (or its number) -> ``'Reliability'``."""
     try:
