@@ -27,7 +27,7 @@ LAYERS: list[tuple[str, ...]] = [
     ('ros2nb.terminal.pkg_create',),
     ('ros2nb.course',),
     ('ros2nb.explain',),
-    ('ros2nb.runtime',),
+    ('ros2nb.runtime', 'ros2nb.qos'),
     ('ros2nb.terminal',),
     ('ros2nb.kernel',),
     ('ros2nb.checks',),

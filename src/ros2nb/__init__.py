@@ -9,7 +9,7 @@ decides from outside; ``subject`` in the processes that run the learner's code f
 judge.  The instructor's side is the package ``ros2nb_instructor``.
 """
 
-from . import checks, course, domains
+from . import checks, course, domains, qos
 from .errors import (CheckFailed, ColconBuildError, DomainsExhaustedError, FileProtectedError,
                      LearnerCodeError, PkgCreateError, Ros2nbError, UsageError)
 from .kernel import add, install, shutdown, spin, start, stop
@@ -38,8 +38,8 @@ __all__ = [
     'callback_groups', 'checks', 'colcon_build', 'course', 'create_workspace',
     'current_runtime', 'current_workspace', 'domains', 'find_executable', 'graph_edges',
     'graph_picture', 'import_file', 'message_type', 'node_list', 'param_describe',
-    'param_dump', 'param_get', 'param_list', 'param_set', 'pkg_create', 'record', 'ros2_run',
-    'ros2_start', 'run_and_interrupt', 'shutdown', 'source_workspace', 'spin', 'start', 'stop',
-    'stop_all', 'timer_runs', 'topic_echo', 'topic_hz', 'topic_info', 'topic_list', 'tree',
-    'unmatched_topics', 'write_file', 'write_part',
+    'param_dump', 'param_get', 'param_list', 'param_set', 'pkg_create', 'qos', 'record',
+    'ros2_run', 'ros2_start', 'run_and_interrupt', 'shutdown', 'source_workspace', 'spin',
+    'start', 'stop', 'stop_all', 'timer_runs', 'topic_echo', 'topic_hz', 'topic_info',
+    'topic_list', 'tree', 'unmatched_topics', 'write_file', 'write_part',
 ]

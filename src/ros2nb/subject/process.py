@@ -27,11 +27,13 @@ from typing import Any, Callable, Optional
 from rclpy.executors import Executor
 from rclpy.node import Node
 from std_msgs.msg import Float32
+from rclpy.qos import QoSProfile
 
 from .. import domains
 from ..endpoints import node_endpoints
 from ..errors import Ros2nbError
 from ..explain.exceptions import explain_exception, is_library_file, learner_line
+from ..qos import profile_fields
 from ..runtime import Runtime, enable_field_checks
 from ..runtime.rates import callback_groups, timer_runs
 
@@ -49,6 +51,8 @@ def encode(value: Any) -> Any:
         return {'type': 'Path', 'value': str(value)}
     if isinstance(value, (list, tuple)):
         return {'type': type(value).__name__, 'value': [encode(v) for v in value]}
+    if isinstance(value, QoSProfile):  # notebook 09: its policies, which the judge rebuilds
+        return {'type': 'QoSProfile', 'value': profile_fields(value)}
     return {'type': type(value).__name__, 'value': repr(value)[:200]}
 
 

@@ -11,9 +11,9 @@ kernel's simulated clock (:mod:`ros2nb.terminal.echo`), and these keep them comp
 from __future__ import annotations
 
 import difflib
-from typing import Any
 
 from ..errors import Ros2nbError
+from ..qos import endpoint_lines
 from ..runtime import current_runtime
 
 #: Topics every ROS 2 process has; they are never reported as unmatched.
@@ -122,17 +122,6 @@ def _unknown_topic(topic: str) -> Ros2nbError:
     return Ros2nbError(f"Unknown topic '{topic}'.{hint}")
 
 
-def _policy(value: Any) -> str:
-    return value.name if hasattr(value, 'name') else str(value)
-
-
-def _duration(value: Any) -> str:
-    nanoseconds = value.nanoseconds if hasattr(value, 'nanoseconds') else int(value)
-    # rmw reports "infinite" as the largest representable duration.
-    return 'Infinite' if nanoseconds >= 0x7FFFFFFFFFFFFFFF or nanoseconds == 0 else \
-        f'{nanoseconds} nanoseconds'
-
-
 def topic_info(topic: str, *, verbose: bool = False) -> dict[str, int]:
     """Print a topic's type and publisher/subscription counts, like ``ros2 topic info [-v]``.
 
@@ -158,22 +147,8 @@ def topic_info(topic: str, *, verbose: bool = False) -> dict[str, int]:
         if not verbose:
             continue
         for info in sorted(endpoints, key=lambda e: (e.node_namespace, e.node_name)):
-            qos = info.qos_profile
             print()
-            print(f'Node name: {info.node_name}')
-            print(f'Node namespace: {info.node_namespace}')
-            print(f'Topic type: {info.topic_type}')
-            print(f'Endpoint type: {_policy(info.endpoint_type)}')
-            print('QoS profile:')
-            print(f'  Reliability: {_policy(qos.reliability)}')
-            history = _policy(qos.history)
-            print(f'  History (Depth): {history}' if history == 'UNKNOWN' else
-                  f'  History (Depth): {history} ({qos.depth})')
-            print(f'  Durability: {_policy(qos.durability)}')
-            print(f'  Lifespan: {_duration(qos.lifespan)}')
-            print(f'  Deadline: {_duration(qos.deadline)}')
-            print(f'  Liveliness: {_policy(qos.liveliness)}')
-            print(f'  Liveliness lease duration: {_duration(qos.liveliness_lease_duration)}')
+            print('\n'.join(endpoint_lines(info)))
     if name not in INFRASTRUCTURE_TOPICS and (not pubs or not subs):
         _print_unmatched()
     return {'publishers': len(pubs), 'subscriptions': len(subs)}

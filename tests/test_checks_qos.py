@@ -1,0 +1,147 @@
+"""The checks of notebook 09 (QoS) against the mistakes learners make: one line each.
+
+Every check runs a real publisher and subscription over DDS with the learner's profile.
+Each mistake runs twice: as the kernel runs it (the learner's function called here) and as
+the grader runs it (this process is the judge; the answer cell runs in a real subject, which
+sends back only the profile's policies).  The answer cells are the solution notebook's, so
+they never go stale; they pass all three checks, so every failure below is the planted
+mistake's.
+"""
+
+import os
+import re
+
+import nbformat
+import pytest
+
+from ros2nb import checks
+from ros2nb.checks.base import AnswerRef, bind_judge
+from ros2nb.checks.dispatch import IN_JUDGE_ENV
+from ros2nb.errors import CheckFailed
+from ros2nb.judge.session import Session
+
+pytestmark = pytest.mark.timeout(300)
+
+HERE = os.path.dirname(__file__)
+SOLUTION = os.path.join(HERE, '..', 'solutions', '09-qos.ipynb')
+LEARNER = os.path.join(HERE, '..', 'notebooks', '09-qos.ipynb')
+
+
+def _cells(path: str = SOLUTION) -> tuple[str, dict[str, str]]:
+    """The notebook's grading context, and each answer cell by the function it defines."""
+    context, answers = '', {}
+    for cell in nbformat.read(path, as_version=4).cells:
+        if 'grading-context' in cell.metadata.get('tags', []):
+            context = cell.source
+        if cell.metadata.get('nbgrader', {}).get('solution'):
+            name = re.match(r'def (\w+)\(', cell.source).group(1)
+            answers[name] = '\n'.join(line for line in cell.source.splitlines()
+                                      if not line.strip().startswith('###'))
+    return context, answers
+
+
+CONTEXT, ANSWERS = _cells()
+UNTOUCHED = _cells(LEARNER)[1]  # the learner's copy: '# YOUR CODE HERE', NotImplementedError
+CHECKS = {'newest_only_profile': checks.check_newest_only,
+          'sensor_subscription_profile': checks.check_sensor_subscription,
+          'latched_thresholds_profile': checks.check_latched_thresholds}
+
+
+@pytest.fixture(scope='module')
+def session(tmp_path_factory):
+    """A judge session (this process is the judge) with a workspace of its own."""
+    root = tmp_path_factory.mktemp('checks09')
+    saved = os.environ.get(IN_JUDGE_ENV)
+    os.environ[IN_JUDGE_ENV] = '1'
+    (root / 'ws').mkdir()
+    session = Session(root / 'ws')
+    bind_judge(session)
+    yield session
+    bind_judge(None)
+    session.close()
+    if saved is None:
+        os.environ.pop(IN_JUDGE_ENV, None)
+    else:
+        os.environ[IN_JUDGE_ENV] = saved
+
+
+def run_check(session, path: str, name: str, answer: str) -> None:
+    """Run the check of ``name`` on ``answer``: in this process, or from source in a subject."""
+    if path == 'kernel':
+        namespace: dict = {}
+        exec(CONTEXT + '\n' + answer, namespace)
+        CHECKS[name](namespace[name])
+    else:
+        ref = AnswerRef(name, (CONTEXT, answer))
+        try:
+            CHECKS[name](ref)
+        finally:
+            session.drop(('cells', ref.sources))  # one subject at a time
+
+
+@pytest.mark.parametrize('path', ['kernel', 'judge'])
+def test_the_solutions_pass(session, capsys, path):
+    for name, answer in ANSWERS.items():
+        run_check(session, path, name, answer)
+    assert capsys.readouterr().out.count('Check passed:') == 3
+
+
+NEWEST = 'QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1)'
+SENSOR = 'QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)'
+LATCHED = 'durability=DurabilityPolicy.TRANSIENT_LOCAL)'
+MISTAKES = [
+    ('newest_only_profile', 'a number', NEWEST, '1',
+     r'newest_only_profile\(\) returned int 1; return a QoSProfile\(...\)\.'),
+    ('newest_only_profile', 'depth 10', 'depth=1)', 'depth=10)',
+     r'After a burst of 30 your subscription got 10 messages \[20, 21, \.\.\., 29\]: its '
+     r'history keeps that many; a display of the newest reading keeps depth=1\.'),
+    ('newest_only_profile', 'keep all', 'history=HistoryPolicy.KEEP_LAST',
+     'history=HistoryPolicy.KEEP_ALL',
+     r'got all 30: KEEP_ALL keeps every message; use KEEP_LAST with depth=1\.'),
+    ('newest_only_profile', 'transient local', 'depth=1)',
+     'depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)',
+     r'never matched the reliable, volatile publisher: the publisher offers Durability VOLATILE '
+     r'but the subscription requests TRANSIENT_LOCAL'),
+    ('sensor_subscription_profile', 'reliable', 'ReliabilityPolicy.BEST_EFFORT',
+     'ReliabilityPolicy.RELIABLE',
+     r'^Incompatible QoS: the sensor publishes with BEST_EFFORT, KEEP_LAST \(5\), VOLATILE, your '
+     r'subscription asks for RELIABLE, KEEP_LAST \(5\), VOLATILE; the publisher offers '
+     r'Reliability BEST_EFFORT but the subscription requests RELIABLE'),
+    ('sensor_subscription_profile', 'transient local', 'BEST_EFFORT)',
+     'BEST_EFFORT, durability=DurabilityPolicy.TRANSIENT_LOCAL)',
+     r'the publisher offers Durability VOLATILE but the subscription requests TRANSIENT_LOCAL'),
+    ('latched_thresholds_profile', 'volatile', LATCHED, 'durability=DurabilityPolicy.VOLATILE)',
+     r'joined after 20 thresholds were published \(0 to 19\) got none: make durability '
+     r'TRANSIENT_LOCAL'),
+    ('latched_thresholds_profile', 'best effort', 'ReliabilityPolicy.RELIABLE',
+     'ReliabilityPolicy.BEST_EFFORT',
+     r'got none: it is BEST_EFFORT, KEEP_LAST \(5\), TRANSIENT_LOCAL, and a best-effort '
+     r'subscription is not sent what was published before it joined: make it RELIABLE\.'),
+    ('latched_thresholds_profile', 'depth 1', 'depth=5', 'depth=1',
+     r'got 1 \[19\], expected the last 5 \[15, 16, \.\.\., 19\]: depth=5\.'),
+    ('latched_thresholds_profile', 'keep all', 'depth=5,', 'history=HistoryPolicy.KEEP_ALL,',
+     r'got all 20: KEEP_ALL keeps every message; keep the last 5'),
+]
+
+
+@pytest.mark.parametrize('path', ['kernel', 'judge'])
+@pytest.mark.parametrize('name', sorted(CHECKS))
+def test_an_untouched_cell_gets_one_line(session, path, name):
+    assert 'raise NotImplementedError()' in UNTOUCHED[name]
+    with pytest.raises(CheckFailed) as caught:
+        run_check(session, path, name, UNTOUCHED[name])
+    message = str(caught.value)
+    assert '\n' not in message and message.startswith(f'{name}() still raises '
+                                                       'NotImplementedError'), message
+
+
+@pytest.mark.parametrize('path', ['kernel', 'judge'])
+@pytest.mark.parametrize('name, label, old, new, pattern', MISTAKES,
+                         ids=[f'{m[0]}: {m[1]}' for m in MISTAKES])
+def test_a_mistake_gets_one_line(session, path, name, label, old, new, pattern):
+    answer = ANSWERS[name]
+    assert old in answer, old
+    with pytest.raises(CheckFailed) as caught:
+        run_check(session, path, name, answer.replace(old, new, 1))
+    message = str(caught.value)
+    assert '\n' not in message and re.search(pattern, message), message
