@@ -14,7 +14,6 @@ import itertools
 import math
 import sys
 import os
-import threading
 import time
 from typing import Optional
 

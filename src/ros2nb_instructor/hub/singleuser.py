@@ -26,7 +26,6 @@ Python and read the course. A venv built on a Python under ``/root`` (pyenv) fai
 from __future__ import annotations
 
 import os
-import shutil
 import stat
 import sys
 from pathlib import Path
