@@ -10,6 +10,7 @@ from __future__ import annotations
 import collections
 import sys
 import threading
+import time
 from dataclasses import dataclass
 
 #: Log lines kept while no cell is reading them; older ones are counted, not kept.
@@ -53,7 +54,8 @@ class LogLines:
         self._log_lines: collections.deque[tuple] = collections.deque()
         self._overflow = 0
         self._epoch = 0
-        self._muted_epoch = -1
+        # (epoch, wall-clock ns): lines of that cell stamped before then are not shown
+        self._muted: tuple[int, int] = (-1, 0)
         self._lock = threading.Lock()
 
     def own_logger(self, name: str) -> None:
@@ -70,8 +72,10 @@ class LogLines:
             self._our_loggers &= running
 
     def mute_cell(self) -> None:
-        """Show no more log lines of the running cell (an interrupted simulated spin)."""
-        self._muted_epoch = self._epoch
+        """Show none of the running cell's log lines made until now (an interrupted simulated
+        spin): those still on their way over /rosout are dropped, a later spin's are shown.
+        /rosout stamps every line with the wall clock, in simulated time too."""
+        self._muted = (self._epoch, time.time_ns())
 
     def begin_cell(self) -> None:
         """A new cell starts: lines made before it are no longer news (IPython pre_run_cell)."""
@@ -84,17 +88,18 @@ class LogLines:
             if len(self._log_lines) >= MAX_PENDING_LOG_LINES:
                 self._log_lines.popleft()
                 self._overflow += 1
-            self._log_lines.append((self._epoch, msg.name, msg.level, msg.msg))
+            stamp_ns = msg.stamp.sec * 1_000_000_000 + msg.stamp.nanosec
+            self._log_lines.append((self._epoch, msg.name, msg.level, msg.msg, stamp_ns))
 
     def emit(self, text: str) -> None:
         """Queue a line of our own (e.g. an echoed message) in order with the log lines."""
         with self._lock:
-            self._log_lines.append((self._epoch, None, 0, text))
+            self._log_lines.append((self._epoch, None, 0, text, time.time_ns()))
 
     def _report_failure(self, failure: CallbackFailure) -> None:
         """Queue a callback that raised, to be shown with the lines of its cell."""
         with self._lock:
-            self._log_lines.append((self._epoch, CallbackFailure, 0, failure))
+            self._log_lines.append((self._epoch, CallbackFailure, 0, failure, time.time_ns()))
 
     def is_ours(self, logger_name: str) -> bool:
         """True for the loggers of nodes handed over (and their child loggers)."""
@@ -116,7 +121,7 @@ class LogLines:
         earlier = overflow
         taken = 0
         lines: list[str] = []
-        for epoch, name, level, text in queued:
+        for epoch, name, level, text, stamp_ns in queued:
             if name is CallbackFailure:
                 sys.stdout.flush()
                 print(text, file=sys.stderr)
@@ -125,7 +130,7 @@ class LogLines:
                 if epoch < self._epoch:
                     earlier += 1
                     continue
-                if epoch == self._muted_epoch:
+                if (epoch, stamp_ns) <= self._muted:
                     continue
                 taken += 1
                 lines.append(text if name is None else
