@@ -57,10 +57,11 @@ def session(tmp_path_factory):
 
 
 def strangers(session) -> list[str]:
-    """Nodes on the judge's domain other than its own (the judge's graph, now)."""
-    own = session.observer.node.get_name()
+    """The course's nodes (a sensor, a monitor) on the judge's domain now, in its graph."""
+    names = (course.SENSOR_NODE, course.MONITOR_NODE)
     return sorted(f'{ns.rstrip("/")}/{n}'
-                  for n, ns in session.observer.node.get_node_names_and_namespaces() if n != own)
+                  for n, ns in session.observer.node.get_node_names_and_namespaces()
+                  if n in names)
 
 
 def alone(session) -> None:
