@@ -25,9 +25,10 @@ class PlotFeeder(Node):
         self.redraws += 1
         if self.line is None:
             return
-        self.line.set_data(self.times_s, self.temps_c)
         start_s = self.times_s[0] if self.times_s else 0.0
-        self.line.axes.set_xlim(start_s, max(start_s + WINDOW_S, self.times_s[-1]))
+        since_s = [t - start_s for t in self.times_s]   # seconds since the first reading
+        self.line.set_data(since_s, self.temps_c)
+        self.line.axes.set_xlim(0.0, max(WINDOW_S, since_s[-1] if since_s else 0.0))
         self.line.figure.canvas.draw_idle()
 
     def temperature_callback(self, msg):
