@@ -66,8 +66,7 @@ def test_reference_files_pass(session, capsys):
         check()
     out = capsys.readouterr().out
     assert out.count('Check passed:') == 6, out
-    found = re.search(r'heartbeat still ran (\d+) times', out)
-    print(f'heartbeat runs in 2 s with the fix: {found.group(1)}')
+    assert 'heartbeat kept at least 60% of its 20 runs in 2 s on a MultiThreadedExecutor' in out
 
 
 MISTAKES = [
@@ -94,7 +93,7 @@ MISTAKES = [
      checks.check_counting_monitor, r'has no attribute received: set self.received = 0'),
     ('worker: single-threaded', PROMISES, 'executor = MultiThreadedExecutor(num_threads=2)',
      'from rclpy.executors import SingleThreadedExecutor\n    executor = SingleThreadedExecutor()',
-     checks.check_responsive_worker, r'heartbeat ran \d+ times in 2 s \(20 expected\): a '
+     checks.check_responsive_worker, r'heartbeat cannot keep its 10 Hz while slow_work runs: a '
                                      r'SingleThreadedExecutor runs one callback at a time'),
     ('worker: one group', PROMISES, '''slow_group=MutuallyExclusiveCallbackGroup(),
                   heartbeat_group=MutuallyExclusiveCallbackGroup())''', ')',
