@@ -75,8 +75,7 @@ def run_main(judge: Judge, relative: str, node_name: str) -> str:
     # once the node runs: earlier, a busy machine would decide what the learner is told.
     observer.wait_until(lambda: proc.poll() is not None or observer.has_node(node_name),
                         ARRIVAL_TIMEOUT_S)
-    if proc.poll() is None:
-        observer.spins(node_name)
+    spins = proc.poll() is None and observer.has_node(node_name) and observer.spins(node_name)
     if proc.poll() is not None:
         text = output.text()
         if 'NotImplementedError' in text:
@@ -87,6 +86,11 @@ def run_main(judge: Judge, relative: str, node_name: str) -> str:
                               'first; the checks of the parts above show where.')
         raise CheckFailed(f'{path.name} ended by itself before Ctrl+C (exit code '
                           f'{proc.returncode}); main() should spin until Ctrl+C.')
+    if not spins:  # the judge's own graph: no node of that name answered while it ran
+        kill_process_group(proc)
+        raise CheckFailed(f'{path.name} never started its node {node_name} (none answered the '
+                          f'grader within {ARRIVAL_TIMEOUT_S:g} s): main() should bring rclpy up, '
+                          'create the node and spin it until Ctrl+C.')
     interrupt(proc)
     try:
         code = proc.wait(EXIT_AFTER_CTRL_C_S)
