@@ -4,10 +4,11 @@ As tests/test_checks.py: this process is the judge, the learner's code runs in r
 processes and the verdicts come from the judge's own ROS node. Each learner below is the
 course's reference with one piece of work left out and, at import, code that walks up the
 stack to the subject's request loop and rewrites its replies (or does the missing work
-itself inside them, or rewrites the files the judge reads). Every such file passed its
-check before the judge stopped believing subjects (commit history of this file says how
-many points each gained); now the check fails, with the line the honest mistake gets.
-The honest twin of each is the reference, which passes (tests/test_checks.py).
+itself inside them, or rewrites the files the judge reads). Against the judge of 31f397c,
+which believed the subject's replies, every check below passed (notebook 03: no timer 6/6,
+a callback doing nothing 6/6, a property's start value 3/6, a main() that never starts ROS
+6/6; notebook 04: a callback doing nothing 5/5; notebook 02's reader 1/1). Now each fails
+with one line; the honest twin of each is the reference, which passes (tests/test_checks.py).
 """
 
 import pytest
@@ -96,6 +97,7 @@ def test_a_callback_that_does_nothing_while_its_subject_publishes(session):
     try:
         checks.check_sensor_constructor()  # part 3 is the reference's: it deserves its point
         fails(checks.check_sensor_callback, r'publish_temperature never publishes')
+        fails(checks.check_sensor_hour, r'publish_temperature never publishes')
     finally:
         restore(session, PUB)
 

@@ -66,10 +66,10 @@ def _timer_verdict(source: ClassSource) -> None:
 
 
 def _start_verdict(source: ClassSource) -> None:
-    if source.defines('temperature'):
-        raise CheckFailed(f'temperature of {course.SENSOR_CLASS} is a property or a class '
-                          'attribute: make it a plain attribute of the node, set in __init__ '
-                          'with self.temperature = START_TEMPERATURE_C.')
+    if source.computes('temperature'):
+        raise CheckFailed(f'temperature of {course.SENSOR_CLASS} is a property (or a method): '
+                          'make it a plain attribute of the node, set in __init__ with '
+                          'self.temperature = START_TEMPERATURE_C.')
     start = source.attribute('temperature')
     if not source.assignments('temperature') and not source.assigned_anywhere('temperature'):
         raise CheckFailed(f'{course.SENSOR_CLASS} has no attribute temperature: start the walk '
@@ -78,6 +78,19 @@ def _start_verdict(source: ClassSource) -> None:
             start, course.START_TEMPERATURE_C)):  # else the first reading decides
         raise CheckFailed(f'self.temperature starts at {start!r}; the walk starts at '
                           f'START_TEMPERATURE_C = {course.START_TEMPERATURE_C} °C.')
+
+
+def _publishes_verdict(judge: Judge) -> None:
+    """The readings that arrived came from publish_temperature, as the file (text) says.
+
+    The judge hears readings, not which code sent them, and what a subject says about that
+    counts for nothing: the method the timer calls must publish.
+    """
+    source = ClassSource.read(judge.workspace / course.PUBLISHER_FILE, course.SENSOR_CLASS)
+    if source is None or not source.reaches_call('publish_temperature', 'publish'):
+        raise CheckFailed('publish_temperature never publishes, yet readings arrived from '
+                          'elsewhere: put the new reading into a Float32 message and publish it '
+                          'with the publisher from __init__, in publish_temperature.')
 
 
 def _is_number(value: Any) -> bool:
@@ -196,11 +209,7 @@ def _sensor_callback(judge: Judge) -> str:
                           'new reading into a Float32 message and publish it with the publisher '
                           'from __init__.' if fired else
                           'The timer never called publish_temperature: check the timer in part 3.')
-    source = ClassSource.read(judge.workspace / course.PUBLISHER_FILE, course.SENSOR_CLASS)
-    if source is None or not source.reaches_call('publish_temperature', 'publish'):
-        raise CheckFailed('publish_temperature never publishes, yet readings arrived from '
-                          'elsewhere: put the new reading into a Float32 message and publish it '
-                          'with the publisher from __init__, in publish_temperature.')
+    _publishes_verdict(judge)
     if logged < len(readings):
         raise CheckFailed(f'{len(readings)} readings were published but {logged} logged: log each '
                           "reading with the node's logger, e.g. 'Publishing: 22.31C'.")
@@ -237,6 +246,7 @@ def _sensor_hour(judge: Judge) -> str:
     seconds = 3600
     readings, _, _ = _run_sensor(judge, subject, info, seconds, step_s=5.0)
     _samples_verdict(readings, seconds=seconds)
+    _publishes_verdict(judge)
     return (f'an hour of simulated time: {len(readings)} readings, steps within '
             f'±{course.MAX_STEP_C} °C, all inside [{course.MIN_TEMPERATURE_C}, '
             f'{course.MAX_TEMPERATURE_C}] °C.')

@@ -13,11 +13,11 @@ from .base import ARRIVAL_TIMEOUT_S, Judge, learner_error
 
 
 def new_node(judge: Judge, relative: str, cls: str, *, placeholders: tuple[str, ...] = (),
-              attributes: tuple[str, ...] = (), seed: Optional[int] = None) -> tuple[Any, dict]:
+              seed: Optional[int] = None) -> tuple[Any, dict]:
     """Create the learner's node from their file in a subject; raise for what went wrong."""
     subject = judge.file_subject(relative)
     reply = subject.request('new_node', cls=cls, placeholders=list(placeholders),
-                            attributes=list(attributes), seed=seed)
+                            seed=seed)
     file = Path(relative).name
     if reply.get('no_class'):
         others = reply['classes']

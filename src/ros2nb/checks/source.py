@@ -72,15 +72,19 @@ class ClassSource:
         found = [s for s in self.cls.body if isinstance(s, ast.FunctionDef) and s.name == name]
         return found[-1] if found else None
 
-    def defines(self, name: str) -> bool:
-        """True when the class body itself defines ``name`` (a method, property, attribute)."""
+    def computes(self, name: str) -> bool:
+        """True when the class body makes ``name`` something other than a plain value: a
+        method or ``@property`` of that name, or a class attribute set to what is not a
+        constant (``property(...)``, a descriptor).  Reading it may then run any code."""
         for statement in self.cls.body:
             if isinstance(statement, (ast.FunctionDef, ast.AsyncFunctionDef)) \
                     and statement.name == name:
                 return True
-            if isinstance(statement, (ast.Assign, ast.AnnAssign)) and any(
-                    isinstance(t, ast.Name) and t.id == name
-                    for t in getattr(statement, 'targets', [getattr(statement, 'target', None)])):
+            if isinstance(statement, (ast.Assign, ast.AnnAssign)) and statement.value is not None \
+                    and any(isinstance(t, ast.Name) and t.id == name for t in (
+                        statement.targets if isinstance(statement, ast.Assign)
+                        else [statement.target])) \
+                    and self.value(statement.value) is UNKNOWN:
                 return True
         return False
 
