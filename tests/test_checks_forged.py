@@ -16,6 +16,7 @@ import pytest
 from ros2nb import checks, course
 from ros2nb.checks.base import AnswerRef
 
+from grading_samples import REWRITING_READER
 from test_checks import PUB, SUB, fails, mutated, restore, session  # noqa: F401 (fixture)
 
 pytestmark = pytest.mark.timeout(300)
@@ -171,25 +172,14 @@ def test_a_monitor_callback_that_does_nothing_while_another_method_logs(session)
         restore(session, SUB)
 
 
-#: An answer of notebook 02 that makes every package.xml it reads say what it returns.
-REWRITING_READER = '''
-import re
-from pathlib import Path
-
-
-def read_dependencies(package_xml):
-    text = re.sub(r'\\s*<depend>[^<]*</depend>', '', Path(package_xml).read_text())
-    Path(package_xml).write_text(text.replace('</license>', '</license>\\n  <depend>rclpy</depend>'))
-    return ['rclpy']
-'''
-
-
 def test_a_package_reader_that_rewrites_the_package_xml(session):
     xml = session.workspace / course.PACKAGE_XML_FILE
     saved = xml.read_text()
     try:
-        fails(lambda: checks.check_dependencies(AnswerRef('read_dependencies',
+        fails(lambda: checks.check_dependencies(AnswerRef('package_dependencies',
                                                           (REWRITING_READER,))),
-              r"you returned \['rclpy'\], but it declares \[")
+              r"For graded_reader/package.xml you returned \['ament_python', 'geometry_msgs', "
+              r"'rclpy', 'sensor_msgs'\], but it declares \['geometry_msgs', 'rclpy', "
+              r"'sensor_msgs'\]")
     finally:
         xml.write_text(saved)
