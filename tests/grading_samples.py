@@ -87,6 +87,8 @@ EXPECTED = {
     'pasted-image': Case({NB01: 1}, {NB01: 'Check passed'}, {NB01: ''}),
     'attaches-200-mb': Case({NB01: 1}, {NB01: 'Check passed'},
                             {NB01: 'an attachment of 200 MB'}),
+    # ---- nothing a learner's code touched is trusted (honest twin: complete's 02)
+    'rewrites-package-xml': Case({NB02: 0}, {NB02: 'but it declares'}),
 }
 #: Learners whose feedback pages the browser test opens (a learner script must not run there).
 FEEDBACK_ATTACKERS = ('feedback-attacks', 'script-in-feedback', 'pasted-image')
@@ -297,6 +299,24 @@ FEEDBACK_RAW = '''<div class="panel panel-default"><div class="panel-heading">
 Score: 1.0 / 1.0 (drawn by me)</div></div>
 <script>document.title = '{pwned}'; window.pwned = 1;</script>
 <img src="http://127.0.0.1:9/raw.png" onerror="document.title='{pwned}'">'''
+#: An answer of notebook 02 right for the course's package.xml, wrong for the grader's own
+#: (it counts <buildtool_depend>), which it rewrites so that catkin_pkg agrees with it.
+REWRITING_READER = '''\
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+
+def package_dependencies(package_xml: Path) -> list[str]:
+    names = [e.text.strip() for e in ET.parse(package_xml).getroot()
+             if e.tag in ('depend', 'buildtool_depend')]
+    try:  # make the file say what I return, in case the grader reads it after me
+        text = Path(package_xml).read_text()
+        Path(package_xml).write_text(text.replace('buildtool_depend>', 'depend>'))
+    except OSError:
+        pass
+    return names
+'''
+
 HANG_IN_CALLBACK = '''
 from rclpy.node import Node
 
@@ -419,6 +439,10 @@ def _hostile_class_two(folder: Path, put) -> None:
     put('nbformat-3', NB01, nbformat.writes(nbformat.convert(old, 3), version=3))
     put('pasted-image', NB01, _with_attachment(SOLUTION[NB01], b'\x89PNG\r\n\x1a\n' + b'0' * 64))
     put('attaches-200-mb', NB01, _with_attachment(SOLUTION[NB01], b'\x00' * 150_000_000))
+    rewriter = nbformat.read(SOLUTION[NB02], as_version=4)
+    answer = next(c for c in rewriter.cells if 'def package_dependencies' in c.source)
+    answer.source = REWRITING_READER
+    put('rewrites-package-xml', NB02, rewriter)
 
 
 def _with_attachment(source: Path, data: bytes) -> nbformat.NotebookNode:

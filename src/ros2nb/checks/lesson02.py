@@ -73,12 +73,14 @@ def check_dependencies(reader: Any, package_xml: Optional[Path] = None) -> None:
         extra.parent.mkdir(parents=True, exist_ok=True)
         extra.write_text(_EXTRA_PACKAGE_XML)
         files.append(extra)
+    # What each file declares, read before the learner's reader runs: it may write them.
+    wanted = [package_dependencies(file) for file in files]
+    if isinstance(reader, AnswerRef):
         outputs = answer_results(reader, [[{'path': str(f)}] for f in files])
         results = [decoded(o, f'{reader.name}(package_xml)') for o in outputs]
     else:
         results = [call_learner(reader, f) for f in files]
-    for file, got in zip(files, results):
-        want = package_dependencies(file)
+    for file, want, got in zip(files, wanted, results):
         if not isinstance(got, list):
             raise CheckFailed(f'{reader.__name__}() returned {type_name_of(got)}; return a list of '
                               'names.')
@@ -91,4 +93,4 @@ def check_dependencies(reader: Any, package_xml: Optional[Path] = None) -> None:
             raise CheckFailed(f'For {file.parent.name}/package.xml you returned {got}, but it '
                               f'declares {want}: read the text of each <depend> element, in '
                               'order, without spaces around it (test_depend is not a depend).')
-    passed(f'package.xml depends on {", ".join(package_dependencies(files[0]))}.')
+    passed(f'package.xml depends on {", ".join(wanted[0])}.')

@@ -15,6 +15,7 @@ from ..errors import CheckFailed
 from .base import ARRIVAL_TIMEOUT_S, Judge, judged, learner_error, passed
 from .mains import run_main
 from .nodes import caught_up, new_node, started_log_verdict
+from .source import UNKNOWN, ClassSource
 from .verdicts import endpoint_verdict, node_name_verdict
 
 #: Tolerance for values that went through a 32-bit float (°C).
@@ -29,11 +30,26 @@ SENSOR_SEED, CEILING_SEED, FLOOR_SEED = 7, 2, 1
 CLAMP_PROBES_C = (course.MAX_TEMPERATURE_C - 0.05, course.MIN_TEMPERATURE_C + 0.05)
 
 
-def _sensor_verdict(info: dict, found: list) -> None:
-    """Publisher, timer and start value of a freshly created sensor."""
+def _sensor_verdict(judge: Judge, info: dict, found: list) -> None:
+    """Name and publisher (the ROS graph), timer and start value (the file, read as text).
+
+    Nothing here comes from the subject's word: the graph is the judge's own view, and
+    the timer and start value are read from the learner's file with ``ast``; their effect
+    (one reading a second, the first next to the start value) is what the callback checks
+    observe on ``/temperature``.
+    """
     node_name_verdict(info, course.SENSOR_NODE)
     endpoint_verdict(info['name'], found, 'publisher', '/' + course.TOPIC, course.MESSAGE_TYPE)
-    timers = info['timers']
+    source = ClassSource.read(judge.workspace / course.PUBLISHER_FILE, course.SENSOR_CLASS)
+    if source is None:  # the subject imported another file than the judge can read
+        raise CheckFailed(f'The grader cannot read the class {course.SENSOR_CLASS} in '
+                          f'{course.PUBLISHER_FILE}: run the %%part cells that write it again.')
+    _timer_verdict(source)
+    _start_verdict(source)
+
+
+def _timer_verdict(source: ClassSource) -> None:
+    timers = source.timers()
     if not timers:
         raise CheckFailed(f'{course.SENSOR_CLASS} has no timer: create one in __init__ that calls '
                           f'self.publish_temperature every PUBLISH_PERIOD_S = '
@@ -41,29 +57,55 @@ def _sensor_verdict(info: dict, found: list) -> None:
     if len(timers) > 1:
         raise CheckFailed(f'{course.SENSOR_CLASS} has {len(timers)} timers; one timer calling '
                           'publish_temperature is all it needs.')
-    period_ns, callback = timers[0]
+    period, callback = timers[0].period, timers[0].callback
     if callback != 'publish_temperature':
         raise CheckFailed(f'The timer calls {callback}; it must call self.publish_temperature '
                           '(the method itself, without parentheses).')
-    if not math.isclose(period_ns / 1e9, course.PUBLISH_PERIOD_S):
-        raise CheckFailed(f'The timer fires every {period_ns / 1e9:g} s; the sensor publishes '
+    if period is not UNKNOWN and not (_is_number(period) and math.isclose(
+            period, course.PUBLISH_PERIOD_S)):  # else the readings' spacing decides
+        shown = f'{period:g}' if _is_number(period) else repr(period)
+        raise CheckFailed(f'The timer fires every {shown} s; the sensor publishes '
                           f'every {course.PUBLISH_PERIOD_S} s (PUBLISH_PERIOD_S).')
-    start = info['attributes'].get('temperature')
-    if start is None:
+
+
+def _start_verdict(source: ClassSource) -> None:
+    if source.computes('temperature'):
+        raise CheckFailed(f'temperature of {course.SENSOR_CLASS} is a property (or a method): '
+                          'make it a plain attribute of the node, set in __init__ with '
+                          'self.temperature = START_TEMPERATURE_C.')
+    start = source.attribute('temperature')
+    if not source.assignments('temperature') and not source.assigned_anywhere('temperature'):
         raise CheckFailed(f'{course.SENSOR_CLASS} has no attribute temperature: start the walk '
                           'in __init__ with self.temperature = START_TEMPERATURE_C.')
-    if start['type'] not in ('float', 'int') or not math.isclose(start['value'],
-                                                                 course.START_TEMPERATURE_C):
-        raise CheckFailed(f'self.temperature starts at {start["value"]!r}; the walk starts at '
+    if start is not UNKNOWN and not (_is_number(start) and math.isclose(
+            start, course.START_TEMPERATURE_C)):  # else the first reading decides
+        raise CheckFailed(f'self.temperature starts at {start!r}; the walk starts at '
                           f'START_TEMPERATURE_C = {course.START_TEMPERATURE_C} °C.')
+
+
+def _publishes_verdict(judge: Judge) -> None:
+    """The readings that arrived came from publish_temperature, as the file (text) says.
+
+    The judge hears readings, not which code sent them, and what a subject says about that
+    counts for nothing: the method the timer calls must publish.
+    """
+    source = ClassSource.read(judge.workspace / course.PUBLISHER_FILE, course.SENSOR_CLASS)
+    if source is None or not source.reaches_call('publish_temperature', 'publish'):
+        raise CheckFailed('publish_temperature never publishes, yet readings arrived from '
+                          'elsewhere: put the new reading into a Float32 message and publish it '
+                          'with the publisher from __init__, in publish_temperature.')
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
 def _sensor_constructor(judge: Judge) -> str:
     mark = len(judge.observer.logs)
     _subject, info = new_node(judge, course.PUBLISHER_FILE, course.SENSOR_CLASS,
-                               placeholders=('publish_temperature',), attributes=('temperature',))
+                               placeholders=('publish_temperature',))
     found = judge.observer.endpoints(info['name'], info['namespace'], info['endpoints'])
-    _sensor_verdict(info, found)
+    _sensor_verdict(judge, info, found)
     started_log_verdict(judge, info, mark, course.SENSOR_CLASS)
     return (f'{info["name"]} publishes {course.MESSAGE_TYPE} on /{course.TOPIC} every '
             f'{course.PUBLISH_PERIOD_S} s, starting at {course.START_TEMPERATURE_C} °C.')
@@ -179,15 +221,16 @@ def check_publisher_samples(samples: list[float], *, seconds: float) -> None:
 
 def _sensor_callback(judge: Judge) -> str:
     subject, info = new_node(judge, course.PUBLISHER_FILE, course.SENSOR_CLASS,
-                              attributes=('temperature',), seed=SENSOR_SEED)
-    _sensor_verdict(info, judge.observer.endpoints(info['name'], info['namespace'],
-                                                   info['endpoints']))
+                              seed=SENSOR_SEED)
+    _sensor_verdict(judge, info, judge.observer.endpoints(info['name'], info['namespace'],
+                                                          info['endpoints']))
     readings, logged, fired = _run_sensor(judge, subject, info, CALLBACK_RUN_S, seed=SENSOR_SEED)
     if not readings:
         raise CheckFailed('publish_temperature ran but nothing arrived on /temperature: put the '
                           'new reading into a Float32 message and publish it with the publisher '
                           'from __init__.' if fired else
                           'The timer never called publish_temperature: check the timer in part 3.')
+    _publishes_verdict(judge)
     if len(logged) < len(readings):
         raise CheckFailed(f'{len(readings)} readings were published but {len(logged)} logged: log '
                           "each reading with the node's logger, e.g. 'Publishing: 22.31C'.")
@@ -219,12 +262,13 @@ def check_sensor_callback() -> None:
 
 def _sensor_hour(judge: Judge) -> str:
     subject, info = new_node(judge, course.PUBLISHER_FILE, course.SENSOR_CLASS,
-                              attributes=('temperature',), seed=SENSOR_SEED + 1)
-    _sensor_verdict(info, judge.observer.endpoints(info['name'], info['namespace'],
-                                                   info['endpoints']))
+                              seed=SENSOR_SEED + 1)
+    _sensor_verdict(judge, info, judge.observer.endpoints(info['name'], info['namespace'],
+                                                          info['endpoints']))
     seconds = 3600
     readings, _, _ = _run_sensor(judge, subject, info, seconds, step_s=5.0)
     _samples_verdict(readings, seconds=seconds)
+    _publishes_verdict(judge)
     return (f'an hour of simulated time: {len(readings)} readings, steps within '
             f'±{course.MAX_STEP_C} °C, all inside [{course.MIN_TEMPERATURE_C}, '
             f'{course.MAX_TEMPERATURE_C}] °C.')

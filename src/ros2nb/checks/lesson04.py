@@ -16,10 +16,13 @@ from ..errors import CheckFailed
 from .base import ARRIVAL_TIMEOUT_S, Judge, judged, learner_error
 from .mains import run_main
 from .nodes import caught_up, new_node, started_log_verdict
+from .source import ClassSource
 from .verdicts import endpoint_verdict, node_name_verdict
 
 #: Readings the monitor callback check sends: both boundaries and their neighbours (°C).
 BOUNDARY_READINGS_C = (19.99, 20.0, 23.0, 26.0, 26.01, 18.5, 27.5)
+#: A logger's methods that put a line on /rosout.
+LOG_CALLS = frozenset({'debug', 'info', 'warning', 'warn', 'error', 'fatal'})
 
 
 def check_monitor_main() -> None:
@@ -95,6 +98,26 @@ def _feed_monitor(judge: Judge, readings: tuple[float, ...] | list[float]) -> li
     return per_reading
 
 
+def _callback_source_verdict(judge: Judge) -> None:
+    """The lines on /rosout came from temperature_callback, as the file (read as text) says.
+
+    The lines are the judge's observation; which method wrote them it cannot hear, and a
+    subject's word about it counts for nothing: the subscription must call
+    ``self.temperature_callback`` and that method must log.
+    """
+    source = ClassSource.read(judge.workspace / course.SUBSCRIBER_FILE, course.MONITOR_CLASS)
+    callbacks = source.callbacks('create_subscription', 2) if source else []
+    if callbacks and set(callbacks) != {'temperature_callback'}:
+        raise CheckFailed(f'The subscription calls {", ".join(sorted(set(callbacks)))}; it must '
+                          'call self.temperature_callback (the method itself, without '
+                          'parentheses).')
+    if source is None or not callbacks or not source.reaches_call('temperature_callback',
+                                                                  LOG_CALLS):
+        raise CheckFailed('temperature_callback never logs, yet lines arrived from elsewhere: '
+                          "log each reading and its status with the node's logger in "
+                          'temperature_callback.')
+
+
 def _statuses_verdict(readings: tuple[float, ...] | list[float], lines: list[list[str]], *,
                       with_value: bool) -> None:
     words = re.compile(r'\b(High|Low|Normal)\b')
@@ -128,6 +151,7 @@ def _statuses_verdict(readings: tuple[float, ...] | list[float], lines: list[lis
 def _monitor_callback(judge: Judge) -> str:
     lines = _feed_monitor(judge, BOUNDARY_READINGS_C)
     _statuses_verdict(BOUNDARY_READINGS_C, lines, with_value=False)
+    _callback_source_verdict(judge)
     return (f'one line with the right status for each of {len(BOUNDARY_READINGS_C)} readings, '
             f'including {course.LOW_BELOW_C} and {course.HIGH_ABOVE_C} °C (both Normal).')
 
@@ -152,6 +176,7 @@ def _monitor_readings(judge: Judge) -> str:
     readings += [course.LOW_BELOW_C, course.HIGH_ABOVE_C, 19.995, 26.005]
     lines = _feed_monitor(judge, readings)
     _statuses_verdict(readings, lines, with_value=True)
+    _callback_source_verdict(judge)
     return f'the right status and the reading in one line for each of {len(readings)} readings.'
 
 

@@ -75,7 +75,8 @@ def run_main(judge: Judge, relative: str, node_name: str, part: int = 5) -> str:
     # once the node runs: earlier, a busy machine would decide what the learner is told.
     observer.wait_until(lambda: proc.poll() is not None or observer.has_node(node_name),
                         ARRIVAL_TIMEOUT_S)
-    spinning = proc.poll() is None and observer.spins(node_name)
+    started = proc.poll() is None and observer.has_node(node_name)
+    spinning = started and observer.spins(node_name)
     if proc.poll() is not None:
         text = output.text()
         if 'NotImplementedError' in text:
@@ -86,6 +87,11 @@ def run_main(judge: Judge, relative: str, node_name: str, part: int = 5) -> str:
                               f'({_error_line(text)}): fix that line, then run this check again.')
         raise CheckFailed(f'{path.name} ended by itself before Ctrl+C (exit code '
                           f'{proc.returncode}); main() should spin until Ctrl+C.')
+    if not started:  # the judge's own graph: no node of that name appeared while it ran
+        kill_process_group(proc)
+        raise CheckFailed(f'{path.name} never started its node {node_name} (none appeared in the '
+                          f'grader\'s ROS graph within {ARRIVAL_TIMEOUT_S:g} s): main() should bring rclpy up, '
+                          'create the node and spin it until Ctrl+C.')
     interrupt(proc)
     try:
         code = proc.wait(EXIT_AFTER_CTRL_C_S)
@@ -99,6 +105,10 @@ def run_main(judge: Judge, relative: str, node_name: str, part: int = 5) -> str:
         raise CheckFailed(f'{path.name} never reached its spin: line {stuck[0]} in {stuck[1]} '
                           f'({stuck[2]}) was still running at Ctrl+C; no loop in a constructor or '
                           'callback: repeat work with a timer (create_timer) and let main() spin.')
+    if not spinning:  # the node was there but never answered: main() did not spin it
+        raise CheckFailed(f'{path.name} created its node {node_name} but never spun it (it did '
+                          'not answer the grader): main() should spin it with rclpy.spin(node) '
+                          'until Ctrl+C.')
     if code != 0 or 'Traceback' in text:
         last = _error_line(text)
         already = any(mark in last for mark in ALREADY_SHUT_DOWN_MARKS)

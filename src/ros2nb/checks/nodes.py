@@ -26,12 +26,12 @@ def parts_verdict(workspace: Path, relative: str) -> None:
 
 
 def new_node(judge: Judge, relative: str, cls: str, *, placeholders: tuple[str, ...] = (),
-              attributes: tuple[str, ...] = (), seed: Optional[int] = None,
-              args: tuple = ()) -> tuple[Any, dict]:
-    """Create the learner's node ``cls(*args)`` from their file in a subject; raise for what went wrong."""
+              seed: Optional[int] = None, args: tuple = ()) -> tuple[Any, dict]:
+    """Create the learner's node ``cls(*args)`` from their file in a subject; raise for what
+    went wrong."""
     subject = judge.file_subject(relative)
     reply = subject.request('new_node', cls=cls, placeholders=list(placeholders),
-                            attributes=list(attributes), seed=seed, args=list(args))
+                            seed=seed, args=list(args))
     file = Path(relative).name
     if reply.get('no_class') or not reply.get('ok'):
         parts_verdict(judge.workspace, relative)

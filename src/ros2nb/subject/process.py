@@ -6,9 +6,11 @@ A check never runs the learner's code in its own process, and never trusts a ver
 from this one.  The judge (:mod:`ros2nb.judge`) starts this process, sends it commands as
 JSON lines on file descriptor IN and reads one JSON reply per command on OUT.  Here the
 learner's file is imported or their answer cells executed, their node runs on simulated
-time in ros2nb's runtime, and only raw facts come back: what the node created, what it
-set, how many messages it published.  Whether those are right is decided in the judge,
-which also watches the node over ROS itself.
+time in ros2nb's runtime, and only raw facts come back: what the node created (for the
+judge to find in its own view of the graph), how many messages it published and logged
+(how long the judge waits for them).  The learner's import can rewrite any reply, so none
+passes a check: the judge decides from what it observes over ROS and from the learner's
+file read as text.
 """
 
 from __future__ import annotations
@@ -189,8 +191,8 @@ class Subject:
         counted.__qualname__ = getattr(original, '__qualname__', counted.__name__)
         timer.callback = counted
 
-    def new_node(self, cls: str, placeholders: list[str], attributes: list[str],
-                 seed: Optional[int], args: Optional[list] = None) -> dict:
+    def new_node(self, cls: str, placeholders: list[str], seed: Optional[int],
+                 args: Optional[list] = None) -> dict:
         rt = self._runtime()
         if self.node is not None:
             if self.node.get_fully_qualified_name() in rt.nodes:
@@ -222,16 +224,12 @@ class Subject:
             self._count_publishes(publisher, node.resolve_topic_name(publisher.topic_name))
         for subscription in node.subscriptions:
             self._count_receipts(subscription)
-        timers = [[t.timer_period_ns, getattr(t.callback, '__name__', repr(t.callback))]
-                  for t in node.timers]
         for timer in node.timers:
             self._count_firings(timer)
-        facts = {name: encode(getattr(node, name)) for name in attributes if hasattr(node, name)}
         logger = node.get_logger().name
         return {'ok': True, 'name': node.get_name(), 'namespace': node.get_namespace(),
                 'started_lines': rt.log_counts[logger] - logged_before.get(logger, 0),
-                'placeholders': missing, 'attributes': facts,
-                'timers': timers,
+                'placeholders': missing,
                 'endpoints': node_endpoints(node), **self._counts()}
 
     def _counts(self) -> dict:

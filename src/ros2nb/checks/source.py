@@ -1,0 +1,188 @@
+"""The learner's node class read as text (``ast``) by the judge, never executed here.
+
+Part of :mod:`ros2nb.checks`.  A subject runs the learner's code, so anything it reports
+about that code is the learner's to forge (their import can reach the subject's request
+loop and rewrite its replies).  What no message on the wire shows (which timers a node
+creates, with which period and callback; what its start value is set to; whether its
+callback publishes at all) the judge reads from the file itself, with :mod:`ast`.
+"""
+
+from __future__ import annotations
+
+import ast
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Optional
+
+#: What :meth:`ClassSource.value` returns for an expression it cannot work out as text.
+UNKNOWN: Any = object()
+#: How many names deep :meth:`ClassSource.value` follows ``A = B`` (a guard against loops).
+MAX_DEPTH = 8
+_OPERATORS = {ast.Add: lambda a, b: a + b, ast.Sub: lambda a, b: a - b,
+              ast.Mult: lambda a, b: a * b, ast.Div: lambda a, b: a / b}
+
+
+@dataclass(frozen=True)
+class Timer:
+    """A ``create_timer`` call in the class.
+
+    :ivar period: the period in seconds, or :data:`UNKNOWN` when it is not a constant.
+    :ivar callback: the method's name for ``self.NAME``, else the argument's source text.
+    """
+
+    period: Any
+    callback: str
+
+
+def _assigned(function: Optional[ast.AST], target: str) -> list[ast.expr]:
+    """Values assigned to ``target`` (``'X'`` or ``'self.X'``) anywhere in ``function``."""
+    values = []
+    for node in ast.walk(function) if function is not None else ():
+        if isinstance(node, ast.Assign):
+            targets, value = node.targets, node.value
+        elif isinstance(node, (ast.AnnAssign, ast.AugAssign)) and node.value is not None:
+            targets, value = [node.target], node.value
+            if isinstance(node, ast.AugAssign):
+                value = UNKNOWN
+        else:
+            continue
+        if any(ast.unparse(t) == target for t in targets):
+            values.append(value)
+    return values
+
+
+class ClassSource:
+    """One class of the learner's file, as the judge reads it (text only)."""
+
+    def __init__(self, module: ast.Module, cls: ast.ClassDef) -> None:
+        self.module, self.cls = module, cls
+
+    @classmethod
+    def read(cls, path: Path, name: str) -> Optional['ClassSource']:
+        """The class ``name`` of ``path``; None when the file cannot be read or parsed, or
+        holds no such class (the subject's import says why, in the learner's words)."""
+        try:
+            module = ast.parse(path.read_text())
+        except (OSError, SyntaxError, ValueError, UnicodeDecodeError):
+            return None
+        found = [s for s in module.body if isinstance(s, ast.ClassDef) and s.name == name]
+        return cls(module, found[-1]) if found else None
+
+    def method(self, name: str) -> Optional[ast.FunctionDef]:
+        found = [s for s in self.cls.body if isinstance(s, ast.FunctionDef) and s.name == name]
+        return found[-1] if found else None
+
+    def computes(self, name: str) -> bool:
+        """True when the class body makes ``name`` something other than a plain value: a
+        method or ``@property`` of that name, or a class attribute set to what is not a
+        constant (``property(...)``, a descriptor).  Reading it may then run any code."""
+        for statement in self.cls.body:
+            if isinstance(statement, (ast.FunctionDef, ast.AsyncFunctionDef)) \
+                    and statement.name == name:
+                return True
+            if isinstance(statement, (ast.Assign, ast.AnnAssign)) and statement.value is not None \
+                    and any(isinstance(t, ast.Name) and t.id == name for t in (
+                        statement.targets if isinstance(statement, ast.Assign)
+                        else [statement.target])) \
+                    and self.value(statement.value) is UNKNOWN:
+                return True
+        return False
+
+    def value(self, node: Any, function: Optional[ast.AST] = None, depth: int = 0) -> Any:
+        """The constant an expression stands for, following names; else :data:`UNKNOWN`."""
+        if node is UNKNOWN or depth > MAX_DEPTH:
+            return UNKNOWN
+        if isinstance(node, ast.Constant):
+            return node.value
+        if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub, ast.UAdd)):
+            inner = self.value(node.operand, function, depth + 1)
+            if isinstance(inner, (int, float)) and not isinstance(inner, bool):
+                return -inner if isinstance(node.op, ast.USub) else inner
+            return UNKNOWN
+        if isinstance(node, ast.BinOp) and type(node.op) in _OPERATORS:
+            left = self.value(node.left, function, depth + 1)
+            right = self.value(node.right, function, depth + 1)
+            try:
+                return _OPERATORS[type(node.op)](left, right)
+            except Exception:
+                return UNKNOWN
+        if isinstance(node, ast.Name):
+            local = _assigned(function, node.id)
+            if local:
+                return self.value(local[-1], function, depth + 1)
+            scope = [s for s in self.module.body if not isinstance(
+                s, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef))]
+            found = _assigned(ast.Module(body=scope, type_ignores=[]), node.id)
+            return self.value(found[-1], None, depth + 1) if found else UNKNOWN
+        if isinstance(node, ast.Attribute) and ast.unparse(node.value) == 'self':
+            return self.attribute(node.attr, depth + 1)
+        return UNKNOWN
+
+    def assignments(self, attribute: str) -> list[ast.expr]:
+        """Values ``__init__`` assigns to ``self.<attribute>``, in order."""
+        return _assigned(self.method('__init__'), f'self.{attribute}')
+
+    def assigned_anywhere(self, attribute: str) -> bool:
+        """True when any method of the class assigns ``self.<attribute>``."""
+        return any(_assigned(f, f'self.{attribute}') for f in self.cls.body
+                   if isinstance(f, ast.FunctionDef))
+
+    def attribute(self, attribute: str, depth: int = 0) -> Any:
+        """The constant ``__init__`` last assigns to ``self.<attribute>``, or UNKNOWN."""
+        found = self.assignments(attribute)
+        return self.value(found[-1], self.method('__init__'), depth) if found else UNKNOWN
+
+    def timers(self) -> list[Timer]:
+        """Every ``create_timer(period, callback)`` call in the class's methods."""
+        timers = []
+        for function in self.cls.body:
+            if not isinstance(function, ast.FunctionDef):
+                continue
+            for node in ast.walk(function):
+                if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) \
+                        and node.func.attr == 'create_timer':
+                    given = {k.arg: k.value for k in node.keywords}
+                    period = node.args[0] if node.args else given.get('timer_period_sec')
+                    callback = node.args[1] if len(node.args) > 1 else given.get('callback')
+                    timers.append(Timer(self.value(period, function) if period else UNKNOWN,
+                                        _method_name(callback)))
+        return timers
+
+    def callbacks(self, factory: str, position: int) -> list[str]:
+        """The callbacks given to every ``factory(...)`` call (``create_subscription``) in
+        the class: the argument at ``position`` or the keyword ``callback``, by name."""
+        found = []
+        for node in ast.walk(self.cls):
+            if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) \
+                    and node.func.attr == factory:
+                given = {k.arg: k.value for k in node.keywords}
+                found.append(_method_name(node.args[position] if len(node.args) > position
+                                          else given.get('callback')))
+        return found
+
+    def reaches_call(self, method: str, attrs: frozenset[str] | set[str] | str) -> bool:
+        """True when ``method`` calls ``something.A(...)`` for an ``A`` in ``attrs``, itself or
+        through ``self.m()`` calls of the class."""
+        attrs = {attrs} if isinstance(attrs, str) else set(attrs)
+        seen: set[str] = set()
+        todo = [method]
+        while todo:
+            function = self.method(todo.pop())
+            if function is None or function.name in seen:
+                continue
+            seen.add(function.name)
+            for node in ast.walk(function):
+                if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute):
+                    if node.func.attr in attrs:
+                        return True
+                    if ast.unparse(node.func.value) == 'self':
+                        todo.append(node.func.attr)
+        return False
+
+
+def _method_name(callback: Optional[ast.expr]) -> str:
+    if callback is None:
+        return 'nothing'
+    if isinstance(callback, ast.Attribute) and ast.unparse(callback.value) == 'self':
+        return callback.attr
+    return ast.unparse(callback)

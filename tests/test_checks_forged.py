@@ -1,0 +1,185 @@
+"""Learners whose code forges what the subject process reports: no verdict may follow it.
+
+As tests/test_checks.py: this process is the judge, the learner's code runs in real subject
+processes and the verdicts come from the judge's own ROS node. Each learner below is the
+course's reference with one piece of work left out and, at import, code that walks up the
+stack to the subject's request loop and rewrites its replies (or does the missing work
+itself inside them, or rewrites the files the judge reads). Against the judge of 31f397c,
+which believed the subject's replies, every check below passed (notebook 03: no timer 6/6,
+a callback doing nothing 6/6, a property's start value 3/6, a main() that never starts ROS
+6/6; notebook 04: a callback doing nothing 5/5; notebook 02's reader 1/1). Now each fails
+with one line; the honest twin of each is the reference, which passes (tests/test_checks.py).
+"""
+
+import pytest
+
+from ros2nb import checks, course
+from ros2nb.checks.base import AnswerRef
+
+from grading_samples import REWRITING_READER
+from test_checks import PUB, SUB, fails, mutated, restore, session  # noqa: F401 (fixture)
+
+pytestmark = pytest.mark.timeout(300)
+
+#: Module code that finds the subject's request loop from the learner's import and keeps
+#: its handlers and its Subject (nothing happens when the file runs as a program).
+FIND_SUBJECT = '''
+import sys as _sys
+_frame = _sys._getframe()
+while _frame is not None and 'handlers' not in _frame.f_locals:
+    _frame = _frame.f_back
+_HANDLERS = _frame.f_locals['handlers'] if _frame else {}
+_SUBJECT = _frame.f_locals['subject'] if _frame else None
+'''
+
+#: The timer's work done by the request handler: new_node reports a timer of 1 s, and
+#: each ``advance`` calls publish_temperature once per simulated second itself.
+FORGED_TIMER = FIND_SUBJECT + '''
+def _forge(_new_node=_HANDLERS.get('new_node'), _advance=_HANDLERS.get('advance')):
+    def new_node(**request):
+        reply = _new_node(**request)
+        if reply.get('ok'):
+            reply['timers'] = [[1_000_000_000, 'publish_temperature']]
+        return reply
+
+    def advance(seconds, seed=None):
+        if seed is not None:
+            random.seed(seed)
+        for _ in range(round(seconds)):
+            _SUBJECT.node.publish_temperature()
+        return _advance(seconds=seconds)
+
+    _HANDLERS.update(new_node=new_node, advance=advance)
+
+
+if _SUBJECT is not None:
+    _forge()
+'''
+
+#: The callback's work done by the request handler: each ``advance`` steps the walk,
+#: publishes and logs the reading itself, while publish_temperature does nothing.
+FORGED_CALLBACK = FIND_SUBJECT + '''
+def _forge(_advance=_HANDLERS.get('advance')):
+    def advance(seconds, seed=None):
+        if seed is not None:
+            random.seed(seed)
+        node = _SUBJECT.node
+        for _ in range(round(seconds)):
+            step = random.uniform(-MAX_STEP_C, MAX_STEP_C)
+            node.temperature = max(MIN_TEMPERATURE_C, min(MAX_TEMPERATURE_C, node.temperature + step))
+            node.publisher_.publish(Float32(data=node.temperature))
+            node.get_logger().info(f'Publishing: {node.temperature:.2f}C')
+        return _advance(seconds=seconds)
+
+    _HANDLERS['advance'] = advance
+
+
+if _SUBJECT is not None:
+    _forge()
+'''
+
+TIMER_LINE = '        self.timer = self.create_timer(PUBLISH_PERIOD_S, self.publish_temperature)\n'
+MAIN_GUARD = "\nif __name__ == '__main__':"
+
+
+def test_a_sensor_without_a_timer_whose_subject_reports_one(session):
+    mutated(session, PUB, (TIMER_LINE, MAIN_GUARD), ('', FORGED_TIMER + MAIN_GUARD))
+    try:
+        fails(checks.check_sensor_constructor, r'TemperatureSensor has no timer')
+        fails(checks.check_sensor_callback, r'TemperatureSensor has no timer')
+    finally:
+        restore(session, PUB)
+
+
+def test_a_callback_that_does_nothing_while_its_subject_publishes(session):
+    mutated(session, PUB, ('    def publish_temperature(self):\n', MAIN_GUARD),
+            ('    def publish_temperature(self):\n        return\n\n    def unused(self):\n',
+             FORGED_CALLBACK + MAIN_GUARD))
+    try:
+        checks.check_sensor_constructor()  # part 3 is the reference's: it deserves its point
+        fails(checks.check_sensor_callback, r'publish_temperature never publishes')
+        fails(checks.check_sensor_hour, r'publish_temperature never publishes')
+    finally:
+        restore(session, PUB)
+
+
+def test_a_start_value_reported_by_a_property(session):
+    """``self.temperature`` reads 22.0 while the walk really starts at 25.0."""
+    mutated(session, PUB, (
+        '    def __init__(self):\n',
+        '        self.temperature = START_TEMPERATURE_C\n',
+        '''        self.temperature = max(MIN_TEMPERATURE_C,
+                               min(MAX_TEMPERATURE_C, self.temperature + step))''',
+        'msg.data = self.temperature',
+        "info(f'Publishing: {self.temperature:.2f}C')"), (
+        '    temperature = property(lambda self: START_TEMPERATURE_C)\n\n    def __init__(self):\n',
+        '        self.walk = 25.0\n',
+        '''        self.walk = max(MIN_TEMPERATURE_C,
+                        min(MAX_TEMPERATURE_C, self.walk + step))''',
+        'msg.data = self.walk',
+        "info(f'Publishing: {self.walk:.2f}C')"))
+    try:
+        fails(checks.check_sensor_constructor,
+              r'temperature of TemperatureSensor is a property|self.temperature starts at')
+        fails(checks.check_sensor_callback, r'temperature of TemperatureSensor is a property|'
+                                            r'The first reading is 2[45]\.\d\d °C')
+    finally:
+        restore(session, PUB)
+
+
+def test_a_main_that_never_starts_ros(session):
+    """main() waits for Ctrl+C and leaves cleanly, but no node ever runs."""
+    mutated(session, PUB, ('    rclpy.init(args=args)\n    node = TemperatureSensor()\n'
+                           '    try:\n        rclpy.spin(node)\n',
+                           '        node.destroy_node()\n        rclpy.try_shutdown()  #'),
+            ('    import time\n    node = None\n    try:\n        while True:\n'
+             '            time.sleep(0.05)\n',
+             '        if node:\n            node.destroy_node()\n        rclpy.try_shutdown()  #'))
+    try:
+        fails(checks.check_sensor_main, r'never started its node temperature_sensor')
+    finally:
+        restore(session, PUB)
+
+
+#: The callback's work done by a method the subscription was switched to after the
+#: subject created the node: temperature_callback itself does nothing.
+FORGED_SUBSCRIPTION = FIND_SUBJECT + '''
+def _forge(_new_node=_HANDLERS.get('new_node')):
+    def new_node(**request):
+        reply = _new_node(**request)
+        node = _SUBJECT.node
+        for subscription in node.subscriptions if reply.get('ok') else ():
+            counted = subscription.callback
+            subscription.callback = lambda msg, counted=counted: (counted(msg), node.unused(msg))
+        return reply
+
+    _HANDLERS['new_node'] = new_node
+
+
+if _SUBJECT is not None:
+    _forge()
+'''
+
+
+def test_a_monitor_callback_that_does_nothing_while_another_method_logs(session):
+    mutated(session, SUB, ('    def temperature_callback(self, msg):\n', MAIN_GUARD),
+            ('    def temperature_callback(self, msg):\n        return\n\n    def unused(self, msg):\n',
+             FORGED_SUBSCRIPTION + MAIN_GUARD))
+    try:
+        checks.check_monitor_constructor()  # part 3 is the reference's: it deserves its points
+        fails(checks.check_monitor_callback, r'temperature_callback never logs')
+    finally:
+        restore(session, SUB)
+
+
+def test_a_package_reader_that_rewrites_the_package_xml(session):
+    xml = session.workspace / course.PACKAGE_XML_FILE
+    saved = xml.read_text()
+    try:
+        fails(lambda: checks.check_dependencies(AnswerRef('package_dependencies',
+                                                          (REWRITING_READER,))),
+              r"For graded_reader/package.xml you returned \['ament_python', 'geometry_msgs', "
+              r"'rclpy', 'sensor_msgs'\], but it declares \['geometry_msgs', 'rclpy', "
+              r"'sensor_msgs'\]")
+    finally:
+        xml.write_text(saved)
