@@ -11,6 +11,7 @@ import ast
 import re
 import subprocess
 import sys
+from pathlib import Path
 from typing import Optional
 
 from ..errors import CheckFailed
@@ -78,15 +79,7 @@ def run_main(judge: Judge, relative: str, node_name: str, part: int = 5) -> str:
     started = proc.poll() is None and observer.has_node(node_name)
     spinning = started and observer.spins(node_name)
     if proc.poll() is not None:
-        text = output.text()
-        if 'NotImplementedError' in text:
-            raise CheckFailed(f'main() still raises NotImplementedError: write part {part} where '
-                              'it says YOUR CODE HERE.')
-        if 'Traceback' in text:
-            raise CheckFailed(f'{path.name} crashed before Ctrl+C{_crash_place(text, path)} '
-                              f'({_error_line(text)}): fix that line, then run this check again.')
-        raise CheckFailed(f'{path.name} ended by itself before Ctrl+C (exit code '
-                          f'{proc.returncode}); main() should spin until Ctrl+C.')
+        raise _ended_early(path, part, output.text(), proc.returncode)
     if not started:  # the judge's own graph: no node of that name appeared while it ran
         kill_process_group(proc)
         raise CheckFailed(f'{path.name} never started its node {node_name} (none appeared in the '
@@ -118,6 +111,18 @@ def run_main(judge: Judge, relative: str, node_name: str, part: int = 5) -> str:
     _cleanup_verdict(main)
     return (f'{path.name} stops cleanly on Ctrl+C (exit code 0, no traceback) and cleans up in '
             'finally.')
+
+
+def _ended_early(path: Path, part: int, text: str, code: int) -> CheckFailed:
+    """Why the learner's program ended before Ctrl+C, from its output, as the check's line."""
+    if 'NotImplementedError' in text:
+        return CheckFailed(f'main() still raises NotImplementedError: write part {part} where '
+                           'it says YOUR CODE HERE.')
+    if 'Traceback' in text:
+        return CheckFailed(f'{path.name} crashed before Ctrl+C{_crash_place(text, path)} '
+                           f'({_error_line(text)}): fix that line, then run this check again.')
+    return CheckFailed(f'{path.name} ended by itself before Ctrl+C (exit code {code}); main() '
+                       'should spin until Ctrl+C.')
 
 
 def _caught(main: ast.FunctionDef) -> set[str]:
