@@ -8,7 +8,6 @@ says nothing.
 """
 
 import json
-import os
 import re
 import shutil
 from pathlib import Path
@@ -16,12 +15,11 @@ from pathlib import Path
 import pytest
 
 from ros2nb import checks, course
-from ros2nb.checks.base import bind_judge
 from ros2nb.checks.dispatch import IN_JUDGE_ENV
-from ros2nb.judge.session import Session
 from ros2nb.errors import CheckFailed, LearnerCodeError
 
 from waiting import wait_for
+from judging import judge_session
 
 pytestmark = pytest.mark.timeout(300)
 
@@ -35,25 +33,8 @@ MESSAGES: list[str] = []
 @pytest.fixture(scope='module')
 def session(tmp_path_factory):
     """A judge session (this process is the judge) on a workspace with the course's package."""
-    import ros2nb
-    from ros2nb.terminal import workspace as ws_module
-    root = tmp_path_factory.mktemp('checks')
-    saved = {k: os.environ.get(k) for k in ('ROS2NB_WORKSPACE', IN_JUDGE_ENV)}
-    os.environ['ROS2NB_WORKSPACE'] = str(root / 'ws')
-    os.environ[IN_JUDGE_ENV] = '1'
-    ws_module._current = None
-    ros2nb.course.catch_up(5)
-    session = Session(root / 'ws')
-    bind_judge(session)  # this process is the judge
-    yield session
-    bind_judge(None)
-    session.close()
-    for key, value in saved.items():
-        if value is None:
-            os.environ.pop(key, None)
-        else:
-            os.environ[key] = value
-    ws_module._current = None
+    with judge_session(tmp_path_factory.mktemp('checks'), 5) as judge:
+        yield judge
 
 
 def strangers(session) -> list[str]:

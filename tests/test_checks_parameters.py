@@ -14,10 +14,8 @@ import nbformat
 import pytest
 
 from ros2nb import checks, course
-from ros2nb.checks.base import bind_judge
-from ros2nb.checks.dispatch import IN_JUDGE_ENV
 from ros2nb.errors import CheckFailed
-from ros2nb.judge.session import Session
+from judging import judge_session
 
 pytestmark = pytest.mark.timeout(300)
 
@@ -42,25 +40,8 @@ REFERENCE = solution_monitor()
 @pytest.fixture(scope='module')
 def session(tmp_path_factory):
     """A judge session (this process is the judge) on a workspace with the course's package."""
-    import ros2nb
-    from ros2nb.terminal import workspace as ws_module
-    root = tmp_path_factory.mktemp('checks08')
-    saved = {k: os.environ.get(k) for k in ('ROS2NB_WORKSPACE', IN_JUDGE_ENV)}
-    os.environ['ROS2NB_WORKSPACE'] = str(root / 'ws')
-    os.environ[IN_JUDGE_ENV] = '1'
-    ws_module._current = None
-    ros2nb.course.catch_up(5)
-    session = Session(root / 'ws')
-    bind_judge(session)
-    yield session
-    bind_judge(None)
-    session.close()
-    for key, value in saved.items():
-        if value is None:
-            os.environ.pop(key, None)
-        else:
-            os.environ[key] = value
-    ws_module._current = None
+    with judge_session(tmp_path_factory.mktemp('checks08'), 5) as judge:
+        yield judge
 
 
 def write_monitor(session, text: str) -> None:

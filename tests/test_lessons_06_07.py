@@ -5,17 +5,14 @@ processes, verdicts come from the judge's own ROS node.  The course's reference 
 first, so every failure below is its mistake's.
 """
 
-import os
 import re
 from pathlib import Path
 
 import pytest
 
 from ros2nb import checks, course
-from ros2nb.checks.base import bind_judge
-from ros2nb.checks.dispatch import IN_JUDGE_ENV
 from ros2nb.errors import CheckFailed
-from ros2nb.judge.session import Session
+from judging import judge_session
 
 pytestmark = pytest.mark.timeout(300)
 
@@ -25,26 +22,10 @@ FAN, PROMISES, PLOT = course.FAN_FILE, course.PROMISES_FILE, course.LIVE_PLOT_FI
 @pytest.fixture(scope='module')
 def session(tmp_path_factory):
     """A judge session on a workspace with the course's package and its 06 files."""
-    from ros2nb.terminal import workspace as ws_module
-    root = tmp_path_factory.mktemp('lesson06')
-    saved = {k: os.environ.get(k) for k in ('ROS2NB_WORKSPACE', IN_JUDGE_ENV)}
-    os.environ['ROS2NB_WORKSPACE'] = str(root / 'ws')
-    os.environ[IN_JUDGE_ENV] = '1'
-    ws_module._current = None
-    course.catch_up(7)
-    session = Session(root / 'ws')
-    for relative in (FAN, PROMISES, PLOT):
-        restore(session, relative)
-    bind_judge(session)
-    yield session
-    bind_judge(None)
-    session.close()
-    for key, value in saved.items():
-        if value is None:
-            os.environ.pop(key, None)
-        else:
-            os.environ[key] = value
-    ws_module._current = None
+    with judge_session(tmp_path_factory.mktemp('lesson06'), 7) as judge:
+        for relative in (FAN, PROMISES, PLOT):
+            restore(judge, relative)
+        yield judge
 
 
 def restore(session, relative: str) -> None:
