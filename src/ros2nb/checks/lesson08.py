@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import re
 import time
-from typing import Any
+from typing import Any, Callable
 
 from rcl_interfaces.msg import ParameterType
 from rclpy.parameter import Parameter, parameter_value_to_python
@@ -19,6 +19,7 @@ from rclpy.parameter_client import AsyncParameterClient
 
 from .. import course
 from ..errors import CheckFailed
+from ..runtime.services import call_until_answered
 from .base import ARRIVAL_TIMEOUT_S, Judge, judged, learner_error
 from .nodes import new_node
 
@@ -57,32 +58,38 @@ class _Parameters:
                               f'within {ARRIVAL_TIMEOUT_S:g} s (is the machine very busy?): run '
                               'this check again.')
 
-    def answer(self, future: Any, what: str) -> Any:
-        """Wait for the node's answer; a callback of the learner's that raised is named."""
-        deadline = time.monotonic() + ARRIVAL_TIMEOUT_S
-        while not self.observer.wait_until(future.done, 0.5):
+    def answer(self, send: Callable[[], Any], what: str) -> Any:
+        """Ask until the node answers (asked again now and then: a request or its reply can
+        be lost right after the node appeared); a callback of the learner's that raised is
+        named."""
+        def failed() -> None:
             failure = self.subject.request('counts')['failure']
             if failure:
                 _callback_failure(failure, what)
-            if time.monotonic() > deadline:
-                raise CheckFailed(f'{self.name} did not answer {what} within '
-                                  f'{ARRIVAL_TIMEOUT_S:g} s: does your callback wait for '
-                                  'something?')
-        return future.result()
+
+        done = call_until_answered(send, lambda f, s: self.observer.wait_until(f.done, s),
+                                   ARRIVAL_TIMEOUT_S, failed)
+        if done is None:
+            failed()
+            raise CheckFailed(f'{self.name} did not answer {what} within '
+                              f'{ARRIVAL_TIMEOUT_S:g} s: does your callback wait for '
+                              'something?')
+        return done.result()
 
     def names(self) -> list[str]:
-        return sorted(self.answer(self.client.list_parameters(), 'ros2 param list').result.names)
+        return sorted(self.answer(self.client.list_parameters, 'ros2 param list').result.names)
 
     def values(self, names: list[str]) -> list[Any]:
-        return list(self.answer(self.client.get_parameters(names), 'ros2 param get').values)
+        return list(self.answer(lambda: self.client.get_parameters(names),
+                                'ros2 param get').values)
 
     def descriptors(self, names: list[str]) -> list[Any]:
-        return list(self.answer(self.client.describe_parameters(names),
+        return list(self.answer(lambda: self.client.describe_parameters(names),
                                 'ros2 param describe').descriptors)
 
     def set(self, name: str, value: float) -> Any:
-        future = self.client.set_parameters([Parameter(name, value=value)])
-        return self.answer(future, f'ros2 param set {name} {value}').results[0]
+        return self.answer(lambda: self.client.set_parameters([Parameter(name, value=value)]),
+                           f'ros2 param set {name} {value}').results[0]
 
 
 def _callback_failure(failure: dict, what: str) -> None:

@@ -23,6 +23,7 @@ from std_msgs.msg import Float32
 from .. import domains
 from ..checks.base import ARRIVAL_TIMEOUT_S
 from ..errors import CheckFailed
+from ..runtime.services import call_until_answered
 
 
 class Observer:
@@ -151,14 +152,14 @@ class Observer:
         client = self.node.create_client(ListParameters, service)
         try:
             deadline = time.monotonic() + seconds
-            while time.monotonic() < deadline:
-                # Ask again now and then: a request goes only to the servers discovered
-                # when it is sent (a node of that name that just ended may be one of them).
-                if client.wait_for_service(timeout_sec=0.1):
-                    answer = client.call_async(ListParameters.Request())
-                    if self.wait_until(answer.done, min(1.0, max(0.0, deadline - time.monotonic()))):
-                        return True
-            return False
+            while not client.wait_for_service(timeout_sec=0.1):
+                if time.monotonic() > deadline:
+                    return False
+            # Asked again now and then: a request goes only to the servers discovered when
+            # it is sent (a node of that name that just ended may be one of them).
+            return call_until_answered(lambda: client.call_async(ListParameters.Request()),
+                                       lambda f, s: self.wait_until(f.done, s),
+                                       max(0.0, deadline - time.monotonic())) is not None
         finally:
             self.node.destroy_client(client)
 

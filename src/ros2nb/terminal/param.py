@@ -16,7 +16,7 @@ import os
 import shutil
 import subprocess
 import time
-from typing import Any, Iterator, Optional
+from typing import Any, Callable, Iterator, Optional
 
 import yaml
 from rcl_interfaces.msg import Parameter as ParameterMsg
@@ -27,6 +27,7 @@ from rclpy.parameter_client import AsyncParameterClient
 
 from ..errors import Ros2nbError, UsageError
 from ..runtime import current_runtime
+from ..runtime.services import call_until_answered
 from .run import node_process_env
 
 #: Seconds a verb waits for the node's parameter services and their answer (wall clock).
@@ -106,15 +107,21 @@ class _Client:
             raise Ros2nbError(f'{self.name} does not answer parameter calls (its services did '
                               f'not appear within {SERVICE_WAIT_S:g} s): is it spinning?')
 
-    def answer(self, future: Any) -> Any:
-        deadline = time.monotonic() + SERVICE_WAIT_S
-        while not future.done():
-            if time.monotonic() > deadline:
-                raise Ros2nbError(f'{self.name} did not answer within {SERVICE_WAIT_S:g} s: is '
-                                  'it spinning (ros2nb.add(node))?')
-            time.sleep(0.002)
+    def answer(self, send: Callable[[], Any]) -> Any:
+        """Ask with ``send()`` (again now and then: a request or reply can be lost right
+        after a node appeared) until the node answers."""
+        def wait(future: Any, seconds: float) -> bool:
+            until = time.monotonic() + seconds
+            while not future.done() and time.monotonic() < until:
+                time.sleep(0.002)
+            return future.done()
+
+        done = call_until_answered(send, wait, SERVICE_WAIT_S)
+        if done is None:
+            raise Ros2nbError(f'{self.name} did not answer within {SERVICE_WAIT_S:g} s: is '
+                              'it spinning (ros2nb.add(node))?')
         self.rt.print_pending()
-        return future.result()
+        return done.result()
 
     def close(self) -> None:
         with self.rt.exclusive():
@@ -132,7 +139,7 @@ def _client(node: str) -> Iterator[_Client]:
 
 
 def _names(client: _Client) -> list[str]:
-    return sorted(client.answer(client.client.list_parameters()).result.names)
+    return sorted(client.answer(client.client.list_parameters).result.names)
 
 
 def param_list(node: str) -> list[str]:
@@ -155,7 +162,7 @@ def param_list(node: str) -> list[str]:
 
 
 def _values(client: _Client, names: list[str]) -> list[Any]:
-    return list(client.answer(client.client.get_parameters(names)).values)
+    return list(client.answer(lambda: client.client.get_parameters(names)).values)
 
 
 def param_get(node: str, name: str) -> Any:
@@ -216,7 +223,7 @@ def param_set(node: str, name: str, value: Any) -> bool:
         return out.startswith('Set parameter successful')
     parameter = _as_parameter(name, value)
     with _client(node) as client:
-        result = client.answer(client.client.set_parameters([parameter])).results[0]
+        result = client.answer(lambda: client.client.set_parameters([parameter])).results[0]
     if result.successful:
         print('Set parameter successful' + (f': {result.reason}' if result.reason else ''))
     else:
@@ -238,7 +245,7 @@ def param_describe(node: str, *names: str) -> list[Any]:
     if _real_ros2('describe', _absolute(node), *names) is not None:
         return []
     with _client(node) as client:
-        descriptors = list(client.answer(client.client.describe_parameters(list(names)))
+        descriptors = list(client.answer(lambda: client.client.describe_parameters(list(names)))
                            .descriptors)
     for descriptor in descriptors:
         print('Parameter name:', descriptor.name)
