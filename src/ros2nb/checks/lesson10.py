@@ -11,6 +11,8 @@ reading function returns with a bag the check wrote itself.
 
 from __future__ import annotations
 
+import contextlib
+import io
 import math
 import re
 import tempfile
@@ -34,8 +36,6 @@ TEMPERATURE, ROSOUT = '/' + course.TOPIC, course.ROSOUT_TOPIC
 STATUS_LINE = re.compile(r'Temperature: (-?[\d.]+)C - Status: (\w+)')
 #: Readings of the bags the check writes itself (parts b and c): a walk through all statuses.
 CHECK_READINGS = [round(22.0 + 6.5 * math.sin(k / 7.0), 2) for k in range(60)]
-#: Seconds the judge waits for the monitor's log lines once the replayed readings arrived.
-LOGS_AFTER_S = 10.0
 #: Rate the check replays at (simulated s per wall s): fast, and below what play reaches.
 CHECK_RATE = 100.0
 
@@ -54,7 +54,8 @@ def _call(function: Any, label: str, *args: Any) -> Any:
         if 'error' in output:
             raise learner_error(label, output['error'])
         return _plain(output['result'])
-    return call_learner(function, *args)
+    with contextlib.redirect_stdout(io.StringIO()):  # the verdict is the check's line alone
+        return call_learner(function, *args)
 
 
 def _plain(result: dict) -> Any:
@@ -179,12 +180,10 @@ class _Watch:
         """Readings and log lines heard since the watch began (waiting for ``expected``)."""
         if self.observer is not None:
             observer, (readings, logs) = self.observer, self.start
-            # The replay has ended when the learner's function returned: once its readings
-            # are here, its log lines (sent at the same moments) are due too.
-            observer.wait_until(lambda: len(observer.readings) - readings >= expected,
-                                ARRIVAL_TIMEOUT_S)
+            # /rosout is transient local: the monitor's lines reach the judge even when its
+            # subscription matched late (replayed readings published before that would not).
             observer.wait_until(lambda: len(_statuses(
-                [(n, t) for n, _l, t in observer.logs[logs:]])) >= expected, LOGS_AFTER_S)
+                [(n, t) for n, _l, t in observer.logs[logs:]])) >= expected, ARRIVAL_TIMEOUT_S)
             return (list(observer.readings[readings:]),
                     [(n, t) for n, _level, t in observer.logs[logs:]])
         with self.rt.exclusive():
@@ -201,9 +200,6 @@ def _replay(replay: Any) -> str:
     _call(replay, f'{replay.__name__}(bag_path, rate)', path, CHECK_RATE)
     readings, logs = watch.heard(len(CHECK_READINGS))
     sent = len(CHECK_READINGS)
-    if len(readings) != sent:
-        raise CheckFailed(f'The replay delivered {len(readings)} of the bag\'s {sent} readings on '
-                          f'{TEMPERATURE}: play the bag_path you were given, with bag_play.')
     statuses = _statuses(logs)
     expected = [(round(r, 2), course.monitor_status(r)) for r in CHECK_READINGS]
     if not statuses:
