@@ -21,7 +21,7 @@ NB = sorted(SOLUTION)
 NB00, NB01, NB02, NB03, NB04, NB05 = NB[:6]
 #: Points of each notebook, by its number: what a complete learner scores.
 POINTS = {'00': 1, '01': 1, '02': 1, '03': 6, '04': 5, '05': 4, '06': 7, '07': 2, '08': 4,
-          '09': 6}
+          '09': 6, '10': 6}
 FULL = {notebook: POINTS[notebook[:2]] for notebook in NB}
 #: Marks the hostile processes, so the test can look for survivors.
 MARK = 'ros2nb-hostile-sample'

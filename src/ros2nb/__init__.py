@@ -15,6 +15,7 @@ from .errors import (CheckFailed, ColconBuildError, DomainsExhaustedError, FileP
 from .kernel import add, install, shutdown, spin, start, stop
 from .runtime import current_runtime
 from .runtime.rates import callback_groups, timer_runs
+from .terminal.bag import Recording, bag_info, bag_play, bag_record
 from .terminal.background import NodeProcess, ros2_start, stop_all
 from .terminal.colcon import colcon_build, source_workspace
 from .terminal.echo import message_type, record, topic_echo, topic_hz
@@ -34,7 +35,8 @@ def load_ipython_extension(ipython) -> None:
 
 __all__ = [
     'CheckFailed', 'ColconBuildError', 'DomainsExhaustedError', 'FileProtectedError',
-    'LearnerCodeError', 'NodeProcess', 'PkgCreateError', 'Ros2nbError', 'UsageError', 'add',
+    'LearnerCodeError', 'NodeProcess', 'PkgCreateError', 'Recording', 'Ros2nbError', 'UsageError',
+    'add', 'bag_info', 'bag_play', 'bag_record',
     'callback_groups', 'checks', 'colcon_build', 'course', 'create_workspace',
     'current_runtime', 'current_workspace', 'domains', 'find_executable', 'graph_edges',
     'graph_picture', 'import_file', 'message_type', 'node_list', 'param_describe',

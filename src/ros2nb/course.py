@@ -79,6 +79,12 @@ THRESHOLD_DEFAULTS_C = {HIGH_PARAMETER: HIGH_ABOVE_C, LOW_PARAMETER: LOW_BELOW_C
 PERIOD_PARAMETER, START_PARAMETER = 'publish_period_s', 'start_temperature_c'
 MIN_PERIOD_S, MAX_PERIOD_S = 0.1, 10.0
 
+# ------------------------------------------------------------------ notebook 10: bags
+#: What a recording holds: one simulated hour of the sensor (s); the monitor's statuses
+#: travel in its log messages on /rosout.
+RECORD_S = 3600.0
+ROSOUT_TOPIC = '/rosout'
+
 #: Environment variable the grader sets: the course's reference code never stands in.
 GRADING_ENV = 'ROS2NB_GRADING'
 #: Notebook number -> what must exist before it starts.
@@ -87,7 +93,8 @@ STEPS = {1: (), 2: ('workspace',), 3: ('workspace', 'package'),
          5: ('workspace', 'package', 'publisher', 'subscriber'),
          6: ('workspace', 'package', 'publisher', 'subscriber'),
          7: ('workspace', 'package', 'publisher', 'subscriber'),
-         8: ('workspace', 'package', 'publisher', 'subscriber', 'entry_points')}
+         8: ('workspace', 'package', 'publisher', 'subscriber', 'entry_points'),
+         10: ('workspace', 'package', 'publisher', 'subscriber', 'entry_points')}
 
 
 def monitor_status(temperature_c: float) -> str:
@@ -153,7 +160,7 @@ def catch_up(notebook: int) -> Path:
 
     Introduced in ``01-create-a-workspace.ipynb``.
 
-    :param notebook: the number of the notebook about to run (1-8).
+    :param notebook: the number of the notebook about to run (1-8, 10).
     :return: the workspace path.
     :raises ValueError: for a notebook number without steps.
     """
