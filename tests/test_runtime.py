@@ -456,3 +456,42 @@ def test_kernel_nodes_keep_running_while_processes_run(ros, tmp_path, capsys):
 
 
 
+
+
+@pytest.mark.parametrize('keep', [False, True])
+def test_a_stopped_node_keeps_its_log_lines_for_a_late_listener_only_when_asked(
+        ros, monkeypatch, keep):
+    """Notebook 10's replay check: the learner's code stops the monitor right after its last
+    status, and the judge's /rosout subscription may match only then. A destroyed node takes
+    its transient-local /rosout history with it; a kept (emptied) one still hands it over."""
+    from rcl_interfaces.msg import Log
+    from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+
+    from ros2nb.runtime.nodes import KEEP_STOPPED_ENV
+    if keep:
+        monkeypatch.setenv(KEEP_STOPPED_ENV, '1')
+    else:
+        monkeypatch.delenv(KEEP_STOPPED_ENV, raising=False)
+    node = ros2nb.add(Sensor('late_logger'))  # logs 'started' when made
+    ros2nb.stop(node)
+    heard = []
+    late = rclpy.create_node('late_listener', context=ros.context)
+    try:
+        late.create_subscription(
+            Log, '/rosout', lambda m: heard.append(m.msg) if m.name == 'late_logger' else None,
+            QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE,
+                       durability=DurabilityPolicy.TRANSIENT_LOCAL))
+        executor = rclpy.executors.SingleThreadedExecutor(context=ros.context)
+        executor.add_node(late)
+        writers = lambda: [i for i in late.get_publishers_info_by_topic('/rosout')  # noqa: E731
+                           if i.node_name == 'late_logger']
+        if keep:
+            assert wait_until(lambda: executor.spin_once(timeout_sec=0.05) or heard)
+            assert heard == ['started']
+        else:  # nothing left that could ever send it
+            assert wait_until(lambda: not writers())
+            executor.spin_once(timeout_sec=0.1)
+            assert heard == []
+        executor.shutdown()
+    finally:
+        late.destroy_node()

@@ -15,9 +15,10 @@ import contextlib
 import io
 import math
 import re
+import shutil
 import tempfile
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
 from rcl_interfaces.msg import Log
 from std_msgs.msg import Float32
@@ -40,15 +41,23 @@ CHECK_READINGS = [round(22.0 + 6.5 * math.sin(k / 7.0), 2) for k in range(60)]
 CHECK_RATE = 100.0
 
 
-def _fresh_path(name: str) -> Path:
-    """A bag folder that does not exist yet, in the judge's scratch folder or a temporary one."""
+@contextlib.contextmanager
+def _fresh_path(name: str) -> Iterator[Path]:
+    """A bag folder that does not exist yet, in the judge's scratch folder or a temporary
+    one; removed with what the learner's function put beside it once the check is done."""
     parent = str(current_judge().scratch) if in_judge() else None
-    return Path(tempfile.mkdtemp(prefix='ros2nb-bag-', dir=parent)) / name
+    folder = Path(tempfile.mkdtemp(prefix='ros2nb-bag-', dir=parent))
+    try:
+        yield folder / name
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
 
 
 def _call(function: Any, label: str, *args: Any) -> Any:
     """Call the learner's function (in the kernel, or from source in a subject)."""
     if isinstance(function, AnswerRef):
+        # The monitor the learner stops at the end keeps its /rosout lines for the judge.
+        current_judge().answer_subject(function).request('keep_stopped_nodes')
         encoded = [{'path': str(a)} if isinstance(a, Path) else a for a in args]
         output = answer_results(function, [encoded])[0]
         if 'error' in output:
@@ -105,7 +114,11 @@ def _bag_verdict(path: Path, label: str) -> dict[str, int]:
 
 
 def _recording(record_hour: Any) -> str:
-    path = _fresh_path('hour')
+    with _fresh_path('hour') as path:
+        return _recording_in(path, record_hour)
+
+
+def _recording_in(path: Path, record_hour: Any) -> str:
     label = f'{record_hour.__name__}(bag_path)'
     _call(record_hour, label, path)
     counts = _bag_verdict(path, label)
@@ -194,7 +207,11 @@ class _Watch:
 
 
 def _replay(replay: Any) -> str:
-    path = _fresh_path('sixty')
+    with _fresh_path('sixty') as path:
+        return _replay_in(path, replay)
+
+
+def _replay_in(path: Path, replay: Any) -> str:
     write_check_bag(path, CHECK_READINGS)
     watch = _Watch()
     _call(replay, f'{replay.__name__}(bag_path, rate)', path, CHECK_RATE)
@@ -230,7 +247,11 @@ def check_replay(replay: Any) -> None:
 
 
 def _readings(read_temperatures: Any) -> str:
-    path = _fresh_path('sixty')
+    with _fresh_path('sixty') as path:
+        return _readings_in(path, read_temperatures)
+
+
+def _readings_in(path: Path, read_temperatures: Any) -> str:
     write_check_bag(path, CHECK_READINGS)
     got = _call(read_temperatures, f'{read_temperatures.__name__}(bag_path)', path)
     name = f'{getattr(read_temperatures, "__name__", "your function")}()'

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import contextlib
 import gc
+import os
 from typing import Optional, Union
 
 import rclpy
@@ -17,6 +18,12 @@ from ..errors import Ros2nbError, UsageError
 from ..explain.guards import check_node
 
 NodeOrName = Union[Node, str]
+
+#: Set (to 1) in a subject whose nodes' last log lines the judge must still receive after the
+#: learner's code stopped them (notebook 10's replay): a stopped node is then emptied but kept
+#: until the process ends, so its /rosout publisher, with its transient-local history, stays
+#: for a judge whose subscription matches late.
+KEEP_STOPPED_ENV = 'ROS2NB_KEEP_STOPPED_NODES'
 
 
 class NodeKeeping:
@@ -87,8 +94,9 @@ class NodeKeeping:
         with self.exclusive():
             targets = list(self._nodes.values()) if node is None else [self.find(node)]
             names = [target.get_name() for target in targets]
+            keep = os.environ.get(KEEP_STOPPED_ENV) == '1'
             for target in targets:
-                self._discard(target)
+                self._retire(target) if keep else self._discard(target)
             if self.alive:
                 self.drain()
         return names

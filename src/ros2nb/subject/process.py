@@ -18,6 +18,7 @@ from __future__ import annotations
 import importlib.util
 import json
 import math
+import os
 import random
 import sys
 import time
@@ -37,6 +38,7 @@ from ..errors import Ros2nbError
 from ..explain.exceptions import explain_exception, is_library_file, learner_line
 from ..qos import profile_fields
 from ..runtime import Runtime, enable_field_checks
+from ..runtime.nodes import KEEP_STOPPED_ENV
 from ..runtime.rates import callback_groups, timer_runs
 
 #: Exit code when a command could not even be read.
@@ -262,6 +264,12 @@ class Subject:
     def counts(self) -> dict:
         return {'ok': True, **self._counts()}
 
+    def keep_stopped_nodes(self) -> dict:
+        """From now on a node the learner's code stops stays in the graph, emptied, until this
+        process ends: the judge still receives its last /rosout lines (notebook 10)."""
+        os.environ[KEEP_STOPPED_ENV] = '1'
+        return {'ok': True}
+
     def serve(self) -> dict:
         """Spin the node in the background from now on: it answers service calls (its
         parameters) whenever the judge makes them."""
@@ -359,6 +367,7 @@ def serve(commands: Any, replies: Any) -> None:
         'counts': subject.counts, 'serve': subject.serve, 'attribute': subject.attribute,
         'timer_runs': subject.timer_runs, 'room_nodes': subject.room_nodes,
         'wait_publishers': subject.wait_publishers,
+        'keep_stopped_nodes': subject.keep_stopped_nodes,
     }
     for line in commands:
         request = json.loads(line)
