@@ -21,7 +21,6 @@ from pathlib import Path
 from typing import Any, Callable, Iterator
 
 from rcl_interfaces.msg import Log
-from std_msgs.msg import Float32
 
 from .. import course
 from ..errors import CheckFailed
@@ -172,38 +171,36 @@ def write_check_bag(path: Path, readings: list[float]) -> None:
 
 
 class _Watch:
-    """What the check's own ROS node hears during a replay: readings and the monitor's logs."""
+    """What the check's own ROS node hears during a replay: the monitor's log lines."""
 
     def __init__(self) -> None:
         if in_judge():
-            self.observer = current_judge().observer
-            self.observer.watch_readings(TEMPERATURE)
-            self.start = (len(self.observer.readings), len(self.observer.logs))
+            judge = current_judge()
+            # Monitors of earlier checks (kept after the learner stopped them, with their
+            # /rosout history) leave first: only this replay's monitor can speak below.
+            judge.drop_all()
+            self.observer = judge.observer
+            self.logs, self._close = self.observer.listen_logs()
             return
-        self.observer, self.readings, self.logs = None, [], []
+        self.observer, self.logs = None, []
         self.rt = current_runtime()
         with self.rt.exclusive():
-            self.subscriptions = [
-                self.rt.node.create_subscription(Float32, TEMPERATURE, lambda m: self.readings.append(
-                    float(m.data)), bag.KEEP_ALL),
-                self.rt.node.create_subscription(Log, ROSOUT, lambda m: self.logs.append(
-                    (m.name, m.msg)), bag.KEEP_ALL)]
+            self.subscription = self.rt.node.create_subscription(
+                Log, ROSOUT, lambda m: self.logs.append((m.name, m.msg)), bag.KEEP_ALL)
 
-    def heard(self, expected: int) -> tuple[list[float], list[tuple[str, str]]]:
-        """Readings and log lines heard since the watch began (waiting for ``expected``)."""
+    def heard(self, expected: int) -> list[tuple[str, str]]:
+        """Log lines heard since the watch began (waiting for ``expected`` statuses)."""
         if self.observer is not None:
-            observer, (readings, logs) = self.observer, self.start
-            # /rosout is transient local: the monitor's lines reach the judge even when its
-            # subscription matched late (replayed readings published before that would not).
-            observer.wait_until(lambda: len(_statuses(
-                [(n, t) for n, _l, t in observer.logs[logs:]])) >= expected, ARRIVAL_TIMEOUT_S)
-            return (list(observer.readings[readings:]),
-                    [(n, t) for n, _level, t in observer.logs[logs:]])
+            # A subscription of its own, transient local: the monitor's lines reach it even
+            # when it matched the monitor only after the replay (the monitor is kept).
+            self.observer.wait_until(lambda: len(_statuses(list(self.logs))) >= expected,
+                                     ARRIVAL_TIMEOUT_S)
+            self._close()
+            return list(self.logs)
         with self.rt.exclusive():
             self.rt.drain()
-            for subscription in self.subscriptions:
-                self.rt.node.destroy_subscription(subscription)
-        return self.readings, self.logs
+            self.rt.node.destroy_subscription(self.subscription)
+        return self.logs
 
 
 def _replay(replay: Any) -> str:
@@ -215,7 +212,7 @@ def _replay_in(path: Path, replay: Any) -> str:
     write_check_bag(path, CHECK_READINGS)
     watch = _Watch()
     _call(replay, f'{replay.__name__}(bag_path, rate)', path, CHECK_RATE)
-    readings, logs = watch.heard(len(CHECK_READINGS))
+    logs = watch.heard(len(CHECK_READINGS))
     sent = len(CHECK_READINGS)
     statuses = _statuses(logs)
     expected = [(round(r, 2), course.monitor_status(r)) for r in CHECK_READINGS]

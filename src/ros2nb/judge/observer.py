@@ -65,6 +65,18 @@ class Observer:
                                       lambda m: self._note(self.logs, (m.name, m.level, m.msg)),
                                       qos)
 
+    def listen_logs(self) -> tuple[list[tuple[str, str]], Callable[[], None]]:
+        """A /rosout subscription of its own from now on: its ``(node, text)`` lines, and a
+        function that ends it.  Transient local, so it also gets what live nodes logged
+        shortly before (rcl keeps /rosout lines 10 s), but nothing of nodes already gone.
+        """
+        lines: list[tuple[str, str]] = []
+        qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE,
+                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        subscription = self.node.create_subscription(
+            Log, '/rosout', lambda m: self._note(lines, (m.name, m.msg)), qos)
+        return lines, lambda: self.node.destroy_subscription(subscription)
+
     def watch_readings(self, topic: str) -> None:
         """Collect every Float32 on ``topic``, reliably (a long queue, nothing dropped)."""
         if topic in self._watching:

@@ -68,6 +68,11 @@ class Session:
         if subject is not None:
             subject.close()
 
+    def drop_all(self) -> None:
+        """End every subject of this session (their nodes leave the graph)."""
+        for key in list(self._subjects):
+            self.drop(key)
+
     def subject_env(self) -> dict[str, str]:
         """The environment of a subject of this judge (its domain, plain logs, field checks)."""
         return subject_env()
@@ -118,8 +123,7 @@ class Session:
         return code, output.text()
 
     def close(self) -> None:
-        for key in list(self._subjects):
-            self.drop(key)
+        self.drop_all()
         if self._observer is not None:
             self._observer.close()
         shutil.rmtree(self.scratch, ignore_errors=True)
