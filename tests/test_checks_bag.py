@@ -24,7 +24,7 @@ import ros2nb  # noqa: E402
 from ros2nb import checks  # noqa: E402
 from ros2nb.checks.base import AnswerRef, bind_judge  # noqa: E402
 from ros2nb.checks.dispatch import IN_JUDGE_ENV  # noqa: E402
-from ros2nb.errors import CheckFailed  # noqa: E402
+from ros2nb.errors import CheckFailed, Ros2nbError, UsageError  # noqa: E402
 from ros2nb.judge.session import Session  # noqa: E402
 from ros2nb.terminal.workspace import WORKSPACE_ENV  # noqa: E402
 
@@ -187,3 +187,21 @@ def test_a_bag_opens_with_readers_the_course_does_not_own(session):
         logs = [reader.deserialize(raw, c.msgtype) for c, _t, raw in
                 reader.messages([c for c in reader.connections if c.topic == '/rosout'])]
     assert sum('Status: ' in log.msg for log in logs) == 3600
+
+
+@pytest.mark.parametrize('call, pattern', [
+    (lambda d: ros2nb.bag_info(d / 'none'), r'is not a bag: a bag is a folder with a metadata'),
+    (lambda d: ros2nb.bag_play(d / 'none'), r'is not a bag'),
+    (lambda d: ros2nb.bag_record(d, '/temperature').__enter__(), r'already exists: choose'),
+    (lambda d: ros2nb.bag_record(d / 'x', 5).__enter__(), r"Topics are names in quotes.*got 5"),
+    (lambda d: ros2nb.bag_record(d / 'x').__enter__(), r'Name the topics to record'),
+], ids=['info of no bag', 'play of no bag', 'record into an existing folder',
+        'a topic that is not a name', 'no topic'])
+def test_bad_input_to_the_bag_verbs_gets_one_line(tmp_path, call, pattern):
+    ros2nb.start(sim_time=True)
+    try:
+        with pytest.raises((Ros2nbError, UsageError)) as caught:
+            call(tmp_path)
+        assert re.search(pattern, str(caught.value)) and '\n' not in str(caught.value)
+    finally:
+        ros2nb.shutdown()

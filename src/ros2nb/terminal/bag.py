@@ -153,11 +153,15 @@ def bag_record(output: Any, *topics: str) -> Recording:
     :param topics: topic names, e.g. ``'/temperature'``, ``'/rosout'``; each must have a
         publisher already (its type is taken from the graph).
     :return: the running recording.
-    :raises UsageError: for no topics, a folder that exists, or a topic nobody publishes.
+    :raises UsageError: for no topics, a topic that is not a name, a folder that exists,
+        or a topic nobody publishes.
     """
     path = _bag_path(output)
     if not topics:
         raise UsageError("Name the topics to record, e.g. bag_record('hour', '/temperature').")
+    wrong = [t for t in topics if not isinstance(t, str) or not t.strip()]
+    if wrong:
+        raise UsageError(f'Topics are names in quotes, e.g. \'/temperature\' (got {wrong[0]!r}).')
     if path.exists():
         raise UsageError(f"Output folder '{path}' already exists: choose another name, or "
                          'delete the old bag first.')
