@@ -64,15 +64,8 @@ def pytest_runtest_call(item):
 
 #: Test files that take longest, started first so that pytest-xdist's workers finish
 #: together (scheduling only: no test depends on it).
-LONGEST_FIRST = ('test_grading.py', 'test_jupyterhub.py', 'test_isolation.py',
-                 'test_grading_cli.py', 'test_checks.py', 'test_sandbox.py')
-
-
-def pytest_collection_modifyitems(config, items) -> None:
-    def rank(item) -> int:
-        name = Path(str(item.fspath)).name
-        return LONGEST_FIRST.index(name) if name in LONGEST_FIRST else len(LONGEST_FIRST)
-    items.sort(key=rank)  # stable: the order inside a file is kept
+LONGEST_FIRST = ('test_grading.py', 'test_jupyterhub.py', 'test_checks_bag.py',
+                 'test_isolation.py', 'test_grading_cli.py', 'test_checks.py', 'test_sandbox.py')
 
 
 #: Notebooks that need a newer Python than the course's oldest (3.10): 10 reads and writes
@@ -81,6 +74,10 @@ NEEDS_PYTHON = {'10-record-and-replay.ipynb': (3, 11)}
 
 
 def pytest_collection_modifyitems(config, items) -> None:
+    def rank(item) -> int:
+        name = Path(str(item.fspath)).name
+        return LONGEST_FIRST.index(name) if name in LONGEST_FIRST else len(LONGEST_FIRST)
+    items.sort(key=rank)  # stable: the order inside a file is kept
     for item in items:
         needed = NEEDS_PYTHON.get(Path(str(item.fspath)).name)
         if needed and sys.version_info[:2] < needed:
