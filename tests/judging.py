@@ -7,9 +7,12 @@ notebook, bound as the current judge, and puts everything back afterwards.
 from __future__ import annotations
 
 import os
+import re
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterator
+
+import nbformat
 
 from ros2nb import course
 from ros2nb.checks.base import bind_judge
@@ -39,3 +42,17 @@ def judge_session(root: Path, notebook: int) -> Iterator[Session]:
             else:
                 os.environ[key] = value
         ws_module._current = None
+
+
+def answer_cells(path: str) -> tuple[str, dict[str, str]]:
+    """A notebook's grading-context cell, and each answer cell by the function it defines
+    (nbgrader's ``### BEGIN/END SOLUTION`` lines left out)."""
+    context, answers = '', {}
+    for cell in nbformat.read(path, as_version=4).cells:
+        if 'grading-context' in cell.metadata.get('tags', []):
+            context = cell.source
+        if cell.metadata.get('nbgrader', {}).get('solution'):
+            name = re.match(r'def (\w+)\(', cell.source).group(1)
+            answers[name] = '\n'.join(line for line in cell.source.splitlines()
+                                      if not line.strip().startswith('###'))
+    return context, answers

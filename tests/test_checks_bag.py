@@ -13,7 +13,6 @@ import sys
 import tempfile
 from pathlib import Path
 
-import nbformat
 import pytest
 
 pytestmark = [pytest.mark.timeout(600),
@@ -28,6 +27,8 @@ from ros2nb.errors import CheckFailed, Ros2nbError, UsageError  # noqa: E402
 from ros2nb.judge.session import Session  # noqa: E402
 from ros2nb.terminal.workspace import WORKSPACE_ENV  # noqa: E402
 
+from judging import answer_cells  # noqa: E402
+
 HERE = os.path.dirname(__file__)
 SOLUTION = os.path.join(HERE, '..', 'solutions', '10-record-and-replay.ipynb')
 LEARNER = os.path.join(HERE, '..', 'notebooks', '10-record-and-replay.ipynb')
@@ -35,20 +36,7 @@ CHECKS = {'record_hour': checks.check_recording, 'replay': checks.check_replay,
           'read_temperatures': checks.check_readings}
 
 
-def _cells(path: str = SOLUTION) -> tuple[str, dict[str, str]]:
-    """The notebook's grading context, and each answer cell by the function it defines."""
-    context, answers = '', {}
-    for cell in nbformat.read(path, as_version=4).cells:
-        if 'grading-context' in cell.metadata.get('tags', []):
-            context = cell.source
-        if cell.metadata.get('nbgrader', {}).get('solution'):
-            name = re.match(r'def (\w+)\(', cell.source).group(1)
-            answers[name] = '\n'.join(line for line in cell.source.splitlines()
-                                      if not line.strip().startswith('###'))
-    return context, answers
-
-
-CONTEXT, ANSWERS = _cells()
+CONTEXT, ANSWERS = answer_cells(SOLUTION)
 
 
 @pytest.fixture(scope='module')
@@ -146,7 +134,7 @@ def test_a_mistake_gets_one_line(session, path, name, label, old, new, pattern):
 
 
 def test_an_untouched_cell_gets_one_line(session):
-    untouched = _cells(LEARNER)[1]
+    untouched = answer_cells(LEARNER)[1]
     for name in CHECKS:
         assert 'raise NotImplementedError()' in untouched[name]
         with pytest.raises(CheckFailed) as caught:

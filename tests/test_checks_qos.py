@@ -11,7 +11,6 @@ mistake's.
 import os
 import re
 
-import nbformat
 import pytest
 
 from ros2nb import checks
@@ -22,26 +21,15 @@ from ros2nb.judge.session import Session
 
 pytestmark = pytest.mark.timeout(300)
 
+from judging import answer_cells  # noqa: E402
+
 HERE = os.path.dirname(__file__)
 SOLUTION = os.path.join(HERE, '..', 'solutions', '09-qos.ipynb')
 LEARNER = os.path.join(HERE, '..', 'notebooks', '09-qos.ipynb')
 
 
-def _cells(path: str = SOLUTION) -> tuple[str, dict[str, str]]:
-    """The notebook's grading context, and each answer cell by the function it defines."""
-    context, answers = '', {}
-    for cell in nbformat.read(path, as_version=4).cells:
-        if 'grading-context' in cell.metadata.get('tags', []):
-            context = cell.source
-        if cell.metadata.get('nbgrader', {}).get('solution'):
-            name = re.match(r'def (\w+)\(', cell.source).group(1)
-            answers[name] = '\n'.join(line for line in cell.source.splitlines()
-                                      if not line.strip().startswith('###'))
-    return context, answers
-
-
-CONTEXT, ANSWERS = _cells()
-UNTOUCHED = _cells(LEARNER)[1]  # the learner's copy: '# YOUR CODE HERE', NotImplementedError
+CONTEXT, ANSWERS = answer_cells(SOLUTION)
+UNTOUCHED = answer_cells(LEARNER)[1]  # the learner's copy: '# YOUR CODE HERE', NotImplementedError
 CHECKS = {'newest_only_profile': checks.check_newest_only,
           'sensor_subscription_profile': checks.check_sensor_subscription,
           'latched_thresholds_profile': checks.check_latched_thresholds}
