@@ -117,3 +117,45 @@ def test_a_mistake_gets_one_line(session, label, file, old, new, check, pattern)
     message = str(caught.value)
     assert re.search(pattern, message), message
     assert '\n' not in message
+
+
+#: A program with a node named like the learner's that owns no endpoint of the learner's:
+#: what the grader's graph can still list for a moment after a subject's process ended.
+DECOY = '''
+import sys
+import rclpy
+from rclpy.node import Node
+rclpy.init()
+node = Node(sys.argv[1])
+print('up', flush=True)
+sys.stdin.read()
+'''
+
+
+def test_a_node_of_the_same_name_in_another_program_hides_nothing(session):
+    """The graph's per-node query answers for one of two same-named nodes (whichever it
+    lists first); the check reads the endpoints themselves, so the learner's shows."""
+    import subprocess
+    import sys
+    from waiting import wait_for
+    decoy = subprocess.Popen([sys.executable, '-c', DECOY, course.PLOT_NODE],
+                             env=session.subject_env(), stdin=subprocess.PIPE,
+                             stdout=subprocess.PIPE, text=True)
+    try:
+        assert decoy.stdout.readline().strip() == 'up'
+        observer = session.observer
+        wait_for(lambda: observer.has_node(course.PLOT_NODE), 'the decoy node in the graph')
+        checks.check_plot_callback()  # the learner's node is alive in its subject after it
+        by_process = observer._endpoints_by_process(course.PLOT_NODE, '/')
+        assert len(by_process) == 2, by_process
+        per_node = {('subscription', topic, kind) for topic, kinds in
+                    observer.node.get_subscriber_names_and_types_by_node(course.PLOT_NODE, '/')
+                    for kind in kinds}
+        # One process's subscriptions, never both: with the decoy listed first, the learner's
+        # /temperature subscription was invisible to the query the check used before.
+        assert per_node in [{e for e in found if e[0] == 'subscription'}
+                            for found in by_process.values()]
+    finally:
+        decoy.stdin.close()
+        decoy.wait(30)
+        session.drop(('file', PLOT))

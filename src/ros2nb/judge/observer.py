@@ -26,6 +26,11 @@ from ..errors import CheckFailed
 from ..runtime.services import call_until_answered
 
 
+#: Bytes of an endpoint's gid that name its participant (the DDS GUID prefix): one per
+#: process that brought ROS up.
+PARTICIPANT_PREFIX_BYTES = 12
+
+
 class Observer:
     """The judge's own ROS node on the judge's domain: graph, readings, logs, probes."""
 
@@ -118,33 +123,52 @@ class Observer:
                   seconds: float = ARRIVAL_TIMEOUT_S) -> list[tuple[str, str, str]]:
         """The node's publishers and subscriptions as the ROS graph shows them.
 
-        Waits until the graph holds at least ``expected`` (what the subject said it made)
-        or ``seconds`` pass.
+        Waits until one process's node ``namespace/name`` holds at least ``expected`` (what
+        the subject said it made) or ``seconds`` pass.  Read from the endpoints DDS
+        discovered, topic by topic, and grouped by the process (participant) that owns
+        them: a node of that name the graph still lists after its process ended, with
+        none of its endpoints left, hides nothing.
+
+        :return: ``(kind, topic, type)`` triples, ``kind`` being ``'publisher'`` or
+            ``'subscription'``, sorted, without ROS's own topics.
+        :raises CheckFailed: when ``seconds`` pass first (the line says what was seen).
         """
         want = {tuple(e) for e in expected}
         deadline = time.monotonic() + seconds
-        found: set[tuple[str, str, str]] = set()
         while True:
-            try:
-                pubs = self.node.get_publisher_names_and_types_by_node(name, namespace)
-                subs = self.node.get_subscriber_names_and_types_by_node(name, namespace)
-                found = {('publisher', t, ty) for t, types in pubs for ty in types} | \
-                        {('subscription', t, ty) for t, types in subs for ty in types}
-            except Exception:  # the node is not discovered yet
-                found = set()
+            owners = self._endpoints_by_process(name, namespace)
+            # The process whose node holds what the subject made (exactly, if one does: an
+            # earlier subject's node of that name may linger a moment after its process).
+            covering = sorted((e for e in owners.values() if want <= e), key=len)
+            found = covering[0] if covering else max(owners.values(), key=len, default=set())
             if want <= found:
                 return sorted(e for e in found if e[1] not in ('/rosout', '/parameter_events',
                                                                 '/clock'))
             if time.monotonic() > deadline:  # not the learner's mistake: say what happened
-                raise CheckFailed(self._unseen(name, namespace, want, found, seconds))
+                raise CheckFailed(self._unseen(name, len(owners), want, found, seconds))
             time.sleep(0.02)
 
-    def _unseen(self, name: str, namespace: str, want: set, found: set, seconds: float) -> str:
+    def _endpoints_by_process(self, name: str, namespace: str) -> dict[bytes, set]:
+        """Endpoints of the nodes ``namespace/name``, by the participant that owns them."""
+        owners: dict[bytes, set] = {}
+        try:
+            for topic, _types in self.node.get_topic_names_and_types():
+                for kind, infos in (('publisher', self.node.get_publishers_info_by_topic(topic)),
+                                    ('subscription',
+                                     self.node.get_subscriptions_info_by_topic(topic))):
+                    for info in infos:
+                        if info.node_name == name and info.node_namespace == namespace:
+                            owner = bytes(info.endpoint_gid[:PARTICIPANT_PREFIX_BYTES])
+                            owners.setdefault(owner, set()).add((kind, topic, info.topic_type))
+        except Exception:  # a topic that went away between the two calls: ask again later
+            return {}
+        return owners
+
+    def _unseen(self, name: str, processes: int, want: set, found: set,
+                seconds: float) -> str:
         """Why the graph never showed what a subject said its node made, in one line."""
-        same = [n for n, ns in self.node.get_node_names_and_namespaces()
-                if n == name and ns == namespace]
-        if len(same) > 1:
-            return (f'{len(same)} nodes named {name} are on the grader\'s ROS domain '
+        if processes > 1:
+            return (f'{processes} programs have a node named {name} on the grader\'s ROS domain '
                     f'{self.domain_id}, so the grader cannot tell yours apart: run this check '
                     'again (another program on this machine uses that domain).')
         missing = ', '.join(f'{kind} on {topic}' for kind, topic, _ in sorted(want - found))
