@@ -2,7 +2,8 @@
 
 Every process ros2nb starts (a node for ``ros2 run``, colcon, a check's helper process)
 gets a session and process group of its own (``start_new_session=True``), so a signal
-sent to the group reaches whatever it started too.  No mention of ROS here.
+sent to the group reaches whatever it started too.  It is also the one place that decides
+when a process has had long enough (:class:`Patience`).  No mention of ROS here.
 """
 
 from __future__ import annotations
@@ -10,6 +11,8 @@ from __future__ import annotations
 import os
 import signal
 import subprocess
+import time
+from collections import deque
 from typing import Optional, Sequence
 
 #: Seconds a process gets to exit after Ctrl+C (SIGINT) before SIGTERM, then SIGKILL.
@@ -63,9 +66,19 @@ def kill_process_group(proc: subprocess.Popen) -> Optional[int]:
     return stop_process_group(proc, signals=((signal.SIGKILL, TERM_GRACE_S),))
 
 
-def _children() -> dict[int, list[int]]:
-    """Every process's children, read from /proc."""
-    found: dict[int, list[int]] = {}
+#: A process tree using less than this share of one CPU is waiting, not working.
+BUSY_SHARE = 0.05
+#: Seconds over which that share is measured.
+BUSY_WINDOW_S = 5.0
+#: However busy it is, a process tree gets at most this many times its limit on the wall clock.
+WALL_LIMIT_FACTOR = 10.0
+_TICKS_PER_S = os.sysconf('SC_CLK_TCK')
+
+
+def _processes() -> tuple[dict[int, list[int]], dict[int, float]]:
+    """Every process's children, and the CPU seconds each used (with its reaped children's)."""
+    children: dict[int, list[int]] = {}
+    cpu: dict[int, float] = {}
     for entry in os.listdir('/proc'):
         if not entry.isdigit():
             continue
@@ -74,8 +87,65 @@ def _children() -> dict[int, list[int]]:
                 fields = stat.read().rsplit(')', 1)[1].split()
         except OSError:
             continue
-        found.setdefault(int(fields[1]), []).append(int(entry))
-    return found
+        children.setdefault(int(fields[1]), []).append(int(entry))
+        # utime, stime, cutime, cstime: fields 14-17 of proc(5), counted from "state" here
+        cpu[int(entry)] = sum(int(field) for field in fields[11:15]) / _TICKS_PER_S
+    return children, cpu
+
+
+def _children() -> dict[int, list[int]]:
+    """Every process's children, read from /proc."""
+    return _processes()[0]
+
+
+def tree_cpu_seconds(pid: int) -> float:
+    """CPU seconds (user + system) used so far by ``pid`` and every process under it.
+
+    Processes of the tree that already ended count when their parent has reaped them.
+    A process that is gone counts 0.
+    """
+    children, cpu = _processes()
+    total, pending = 0.0, [pid]
+    while pending:
+        current = pending.pop()
+        total += cpu.get(current, 0.0)
+        pending.extend(children.get(current, []))
+    return total
+
+
+class Patience:
+    """Whether a process tree asked to do something has had long enough to do it.
+
+    A limit on the wall clock alone cuts honest work short on a busy machine, where a
+    process gets a fraction of a CPU.  So the limit counts work: the tree has had long
+    enough once it used ``limit_s`` CPU seconds (an endless loop), or once ``limit_s``
+    seconds passed on the wall clock while it sat waiting (less than :data:`BUSY_SHARE`
+    of a CPU over the last :data:`BUSY_WINDOW_S` seconds: a call that waits for ever).
+    A tree that keeps working slowly is cut after ``WALL_LIMIT_FACTOR * limit_s`` seconds.
+
+    :param pid: the process at the top of the tree (a sandbox's own process is fine).
+    :param limit_s: seconds of CPU time, or of waiting, the tree is given.
+    """
+
+    def __init__(self, pid: int, limit_s: float) -> None:
+        self.pid, self.limit_s = pid, limit_s
+        self.started = time.monotonic()
+        self.cpu_at_start = tree_cpu_seconds(pid)
+        self._samples: deque[tuple[float, float]] = deque([(self.started, self.cpu_at_start)])
+
+    def exhausted(self) -> bool:
+        """True once the tree has had its limit (call it every fraction of a second)."""
+        now, cpu = time.monotonic(), tree_cpu_seconds(self.pid)
+        self._samples.append((now, cpu))
+        while len(self._samples) > 2 and now - self._samples[1][0] >= BUSY_WINDOW_S:
+            self._samples.popleft()
+        waited = now - self.started
+        if cpu - self.cpu_at_start >= self.limit_s or waited >= WALL_LIMIT_FACTOR * self.limit_s:
+            return True
+        if waited < self.limit_s:
+            return False
+        since, cpu_then = self._samples[0]
+        return cpu - cpu_then < BUSY_SHARE * (now - since)
 
 
 def _name(pid: int) -> str:

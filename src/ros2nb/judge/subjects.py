@@ -15,19 +15,21 @@ import select
 import subprocess
 import sys
 import threading
-import time
 from pathlib import Path
 from typing import Any, Optional
 
 from .. import domains
 from ..checks.dispatch import IN_JUDGE_ENV
 from ..errors import CheckFailed
-from ..processes import kill_process_group, stop_process_group
+from ..processes import Patience, kill_process_group, stop_process_group
 
 #: JSON list put in front of every subject's command (the grader's sandbox).
 SUBJECT_PREFIX_ENV = 'ROS2NB_SUBJECT_PREFIX'
-#: Seconds a subject may take to answer one command before it counts as hanging.
+#: Seconds a subject may take to answer one command before it counts as hanging: CPU
+#: seconds while it works, wall-clock seconds while it waits (ros2nb.processes.Patience).
 REPLY_TIMEOUT_S = 30.0
+#: Seconds between two looks at a subject that has not answered yet.
+POLL_S = 0.25
 #: Lines of a subject's own output kept for hints.
 KEPT_OUTPUT_LINES = 200
 
@@ -90,6 +92,9 @@ class SubjectProcess:
     def request(self, op: str, *, timeout: float = REPLY_TIMEOUT_S, **arguments: Any) -> dict:
         """Send one command and return its reply.
 
+        :param timeout: seconds the subject gets: of CPU time while it works, of the wall
+            clock while it waits (:class:`~ros2nb.processes.Patience`), so that a busy
+            machine never turns slow honest work into a hang.
         :raises SubjectHung: when no reply comes within ``timeout`` seconds, or the
             process died (its last output line is in the message).
         """
@@ -97,15 +102,14 @@ class SubjectProcess:
             os.write(self._commands, (json.dumps({'op': op, **arguments}) + '\n').encode())
         except BrokenPipeError:
             raise self._died() from None
-        deadline = time.monotonic() + timeout
+        patience = Patience(self.proc.pid, timeout)
         while b'\n' not in self._buffer:
-            left = deadline - time.monotonic()
-            if left <= 0:
+            if patience.exhausted():
                 kill_process_group(self.proc)
                 raise SubjectHung(f'Your code did not finish within {timeout:g} s (an endless '
                                   'loop, or a call that waits for ever?): look for a loop that '
                                   'never ends in the part you wrote.')
-            ready, _, _ = select.select([self._replies], [], [], min(left, 0.5))
+            ready, _, _ = select.select([self._replies], [], [], POLL_S)
             if ready:
                 chunk = os.read(self._replies, 65536)
                 if not chunk:

@@ -21,10 +21,7 @@ import nbformat
 from ..paths import ROOT, SOLUTIONS
 from . import sandbox
 from .scratch import Scratch, sandbox_env
-from .settings import Settings
-
-#: Seconds the judge may take for one notebook.
-JUDGE_TIMEOUT_S = 600
+from .settings import JUDGE_TIMEOUT_S, Settings
 
 
 def judge_notebook(scratch: Scratch, notebook: str, submitted: nbformat.NotebookNode,

@@ -1,0 +1,71 @@
+"""How long the judge waits for a subject: work counts, not the wall clock.
+
+A subject that computes slowly because the machine is busy is not hanging; one that loops
+for ever or waits for ever is, and its learner hears so in one line.  The slow worker below
+gets about a third of a CPU, as a subject does beside two CPU-bound programs: a limit on the
+wall clock alone (the judge's old one) would have called it hung.
+"""
+
+import time
+
+import pytest
+
+from ros2nb.judge.subjects import SubjectHung, SubjectProcess
+
+#: Seconds the subject is given in these tests.
+LIMIT_S = 2.0
+
+CELLS = '''
+import time
+
+def slow_but_honest(cpu_s):
+    """Work for cpu_s CPU seconds, a third of the time (a busy machine's share)."""
+    start = time.process_time()
+    while time.process_time() - start < cpu_s:
+        burst = time.process_time()
+        while time.process_time() - burst < 0.02:
+            pass
+        time.sleep(0.04)
+    return 'done'
+
+def loops_for_ever():
+    while True:
+        pass
+
+def waits_for_ever():
+    time.sleep(3600)
+'''
+
+
+@pytest.fixture
+def subject(tmp_path):
+    process = SubjectProcess(tmp_path)
+    assert process.request('exec_cells', sources=[CELLS])['cell_errors'] == []
+    yield process
+    process.close()
+
+
+def call(subject: SubjectProcess, name: str, *arguments) -> tuple[dict, float]:
+    began = time.monotonic()
+    reply = subject.request('call', name=name, inputs=[list(arguments)], timeout=LIMIT_S)
+    return reply, time.monotonic() - began
+
+
+def test_slow_honest_work_on_a_busy_machine_is_not_a_hang(subject):
+    reply, waited = call(subject, 'slow_but_honest', 0.75 * LIMIT_S)
+    assert reply['outputs'] == [{'result': {'type': 'str', 'value': 'done'}}]
+    assert waited > LIMIT_S  # the failure prevented: a wall-clock limit would have cut it
+
+
+def test_an_endless_loop_is_cut_once_it_used_the_limit_in_cpu_time(subject):
+    with pytest.raises(SubjectHung, match=r'^Your code did not finish within 2 s \(an endless '
+                                          r'loop, or a call that waits for ever\?\): look for a '
+                                          r'loop that never ends in the part you wrote\.$'):
+        call(subject, 'loops_for_ever')
+
+
+def test_a_call_that_waits_for_ever_is_cut_after_the_limit_on_the_wall_clock(subject):
+    began = time.monotonic()
+    with pytest.raises(SubjectHung, match=r'^Your code did not finish within 2 s'):
+        call(subject, 'waits_for_ever')
+    assert time.monotonic() - began >= LIMIT_S
