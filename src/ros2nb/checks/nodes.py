@@ -28,7 +28,12 @@ def parts_verdict(workspace: Path, relative: str) -> None:
 def new_node(judge: Judge, relative: str, cls: str, *, placeholders: tuple[str, ...] = (),
               seed: Optional[int] = None, args: tuple = ()) -> tuple[Any, dict]:
     """Create the learner's node ``cls(*args)`` from their file in a subject; raise for what
-    went wrong."""
+    went wrong.
+
+    Returns once the judge has the lines the node logged while it started (over /rosout):
+    a start-up line arriving late would otherwise be taken for one of the next lines.
+    """
+    mark = len(judge.observer.logs)
     subject = judge.file_subject(relative)
     reply = subject.request('new_node', cls=cls, placeholders=list(placeholders),
                             seed=seed, args=list(args))
@@ -45,6 +50,7 @@ def new_node(judge: Judge, relative: str, cls: str, *, placeholders: tuple[str, 
     if not reply['ok']:
         shown = ', '.join(repr(a) for a in args)
         raise learner_error(f'{cls}({shown})', reply['error'])
+    caught_up(judge, reply, mark, reply['started_lines'])
     return subject, reply
 
 
