@@ -8,17 +8,26 @@
 # Steps 2 and 3 run alongside step 1, each in its own pytest process (every process and
 # kernel claims a ROS domain and a workspace of its own); their output is kept in a log
 # and shown once step 1 has ended.  One failure never hides another: the exit code is 1
-# if any step failed.  Usage: tests/run_steps.sh PYTHON WORKERS
+# if any step failed.  A step still running after STEP_LIMIT_S seconds (a hang that every
+# per-test limit missed) is stopped and says so: make test always ends with its results.
+# Usage: tests/run_steps.sh PYTHON WORKERS
 set -u
 python=$1 workers=$2
+STEP_LIMIT_S=${STEP_LIMIT_S:-3000}
 logs=$(mktemp -d "${TMPDIR:-/tmp}/ros2nb-make-test-XXXXXX")
 trap 'rm -rf "$logs"' EXIT
 
 run() {  # run NAME ARGS...: pytest ARGS, exit code to $logs/NAME.rc, seconds to $logs/NAME.s
     local name=$1 began=$SECONDS
     shift
-    "$python" -m pytest "$@"
-    echo $? > "$logs/$name.rc"
+    # --foreground: Ctrl+C at the terminal still reaches pytest; SIGINT lets it say where it was.
+    timeout --foreground --signal=INT --kill-after=60 "$STEP_LIMIT_S" "$python" -m pytest "$@"
+    local rc=$?
+    if [ "$rc" = 124 ] || [ "$rc" = 137 ] || [ $((SECONDS - began)) -ge "$STEP_LIMIT_S" ]; then
+        echo "=== make test: $name was still running after $STEP_LIMIT_S s and was stopped" \
+             "(a hang no test limit caught: its output above ends where it hung)"
+    fi
+    echo "$rc" > "$logs/$name.rc"
     echo $((SECONDS - began)) > "$logs/$name.s"
 }
 
