@@ -317,17 +317,23 @@ def package_dependencies(package_xml: Path) -> list[str]:
     return names
 '''
 
+#: A callback that waits for a flag only another callback could set: with one thread
+#: spinning, it waits for ever. (The hangs wait rather than compute: a hung cell keeps its
+#: sandbox for the whole cell limit, and a loop burning a CPU for those two minutes took a
+#: third of the sample class's CPU time from the learners graded beside it.)
 HANG_IN_CALLBACK = '''
+import time
 from rclpy.node import Node
 
 class Stuck(Node):
     def __init__(self):
         super().__init__('stuck')
+        self.ready = False
         self.create_timer(1.0, self.forever)
 
     def forever(self):
-        while True:
-            pass
+        while not self.ready:
+            time.sleep(0.2)
 
 ros2nb.add(Stuck())
 ros2nb.spin(3)
@@ -389,7 +395,8 @@ def build(folder: Path, *, grading_out: Path, submissions: Path, decoy_gradebook
     put('script-in-feedback', NB01, script)
     put('kills-its-kernel', NB01, _with_cells(
         SOLUTION[NB01], {1: 'import os, signal\nos.kill(os.getpid(), signal.SIGKILL)'}))
-    put('hangs-after-a-check', NB01, _after_first_check(SOLUTION[NB01], 'while True:\n    pass'))
+    put('hangs-after-a-check', NB01, _after_first_check(  # waits for what never comes
+        SOLUTION[NB01], 'import time\nwhile True:\n    time.sleep(0.2)'))
     put('hang-in-callback', NB01, _with_cells(SOLUTION[NB01], {-1: HANG_IN_CALLBACK}))
     put('calls-rclpy-shutdown', NB01, _with_cells(
         SOLUTION[NB01], {-1: 'import rclpy\nrclpy.shutdown()'}))
