@@ -10,7 +10,7 @@ else the machine does falls on both alike.
    seconds over ros2nb's: 1.0 is as fast as bare rclpy) and ros2nb's speed in real time.
 2. From starting the sensor to the first reading heard: in a kernel's runtime, and as two
    separate processes (what ``ros2 run`` starts).
-3. Grading, in seconds per notebook: one learner who handed in the six notebooks complete
+3. Grading, in seconds per notebook: one learner who handed in every notebook complete
    (every cell runs, every check passes) and one who handed them in untouched, each graded
    alone with ``ros2nb-grade`` in its sandboxes, nbgrader's set-up and feedback included.
 
@@ -124,6 +124,15 @@ def main() -> None:
     parser.add_argument('--learners', type=int, default=30, help='class size for --only class')
     args = parser.parse_args()
     lines = ['| measure | median s | spread s | runs | |', '|---|---|---|---|---|']
+    shown = 0
+
+    def show() -> None:
+        """Print the rows measured so far: a run cut short keeps what it measured."""
+        nonlocal shown
+        if lines[shown:]:
+            print('\n'.join(lines[shown:]), flush=True)
+        shown = len(lines)
+
     if args.only in (None, 'sim'):
         runs = interleaved({'ros2nb': lambda: both('sim-hour-ros2nb'),
                             'bare': lambda: both('sim-hour-bare')}, args.reps)
@@ -141,6 +150,7 @@ def main() -> None:
         lines.append(row('simulated hour, bare rclpy, CPU s of the process', cpu['bare']))
         lines.append(f'| CPU ratio, bare / ros2nb | {bare_cpu / ours_cpu:.2f} | | | less '
                      'sensitive to a busy machine than wall time |')
+        show()
     if args.only in (None, 'first'):
         first = interleaved({'kernel': lambda: peer('first-message-kernel'),
                              'processes': lambda: peer('first-message-processes')}, args.reps)
@@ -148,6 +158,7 @@ def main() -> None:
                          'the sensor publishes every 1 s'))
         lines.append(row('first message, two processes', first['processes'],
                          'process start and discovery included'))
+        show()
     if args.only in (None, 'grading'):
         graded = interleaved({'complete': lambda: grading_seconds_per_notebook('solutions'),
                               'untouched': lambda: grading_seconds_per_notebook('notebooks')},
@@ -160,7 +171,7 @@ def main() -> None:
         lines.append(f'| a class of {args.learners} complete learners | {elapsed:.0f} | | 1 | '
                      f'{elapsed / 60:.1f} min, {elapsed / count:.1f} s per notebook; {full} '
                      'with the highest total |')
-    print('\n'.join(lines))
+    show()
 
 
 if __name__ == '__main__':
