@@ -123,55 +123,44 @@ def main() -> None:
     parser.add_argument('--only', choices=('sim', 'first', 'grading', 'class'))
     parser.add_argument('--learners', type=int, default=30, help='class size for --only class')
     args = parser.parse_args()
-    lines = ['| measure | median s | spread s | runs | |', '|---|---|---|---|---|']
-    shown = 0
-
-    def show() -> None:
-        """Print the rows measured so far: a run cut short keeps what it measured."""
-        nonlocal shown
-        if lines[shown:]:
-            print('\n'.join(lines[shown:]), flush=True)
-        shown = len(lines)
-
+    sys.stdout.reconfigure(line_buffering=True)  # each row as measured: a run cut short keeps it
+    print('| measure | median s | spread s | runs | |\n|---|---|---|---|---|')
     if args.only in (None, 'sim'):
         runs = interleaved({'ros2nb': lambda: both('sim-hour-ros2nb'),
                             'bare': lambda: both('sim-hour-bare')}, args.reps)
         wall = {k: [w for w, _ in v] for k, v in runs.items()}
         cpu = {k: [c for _, c in v] for k, v in runs.items()}
         ours, bare = (statistics.median(wall[k]) for k in ('ros2nb', 'bare'))
-        lines.append(row('simulated hour, ros2nb', wall['ros2nb'],
-                         f'{SIMULATED_S / ours:.0f}x real time (target >= 1000x)'))
-        lines.append(row('simulated hour, bare rclpy', wall['bare'],
-                         f'{SIMULATED_S / bare:.0f}x real time'))
-        lines.append(f'| speed ratio, bare seconds / ros2nb seconds | {bare / ours:.2f} | | | '
-                     'target >= 0.9 |')
+        print(row('simulated hour, ros2nb', wall['ros2nb'],
+                  f'{SIMULATED_S / ours:.0f}x real time (target >= 1000x)'))
+        print(row('simulated hour, bare rclpy', wall['bare'],
+                  f'{SIMULATED_S / bare:.0f}x real time'))
+        print(f'| speed ratio, bare seconds / ros2nb seconds | {bare / ours:.2f} | | | '
+              'target >= 0.9 |')
         ours_cpu, bare_cpu = (statistics.median(cpu[k]) for k in ('ros2nb', 'bare'))
-        lines.append(row('simulated hour, ros2nb, CPU s of the process', cpu['ros2nb']))
-        lines.append(row('simulated hour, bare rclpy, CPU s of the process', cpu['bare']))
-        lines.append(f'| CPU ratio, bare / ros2nb | {bare_cpu / ours_cpu:.2f} | | | less '
-                     'sensitive to a busy machine than wall time |')
-        show()
+        print(row('simulated hour, ros2nb, CPU s of the process', cpu['ros2nb']))
+        print(row('simulated hour, bare rclpy, CPU s of the process', cpu['bare']))
+        print(f'| CPU ratio, bare / ros2nb | {bare_cpu / ours_cpu:.2f} | | | less '
+              'sensitive to a busy machine than wall time |')
     if args.only in (None, 'first'):
         first = interleaved({'kernel': lambda: peer('first-message-kernel'),
                              'processes': lambda: peer('first-message-processes')}, args.reps)
-        lines.append(row('first message, in a kernel', first['kernel'],
-                         'the sensor publishes every 1 s'))
-        lines.append(row('first message, two processes', first['processes'],
-                         'process start and discovery included'))
-        show()
+        print(row('first message, in a kernel', first['kernel'],
+                  'the sensor publishes every 1 s'))
+        print(row('first message, two processes', first['processes'],
+                  'process start and discovery included'))
     if args.only in (None, 'grading'):
         graded = interleaved({'complete': lambda: grading_seconds_per_notebook('solutions'),
                               'untouched': lambda: grading_seconds_per_notebook('notebooks')},
                              args.reps)
-        lines.append(row('grading, complete learner, per notebook', graded['complete'],
-                         'target <= 10 s'))
-        lines.append(row('grading, untouched learner, per notebook', graded['untouched']))
+        print(row('grading, complete learner, per notebook', graded['complete'],
+                  'target <= 10 s'))
+        print(row('grading, untouched learner, per notebook', graded['untouched']))
     if args.only == 'class':
         elapsed, count, full = grade_class(args.learners)
-        lines.append(f'| a class of {args.learners} complete learners | {elapsed:.0f} | | 1 | '
-                     f'{elapsed / 60:.1f} min, {elapsed / count:.1f} s per notebook; {full} '
-                     'with the highest total |')
-    show()
+        print(f'| a class of {args.learners} complete learners | {elapsed:.0f} | | 1 | '
+              f'{elapsed / 60:.1f} min, {elapsed / count:.1f} s per notebook; {full} '
+              'with the highest total |')
 
 
 if __name__ == '__main__':

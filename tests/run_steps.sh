@@ -23,7 +23,7 @@ run() {  # run NAME ARGS...: pytest ARGS, exit code to $logs/NAME.rc, seconds to
     # --foreground: Ctrl+C at the terminal still reaches pytest; SIGINT lets it say where it was.
     timeout --foreground --signal=INT --kill-after=60 "$STEP_LIMIT_S" "$python" -m pytest "$@"
     local rc=$?
-    if [ "$rc" = 124 ] || [ "$rc" = 137 ] || [ $((SECONDS - began)) -ge "$STEP_LIMIT_S" ]; then
+    if [ $((SECONDS - began)) -ge "$STEP_LIMIT_S" ]; then
         echo "=== make test: $name was still running after $STEP_LIMIT_S s and was stopped" \
              "(a hang no test limit caught: its output above ends where it hung)"
     fi
