@@ -1,7 +1,10 @@
 """Small real nodes the unit tests hand to ros2nb."""
 
 import random
+from contextlib import contextmanager
+from typing import Iterator
 
+import rclpy
 from rclpy.node import Node
 from std_msgs.msg import Float32, String
 
@@ -55,3 +58,24 @@ class Chatter(Node):
         super().__init__('chatter_talker')
         self.publisher = self.create_publisher(String, 'chatter', 10)
         self.create_timer(PERIOD_S, lambda: self.publisher.publish(String(data='hi')))
+
+
+@contextmanager
+def name_without_endpoints(name: str, domain_id: int) -> Iterator[Node]:
+    """A node called ``name`` on ``domain_id`` that owns no endpoint, for as long as the block.
+
+    What the ROS graph shows after a process ended while its last discovery message was
+    still on its way (ros2/ros2#1413): the node's name, none of its publishers or
+    subscriptions. That race cannot be started on purpose; this real node, with rosout off
+    and its /parameter_events publisher destroyed, shows the graph the same thing.
+    """
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=domain_id)
+    node = Node(name, context=context, enable_rosout=False, start_parameter_services=False)
+    try:
+        for publisher in list(node.publishers):
+            node.destroy_publisher(publisher)
+        yield node
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown(context=context)

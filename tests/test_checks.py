@@ -38,17 +38,18 @@ def session(tmp_path_factory):
 
 
 def strangers(session) -> list[str]:
-    """The course's nodes (a sensor, a monitor) on the judge's domain now, in its graph."""
+    """The course's nodes (a sensor, a monitor) running on the judge's domain now."""
     names = (course.SENSOR_NODE, course.MONITOR_NODE)
-    return sorted(f'{ns.rstrip("/")}/{n}'
-                  for n, ns in session.observer.node.get_node_names_and_namespaces()
+    return sorted(f'{ns.rstrip("/")}/{n}' for n, ns in session.observer.live_nodes()
                   if n in names)
 
 
 def alone(session) -> None:
-    """Wait until the judge's graph holds no node of an earlier subject: a subject that was
+    """Wait until no node of an earlier subject runs on the judge's domain: a subject that was
     dropped leaves the graph at once when it ends cleanly, and within the DDS lease (20 s)
-    when it had to be killed. The next check must not meet its node under the same name."""
+    when it had to be killed. The next check must not meet its node under the same name.
+    (A name the graph keeps without endpoints after its process ended is no node: the
+    checks look past it, see tests/test_checks_forged.py::test_a_main_that_never_starts_ros.)"""
     wait_for(lambda: not strangers(session), "the judge's domain free of earlier subjects' nodes",
              seen=lambda: strangers(session))
 

@@ -148,20 +148,29 @@ class Observer:
                 raise CheckFailed(self._unseen(name, len(owners), want, found, seconds))
             time.sleep(0.02)
 
-    def _endpoints_by_process(self, name: str, namespace: str) -> dict[bytes, set]:
-        """Endpoints of the nodes ``namespace/name``, by the participant that owns them."""
-        owners: dict[bytes, set] = {}
+    def _endpoint_infos(self) -> list[tuple[str, str, Any]]:
+        """Every topic endpoint DDS discovered on the domain: ``(kind, topic, info)``.
+
+        Empty when a topic went away between two calls (ask again later).
+        """
+        found = []
         try:
             for topic, _types in self.node.get_topic_names_and_types():
                 for kind, infos in (('publisher', self.node.get_publishers_info_by_topic(topic)),
                                     ('subscription',
                                      self.node.get_subscriptions_info_by_topic(topic))):
-                    for info in infos:
-                        if info.node_name == name and info.node_namespace == namespace:
-                            owner = bytes(info.endpoint_gid[:PARTICIPANT_PREFIX_BYTES])
-                            owners.setdefault(owner, set()).add((kind, topic, info.topic_type))
-        except Exception:  # a topic that went away between the two calls: ask again later
-            return {}
+                    found.extend((kind, topic, info) for info in infos)
+        except Exception:
+            return []
+        return found
+
+    def _endpoints_by_process(self, name: str, namespace: str) -> dict[bytes, set]:
+        """Endpoints of the nodes ``namespace/name``, by the participant that owns them."""
+        owners: dict[bytes, set] = {}
+        for kind, topic, info in self._endpoint_infos():
+            if info.node_name == name and info.node_namespace == namespace:
+                owner = bytes(info.endpoint_gid[:PARTICIPANT_PREFIX_BYTES])
+                owners.setdefault(owner, set()).add((kind, topic, info.topic_type))
         return owners
 
     def _unseen(self, name: str, processes: int, want: set, found: set,
@@ -199,8 +208,20 @@ class Observer:
         finally:
             self.node.destroy_client(client)
 
+    def live_nodes(self) -> set[tuple[str, str]]:
+        """The ``(name, namespace)`` of every node on the domain that owns an endpoint now.
+
+        Every rclpy node publishes ``/parameter_events``, so a node that owns no endpoint
+        is not running: it is what the ROS graph keeps listing when a process ended while
+        its last discovery message was still on its way (ros2/ros2#1413: the name stays,
+        its endpoints are gone).  Such a node would otherwise pass for the next subject's.
+        """
+        return {(info.node_name, info.node_namespace) for _kind, _topic, info
+                in self._endpoint_infos()}
+
     def has_node(self, name: str) -> bool:
-        return any(n == name for n, _ns in self.node.get_node_names_and_namespaces())
+        """True when a running node called ``name`` (any namespace) is on the domain."""
+        return any(n == name for n, _ns in self.live_nodes())
 
     def close(self) -> None:
         self._stop = True
