@@ -38,10 +38,11 @@ class Case:
 
 EXPECTED = {
     # ---- what a grade means (the learner writes the code)
-    'untouched': Case({n: 0 for n in NB}, {NB03: 'still raises NotImplementedError'}),
+    'untouched': Case({n: 0 for n in NB}, {NB03: 'not attempted'},  # and not run
+                      {n: 'not attempted' for n in NB}),
     'complete': Case(dict(FULL), {NB03: 'an hour of simulated time: 3600 readings'},
                      {n: '' for n in NB}),  # nothing to note
-    'solved-only-04': Case({NB03: 0, NB04: 5}),
+    'solved-only-04': Case({NB03: 0, NB04: 5}, {}, {NB03: 'not attempted'}),
     'handed-in-only-05': Case({NB05: 4}, {NB05: 'ros2 run starts both entry points'}),
     # ---- the verdict is out of the learner's reach (a publisher with the 10.2 floor: 3 of 6)
     'replaces-the-checks': Case({NB03: 3}, {NB03: "the tutorial's floor of 10.2"}),
@@ -425,7 +426,8 @@ def _hostile_class_two(folder: Path, put) -> None:
     """The second hostile class (issue 14): links, malformed files, feedback, honest oddities."""
     put('links-notebooks-to-solutions', NB01, _with_cells(
         SOLUTION[NB01], {99: LINK_TO_SOLUTIONS.format(solutions=str(ROOT / 'solutions'))}))
-    put('links-notebooks-to-solutions', NB02, LEARNER[NB02])
+    put('links-notebooks-to-solutions', NB02, _with_cells(  # attempted, so it runs after
+        LEARNER[NB02], {99: "print('my notes')"}))  # 01 linked its folder away
     (folder / 'links-to-classmates').mkdir()
     (folder / 'links-to-classmates' / f'{NB01}.ipynb').symlink_to(
         folder / 'complete' / f'{NB01}.ipynb')

@@ -106,3 +106,24 @@ def test_malformed_nbgrader_metadata_is_removed_not_fatal():
     assert 'nbgrader' not in prepared.cells[3].metadata
     scored = notebooks.for_scoring(release, prepared, {})
     assert json.dumps(scored)  # nothing unserialisable left
+
+
+def test_a_notebook_without_code_of_the_learner_is_not_attempted():
+    """Only a notebook whose code cells are the release's, text for text, goes unrun (0 points,
+    noted); any code of the learner's, wherever they put it, gets the notebook run."""
+    from grading_samples import LEARNER
+    release = nbformat.read(LEARNER[NB01], as_version=4)
+    assert notebooks.not_attempted(release, release)
+    same = nbformat.read(LEARNER[NB01], as_version=4)
+    code = [c for c in same.cells if c.cell_type == 'code']
+    code[-1].source += '\n\n'  # blank lines are not writing
+    next(c for c in same.cells if c.cell_type == 'markdown').source = 'my own notes'
+    assert notebooks.not_attempted(release, same)
+    answer = nbformat.read(SOLUTION[NB01], as_version=4)  # the answer cell written
+    assert not notebooks.not_attempted(release, answer)
+    own_cell = nbformat.read(LEARNER[NB01], as_version=4)  # the answer in a cell of their own
+    own_cell.cells.append(nbformat.v4.new_code_cell('def documents_workspace(): ...'))
+    assert not notebooks.not_attempted(release, own_cell)
+    deleted = nbformat.read(LEARNER[NB01], as_version=4)
+    deleted.cells.remove(next(c for c in deleted.cells if c.cell_type == 'code'))
+    assert not notebooks.not_attempted(release, deleted)

@@ -25,10 +25,11 @@ def grade_learner(course: Path, scratch_root: Path, learner: Learner, notebooks:
     """Grade a learner's notebooks in course order; file them in the nbgrader course.
 
     The notebooks run one after the other (each on the workspace the previous ones left);
-    each one's judge starts as soon as it has run.  Whatever goes wrong with one notebook
-    (a malformed file, a dead runner, a full disk) is a note for that notebook, which
-    scores 0 unless what was judged stands; the learner's other notebooks and the rest of
-    the class are graded all the same.
+    each one's judge starts as soon as it has run.  A notebook not attempted (its code cells
+    as handed out) is not run: it scores 0 with a note saying so, as if not handed in.
+    Whatever goes wrong with one notebook (a malformed file, a dead runner, a full disk) is
+    a note for that notebook, which scores 0 unless what was judged stands; the learner's
+    other notebooks and the rest of the class are graded all the same.
     """
     scratch = Scratch(scratch_root, learner)
     target = course / 'submitted' / learner.id / ASSIGNMENT
@@ -62,6 +63,9 @@ def _run_and_judge(scratch: Scratch, learner: Learner, notebook: str,
     if problem:
         learner.note(notebook, f'{problem}; 0 points')
         return f'{problem}; 0 points.'
+    if notebooks_of.not_attempted(release, submitted):  # nothing to run: 0, said in a note
+        learner.note(notebook, notebooks_of.NOT_ATTEMPTED)
+        return f'{notebooks_of.NOT_ATTEMPTED}.'
     for dropped in notebooks_of.drop_large_attachments(submitted):
         learner.note(notebook, dropped)
     prepared = notebooks_of.for_the_run(release, submitted)

@@ -71,6 +71,25 @@ def _course_cells(nb: nbformat.NotebookNode, course: dict[str, Any]) -> list[Any
     return found
 
 
+#: The note of a notebook in which the learner changed no code.
+NOT_ATTEMPTED = ('not attempted: its code cells are as the course handed them out, so it was '
+                 'not run; 0 points')
+
+
+def not_attempted(release: nbformat.NotebookNode, submitted: nbformat.NotebookNode) -> bool:
+    """True when ``submitted`` holds the release's code cells, in order, text for text.
+
+    Blank lines at either end of a cell do not count as writing; markdown does not run.
+    A learner who changed, added, moved or deleted any code cell attempted the notebook
+    (it is run: their work may sit in a cell of their own).  Points come only from what
+    the learner wrote, so running a notebook without any could only ever give 0.
+    """
+    def code(nb: nbformat.NotebookNode) -> list[str]:
+        return [cell.source.strip() for cell in nb.cells if cell.cell_type == 'code']
+
+    return code(submitted) == code(release)
+
+
 def for_the_run(release: nbformat.NotebookNode,
                 submitted: nbformat.NotebookNode) -> nbformat.NotebookNode:
     """The learner's notebook as the sandbox runs it.
