@@ -11,8 +11,9 @@ else the machine does falls on both alike.
 2. From starting the sensor to the first reading heard: in a kernel's runtime, and as two
    separate processes (what ``ros2 run`` starts).
 3. Grading, in seconds per notebook: one learner who handed in every notebook complete
-   (every cell runs, every check passes) and one who handed them in untouched, each graded
-   alone with ``ros2nb-grade`` in its sandboxes, nbgrader's set-up and feedback included.
+   (every cell runs, every check passes) and one who handed them in untouched (not
+   attempted: not run, 0 and a note), each graded alone with ``ros2nb-grade`` in its
+   sandboxes, nbgrader's set-up and feedback included.
 
 Targets (issue "Fast and steady"): simulated hour >= 0.9 x bare rclpy and >= 1000x real
 time; grading <= 10 s per notebook for a complete learner.

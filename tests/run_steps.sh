@@ -35,7 +35,7 @@ run solutions --nbval solutions --nbval-current-env --nbval-sanitize-with tests/
     > "$logs/solutions.log" 2>&1 &
 run notebooks --nbval-lax notebooks --nbval-current-env > "$logs/notebooks.log" 2>&1 &
 echo "=== make test: tests/ (nbval over solutions/ and notebooks/ runs alongside)"
-run tests tests -n "$workers" --dist loadfile --durations=15
+run tests tests -n "$workers" --dist loadfile --no-loadscope-reorder --durations=15
 wait
 for name in solutions notebooks; do
     echo "=== make test: nbval $name/ (ran alongside tests/)"
