@@ -151,18 +151,21 @@ class Observer:
     def _endpoint_infos(self) -> list[tuple[str, str, Any]]:
         """Every topic endpoint DDS discovered on the domain: ``(kind, topic, info)``.
 
-        Empty when a topic went away between two calls (ask again later).
+        Read again when the graph changed under a read (a topic gone between two calls);
+        empty only when five reads in a row failed so.
         """
-        found = []
-        try:
-            for topic, _types in self.node.get_topic_names_and_types():
-                for kind, infos in (('publisher', self.node.get_publishers_info_by_topic(topic)),
-                                    ('subscription',
-                                     self.node.get_subscriptions_info_by_topic(topic))):
-                    found.extend((kind, topic, info) for info in infos)
-        except Exception:
-            return []
-        return found
+        for _attempt in range(5):
+            found = []
+            try:
+                for topic, _types in self.node.get_topic_names_and_types():
+                    for kind, infos in (
+                            ('publisher', self.node.get_publishers_info_by_topic(topic)),
+                            ('subscription', self.node.get_subscriptions_info_by_topic(topic))):
+                        found.extend((kind, topic, info) for info in infos)
+            except Exception:  # noqa: BLE001 - the graph changed meanwhile: read it again
+                continue
+            return found
+        return []
 
     def _endpoints_by_process(self, name: str, namespace: str) -> dict[bytes, set]:
         """Endpoints of the nodes ``namespace/name``, by the participant that owns them."""
