@@ -62,12 +62,14 @@ class Chatter(Node):
 
 @contextmanager
 def name_without_endpoints(name: str, domain_id: int) -> Iterator[Node]:
-    """A node called ``name`` on ``domain_id`` that owns no endpoint, for as long as the block.
+    """A node called ``name`` on ``domain_id`` with no publisher or subscription, for as long
+    as the block.
 
     What the ROS graph shows after a process ended while its last discovery message was
     still on its way (ros2/ros2#1413): the node's name, none of its publishers or
     subscriptions. That race cannot be started on purpose; this real node, with rosout off
-    and its /parameter_events publisher destroyed, shows the graph the same thing.
+    and its /parameter_events publisher destroyed, shows the graph the same thing (it keeps
+    rclpy's type-description service, which the judge does not count).
     """
     context = rclpy.Context()
     rclpy.init(context=context, domain_id=domain_id)

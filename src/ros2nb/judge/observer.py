@@ -163,6 +163,7 @@ class Observer:
                             ('subscription', self.node.get_subscriptions_info_by_topic(topic))):
                         found.extend((kind, topic, info) for info in infos)
             except Exception:  # noqa: BLE001 - the graph changed meanwhile: read it again
+                time.sleep(0.02)
                 continue
             return found
         return []
@@ -212,12 +213,14 @@ class Observer:
             self.node.destroy_client(client)
 
     def live_nodes(self) -> set[tuple[str, str]]:
-        """The ``(name, namespace)`` of every node on the domain that owns an endpoint now.
+        """The ``(name, namespace)`` of every node on the domain that owns a publisher or a
+        subscription now.
 
-        Every rclpy node publishes ``/parameter_events``, so a node that owns no endpoint
-        is not running: it is what the ROS graph keeps listing when a process ended while
+        Every rclpy node publishes ``/parameter_events``, so a node that owns none is not
+        running: it is what the ROS graph keeps listing when a process ended while
         its last discovery message was still on its way (ros2/ros2#1413: the name stays,
-        its endpoints are gone).  Such a node would otherwise pass for the next subject's.
+        its publishers and subscriptions are gone).  Such a node would otherwise pass for the
+        next subject's.
         """
         return {(info.node_name, info.node_namespace) for _kind, _topic, info
                 in self._endpoint_infos()}

@@ -79,10 +79,12 @@ NOT_ATTEMPTED = ('not attempted: its code cells are as the course handed them ou
 def not_attempted(release: nbformat.NotebookNode, submitted: nbformat.NotebookNode) -> bool:
     """True when ``submitted`` holds the release's code cells, in order, text for text.
 
-    Blank lines at either end of a cell do not count as writing; markdown does not run.
+    Whitespace at either end of a cell does not count as writing; markdown does not run.
     A learner who changed, added, moved or deleted any code cell attempted the notebook
     (it is run: their work may sit in a cell of their own).  Points come only from what
-    the learner wrote, so running a notebook without any could only ever give 0.
+    the learner wrote, so running a notebook without any could only ever give it 0; not
+    running it is grading it as not handed in, so the notebooks after it run on the
+    workspace the ones before it left (not on the unwritten parts it would have saved).
     """
     def code(nb: nbformat.NotebookNode) -> list[str]:
         return [cell.source.strip() for cell in nb.cells if cell.cell_type == 'code']
