@@ -74,14 +74,10 @@ def run_main(judge: Judge, relative: str, node_name: str, part: int = 5) -> str:
     proc, output = judge.start([sys.executable, str(path)], cwd=judge.workspace)
     # Ctrl+C once the node spins (it answers a parameter call), as a learner presses it
     # once the node runs: earlier, a busy machine would decide what the learner is told.
-    seen = []  # what the wait saw: the graph is read once for the verdict, not again
-
-    def ended_or_started() -> bool:
-        seen[:] = [observer.has_node(node_name)]
-        return proc.poll() is not None or seen[0]
-
-    observer.wait_until(ended_or_started, ARRIVAL_TIMEOUT_S)
-    started = proc.poll() is None and seen[0]
+    # The graph is read once for the verdict: the read that ended the wait, not a second one.
+    started = observer.wait_until(
+        lambda: proc.poll() is not None or observer.has_node(node_name), ARRIVAL_TIMEOUT_S,
+    ) and proc.poll() is None
     spinning = started and observer.spins(node_name)
     if proc.poll() is not None:
         raise _ended_early(path, part, output.text(), proc.returncode)
