@@ -66,7 +66,7 @@ def pytest_runtest_call(item):
 #: 100, 88, 84, 83, 45), started first so that pytest-xdist's workers finish together
 #: (scheduling only: no test depends on it). make test passes --no-loadscope-reorder:
 #: xdist otherwise sorts files by their number of tests, whatever this order says.
-LONGEST_FIRST = ('test_grading.py', 'test_checks_bag.py', 'test_lessons_06_07.py',
+LONGEST_FIRST = ('test_grading.py', 'test_checks_bag_judge.py', 'test_lessons_06_07.py',
                  'test_checks.py', 'test_jupyterhub.py', 'test_grading_cli.py',
                  'test_isolation.py', 'test_checks_forged.py', 'test_runtime.py')
 

@@ -1,0 +1,83 @@
+"""What the checks of notebook 10 (record and replay) are tested against: shared by two files.
+
+The answers are the solution notebook's answer cells, so they never go stale; each mistake
+is one edit of an answer and the line its check must give. Each mistake runs twice, as the
+kernel runs it (``test_checks_bag_kernel.py``: the learner's function called in the test
+process, with ROS up there on simulated time) and as the grader runs it
+(``test_checks_bag_judge.py``: the test process is the judge; the answer cell runs in a real
+subject). Two files, two processes: a kernel never has a judge listening in its own process,
+and the two halves run side by side.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Iterator
+
+import pytest
+
+import ros2nb
+from ros2nb import checks
+from ros2nb.terminal.workspace import WORKSPACE_ENV
+
+from judging import answer_cells
+
+HERE = os.path.dirname(__file__)
+SOLUTION = os.path.join(HERE, '..', 'solutions', '10-record-and-replay.ipynb')
+LEARNER = os.path.join(HERE, '..', 'notebooks', '10-record-and-replay.ipynb')
+CHECKS = {'record_hour': checks.check_recording, 'replay': checks.check_replay,
+          'read_temperatures': checks.check_readings}
+
+CONTEXT, ANSWERS = answer_cells(SOLUTION)
+#: The grading-context cell without its ``ros2nb.start``: the test module starts ROS itself.
+CONTEXT_WITHOUT_START = CONTEXT.replace('_ = ros2nb.start', '# ')
+
+#: (answer, label, text of the answer, its replacement, the check's line as a regex).
+MISTAKES = [
+    ('record_hour', 'no /rosout', "'/temperature', '/rosout')", "'/temperature')",
+     r"^The bag holds /temperature but not /rosout \(the monitor's statuses\): record both "
+     r'/temperature and /rosout\.$'),
+    ('record_hour', 'a minute', 'spin(HOUR_S,', 'spin(60,',
+     r'^The bag holds 60 readings on /temperature; one simulated hour of the sensor is 3600'),
+    ('record_hour', 'another folder', 'bag_record(bag_path,',
+     "bag_record(Path(tempfile.mkdtemp()) / 'elsewhere',",
+     r'^record_hour\(bag_path\) wrote no bag at the path it was given: pass bag_path'),
+    ('record_hour', 'no monitor', '    ros2nb.add(sub.TemperatureMonitor())\n', '',
+     r'^The bag holds 0 status lines of temperature_monitor on /rosout, expected 3600'),
+    ('replay', 'no monitor', '    ros2nb.add(sub.TemperatureMonitor())\n', '',
+     r'^temperature_monitor logged no status during the replay: add your monitor before '
+     r'bag_play'),
+    ('replay', 'monitor after play', "    ros2nb.add(sub.TemperatureMonitor())\n    "
+     "ros2nb.bag_play(bag_path, rate=rate, topics=['/temperature'])\n",
+     "    ros2nb.bag_play(bag_path, rate=rate, topics=['/temperature'])\n"
+     '    ros2nb.add(sub.TemperatureMonitor())\n',
+     r'^temperature_monitor logged no status during the replay'),
+    ('read_temperatures', 'absolute times', '(stamp - first) / 1e9', 'stamp / 1e9',
+     r'^read_temperatures\(\) returned times \[1\.0, 2\.0, 3\.0\]\.\.\.; expected seconds since '
+     r'the first reading'),
+    ('read_temperatures', 'one list', 'return times_s, temperatures_c', 'return temperatures_c',
+     r'^read_temperatures\(\) returned list; return two lists: \(times_s, temperatures_c\)\.$'),
+]
+MISTAKE_IDS = [f'{m[0]}: {m[1]}' for m in MISTAKES]
+
+
+def edited(name: str, old: str, new: str) -> str:
+    """The solution's answer ``name`` with its first ``old`` replaced by ``new``."""
+    answer = ANSWERS[name]
+    assert old in answer, old
+    return answer.replace(old, new, 1)
+
+
+@pytest.fixture(scope='module')
+def workspace(tmp_path_factory) -> Iterator[Path]:
+    """A workspace with the course's sensor and monitor, as catch_up(10) writes them."""
+    saved = os.environ.get(WORKSPACE_ENV)
+    root = tmp_path_factory.mktemp('checks10')
+    os.environ[WORKSPACE_ENV] = str(root / 'ws')
+    ros2nb.course.catch_up(10)
+    yield root / 'ws'
+    if saved is None:
+        os.environ.pop(WORKSPACE_ENV, None)
+    else:
+        os.environ[WORKSPACE_ENV] = saved

@@ -1,0 +1,115 @@
+"""The checks of notebook 10 as the kernel runs them: the learner's function called here.
+
+ROS is up in this process on simulated time, as in the lesson's kernel, and no judge is
+(the judge's half is ``test_checks_bag_judge.py``; the cases are ``bag_cases.py``'s). Each
+check records or replays with a real rclpy runtime and reads a real bag with rosbags. Also:
+a bag written the lesson's way opens with readers the course does not own, and bad input to
+the bag verbs gets one line.
+"""
+
+import os
+import re
+import sys
+import tempfile
+from pathlib import Path
+
+import pytest
+
+pytestmark = [pytest.mark.timeout(600),
+              pytest.mark.skipif(sys.version_info < (3, 11),
+                                 reason='bags need Python 3.11 or newer (rosbags needs apsw)')]
+
+import ros2nb  # noqa: E402
+from ros2nb.checks.base import bind_judge  # noqa: E402
+from ros2nb.checks.dispatch import IN_JUDGE_ENV  # noqa: E402
+from ros2nb.errors import CheckFailed, Ros2nbError, UsageError  # noqa: E402
+
+from bag_cases import (ANSWERS, CHECKS, CONTEXT_WITHOUT_START, LEARNER, MISTAKE_IDS,  # noqa: E402
+                       MISTAKES, edited, workspace)  # noqa: F401 - workspace is a fixture
+from judging import answer_cells  # noqa: E402
+
+
+@pytest.fixture(scope='module')
+def kernel(workspace):
+    """ROS up in this process on simulated time, as the lesson's kernel has it; no judge."""
+    assert IN_JUDGE_ENV not in os.environ
+    bind_judge(None)
+    ros2nb.start(sim_time=True)
+    yield workspace
+    ros2nb.shutdown()
+
+
+def defined(answer: str) -> dict:
+    """The names an answer cell defines, run after the grading context as the kernel runs it."""
+    namespace: dict = {}
+    exec(CONTEXT_WITHOUT_START + '\n' + answer, namespace)
+    return namespace
+
+
+def test_the_solutions_pass(kernel, capsys):
+    for name, answer in ANSWERS.items():
+        CHECKS[name](defined(answer)[name])
+    assert capsys.readouterr().out.count('Check passed:') == 3
+
+
+@pytest.mark.parametrize('name, label, old, new, pattern', MISTAKES, ids=MISTAKE_IDS)
+def test_a_mistake_gets_one_line(kernel, name, label, old, new, pattern):
+    with pytest.raises(CheckFailed) as caught:
+        CHECKS[name](defined(edited(name, old, new))[name])
+    message = str(caught.value)
+    assert '\n' not in message and re.search(pattern, message), message
+
+
+def test_an_untouched_cell_gets_one_line(kernel):
+    untouched = answer_cells(LEARNER)[1]
+    for name in CHECKS:
+        assert 'raise NotImplementedError()' in untouched[name]
+        with pytest.raises(CheckFailed) as caught:
+            CHECKS[name](defined(untouched[name])[name])
+        assert str(caught.value).startswith(f'{name}() still raises NotImplementedError')
+
+
+def test_a_bag_opens_with_readers_the_course_does_not_own(kernel):
+    """mcap's own reader (with mcap-ros2-support's decoder) and rosbags' AnyReader."""
+    from mcap.reader import make_reader
+    from mcap_ros2.decoder import DecoderFactory
+    from rosbags.highlevel import AnyReader
+
+    bag = Path(tempfile.mkdtemp(prefix='ros2nb-bag-')) / 'hour'
+    defined(ANSWERS['record_hour'])['record_hour'](bag)
+    recorded = ros2nb.bag_info(bag)
+    assert recorded['/temperature'] == 3600 and recorded['/rosout'] == 7200
+    expected = {'/temperature': 'std_msgs/msg/Float32', '/rosout': 'rcl_interfaces/msg/Log'}
+
+    counts, types, first = {}, {}, None
+    with open(next(bag.glob('*.mcap')), 'rb') as stream:
+        reader = make_reader(stream, decoder_factories=[DecoderFactory()])
+        for schema, channel, _message, decoded in reader.iter_decoded_messages():
+            counts[channel.topic] = counts.get(channel.topic, 0) + 1
+            types[channel.topic] = schema.name
+            if channel.topic == '/temperature' and first is None:
+                first = decoded.data
+    assert counts == recorded
+    assert types == expected
+    assert 18.0 <= first <= 28.0
+
+    with AnyReader([bag]) as reader:
+        assert {c.topic: c.msgcount for c in reader.connections} == recorded
+        assert {c.topic: c.msgtype for c in reader.connections} == expected
+        logs = [reader.deserialize(raw, c.msgtype) for c, _t, raw in
+                reader.messages([c for c in reader.connections if c.topic == '/rosout'])]
+    assert sum('Status: ' in log.msg for log in logs) == 3600
+
+
+@pytest.mark.parametrize('call, pattern', [
+    (lambda d: ros2nb.bag_info(d / 'none'), r'is not a bag: a bag is a folder with a metadata'),
+    (lambda d: ros2nb.bag_play(d / 'none'), r'is not a bag'),
+    (lambda d: ros2nb.bag_record(d, '/temperature').__enter__(), r'already exists: choose'),
+    (lambda d: ros2nb.bag_record(d / 'x', 5).__enter__(), r"Topics are names in quotes.*got 5"),
+    (lambda d: ros2nb.bag_record(d / 'x').__enter__(), r'Name the topics to record'),
+], ids=['info of no bag', 'play of no bag', 'record into an existing folder',
+        'a topic that is not a name', 'no topic'])
+def test_bad_input_to_the_bag_verbs_gets_one_line(kernel, tmp_path, call, pattern):
+    with pytest.raises((Ros2nbError, UsageError)) as caught:
+        call(tmp_path)
+    assert re.search(pattern, str(caught.value)) and '\n' not in str(caught.value)
