@@ -495,3 +495,41 @@ def test_a_stopped_node_keeps_its_log_lines_for_a_late_listener_only_when_asked(
         executor.shutdown()
     finally:
         late.destroy_node()
+
+
+LOGGING_FILE = '''def log_here(logger):
+    logger.info('every time')
+    logger.info('once', once=True)
+    logger.warning('throttled', throttle_duration_sec=1.0)
+    return [logger.info(f'in a comprehension {k}') for k in range(2)]
+'''
+
+
+def test_the_cheaper_caller_lookup_finds_what_rclpy_finds(tmp_path, ros):
+    """Every /rosout message names its caller: the kernel's lookup must name the same one
+    (function, file, line and instruction) as rclpy's own, from a file and from a cell."""
+    from rclpy.impl import rcutils_logger
+    from ros2nb.runtime import callers
+
+    assert rcutils_logger.CallerId.__new__ is callers._caller_id_new  # ros2nb.start() set it
+    path = tmp_path / 'learner_file.py'
+    path.write_text(LOGGING_FILE)
+    spec = importlib.util.spec_from_file_location('learner_file', path)
+    from_file = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(from_file)
+    from_cell: dict = {}
+    exec(compile(LOGGING_FILE, '<ipython-input-1>', 'exec'), from_cell)
+    found = {}
+    try:
+        for lookup in (callers.use_rclpy_caller_lookup, callers.use_cheaper_caller_lookup):
+            logger = rclpy.logging.get_logger(f'caller_{lookup.__name__}')
+            from_file.log_here(logger)
+            from_cell['log_here'](logger)
+            found[lookup.__name__] = list(logger.contexts)
+    finally:
+        callers.use_cheaper_caller_lookup()
+    rclpy_found = found['use_rclpy_caller_lookup']
+    assert {(c.function_name, c.file_path) for c in rclpy_found} >= {
+        ('log_here', str(path)), ('<listcomp>', str(path))}  # the learner's frames, not rclpy's
+    assert len(rclpy_found) == 8
+    assert found['use_cheaper_caller_lookup'] == rclpy_found

@@ -23,6 +23,7 @@ from rclpy.signals import SignalHandlerOptions
 from rosgraph_msgs.msg import Clock
 
 from ..errors import SHUT_DOWN_MESSAGE, Ros2nbError
+from .callers import use_cheaper_caller_lookup
 from .clock import SimulatedClock
 from .logs import LogLines
 from .nodes import NodeKeeping, destroy_stray_nodes
@@ -61,6 +62,7 @@ class Runtime(LogLines, Spinning, NodeKeeping, SimulatedClock):
         NodeKeeping.__init__(self)
         SimulatedClock.__init__(self, sim_time)
         self._participant: Optional[bytes] = None
+        use_cheaper_caller_lookup()  # the same /rosout messages, without reading source files
         rclpy.init(args=['--ros-args', '--disable-stdout-logs', '--disable-external-lib-logs'],
                    domain_id=domain_id, signal_handler_options=SignalHandlerOptions.NO)
         self.context = rclpy.get_default_context()
