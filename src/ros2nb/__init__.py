@@ -9,7 +9,7 @@ decides from outside; ``subject`` in the processes that run the learner's code f
 judge.  The instructor's side is the package ``ros2nb_instructor``.
 """
 
-from . import checks, course, domains, qos
+from . import course, domains, qos
 from .errors import (CheckFailed, ColconBuildError, DomainsExhaustedError, FileProtectedError,
                      LearnerCodeError, PkgCreateError, Ros2nbError, UsageError)
 from .kernel import add, install, shutdown, spin, start, stop
@@ -26,6 +26,19 @@ from .terminal.pkg_create import pkg_create
 from .terminal.run import find_executable, ros2_run, run_and_interrupt
 from .terminal.topic import node_list, topic_info, topic_list, unmatched_topics
 from .terminal.workspace import create_workspace, current_workspace, tree
+
+
+def __getattr__(name: str):
+    """``ros2nb.checks`` loads on first use: a process that only runs nodes (a judge's
+    subject) never pays for the notebooks' checks (a quarter of a second of CPU each)."""
+    if name == 'checks':
+        import importlib
+        return importlib.import_module(f'{__name__}.checks')
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), 'checks'})
 
 
 def load_ipython_extension(ipython) -> None:
