@@ -12,14 +12,8 @@ and the two halves run side by side.
 from __future__ import annotations
 
 import os
-from pathlib import Path
-from typing import Iterator
 
-import pytest
-
-import ros2nb
 from ros2nb import checks
-from ros2nb.terminal.workspace import WORKSPACE_ENV
 
 from judging import answer_cells
 
@@ -67,17 +61,3 @@ def edited(name: str, old: str, new: str) -> str:
     answer = ANSWERS[name]
     assert old in answer, old
     return answer.replace(old, new, 1)
-
-
-@pytest.fixture(scope='module')
-def workspace(tmp_path_factory) -> Iterator[Path]:
-    """A workspace with the course's sensor and monitor, as catch_up(10) writes them."""
-    saved = os.environ.get(WORKSPACE_ENV)
-    root = tmp_path_factory.mktemp('checks10')
-    os.environ[WORKSPACE_ENV] = str(root / 'ws')
-    ros2nb.course.catch_up(10)
-    yield root / 'ws'
-    if saved is None:
-        os.environ.pop(WORKSPACE_ENV, None)
-    else:
-        os.environ[WORKSPACE_ENV] = saved

@@ -5,7 +5,6 @@ replay over DDS and reads the real bag the subject wrote. The kernel's half is
 ``test_checks_bag_kernel.py``; the cases are ``bag_cases.py``'s.
 """
 
-import os
 import re
 import sys
 
@@ -15,29 +14,19 @@ pytestmark = [pytest.mark.timeout(600),
               pytest.mark.skipif(sys.version_info < (3, 11),
                                  reason='bags need Python 3.11 or newer (rosbags needs apsw)')]
 
-from ros2nb.checks.base import AnswerRef, bind_judge  # noqa: E402
-from ros2nb.checks.dispatch import IN_JUDGE_ENV  # noqa: E402
+from ros2nb.checks.base import AnswerRef  # noqa: E402
 from ros2nb.errors import CheckFailed  # noqa: E402
 from ros2nb.judge.session import Session  # noqa: E402
 
-from bag_cases import (ANSWERS, CHECKS, CONTEXT, MISTAKE_IDS, MISTAKES, edited,  # noqa: E402
-                       workspace)  # noqa: F401 - workspace is a fixture
+from bag_cases import ANSWERS, CHECKS, CONTEXT, MISTAKE_IDS, MISTAKES, edited  # noqa: E402
+from judging import judge_session  # noqa: E402
 
 
 @pytest.fixture(scope='module')
-def session(workspace):
-    """A judge session, bound as the checks' judge: this process is the judge."""
-    saved = os.environ.get(IN_JUDGE_ENV)
-    os.environ[IN_JUDGE_ENV] = '1'
-    session = Session(workspace)
-    bind_judge(session)
-    yield session
-    bind_judge(None)
-    session.close()
-    if saved is None:
-        os.environ.pop(IN_JUDGE_ENV, None)
-    else:
-        os.environ[IN_JUDGE_ENV] = saved
+def session(tmp_path_factory):
+    """A judge session on a workspace caught up to notebook 10: this process is the judge."""
+    with judge_session(tmp_path_factory.mktemp('checks10'), 10) as session:
+        yield session
 
 
 def judge(session: Session, name: str, answer: str) -> None:

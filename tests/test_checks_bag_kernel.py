@@ -23,20 +23,25 @@ import ros2nb  # noqa: E402
 from ros2nb.checks.base import bind_judge  # noqa: E402
 from ros2nb.checks.dispatch import IN_JUDGE_ENV  # noqa: E402
 from ros2nb.errors import CheckFailed, Ros2nbError, UsageError  # noqa: E402
+from ros2nb.terminal.workspace import WORKSPACE_ENV  # noqa: E402
 
 from bag_cases import (ANSWERS, CHECKS, CONTEXT_WITHOUT_START, LEARNER, MISTAKE_IDS,  # noqa: E402
-                       MISTAKES, edited, workspace)  # noqa: F401 - workspace is a fixture
+                       MISTAKES, edited)
 from judging import answer_cells  # noqa: E402
 
 
 @pytest.fixture(scope='module')
-def kernel(workspace):
-    """ROS up in this process on simulated time, as the lesson's kernel has it; no judge."""
+def kernel(tmp_path_factory):
+    """A workspace caught up to notebook 10 (its sensor and monitor), and ROS up in this
+    process on simulated time, as the lesson's kernel has them; no judge."""
     assert IN_JUDGE_ENV not in os.environ
     bind_judge(None)
-    ros2nb.start(sim_time=True)
-    yield workspace
-    ros2nb.shutdown()
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv(WORKSPACE_ENV, str(tmp_path_factory.mktemp('checks10') / 'ws'))
+        ros2nb.course.catch_up(10)
+        ros2nb.start(sim_time=True)
+        yield
+        ros2nb.shutdown()
 
 
 def defined(answer: str) -> dict:
