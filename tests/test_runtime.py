@@ -40,13 +40,16 @@ def test_import_does_nothing():
     assert out == ['False', '1', 'False', 'False']
 
 
-def test_a_subject_does_not_load_the_checks():
-    """A judge starts hundreds of subjects in a class; the checks cost each a quarter second."""
-    probe = ('import sys, ros2nb.subject.process, ros2nb; loaded = "ros2nb.checks" in sys.modules; '
-             'print(loaded, ros2nb.checks.check_recording.__name__, "checks" in dir(ros2nb))')
+def test_a_subject_does_not_load_the_checks_or_rosbags():
+    """A judge starts hundreds of subjects in a class; checks and rosbags cost each 0.35 CPU-s."""
+    probe = ('import sys, ros2nb.subject.process, ros2nb; '
+             'loaded = [m in sys.modules for m in ("ros2nb.checks", "rosbags")]; '
+             'print(*loaded, ros2nb.checks.check_recording.__name__, ros2nb.bag_info.__name__, '
+             'ros2nb.terminal.bag.__name__, "checks" in dir(ros2nb), "bag_play" in dir(ros2nb))')
     out = subprocess.run([sys.executable, '-c', probe], capture_output=True, text=True,
                          check=True).stdout.split()
-    assert out == ['False', 'check_recording', 'True']  # and there when asked for
+    assert out == ['False', 'False', 'check_recording', 'bag_info', 'ros2nb.terminal.bag',
+                   'True', 'True']  # and each there when asked for
 
 
 def test_start_says_which_domain_and_clock(capsys):

@@ -7,3 +7,11 @@ node``/``ros2 topic``), ``param`` (``ros2 param``).  The real command is used wh
 ``ros2`` when it is on PATH); elsewhere these print what it prints.  This ``__init__``
 imports nothing, so that ``ros2nb.course`` can use the file verbs without ROS.
 """
+
+
+def __getattr__(name: str):
+    """``ros2nb.terminal.bag`` (notebook 10) loads on first use, with rosbags (PEP 562)."""
+    if name != 'bag':
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    import importlib
+    return importlib.import_module(f'{__name__}.bag')
