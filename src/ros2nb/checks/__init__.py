@@ -20,31 +20,40 @@ One module per lesson (``lesson00`` ... ``lesson10``) on a small shared vocabula
 """
 
 from ..errors import CheckFailed
-from .lesson00 import check_endpoint
-from .lesson01 import check_expanded_path
-from .lesson02 import check_dependencies, package_dependencies
-from .lesson03 import (check_publisher_samples, check_sensor_callback, check_sensor_constructor,
-                       check_sensor_hour, check_sensor_main)
-from .lesson04 import (check_monitor_callback, check_monitor_constructor, check_monitor_main,
-                       check_monitor_readings)
-from .lesson05 import check_entry_points, check_package_runs, check_setup_cfg
-from .lesson06 import (check_counting_monitor, check_fan_controller, check_fan_main,
-                       check_responsive_worker, check_room_arguments)
-from .lesson07 import check_plot_callback
-from .lesson08 import check_monitor_parameters, check_threshold_callback
-from .lesson09 import check_latched_thresholds, check_newest_only, check_sensor_subscription
-from .lesson10 import check_readings, check_recording, check_replay
 
-__all__ = [
-    'CheckFailed', 'check_counting_monitor', 'check_dependencies', 'check_endpoint',
-    'check_entry_points', 'check_expanded_path', 'check_fan_controller', 'check_fan_main',
-    'check_latched_thresholds', 'check_monitor_callback', 'check_monitor_constructor',
-    'check_monitor_main', 'check_monitor_parameters', 'check_monitor_readings',
-    'check_newest_only', 'check_package_runs', 'check_plot_callback', 'check_readings',
-    'check_recording', 'check_replay',
-    'check_publisher_samples', 'check_responsive_worker', 'check_room_arguments',
-    'check_sensor_callback', 'check_sensor_constructor', 'check_sensor_hour',
-    'check_sensor_main', 'check_sensor_subscription', 'check_setup_cfg',
-    'check_threshold_callback',
-    'package_dependencies',
-]
+#: Each lesson's checks, by the module that holds them.  A module loads on first use of one
+#: of its names (PEP 562): a notebook's kernel and its judge load their own lesson's
+#: checks, not every lesson's libraries (catkin_pkg for 02, rosbags for 10).
+LESSONS = {
+    'lesson00': ('check_endpoint',),
+    'lesson01': ('check_expanded_path',),
+    'lesson02': ('check_dependencies', 'package_dependencies'),
+    'lesson03': ('check_publisher_samples', 'check_sensor_callback', 'check_sensor_constructor',
+                 'check_sensor_hour', 'check_sensor_main'),
+    'lesson04': ('check_monitor_callback', 'check_monitor_constructor', 'check_monitor_main',
+                 'check_monitor_readings'),
+    'lesson05': ('check_entry_points', 'check_package_runs', 'check_setup_cfg'),
+    'lesson06': ('check_counting_monitor', 'check_fan_controller', 'check_fan_main',
+                 'check_responsive_worker', 'check_room_arguments'),
+    'lesson07': ('check_plot_callback',),
+    'lesson08': ('check_monitor_parameters', 'check_threshold_callback'),
+    'lesson09': ('check_latched_thresholds', 'check_newest_only', 'check_sensor_subscription'),
+    'lesson10': ('check_readings', 'check_recording', 'check_replay'),
+}
+_MODULE_OF = {name: module for module, names in LESSONS.items() for name in names}
+
+
+def __getattr__(name: str):
+    if name not in _MODULE_OF:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    import importlib
+    value = getattr(importlib.import_module(f'{__name__}.{_MODULE_OF[name]}'), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_MODULE_OF})
+
+
+__all__ = ['CheckFailed', *sorted(_MODULE_OF)]
