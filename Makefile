@@ -17,7 +17,7 @@ export ROS_HOME            := $(HERE)/.cache/ros
 export ROS_LOG_DIR         := $(HERE)/.cache/ros/log
 export PIP_DISABLE_PIP_VERSION_CHECK := 1
 
-.PHONY: lab lab-instructor test setup sandbox-tool browser-tool graph-tool solutions learner-notebooks bench grade clean
+.PHONY: lab lab-instructor test setup bytecode sandbox-tool browser-tool graph-tool solutions learner-notebooks bench grade clean
 
 setup: $(STAMP)
 
@@ -31,15 +31,22 @@ $(STAMP): environment/requirements.txt pyproject.toml
 	$(PY) -m pip install --quiet --no-deps --editable .
 	@touch $(STAMP)
 
+# The course's own Python compiled once, here: where PYTHONDONTWRITEBYTECODE is set (as on
+# our machines) every process that imports ros2nb (kernels, judges, subjects: hundreds in
+# make test) would compile it again, 0.1 CPU-s each.  Python checks each file's source time
+# and size, so a stale one is compiled again in memory, never used.
+bytecode: $(STAMP)
+	@$(PY) -m compileall -q src tests benchmarks conftest.py >/dev/null
+
 # The learner's lab: the course's notebooks copied into work/ (git ignores it; a course update
 # never overwrites a notebook there, it puts the new version beside it), nbgrader's instructor
 # tools, the news pop-up and the Extension Manager off (environment/jupyter-learner/).
 # Localhost only, token authentication on (src/ros2nb_instructor/lab.py).
-lab: $(STAMP) graph-tool
+lab: $(STAMP) bytecode graph-tool
 	$(VENV)/bin/ros2nb-lab
 
 # The instructor's lab: the course folder itself, nbgrader's Formgrader and Create Assignment on.
-lab-instructor: $(STAMP) graph-tool
+lab-instructor: $(STAMP) bytecode graph-tool
 	$(VENV)/bin/ros2nb-lab --instructor
 
 # Unit tests of ros2nb, the notebook checks, then nbval over both notebook folders.
@@ -66,7 +73,7 @@ graph-tool:
 # results come together at the end, and make fails if any step failed.
 TEST_WORKERS ?= 3
 
-test: $(STAMP) sandbox-tool browser-tool graph-tool
+test: $(STAMP) bytecode sandbox-tool browser-tool graph-tool
 	@tests/run_steps.sh $(PY) $(TEST_WORKERS)
 
 # Re-run solutions/ in place so their stored outputs are fresh (then make learner-notebooks).
@@ -78,12 +85,12 @@ learner-notebooks: $(STAMP)
 	$(VENV)/bin/ros2nb-learner-notebooks
 
 # ros2nb against bare rclpy, and grading seconds per notebook (benchmarks/bench.py).
-bench: $(STAMP) sandbox-tool
+bench: $(STAMP) bytecode sandbox-tool
 	$(PY) benchmarks/bench.py $(BENCH_ARGS)
 
 # Grade a class: SUBMISSIONS is a folder of <learner-id>/NN-*.ipynb or a platform .zip.
 # Output goes to grading/ (git-ignored); FORCE=1 replaces an earlier grading/.
-grade: $(STAMP) sandbox-tool
+grade: $(STAMP) bytecode sandbox-tool
 	@test -n "$(SUBMISSIONS)" || { echo "Usage: make grade SUBMISSIONS=DIR (DIR/<learner>/NN-title.ipynb) or SUBMISSIONS=class.zip [FORCE=1] [NO_SANDBOX=1]"; exit 2; }
 	$(VENV)/bin/ros2nb-grade "$(SUBMISSIONS)" $(if $(FORCE),--force) $(if $(NO_SANDBOX),--no-sandbox)
 
