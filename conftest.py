@@ -24,6 +24,8 @@ from pathlib import Path
 
 import pytest
 
+import ros2nb_instructor  # noqa: F401 - first, so nbformat's jsonschema skips rfc3987_syntax (see there)
+
 # A shell's background job (`make test &` in a script) starts with Ctrl+C ignored, and every
 # process started from it inherits that: the tests that press Ctrl+C (for a node process, for
 # a spin) would then see it ignored. A person at a terminal never runs with it ignored.

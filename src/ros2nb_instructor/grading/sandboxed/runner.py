@@ -20,13 +20,9 @@ import sys
 from pathlib import Path
 from typing import Any, Optional
 
-# jsonschema, which nbformat imports, would import rfc3987_syntax if it can: that builds a
-# parser for IRIs and costs a second of CPU in every sandbox, for a format no notebook uses.
-sys.modules.setdefault('rfc3987_syntax', None)  # its absence is an ImportError jsonschema expects
-
-import nbformat  # noqa: E402
-from nbclient import NotebookClient  # noqa: E402
-from nbclient.exceptions import DeadKernelError  # noqa: E402
+import nbformat  # ros2nb_instructor, imported first, spared it rfc3987_syntax
+from nbclient import NotebookClient
+from nbclient.exceptions import DeadKernelError
 
 #: Characters of text output one cell may keep (printed text, tracebacks, text/plain).
 MAX_CELL_OUTPUT_BYTES = 100_000
