@@ -545,3 +545,42 @@ def test_the_cheaper_caller_lookup_finds_what_rclpy_finds(tmp_path, ros):
         ('log_here', str(path)), ('<listcomp>', str(path))}  # the learner's frames, not rclpy's
     assert len(rclpy_found) == 8
     assert found['use_cheaper_caller_lookup'] == rclpy_found
+
+
+def test_the_stop_button_while_a_pause_waits_leaves_no_hang(ros):
+    """Stop pressed while a spin waits for the background thread to pause (a busy machine
+    makes that wait long: the thread is still in a callback). Before, the next pause cleared
+    the flag the paused thread had already set and waited for it forever: the kernel hung
+    (seen once beside two CPU burners, in tests/test_browser_lab.py's Interrupt)."""
+    from std_msgs.msg import Empty
+
+    entered, release = threading.Event(), threading.Event()
+
+    class Slow(rclpy.node.Node):
+        def __init__(self):
+            super().__init__('slow')
+            self.create_subscription(Empty, 'slow_work', lambda _m: (entered.set(),
+                                                                      release.wait()), 10)
+
+    ros2nb.add(Slow())
+    publisher = ros.node.create_publisher(Empty, 'slow_work', 10)
+    publisher.publish(Empty())
+    assert wait_until(entered.is_set), 'the background thread never ran the slow callback'
+
+    main = threading.main_thread().ident
+    pressing = threading.Thread(target=lambda: wait_until(ros._pause_requested.is_set)
+                                and signal.pthread_kill(main, signal.SIGINT))
+    pressing.start()
+    with pytest.raises(KeyboardInterrupt):
+        with ros.exclusive():  # waits for the pause: the Stop button lands here
+            pass
+    pressing.join()
+    release.set()
+    assert wait_until(ros._paused.is_set), 'the background thread never paused'
+
+    done = threading.Event()
+    again = threading.Thread(target=lambda: (ros.exclusive().__enter__(), ros._unpause(),
+                                             done.set()), daemon=True)
+    again.start()
+    assert wait_until(done.is_set), 'the next pause waited forever: the kernel would hang'
+    ros2nb.stop()

@@ -135,9 +135,14 @@ class Spinning:
     def _pause(self) -> None:
         """Hold the background thread (re-entrant): this thread may then spin."""
         if self._exclusive_depth == 0 and self._thread.is_alive():
-            self._paused.clear()
-            self._pause_requested.set()
-            self.executor.wake()
+            # A pause still requested was cut short by the Stop button (KeyboardInterrupt in
+            # the wait below, or between an unpause's two steps): the background thread has
+            # paused, or will, and waits to resume.  Clearing its flag again would wait for
+            # a pause that never comes, and the kernel would hang.
+            if not self._pause_requested.is_set():
+                self._paused.clear()
+                self._pause_requested.set()
+                self.executor.wake()
             self._paused.wait()
         self._exclusive_depth += 1
 
