@@ -10,13 +10,17 @@ import os
 import nbformat
 import pytest
 
-from grading_samples import NB01, SOLUTION
+from grading_samples import NB01, NB02, SOLUTION
 
+from ros2nb import course
+from ros2nb.terminal import workspace as ws_module
 from ros2nb.terminal.workspace import WORKSPACE_NAME
-from ros2nb_instructor.grading import notebooks
+from ros2nb_instructor.grading import notebooks, sandbox
+from ros2nb_instructor.grading.judging import judge_notebook
 from ros2nb_instructor.grading.paths_of_learners import NotARegularFile, read_regular
 from ros2nb_instructor.grading.runs import checked_status
 from ros2nb_instructor.grading.scratch import HOME_BYTES, Scratch
+from ros2nb_instructor.grading.settings import Settings
 from ros2nb_instructor.grading.submissions import Learner
 
 
@@ -127,3 +131,50 @@ def test_a_notebook_without_code_of_the_learner_is_not_attempted():
     deleted = nbformat.read(LEARNER[NB01], as_version=4)
     deleted.cells.remove(next(c for c in deleted.cells if c.cell_type == 'code'))
     assert not notebooks.not_attempted(release, deleted)
+
+
+#: Notebook 02's answer, right, that also puts a Python start-up file and a Fast DDS profile
+#: wherever its judge might import or load them: its subject's cwd, home and temporary
+#: folder, and every folder above them.
+PLANTING_READER = '''\
+import os
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+
+def package_dependencies(package_xml: Path) -> list[str]:
+    places = {Path.cwd(), Path(os.environ['HOME']), Path(os.environ.get('TMPDIR', '/tmp'))}
+    for place in list(places):
+        places.update(place.parents)
+    for place in places:
+        for name in ('sitecustomize.py', 'DEFAULT_FASTRTPS_PROFILES.xml'):
+            try:
+                (place / name).write_text('# planted by the learner')
+            except OSError:
+                pass
+    return [e.text.strip() for e in ET.parse(package_xml).getroot() if e.tag == 'depend']
+'''
+PLANTED = ('sitecustomize.py', 'DEFAULT_FASTRTPS_PROFILES.xml')
+
+
+@pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))
+@pytest.mark.timeout(300)
+def test_a_subject_writes_nowhere_its_judge_reads(scratch, monkeypatch):
+    """The learner's code in a subject may write its own folder, never the judge's cwd
+    (``sys.path[0]`` of ``python -m``, where Fast DDS also looks for a profile), home or
+    temporary folder. Before, the judge ran in the folder its subjects wrote, with its home
+    and temporary folder inside: a later import or participant of the judge's could load
+    the learner's file."""
+    monkeypatch.setenv('ROS2NB_WORKSPACE', str(scratch.workspace))
+    monkeypatch.setattr(ws_module, '_current', None)
+    course.catch_up(3)  # the workspace as notebook 02 leaves it
+    submitted = nbformat.read(SOLUTION[NB02], as_version=4)
+    next(c for c in submitted.cells if 'def package_dependencies' in c.source).source = \
+        PLANTING_READER
+    results, problem = judge_notebook(scratch, NB02, submitted, Settings(120, 600, True),
+                                      scratch.snapshot(NB02))
+    assert problem is None and results and all(r.get('passed') for r in results.values()), \
+        results
+    folder = scratch.top / f'judge-{NB02}'
+    planted = {p.relative_to(folder).parts[0] for p in folder.rglob('*') if p.name in PLANTED}
+    assert planted == {'subjects'}, f'a subject wrote files where its judge reads: {planted}'

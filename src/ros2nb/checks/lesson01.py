@@ -11,7 +11,7 @@ from typing import Any
 
 from ..errors import CheckFailed
 from .answers import answer_results, decoded, type_name_of
-from .base import AnswerRef, call_learner, passed
+from .base import AnswerRef, call_learner, current_judge, passed
 
 
 def check_expanded_path(make_path: Any, *, ends_with: str) -> None:
@@ -23,18 +23,19 @@ def check_expanded_path(make_path: Any, *, ends_with: str) -> None:
     :param ends_with: how the path must end, e.g. ``'Documents/ROS2_and_RL_Tutorials'``.
     :raises CheckFailed: e.g. for the tutorial's ``/Documents/...`` (no ``~``).
     """
-    if isinstance(make_path, AnswerRef):
+    if isinstance(make_path, AnswerRef):  # the learner's home: their subject's
         path = decoded(answer_results(make_path, [[]])[0], f'{make_path.name}()')
+        home = Path(current_judge().subject_env()['HOME'])
     else:
-        path = call_learner(make_path)
+        path, home = call_learner(make_path), Path.home()
     if not isinstance(path, Path):
         raise CheckFailed(f'{make_path.__name__}() returned {type_name_of(path)} {path!r}; return '
                           'a pathlib.Path.')
     if '~' in str(path):
         raise CheckFailed(f'{path} still contains "~": Python does not expand it, call '
                           '.expanduser().')
-    if Path.home() not in path.parents:
-        raise CheckFailed(f'{path} is not inside your home folder {Path.home()}: a path that '
+    if home not in path.parents:
+        raise CheckFailed(f'{path} is not inside your home folder {home}: a path that '
                           'starts with "/" starts at the root of the disk.')
     if not str(path).endswith(ends_with):
         raise CheckFailed(f'{path} should end with {ends_with}.')

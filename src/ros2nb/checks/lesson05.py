@@ -219,8 +219,9 @@ def _package_runs(judge: Judge) -> str:
             argvs.append([str(find_executable(course.PACKAGE, executable, env))])
         except Ros2nbError as error:
             raise CheckFailed(f'ros2 run {course.PACKAGE} {executable}: {error}') from None
-    env.update({k: v for k, v in judge.subject_env().items()  # the judge's domain and transports
-                if k.startswith(('ROS_', 'RCUTILS', 'FASTDDS', 'PYTHONUNBUFFERED'))})
+    env.update({k: v for k, v in judge.subject_env().items()  # the judge's domain and transports,
+                if k.startswith(('ROS_', 'RCUTILS', 'FASTDDS', 'PYTHONUNBUFFERED'))  # the
+                or k in ('HOME', 'TMPDIR')})  # subjects' home and temporary folder
     observer = judge.observer
     mark = len(observer.logs)
     started = [judge.start(argv, cwd=ws, env=env) for argv in argvs]

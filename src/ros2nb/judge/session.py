@@ -21,7 +21,8 @@ from ..checks.nodes import parts_verdict
 from ..errors import CheckFailed
 from ..processes import kill_process_group
 from .observer import Observer
-from .subjects import Output, SubjectHung, SubjectProcess, subject_env, subject_prefix
+from .subjects import (Output, SubjectHung, SubjectProcess, subject_env, subject_prefix,
+                       subjects_folder)
 
 
 class Session:
@@ -29,7 +30,9 @@ class Session:
 
     def __init__(self, workspace: Path) -> None:
         self.workspace = workspace
-        self.scratch = Path(tempfile.mkdtemp(prefix='ros2nb-judge-'))
+        shared = subjects_folder()
+        self.scratch = Path(tempfile.mkdtemp(prefix='ros2nb-judge-',
+                                             dir=shared / 'tmp' if shared else None))
         self._observer: Optional[Observer] = None
         self._subjects: dict[tuple, SubjectProcess] = {}
         self._probe: Any = None

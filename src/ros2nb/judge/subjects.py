@@ -25,6 +25,12 @@ from ..processes import Patience, kill_process_group, stop_process_group
 
 #: JSON list put in front of every subject's command (the grader's sandbox).
 SUBJECT_PREFIX_ENV = 'ROS2NB_SUBJECT_PREFIX'
+#: The folder the subjects may write (while grading, the only one): their home
+#: (``home/``), their temporary files (``tmp/``), and what the session shares with them
+#: (builds, bags, files it feeds to the learner's functions).  The judge's own cwd, home
+#: and temporary files stay out of their reach.  Unset (outside grading), subjects share
+#: the judge's home and the session uses a temporary folder.
+SUBJECTS_FOLDER_ENV = 'ROS2NB_SUBJECTS_FOLDER'
 #: Seconds a subject may take to answer one command before it counts as hanging: CPU
 #: seconds while it works, wall-clock seconds while it waits (ros2nb.processes.Patience).
 REPLY_TIMEOUT_S = 30.0
@@ -40,9 +46,27 @@ def subject_prefix() -> list[str]:
     return json.loads(value) if value else []
 
 
+def subjects_folder() -> Optional[Path]:
+    """The folder the judge's subjects may write (:data:`SUBJECTS_FOLDER_ENV`), if one is set."""
+    value = os.environ.get(SUBJECTS_FOLDER_ENV)
+    return Path(value) if value else None
+
+
 def subject_env(extra: Optional[dict[str, str]] = None) -> dict[str, str]:
-    """The environment of a subject: the judge's domain, field checks on, plain logs."""
-    env = {k: v for k, v in os.environ.items() if k not in (IN_JUDGE_ENV, SUBJECT_PREFIX_ENV)}
+    """The environment of a subject: the judge's domain, field checks on, plain logs.
+
+    With a :func:`subjects_folder`, the subject's ``HOME`` is its ``home/`` (every variable
+    the judge has under its own home moves there too: ROS's logs, IPython's and Jupyter's
+    folders) and its ``TMPDIR`` is its ``tmp/``.
+    """
+    env = {k: v for k, v in os.environ.items()
+           if k not in (IN_JUDGE_ENV, SUBJECT_PREFIX_ENV, SUBJECTS_FOLDER_ENV)}
+    folder, own_home = subjects_folder(), os.environ.get('HOME', '')
+    if folder is not None:
+        for name, value in env.items():
+            if own_home and (value == own_home or value.startswith(own_home + os.sep)):
+                env[name] = str(folder / 'home') + value[len(own_home):]
+        env['HOME'], env['TMPDIR'] = str(folder / 'home'), str(folder / 'tmp')
     env.update({'ROS_DOMAIN_ID': str(domains.domain_id()), 'PYTHONUNBUFFERED': '1',
                 'ROS_PYTHON_CHECK_FIELDS': '1', 'RCUTILS_COLORIZED_OUTPUT': '0',
                 'RCUTILS_CONSOLE_OUTPUT_FORMAT': '[{severity}] [{name}]: {message}'})

@@ -18,6 +18,8 @@ from typing import Optional
 
 import nbformat
 
+from ros2nb.judge.subjects import SUBJECTS_FOLDER_ENV
+
 from ..paths import ROOT, SOLUTIONS
 from . import sandbox
 from .scratch import Scratch, sandbox_env
@@ -39,20 +41,23 @@ def judge_notebook(scratch: Scratch, notebook: str, submitted: nbformat.Notebook
     (given / 'submission.ipynb').write_text(nbformat.writes(submitted))
     for path in (source, given / 'submission.ipynb'):
         path.chmod(0o644)
-    home = folder / 'home'
-    home.mkdir()
-    tmp = folder / 'tmp'
-    tmp.mkdir()
+    # The judge's own files (home, temporary files) and the subjects' are apart: a subject
+    # may write only under subjects/, so nothing the judge later loads, imports or reads as
+    # its own (its cwd is `given`, sys.path[0] of `python -m`; its home) is the learner's.
+    own, subjects = folder / 'judge', folder / 'subjects'
+    for part in (own / 'home', own / 'tmp', subjects / 'home', subjects / 'tmp'):
+        part.mkdir(parents=True)
     argv = [sys.executable, '-m', 'ros2nb.judge', 'grade', str(source),
             str(given / 'submission.ipynb')]
-    env = sandbox_env(home, ROS2NB_WORKSPACE=str(workspace), ROS2NB_JUDGE='1', TMPDIR=str(tmp))
+    env = sandbox_env(own / 'home', ROS2NB_WORKSPACE=str(workspace), ROS2NB_JUDGE='1',
+                      TMPDIR=str(own / 'tmp'), **{SUBJECTS_FOLDER_ENV: str(subjects)})
     limits = sandbox.Limits(wall_s=JUDGE_TIMEOUT_S)
     if settings.sandboxed:
         env['FASTDDS_BUILTIN_TRANSPORTS'] = 'UDPv4'  # judge and subjects: own /dev/shm each
         env['ROS2NB_SUBJECT_PREFIX'] = json.dumps(sandbox.inner_prefix(  # the course may be
-            readable=[workspace, ROOT / 'src'], writable=[folder],  # under /tmp too
-            hidden=[ROOT / 'src' / 'ros2nb' / 'reference']))
-        box = sandbox.Sandbox(writable=[folder], env=env, cwd=folder, nested=True,
+            readable=[workspace, ROOT / 'src'], writable=[subjects],  # under /tmp too
+            hidden=[ROOT / 'src' / 'ros2nb' / 'reference', own]))
+        box = sandbox.Sandbox(writable=[folder], env=env, cwd=given, nested=True,
                               readable=[ROOT / 'src', workspace, given],
                               hidden=[ROOT / 'src' / 'ros2nb' / 'reference'])
         try:
@@ -64,7 +69,7 @@ def judge_notebook(scratch: Scratch, notebook: str, submitted: nbformat.Notebook
             result.timed_out
     else:
         try:
-            done = subprocess.run(argv, env={**os.environ, **env}, cwd=folder, text=True,
+            done = subprocess.run(argv, env={**os.environ, **env}, cwd=given, text=True,
                                   capture_output=True, timeout=JUDGE_TIMEOUT_S)
             out, err, code, timed_out = done.stdout, done.stderr, done.returncode, False
         except subprocess.TimeoutExpired:

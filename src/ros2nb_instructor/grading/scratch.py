@@ -92,7 +92,7 @@ class Scratch:
         return target
 
     def judge_folders(self, notebook: str) -> tuple[Path, Path]:
-        """A fresh judge folder (writable by the judge and its subjects) and its inputs."""
+        """A fresh folder of the judge's inputs (read-only inside), and its writable folder."""
         given = self.top / f'judge-in-{notebook}'
         given.mkdir()
         given.chmod(0o755)  # the judge's sandbox user reads the given files
