@@ -10,7 +10,7 @@ import os
 import nbformat
 import pytest
 
-from grading_samples import NB01, NB02, SOLUTION
+from grading_samples import NB01, NB02, NB05, SOLUTION
 
 from ros2nb import course
 from ros2nb.terminal import workspace as ws_module
@@ -178,3 +178,46 @@ def test_a_subject_writes_nowhere_its_judge_reads(scratch, monkeypatch):
     folder = scratch.top / f'judge-{NB02}'
     planted = {p.relative_to(folder).parts[0] for p in folder.rglob('*') if p.name in PLANTED}
     assert planted == {'subjects'}, f'a subject wrote files where its judge reads: {planted}'
+
+
+#: A hook the learner's package declares (colcon.pkg) and installs: colcon has
+#: install/setup.bash source it.  It notes that it ran, and every judge process in sight.
+PLANTED_HOOK = '''\
+touch "$HOME/hook-ran"
+for proc in /proc/[0-9]*; do
+    if tr '\\0' ' ' < "$proc/cmdline" 2>/dev/null | grep -q 'ros2nb[.]judge'; then
+        echo "$proc" >> "$HOME/saw-the-judge"
+    fi
+done
+'''
+
+
+@pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))
+@pytest.mark.timeout(300)
+def test_a_learners_build_scripts_never_run_in_the_judge(scratch, monkeypatch):
+    """install/setup.bash and the hooks it sources were written by a build that ran the
+    learner's setup.py: the judge has a subject source them and reads the environment
+    that gives, as data.  Before, the judge sourced them itself, so a hook of the
+    learner's ran beside the judge, in sight of its processes (and their stdout, where the
+    verdict goes)."""
+    monkeypatch.setenv('ROS2NB_WORKSPACE', str(scratch.workspace))
+    monkeypatch.setattr(ws_module, '_current', None)
+    course.catch_up(8)  # the package as notebook 05 leaves it (06 and 07 add no step)
+    package = scratch.workspace / 'src' / course.PACKAGE
+    (package / 'colcon.pkg').write_text(json.dumps(
+        {'hooks': [f'share/{course.PACKAGE}/hook/planted.sh']}))
+    (package / 'planted.sh').write_text(PLANTED_HOOK)
+    setup = package / 'setup.py'
+    setup.write_text(setup.read_text().replace(
+        '    data_files=[\n', f"    data_files=[\n        ('share/{course.PACKAGE}/hook', "
+                             "['planted.sh']),\n", 1))
+    submitted = nbformat.read(SOLUTION[NB05], as_version=4)
+    results, problem = judge_notebook(scratch, NB05, submitted, Settings(120, 600, True),
+                                      scratch.snapshot(NB05))
+    assert problem is None and results and all(r.get('passed') for r in results.values()), \
+        results
+    folder = scratch.top / f'judge-{NB05}'
+    ran = [p.relative_to(folder).parts[0] for p in folder.rglob('hook-ran')]
+    saw = [p.read_text().split() for p in folder.rglob('saw-the-judge')]
+    assert (ran, saw) == (['subjects'], []), \
+        f'a hook of the learner\'s ran with the home of {ran}, in sight of the judge: {saw}'

@@ -9,8 +9,10 @@ from __future__ import annotations
 
 import ast
 import configparser
+import json
 import shutil
 import subprocess
+import sys
 from hashlib import sha256
 from importlib.metadata import EntryPoint
 from pathlib import Path
@@ -19,7 +21,7 @@ from typing import Any, Optional
 from .. import course
 from ..errors import CheckFailed, Ros2nbError
 from ..processes import interrupt, kill_process_group
-from ..terminal.colcon import build_cause, source_workspace, venv_tool
+from ..terminal.colcon import build_cause, venv_tool
 from ..terminal.run import find_executable
 from .base import ARRIVAL_TIMEOUT_S, Judge, judged
 from .mains import EXIT_AFTER_CTRL_C_S, last_line
@@ -210,9 +212,33 @@ def check_setup_cfg() -> None:
     judged('check_setup_cfg', _setup_cfg)
 
 
+#: What a subject runs in a built workspace: the environment ``source install/setup.bash``
+#: gives, printed as one JSON line.
+SOURCED_ENV = ('source install/setup.bash >/dev/null 2>&1 || exit 3; exec "$0" -c '
+               '"import json, os; print(json.dumps(dict(os.environ)))"')
+
+
+def _sourced(judge: Judge, ws: Path) -> dict[str, str]:
+    """The environment ``source install/setup.bash`` gives in ``ws``, worked out in a subject.
+
+    colcon wrote those scripts, and the hooks they source, in a build that ran the
+    learner's setup.py (a package may declare hooks of its own): the judge never runs them
+    itself, it reads what they gave as data.
+    """
+    code, output = judge.run(['bash', '-c', SOURCED_ENV, sys.executable], seconds=60, cwd=ws)
+    try:
+        env = json.loads(output.splitlines()[-1]) if code == 0 else None
+    except (IndexError, ValueError):
+        env = None
+    if not isinstance(env, dict) or not all(isinstance(v, str) for v in env.values()):
+        raise CheckFailed(f'source install/setup.bash failed in the build of your package '
+                          f'(exit code {code}): {last_line(output)}')
+    return env
+
+
 def _package_runs(judge: Judge) -> str:
     ws = _built(judge)
-    env = source_workspace(ws)
+    env = _sourced(judge, ws)
     argvs = []
     for executable in (course.PUBLISHER_EXECUTABLE, course.SUBSCRIBER_EXECUTABLE):
         try:
