@@ -579,8 +579,12 @@ def test_the_stop_button_while_a_pause_waits_leaves_no_hang(ros):
     assert wait_until(ros._paused.is_set), 'the background thread never paused'
 
     done = threading.Event()
-    again = threading.Thread(target=lambda: (ros.exclusive().__enter__(), ros._unpause(),
-                                             done.set()), daemon=True)
-    again.start()
+
+    def pause_again() -> None:  # a daemon thread: if it hangs, the test still ends
+        with ros.exclusive():
+            pass
+        done.set()
+
+    threading.Thread(target=pause_again, daemon=True).start()
     assert wait_until(done.is_set), 'the next pause waited forever: the kernel would hang'
     ros2nb.stop()
