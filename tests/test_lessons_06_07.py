@@ -159,3 +159,45 @@ def test_a_node_of_the_same_name_in_another_program_hides_nothing(session):
         decoy.stdin.close()
         decoy.wait(30)
         session.drop(('file', PLOT))
+
+
+#: The counting monitor's callback does nothing; at import, the file finds the subject's
+#: request loop (as in tests/test_checks_forged.py) and has it report received = 0 for a
+#: new node and the number of readings the subject delivered since.
+FORGED_COUNT = '''
+import sys as _sys
+_frame = _sys._getframe()
+while _frame is not None and 'handlers' not in _frame.f_locals:
+    _frame = _frame.f_back
+_HANDLERS = _frame.f_locals['handlers'] if _frame else {}
+_SUBJECT = _frame.f_locals['subject'] if _frame else None
+
+
+def _forge(_attribute=_HANDLERS.get('attribute'), _asked=[]):
+    def attribute(name):
+        reply = _attribute(name=name)
+        if name == 'received' and 'value' in reply:
+            _asked.append(_SUBJECT.received)
+            reply['value']['value'] = _SUBJECT.received - _asked[0]
+        return reply
+
+    _HANDLERS['attribute'] = attribute
+
+
+if _SUBJECT is not None:
+    _forge()
+'''
+
+
+def test_a_count_reported_by_a_forged_subject(session):
+    """The subject's reply said received == 5 although the callback counts nothing: against
+    the check before it, that passed (checked by hand); the file, read as text, decides."""
+    mutated(session, PROMISES, 'self.received += 1', 'pass')
+    (session.workspace / PROMISES).write_text((session.workspace / PROMISES).read_text()
+                                              + FORGED_COUNT)
+    try:
+        with pytest.raises(CheckFailed, match=r'The subscription calls count, which never adds '
+                                              r'to self.received'):
+            checks.check_counting_monitor()
+    finally:
+        restore(session, PROMISES)

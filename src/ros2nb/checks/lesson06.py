@@ -3,7 +3,8 @@ a worker that stays responsive, and the arguments that make two rooms of one pac
 
 Part of :mod:`ros2nb.checks`.  Every part is in a file of the learner's package
 (``fan_controller.py``, ``promises.py``); the judge runs it in a subject and decides from
-what its own node sees: the ROS graph, ``/fan_command``, the counts the subject reports.
+what its own node sees (the ROS graph, ``/fan_command``) and from the file read as text; the
+counts the subject reports only name a mistake.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ from ..errors import CheckFailed
 from .base import ARRIVAL_TIMEOUT_S, Judge, judged, learner_error
 from .mains import run_main
 from .nodes import new_node, reach
+from .source import ClassSource
 from .verdicts import endpoint_verdict, node_name_verdict
 
 #: Readings the fan check sends (°C): both sides of the High threshold.
@@ -130,15 +132,32 @@ def _counting_monitor(judge: Judge) -> str:
     if count != COUNTED_READINGS:
         raise CheckFailed(f'After {COUNTED_READINGS} readings self.received is {count!r}: add '
                           'one in the callback for every message.')
+    _counting_source_verdict(judge)
     return (f"{course.COUNTING_CLASS}('{name}') is called {name} and counted "
             f'{COUNTED_READINGS} of {COUNTED_READINGS} readings.')
+
+
+def _counting_source_verdict(judge: Judge) -> None:
+    """The subscription's callback adds to ``self.received``, as the file (read as text) says.
+
+    The count is the subject's word, and a subject runs the learner's code, which may
+    rewrite what it reports: the count only names a mistake, the source decides.
+    """
+    source = ClassSource.read(judge.workspace / course.PROMISES_FILE, course.COUNTING_CLASS)
+    callbacks = source.callbacks('create_subscription', 2) if source else []
+    if source is None or not any(source.reaches_assignment(c, 'received') for c in callbacks):
+        called = ', '.join(sorted(set(callbacks))) or 'nothing'
+        raise CheckFailed(f"The subscription calls {called}, which never adds to "
+                          'self.received: give it a method of the class that does, '
+                          'self.received += 1 (the method itself, without parentheses).')
 
 
 def check_counting_monitor() -> None:
     """Check part 2 of ``promises.py``: a monitor that only counts, named as it is told.
 
     Creates ``CountingMonitor('monitor_7')``, checks its name and subscription in the ROS
-    graph, publishes 5 readings and reads ``received``.
+    graph, publishes 5 readings and reads ``received``, and reads in your file that the
+    subscription's callback adds to ``self.received``.
 
     Introduced in ``06-five-promises.ipynb``.
 

@@ -164,6 +164,27 @@ class ClassSource:
         """True when ``method`` calls ``something.A(...)`` for an ``A`` in ``attrs``, itself or
         through ``self.m()`` calls of the class."""
         attrs = {attrs} if isinstance(attrs, str) else set(attrs)
+        return self._reaches(method, lambda node: isinstance(node, ast.Call) and isinstance(
+            node.func, ast.Attribute) and node.func.attr in attrs)
+
+    def reaches_assignment(self, method: str, attribute: str) -> bool:
+        """True when ``method`` assigns ``self.<attribute>`` (``=``, ``+=``, ``setattr``),
+        itself or through ``self.m()`` calls of the class."""
+        target = f'self.{attribute}'
+
+        def assigns(node: ast.AST) -> bool:
+            if isinstance(node, (ast.Assign, ast.AugAssign, ast.AnnAssign)):
+                targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+                return any(ast.unparse(t) == target for t in targets)
+            return isinstance(node, ast.Call) and ast.unparse(node.func) == 'setattr' \
+                and len(node.args) > 1 and ast.unparse(node.args[0]) == 'self' \
+                and ast.unparse(node.args[1]) in (repr(attribute), f'"{attribute}"')
+
+        return self._reaches(method, assigns)
+
+    def _reaches(self, method: str, hit: Any) -> bool:
+        """True when ``hit(node)`` holds for a node of ``method`` or of a method it calls as
+        ``self.m()``, however deep."""
         seen: set[str] = set()
         todo = [method]
         while todo:
@@ -172,11 +193,11 @@ class ClassSource:
                 continue
             seen.add(function.name)
             for node in ast.walk(function):
-                if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute):
-                    if node.func.attr in attrs:
-                        return True
-                    if ast.unparse(node.func.value) == 'self':
-                        todo.append(node.func.attr)
+                if hit(node):
+                    return True
+                if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) \
+                        and ast.unparse(node.func.value) == 'self':
+                    todo.append(node.func.attr)
         return False
 
 
