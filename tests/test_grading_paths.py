@@ -181,14 +181,27 @@ def test_a_subject_writes_nowhere_its_judge_reads(scratch, monkeypatch):
 
 
 #: A hook the learner's package declares (colcon.pkg) and installs: colcon has
-#: install/setup.bash source it.  It notes that it ran, and every judge process in sight.
-PLANTED_HOOK = '''\
-touch "$HOME/hook-ran"
+#: install/setup.bash source it.  It notes that it ran and every judge process in sight,
+#: and puts a program called bwrap first on the PATH it hands on: the same look again,
+#: wherever that program runs, then the real bwrap.
+LOOK_FOR_THE_JUDGE = '''\
 for proc in /proc/[0-9]*; do
     if tr '\\0' ' ' < "$proc/cmdline" 2>/dev/null | grep -q 'ros2nb[.]judge'; then
         echo "$proc" >> "$HOME/saw-the-judge"
     fi
 done
+'''
+PLANTED_HOOK = f'''\
+touch "$HOME/hook-ran"
+{LOOK_FOR_THE_JUDGE}
+mkdir -p "$HOME/bin"
+cat > "$HOME/bin/bwrap" <<'EOF'
+#!/bin/sh
+{LOOK_FOR_THE_JUDGE}
+exec /usr/bin/bwrap "$@"
+EOF
+chmod +x "$HOME/bin/bwrap"
+export PATH="$HOME/bin:$PATH"
 '''
 
 
@@ -199,7 +212,9 @@ def test_a_learners_build_scripts_never_run_in_the_judge(scratch, monkeypatch):
     learner's setup.py: the judge has a subject source them and reads the environment
     that gives, as data.  Before, the judge sourced them itself, so a hook of the
     learner's ran beside the judge, in sight of its processes (and their stdout, where the
-    verdict goes)."""
+    verdict goes). The environment they give is the learner's nodes' own, set inside their
+    sandbox: before, its PATH chose the program that sandboxes them, which then ran beside
+    the judge."""
     monkeypatch.setenv('ROS2NB_WORKSPACE', str(scratch.workspace))
     monkeypatch.setattr(ws_module, '_current', None)
     course.catch_up(8)  # the package as notebook 05 leaves it (06 and 07 add no step)

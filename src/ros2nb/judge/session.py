@@ -6,8 +6,10 @@ Part of the judge (:mod:`ros2nb.judge`).  The checks get the session as their ju
 
 from __future__ import annotations
 
+import json
 import shutil
 import subprocess
+import sys
 import tempfile
 from pathlib import Path
 from typing import Any, Callable, Optional
@@ -23,6 +25,12 @@ from ..processes import kill_process_group
 from .observer import Observer
 from .subjects import (Output, SubjectHung, SubjectProcess, subject_env, subject_prefix,
                        subjects_folder)
+
+
+#: ``python -I -c SET_ENV_AND_EXEC ENV_JSON PROGRAM ARGS...``: PROGRAM (looked up on the
+#: PATH of ENV) with exactly that environment, from inside a subject's sandbox.
+SET_ENV_AND_EXEC = ('import json, os, sys; env = json.loads(sys.argv[1]); '
+                    'os.execvpe(sys.argv[2], sys.argv[2:], env)')
 
 
 class Session:
@@ -106,9 +114,17 @@ class Session:
               env: Optional[dict[str, str]] = None) -> tuple[subprocess.Popen, Output]:
         """Start a program of the learner's (sandboxed while grading) in a session of its own.
 
+        :param env: the program's whole environment (default :func:`subject_env`).  While
+            grading it is set inside the sandbox, never on the sandbox's own command: an
+            environment a learner's build gave (``PATH``, ``LD_PRELOAD``) must not choose or
+            load the program that sandboxes theirs.
         :return: the process, and its output (stdout and stderr), collected as it comes.
         """
-        proc = subprocess.Popen([*subject_prefix(), *argv], cwd=cwd, env=env or subject_env(),
+        prefix = subject_prefix()
+        if prefix and env is not None:
+            argv = [sys.executable, '-I', '-c', SET_ENV_AND_EXEC, json.dumps(env), *argv]
+            env = None
+        proc = subprocess.Popen([*prefix, *argv], cwd=cwd, env=env or subject_env(),
                                 text=True, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                                 stderr=subprocess.STDOUT, start_new_session=True)
         return proc, Output(proc.stdout)

@@ -56,7 +56,7 @@ def judge_notebook(scratch: Scratch, notebook: str, submitted: nbformat.Notebook
         env['FASTDDS_BUILTIN_TRANSPORTS'] = 'UDPv4'  # judge and subjects: own /dev/shm each
         env['ROS2NB_SUBJECT_PREFIX'] = json.dumps(sandbox.inner_prefix(  # the course may be
             readable=[workspace, ROOT / 'src'], writable=[subjects],  # under /tmp too
-            hidden=[ROOT / 'src' / 'ros2nb' / 'reference', own]))
+            hidden=[ROOT / 'src' / 'ros2nb' / 'reference', own, given]))
         box = sandbox.Sandbox(writable=[folder], env=env, cwd=given, nested=True,
                               readable=[ROOT / 'src', workspace, given],
                               hidden=[ROOT / 'src' / 'ros2nb' / 'reference'])
