@@ -7,6 +7,7 @@ so every failure below is the mistake's, and the test could not pass with a chec
 says nothing.
 """
 
+import contextlib
 import json
 import re
 import shutil
@@ -339,3 +340,33 @@ def test_checks_say_when_ros_was_shut_down():
     from rclpy.node import Node
     with pytest.raises(CheckFailed, match=r'was rclpy.shutdown\(\) called\?'):
         checks.check_endpoint(Node, 'subscription', '/chatter', 'std_msgs/msg/String')
+
+
+def test_links_out_of_the_workspace_are_never_followed(session, tmp_path):
+    """A workspace file may be a link to a file a subject can rewrite, or that only the
+    judge may read. The checks that read the learner's source as text refuse such a link
+    (before, they read whatever it pointed to); a build copies it as a link (before, it
+    copied the target's text where the learner's setup.py runs)."""
+    outside = tmp_path / 'elsewhere.py'
+    outside.write_text(course.reference_source(Path(PUB).name))
+    (session.workspace / PUB).unlink()
+    (session.workspace / PUB).symlink_to(outside)
+    try:
+        fails(checks.check_sensor_callback, r'temperature_publisher.py is a link to .*, outside '
+                                            r'your workspace: the grader reads your files in the '
+                                            r'workspace only')
+    finally:
+        (session.workspace / PUB).unlink()
+        restore(session, PUB)
+    secret = tmp_path / 'judge-only.txt'
+    secret.write_text('what only the judge may read\n')
+    link = session.workspace / 'src' / course.PACKAGE / 'notes.txt'
+    link.symlink_to(secret)
+    try:
+        with contextlib.suppress(CheckFailed):  # the build is what counts here, not its entries
+            checks.check_entry_points()
+        copies = list(session.scratch.glob(f'build-*/src/{course.PACKAGE}/notes.txt'))
+        assert copies and all(c.is_symlink() for c in copies), \
+            [c.read_text() for c in copies if not c.is_symlink()]
+    finally:
+        link.unlink()

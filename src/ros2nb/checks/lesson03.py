@@ -40,7 +40,7 @@ def _sensor_verdict(judge: Judge, info: dict, found: list) -> None:
     """
     node_name_verdict(info, course.SENSOR_NODE)
     endpoint_verdict(info['name'], found, 'publisher', '/' + course.TOPIC, course.MESSAGE_TYPE)
-    source = ClassSource.read(judge.workspace / course.PUBLISHER_FILE, course.SENSOR_CLASS)
+    source = ClassSource.read(judge.workspace, course.PUBLISHER_FILE, course.SENSOR_CLASS)
     if source is None:  # the subject imported another file than the judge can read
         raise CheckFailed(f'The grader cannot read the class {course.SENSOR_CLASS} in '
                           f'{course.PUBLISHER_FILE}: run the %%part cells that write it again.')
@@ -89,7 +89,7 @@ def _publishes_verdict(judge: Judge) -> None:
     The judge hears readings, not which code sent them, and what a subject says about that
     counts for nothing: the method the timer calls must publish.
     """
-    source = ClassSource.read(judge.workspace / course.PUBLISHER_FILE, course.SENSOR_CLASS)
+    source = ClassSource.read(judge.workspace, course.PUBLISHER_FILE, course.SENSOR_CLASS)
     if source is None or not source.reaches_call('publish_temperature', 'publish'):
         raise CheckFailed('publish_temperature never publishes, yet readings arrived from '
                           'elsewhere: put the new reading into a Float32 message and publish it '

@@ -105,7 +105,7 @@ def _callback_source_verdict(judge: Judge) -> None:
     subject's word about it counts for nothing: the subscription must call
     ``self.temperature_callback`` and that method must log.
     """
-    source = ClassSource.read(judge.workspace / course.SUBSCRIBER_FILE, course.MONITOR_CLASS)
+    source = ClassSource.read(judge.workspace, course.SUBSCRIBER_FILE, course.MONITOR_CLASS)
     callbacks = source.callbacks('create_subscription', 2) if source else []
     if callbacks and set(callbacks) != {'temperature_callback'}:
         raise CheckFailed(f'The subscription calls {", ".join(sorted(set(callbacks)))}; it must '

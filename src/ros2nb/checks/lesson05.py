@@ -10,6 +10,7 @@ from __future__ import annotations
 import ast
 import configparser
 import json
+import os
 import shutil
 import subprocess
 import sys
@@ -108,8 +109,12 @@ def _built(judge: Judge) -> Path:
     :raises CheckFailed: with the build's cause in one line.
     """
     source = _package_source(judge)
-    files = sorted(p for p in source.rglob('*') if p.is_file() and '__pycache__' not in p.parts)
-    digest = sha256(b''.join(p.relative_to(source).as_posix().encode() + p.read_bytes()
+    # Links are copied as links, never followed: a link to a file only the judge may read
+    # would otherwise put that file's text in the build, where the learner's setup.py runs.
+    files = sorted(p for p in source.rglob('*') if '__pycache__' not in p.parts
+                   and (p.is_symlink() or p.is_file()))
+    digest = sha256(b''.join(p.relative_to(source).as_posix().encode()
+                             + (os.readlink(p).encode() if p.is_symlink() else p.read_bytes())
                              for p in files)).hexdigest()[:12]
     if digest in judge.builds:
         return judge.builds[digest]
@@ -120,7 +125,8 @@ def _built(judge: Judge) -> Path:
     _entry_point_syntax_verdict(source / 'setup.py')
     ws = judge.scratch / f'build-{digest}'
     package = ws / 'src' / course.PACKAGE
-    shutil.copytree(source, package, ignore=shutil.ignore_patterns('__pycache__', '*.egg-info'))
+    shutil.copytree(source, package, symlinks=True,
+                    ignore=shutil.ignore_patterns('__pycache__', '*.egg-info'))
     for module, text in ((course.PUBLISHER_EXECUTABLE, STAND_IN_PUBLISHER),
                          (course.SUBSCRIBER_EXECUTABLE, STAND_IN_SUBSCRIBER)):
         (package / course.PACKAGE / f'{module}.py').write_text(text)

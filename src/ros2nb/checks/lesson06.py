@@ -143,7 +143,7 @@ def _counting_source_verdict(judge: Judge) -> None:
     The count is the subject's word, and a subject runs the learner's code, which may
     rewrite what it reports: the count only names a mistake, the source decides.
     """
-    source = ClassSource.read(judge.workspace / course.PROMISES_FILE, course.COUNTING_CLASS)
+    source = ClassSource.read(judge.workspace, course.PROMISES_FILE, course.COUNTING_CLASS)
     callbacks = source.callbacks('create_subscription', 2) if source else []
     if source is None or not any(source.reaches_assignment(c, 'received') for c in callbacks):
         called = ', '.join(sorted(set(callbacks))) or 'nothing'

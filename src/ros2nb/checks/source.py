@@ -14,6 +14,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Optional
 
+from ..errors import CheckFailed
+
 #: What :meth:`ClassSource.value` returns for an expression it cannot work out as text.
 UNKNOWN: Any = object()
 #: How many names deep :meth:`ClassSource.value` follows ``A = B`` (a guard against loops).
@@ -58,9 +60,19 @@ class ClassSource:
         self.module, self.cls = module, cls
 
     @classmethod
-    def read(cls, path: Path, name: str) -> Optional['ClassSource']:
-        """The class ``name`` of ``path``; None when the file cannot be read or parsed, or
-        holds no such class (the subject's import says why, in the learner's words)."""
+    def read(cls, workspace: Path, relative: str, name: str) -> Optional['ClassSource']:
+        """The class ``name`` of the file ``relative`` to ``workspace``; None when the file
+        cannot be read or parsed, or holds no such class (the subject's import says why, in
+        the learner's words).
+
+        :raises CheckFailed: when the file is a link to outside the workspace (the judge
+            reads what the learner wrote there, never a file a subject may rewrite).
+        """
+        path = workspace / relative
+        if not path.resolve().is_relative_to(workspace.resolve()):
+            raise CheckFailed(f'{relative} is a link to {path.resolve()}, outside your '
+                              'workspace: the grader reads your files in the workspace only; '
+                              'put the file itself there.')
         try:
             module = ast.parse(path.read_text())
         except (OSError, SyntaxError, ValueError, UnicodeDecodeError):
