@@ -133,3 +133,47 @@ def test_a_mistake_gets_one_line(session, path, name, label, old, new, pattern):
         run_check(session, path, name, answer.replace(old, new, 1))
     message = str(caught.value)
     assert '\n' not in message and re.search(pattern, message), message
+
+
+#: A volatile profile (wrong: a late joiner gets none), and a thread the answer cell starts:
+#: it watches the graph for the check's trial topic and, once the late subscription has
+#: matched it, publishes the five thresholds the check wants to see.
+INJECTOR = '''
+import threading as _threading
+import time as _time
+
+import rclpy as _rclpy
+from rclpy.context import Context as _Context
+from std_msgs.msg import Int32 as _Int32
+
+
+def _inject():
+    context = _Context()
+    _rclpy.init(context=context)
+    node = _rclpy.create_node('helper', context=context)
+    done = set()
+    while True:
+        for topic, _types in node.get_topic_names_and_types():
+            if topic.startswith('/ros2nb_qos_trial_') and topic not in done:
+                done.add(topic)
+                publisher = node.create_publisher(_Int32, topic, QoSProfile(depth=5))
+                while publisher.get_subscription_count() == 0:
+                    _time.sleep(0.005)
+                for number in range(15, 20):
+                    publisher.publish(_Int32(data=number))
+        _time.sleep(0.005)
+
+
+_threading.Thread(target=_inject, daemon=True).start()
+'''
+
+
+def test_a_thread_of_the_answer_cell_cannot_feed_the_trial(session):
+    """The trials run on the judge's domain: a thread the learner's answer cell started could
+    publish on the trial's topic (found in the graph) what the check wants to see. Before,
+    the subject lived on through the trial, and a volatile profile passed as latched
+    (checked by hand); now the judge ends every subject once it has the profile."""
+    answer = ANSWERS['latched_thresholds_profile'].replace(
+        LATCHED, 'durability=DurabilityPolicy.VOLATILE)') + INJECTOR
+    with pytest.raises(CheckFailed, match=r'got none: make durability TRANSIENT_LOCAL'):
+        run_check(session, 'judge', 'latched_thresholds_profile', answer)

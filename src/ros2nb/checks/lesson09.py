@@ -17,7 +17,7 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, qos_profile_s
 from .. import qos
 from ..errors import CheckFailed
 from .answers import answer_results, decoded, type_name_of
-from .base import AnswerRef, call_learner, passed
+from .base import AnswerRef, call_learner, current_judge, passed
 
 #: The burst of part 1 and what a display of the newest reading must be left with.
 BURST = 30
@@ -38,6 +38,9 @@ def learner_profile(make_profile: Any) -> QoSProfile:
     """
     if isinstance(make_profile, AnswerRef):
         profile = decoded(answer_results(make_profile, [[]])[0], f'{make_profile.name}()')
+        # The trials run on the judge's domain: nothing of the learner's (a thread their
+        # answer cell started) may be left to publish on a trial's topic.
+        current_judge().drop_all()
     else:
         profile = call_learner(make_profile)
     if not isinstance(profile, QoSProfile):
