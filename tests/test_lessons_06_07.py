@@ -201,3 +201,15 @@ def test_a_count_reported_by_a_forged_subject(session):
             checks.check_counting_monitor()
     finally:
         restore(session, PROMISES)
+
+
+def test_a_count_through_a_lambda_passes(session, capsys):
+    """The honest twin of the forged count, written another way: the subscription's callback
+    is a lambda that calls the counting method; the file shows it counts, so it passes."""
+    mutated(session, PROMISES, 'Float32, TOPIC, self.count, QUEUE_DEPTH',
+            'Float32, TOPIC, lambda msg: self.count(msg), QUEUE_DEPTH')
+    try:
+        checks.check_counting_monitor()
+    finally:
+        restore(session, PROMISES)
+    assert 'Check passed:' in capsys.readouterr().out

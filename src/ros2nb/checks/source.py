@@ -195,15 +195,19 @@ class ClassSource:
         return self._reaches(method, assigns)
 
     def _reaches(self, method: str, hit: Any) -> bool:
-        """True when ``hit(node)`` holds for a node of ``method`` or of a method it calls as
+        """True when ``hit(node)`` holds for a node of ``method`` (a method's name, or a
+        callback's lambda as :meth:`callbacks` gives it) or of a method it calls as
         ``self.m()``, however deep."""
         seen: set[str] = set()
         todo = [method]
         while todo:
-            function = self.method(todo.pop())
-            if function is None or function.name in seen:
+            name = todo.pop()
+            function: Optional[ast.AST] = self.method(name)
+            if function is None and name.startswith('lambda'):
+                function = ast.parse(name, mode='eval').body
+            if function is None or name in seen:
                 continue
-            seen.add(function.name)
+            seen.add(name)
             for node in ast.walk(function):
                 if hit(node):
                     return True
