@@ -44,6 +44,18 @@ def judge_session(root: Path, notebook: int) -> Iterator[Session]:
         ws_module._current = None
 
 
+#: A forging learner's module code that finds the subject's request loop from the learner's import and keeps
+#: its handlers and its Subject (nothing happens when the file runs as a program).
+FIND_SUBJECT = '''
+import sys as _sys
+_frame = _sys._getframe()
+while _frame is not None and 'handlers' not in _frame.f_locals:
+    _frame = _frame.f_back
+_HANDLERS = _frame.f_locals['handlers'] if _frame else {}
+_SUBJECT = _frame.f_locals['subject'] if _frame else None
+'''
+
+
 def answer_cells(path: str) -> tuple[str, dict[str, str]]:
     """A notebook's grading-context cell, and each answer cell by the function it defines
     (nbgrader's ``### BEGIN/END SOLUTION`` lines left out)."""

@@ -19,20 +19,10 @@ from ros2nb.checks.base import AnswerRef
 from grading_samples import REWRITING_READER
 from nodes import name_without_endpoints
 from waiting import wait_for
+from judging import FIND_SUBJECT
 from test_checks import PUB, SUB, fails, mutated, restore, session  # noqa: F401 (fixture)
 
 pytestmark = pytest.mark.timeout(300)
-
-#: Module code that finds the subject's request loop from the learner's import and keeps
-#: its handlers and its Subject (nothing happens when the file runs as a program).
-FIND_SUBJECT = '''
-import sys as _sys
-_frame = _sys._getframe()
-while _frame is not None and 'handlers' not in _frame.f_locals:
-    _frame = _frame.f_back
-_HANDLERS = _frame.f_locals['handlers'] if _frame else {}
-_SUBJECT = _frame.f_locals['subject'] if _frame else None
-'''
 
 #: The timer's work done by the request handler: new_node reports a timer of 1 s, and
 #: each ``advance`` calls publish_temperature once per simulated second itself.

@@ -12,7 +12,7 @@ import pytest
 
 from ros2nb import checks, course
 from ros2nb.errors import CheckFailed
-from judging import judge_session
+from judging import FIND_SUBJECT, judge_session
 
 pytestmark = pytest.mark.timeout(300)
 
@@ -162,16 +162,9 @@ def test_a_node_of_the_same_name_in_another_program_hides_nothing(session):
 
 
 #: The counting monitor's callback does nothing; at import, the file finds the subject's
-#: request loop (as in tests/test_checks_forged.py) and has it report received = 0 for a
-#: new node and the number of readings the subject delivered since.
-FORGED_COUNT = '''
-import sys as _sys
-_frame = _sys._getframe()
-while _frame is not None and 'handlers' not in _frame.f_locals:
-    _frame = _frame.f_back
-_HANDLERS = _frame.f_locals['handlers'] if _frame else {}
-_SUBJECT = _frame.f_locals['subject'] if _frame else None
-
+#: request loop and has it report received = 0 for a new node and the number of readings
+#: the subject delivered since.
+FORGED_COUNT = FIND_SUBJECT + '''
 
 def _forge(_attribute=_HANDLERS.get('attribute'), _asked=[]):
     def attribute(name):
