@@ -6,8 +6,8 @@ them).  To find the caller it asks :func:`inspect.getframeinfo` for every frame 
 which also reads a line of source from disk, and resolves each file name with
 :func:`os.path.realpath`: 1.3 ms per log line, and a quarter of the CPU time of notebook
 10's ``record_hour`` (a simulated hour, 7200 log lines: 12.0 CPU-s, 9.1 with this).  The same
-caller is found here with ``context=0`` (no source read; the file name is computed the
-same way) and each file's real path remembered (only used to skip rclpy's own frames,
+caller is found here from each frame's own file name (what ``getframeinfo`` returns for
+it, without its look at the disk) and each file's real path remembered (only used to skip rclpy's own frames,
 whose files do not move).  The messages are unchanged: ``tests/test_runtime.py`` compares
 the caller rclpy's own code finds with this one's.
 """
@@ -15,6 +15,7 @@ the caller rclpy's own code finds with this one's.
 from __future__ import annotations
 
 import functools
+import importlib.machinery
 import inspect
 import os
 from types import FrameType
@@ -30,8 +31,19 @@ def _real_path(filename: str) -> str:
     return os.path.realpath(filename)
 
 
+#: File names of compiled code, which inspect maps back to their source's name.
+_BYTECODE_SUFFIXES = tuple(importlib.machinery.DEBUG_BYTECODE_SUFFIXES
+                           + importlib.machinery.OPTIMIZED_BYTECODE_SUFFIXES)
+
+
 def _file_of(frame: FrameType) -> str:
-    return inspect.getframeinfo(frame, context=0).filename
+    """``inspect.getframeinfo(frame).filename``, without its look at the disk: that is the
+    code's own file name unless it names compiled code (inspect returns the name itself,
+    or None and then the name itself, for every other file)."""
+    name = frame.f_code.co_filename
+    if name.endswith(_BYTECODE_SUFFIXES):
+        return inspect.getframeinfo(frame, context=0).filename
+    return name
 
 
 def find_caller(frame: FrameType) -> FrameType:
