@@ -23,8 +23,8 @@ from ..checks.nodes import parts_verdict
 from ..errors import CheckFailed
 from ..processes import kill_process_group
 from .observer import Observer
-from .subjects import (Output, SubjectHung, SubjectProcess, subject_env, subject_prefix,
-                       subjects_folder)
+from .subjects import (Output, SubjectHung, SubjectProcess, home_and_tmp, subject_env,
+                       subject_prefix, subjects_folder)
 
 
 #: ``python -I -c SET_ENV_AND_EXEC ENV_JSON PROGRAM ARGS...``: PROGRAM (looked up on the
@@ -40,7 +40,7 @@ class Session:
         self.workspace = workspace
         shared = subjects_folder()
         self.scratch = Path(tempfile.mkdtemp(prefix='ros2nb-judge-',
-                                             dir=shared / 'tmp' if shared else None))
+                                             dir=home_and_tmp(shared)[1] if shared else None))
         self._observer: Optional[Observer] = None
         self._subjects: dict[tuple, SubjectProcess] = {}
         self._probe: Any = None

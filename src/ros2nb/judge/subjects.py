@@ -52,6 +52,12 @@ def subjects_folder() -> Optional[Path]:
     return Path(value) if value else None
 
 
+def home_and_tmp(folder: Path) -> tuple[Path, Path]:
+    """The subjects' home and temporary folder in the folder they may write (the grader
+    makes both before the judge starts)."""
+    return folder / 'home', folder / 'tmp'
+
+
 def subject_env(extra: Optional[dict[str, str]] = None) -> dict[str, str]:
     """The environment of a subject: the judge's domain, field checks on, plain logs.
 
@@ -63,10 +69,11 @@ def subject_env(extra: Optional[dict[str, str]] = None) -> dict[str, str]:
            if k not in (IN_JUDGE_ENV, SUBJECT_PREFIX_ENV, SUBJECTS_FOLDER_ENV)}
     folder, own_home = subjects_folder(), os.environ.get('HOME', '')
     if folder is not None:
+        home, tmp = home_and_tmp(folder)
         for name, value in env.items():
             if own_home and (value == own_home or value.startswith(own_home + os.sep)):
-                env[name] = str(folder / 'home') + value[len(own_home):]
-        env['HOME'], env['TMPDIR'] = str(folder / 'home'), str(folder / 'tmp')
+                env[name] = str(home) + value[len(own_home):]
+        env['HOME'], env['TMPDIR'] = str(home), str(tmp)
     env.update({'ROS_DOMAIN_ID': str(domains.domain_id()), 'PYTHONUNBUFFERED': '1',
                 'ROS_PYTHON_CHECK_FIELDS': '1', 'RCUTILS_COLORIZED_OUTPUT': '0',
                 'RCUTILS_CONSOLE_OUTPUT_FORMAT': '[{severity}] [{name}]: {message}'})

@@ -18,7 +18,7 @@ from typing import Optional
 
 import nbformat
 
-from ros2nb.judge.subjects import SUBJECTS_FOLDER_ENV
+from ros2nb.judge.subjects import SUBJECTS_FOLDER_ENV, home_and_tmp
 
 from ..paths import ROOT, SOLUTIONS
 from . import sandbox
@@ -45,7 +45,7 @@ def judge_notebook(scratch: Scratch, notebook: str, submitted: nbformat.Notebook
     # may write only under subjects/, so nothing the judge later loads, imports or reads as
     # its own (its cwd is `given`, sys.path[0] of `python -m`; its home) is the learner's.
     own, subjects = folder / 'judge', folder / 'subjects'
-    for part in (own / 'home', own / 'tmp', subjects / 'home', subjects / 'tmp'):
+    for part in (own / 'home', own / 'tmp', *home_and_tmp(subjects)):
         part.mkdir(parents=True)
     argv = [sys.executable, '-m', 'ros2nb.judge', 'grade', str(source),
             str(given / 'submission.ipynb')]
