@@ -69,8 +69,9 @@ class ClassSource:
             reads what the learner wrote there, never a file a subject may rewrite).
         """
         path = workspace / relative
-        if not path.resolve().is_relative_to(workspace.resolve()):
-            raise CheckFailed(f'{relative} is a link to {path.resolve()}, outside your '
+        target = path.resolve()
+        if not target.is_relative_to(workspace.resolve()):
+            raise CheckFailed(f'{relative} is a link to {target}, outside your '
                               'workspace: the grader reads your files in the workspace only; '
                               'put the file itself there.')
         try:
@@ -202,12 +203,14 @@ class ClassSource:
         todo = [method]
         while todo:
             name = todo.pop()
+            if name in seen:
+                continue
+            seen.add(name)
             function: Optional[ast.AST] = self.method(name)
             if function is None and name.startswith('lambda'):
                 function = ast.parse(name, mode='eval').body
-            if function is None or name in seen:
+            if function is None:
                 continue
-            seen.add(name)
             for node in ast.walk(function):
                 if hit(node):
                     return True
