@@ -95,9 +95,23 @@ class Hub:
         return self.folder / 'home' / learner
 
     def log_tail(self, lines: int = 40) -> str:
-        """Return the end of the hub's log (its servers write there too)."""
+        """Return the end of the hub's log (its servers write there too), without the
+        proxy's entries: once the hub is gone the proxy logs an error per request, and those
+        would fill the tail and hide why the hub went (as when a hub exited 1 at start-up
+        beside two CPU burners and its log tail held only the proxy's errors)."""
         text = self.log.read_text(errors='replace') if self.log.exists() else ''
-        return '\n'.join(text.splitlines()[-lines:])
+        kept, proxy, dropped = [], False, 0
+        for line in text.splitlines():
+            if '[ConfigProxy]' in line:
+                proxy = True
+            elif line.startswith('['):  # the hub's and its servers' own entries: [E 2026-...
+                proxy = False
+            if proxy:
+                dropped += 1
+            else:
+                kept.append(line)
+        note = [f'({dropped} lines of the proxy left out)'] if dropped else []
+        return '\n'.join(kept[-lines:] + note)
 
     def api(self, method: str, path: str, **kwargs) -> requests.Response:
         """Call the Hub's REST API (``/hub/api<path>``) as the test's admin service."""
