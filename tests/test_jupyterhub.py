@@ -193,7 +193,11 @@ def start_hub(folder: Path) -> Hub:
                                    env=hub_environment(folder), stdout=log,
                                    stderr=subprocess.STDOUT, start_new_session=True)
     hub = Hub(url=url, token=token, folder=folder, process=process)
-    wait_for(lambda: answers(hub), HUB_START_S, 'JupyterHub answering through the proxy', hub)
+    try:
+        wait_for(lambda: answers(hub), HUB_START_S, 'JupyterHub answering through the proxy', hub)
+    except BaseException:  # the caller never gets the hub to stop: stop it (and its proxy) here
+        stop_hub(hub)
+        raise
     return hub
 
 
