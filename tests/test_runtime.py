@@ -97,11 +97,21 @@ def test_calls_before_start_say_what_to_do():
 
 
 def test_start_takes_over_after_a_learners_rclpy_init(capsys):
+    class PressStopAtTwo(Sensor):
+        def tick(self):
+            super().tick()
+            if ros2nb.runtime.current_runtime().sim_now_ns == 2 * 10 ** 9:
+                os.kill(os.getpid(), signal.SIGINT)
+
     rclpy.init()  # the wrong fix for "rclpy.init() has not been called"
     try:
-        ros2nb.start(sim_time=True)
+        rt = ros2nb.start(sim_time=True)
         assert 'rclpy.init() had been called in this kernel' in capsys.readouterr().out
-        ros2nb.add(Sensor())
+        ros2nb.add(PressStopAtTwo())
+        ros2nb.spin(5)
+        # rclpy.init() had put in rclpy's own Ctrl+C handler, which shuts every context down:
+        # left in place, the Stop button ended ROS in this kernel with an RCLError
+        assert 'Interrupted after 2.0 of 5' in capsys.readouterr().out and rt.alive
         ros2nb.spin(2)
         assert capsys.readouterr().out.count('Publishing:') == 2
     finally:

@@ -67,7 +67,9 @@ def start(*, domain_id: Optional[int] = None, sim_time: Optional[bool] = None) -
         raise UsageError(f'domain_id must be a whole number from 0 to 232, and 0-101 is safe on '
                          f'Linux (got {domain_id!r}).')
     if rclpy.ok():  # rclpy.init() was called in this kernel: take over cleanly
-        rclpy.try_shutdown()
+        # rclpy.shutdown(), not try_shutdown(): it also takes out rclpy's Ctrl+C handler,
+        # which shuts every context down (the Stop button would then end ROS here)
+        rclpy.shutdown()
         print('rclpy.init() had been called in this kernel; ros2nb shut that down and starts '
               'ROS 2 itself (in a notebook, call ros2nb.start() instead of rclpy.init()).')
     if domain_id is None:
