@@ -304,6 +304,32 @@ def test_a_long_simulated_spin_interrupted_is_one_line_not_its_log_lines(ros):
                                                    '(its log lines are not shown)'), lines[:3]
 
 
+def test_a_callback_left_due_by_the_stop_button_adds_no_line_after_it(ros):
+    # The Stop button lands after a step of /clock made two timers due and before the second
+    # ran. Run later, by the thread that spins between cells, its line (0.3 s later) came
+    # after "Interrupted ..." in the same cell (a learner's Lab showed it). The first timer
+    # presses Stop itself, so the interrupt lands there however busy the machine is.
+    ros.run("import os, signal, time\n"
+            "class Sensor(Node):\n    def __init__(self):\n        super().__init__('slow')\n"
+            "        self.ticks = 0\n"
+            "        self.create_timer(1.0, self.press_stop_at_three)\n"
+            "        self.create_timer(1.0, self.tick)\n\n"
+            "    def press_stop_at_three(self):\n        self.ticks += 1\n"
+            "        if self.ticks == 3:\n            os.kill(os.getpid(), signal.SIGINT)\n\n"
+            "    def tick(self):\n        time.sleep(0.3)\n"
+            "        self.get_logger().info('tick')\n\n"
+            "sensor = ros2nb.add(Sensor())")
+    result = ros.run('_ = ros2nb.spin(10 ** 7)\n'
+                     'from ros2nb.runtime import current_runtime\n'
+                     'waited = time.monotonic()\n'  # until the third tick's line is back
+                     "while current_runtime().log_counts['slow'] < 3 and time.monotonic() - waited < 60:\n"
+                     '    time.sleep(0.01)\n')
+    lines = result['stdout'].strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith('Interrupted after 3.0 of 1e+07 simulated s '
+                                                   '(its log lines are not shown)'), lines
+    assert ros.run("print(current_runtime().log_counts['slow'])")['stdout'].strip() == '3'
+
+
 def test_a_part_run_out_of_order_says_which_part_is_missing(kernel, tmp_path):
     kernel.run(f"ros2nb.create_workspace({str(tmp_path / 'ws')!r}, allow_outside_course=True)")
     out = kernel.run('%%part scripts/order.py 3\nc = 3\n')['stdout']

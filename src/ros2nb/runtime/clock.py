@@ -104,18 +104,26 @@ class SimulatedClock:
         The nodes must be on simulated time (inside :meth:`clock`, or a simulated-time kernel).
 
         :return: simulated seconds actually advanced (less when ``until()`` became true).
+        :raises KeyboardInterrupt: the Stop button, once every callback due at ``sim_now_ns``
+            has run.
         """
         start = self.sim_now_ns
         end = start + round(seconds * 1e9)
         with self.exclusive():
             self.drain()
-            while self.sim_now_ns < end and not (until and until()):
-                step = self._next_timer_ns()
-                if step is None or step > MAX_SIM_STEP_S * 1e9:
-                    step = round(MAX_SIM_STEP_S * 1e9)
-                self.sim_now_ns = min(end, self.sim_now_ns + max(step, 1))
-                self._publish_clock()
+            try:
+                while self.sim_now_ns < end and not (until and until()):
+                    step = self._next_timer_ns()
+                    if step is None or step > MAX_SIM_STEP_S * 1e9:
+                        step = round(MAX_SIM_STEP_S * 1e9)
+                    self.sim_now_ns = min(end, self.sim_now_ns + max(step, 1))
+                    self._publish_clock()
+                    self.drain()
+                    if on_step is not None:
+                        on_step()
+            except KeyboardInterrupt:
+                # The Stop button: run, here and now, what the clock already made due, or the
+                # thread that spins between cells would run it after the caller's last line.
                 self.drain()
-                if on_step is not None:
-                    on_step()
+                raise
         return (self.sim_now_ns - start) / 1e9
