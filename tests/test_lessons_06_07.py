@@ -206,3 +206,155 @@ def test_a_count_through_a_lambda_passes(session, capsys):
     finally:
         restore(session, PROMISES)
     assert 'Check passed:' in capsys.readouterr().out
+
+
+#: The plot feeder's callback does nothing; at import, the file finds the subject's request
+#: loop and has it report the lists and the counter a right callback would have made, from
+#: the times the subject itself reported and the check's own readings.
+FORGED_PLOT = FIND_SUBJECT + '''
+
+def _forge(_attribute=_HANDLERS.get('attribute'), _wait=_HANDLERS.get('wait_received'),
+           _times=[]):
+    from ros2nb.checks.lesson07 import PLOT_READINGS_C
+
+    def wait_received(**request):
+        reply = _wait(**request)
+        _times.append(reply['t'])
+        return reply
+
+    def attribute(name):
+        reply = _attribute(name=name)
+        floats = {'temps_c': PLOT_READINGS_C[:len(_times)], 'times_s': _times}.get(name)
+        if floats is not None:
+            reply['value'] = {'type': 'list',
+                              'value': [{'type': 'float', 'value': v} for v in floats]}
+        elif name == 'redraws':
+            reply['value'] = {'type': 'int', 'value': len(_times)}
+        return reply
+
+    _HANDLERS['wait_received'] = wait_received
+    _HANDLERS['attribute'] = attribute
+
+
+if _SUBJECT is not None:
+    _forge()
+'''
+
+
+def test_a_plot_reported_by_a_forged_subject(session):
+    """The subject's replies gave the lists and the redraw count of a right callback although
+    the callback does nothing: against the check before it, that passed (checked by hand);
+    the file, read as text, decides."""
+    right = '''        self.times_s.append(self.get_clock().now().nanoseconds / 1e9)
+        self.temps_c.append(msg.data)
+        self.redraw()
+'''
+    mutated(session, PLOT, right, '        pass\n')
+    (session.workspace / PLOT).write_text((session.workspace / PLOT).read_text() + FORGED_PLOT)
+    try:
+        with pytest.raises(CheckFailed, match=r'The subscription calls temperature_callback, '
+                                              r'which never adds to self.times_s'):
+            checks.check_plot_callback()
+    finally:
+        restore(session, PLOT)
+
+
+def test_a_plot_fed_through_a_helper_method_passes(session, capsys):
+    """The honest twin of the forged plot, written another way: the callback hands the
+    reading to a method of the class, which appends both and redraws."""
+    mutated(session, PLOT, '''    def temperature_callback(self, msg):''', '''    def temperature_callback(self, msg):
+        self.keep(msg.data)
+
+    def keep(self, reading):
+        self.times_s.extend([self.get_clock().now().nanoseconds / 1e9])
+        self.temps_c += [reading]
+        self.redraw()
+
+    def unused(self, msg):''')
+    try:
+        checks.check_plot_callback()
+    finally:
+        restore(session, PLOT)
+    assert 'Check passed:' in capsys.readouterr().out
+
+
+#: The worker spins on a SingleThreadedExecutor with both timers in the node's default group;
+#: at import, the file finds the subject's request loop and has it report what a right
+#: answer would have (a MultiThreadedExecutor, a group per timer, a full heartbeat).
+FORGED_WORKER = FIND_SUBJECT + '''
+
+def _forge(_timer_runs=_HANDLERS.get('timer_runs')):
+    def timer_runs(**request):
+        _timer_runs(**request)
+        return {'ok': True, 'executor': 'MultiThreadedExecutor',
+                'runs': {'slow_work': 4, 'heartbeat': 20},
+                'groups': [['slow_work', 'MutuallyExclusiveCallbackGroup', 1],
+                           ['heartbeat', 'MutuallyExclusiveCallbackGroup', 2]]}
+
+    _HANDLERS['timer_runs'] = timer_runs
+
+
+if _SUBJECT is not None:
+    _forge()
+'''
+RESPONSIVE = '''    node = Worker('responsive_worker', slow_group=MutuallyExclusiveCallbackGroup(),
+                  heartbeat_group=MutuallyExclusiveCallbackGroup())
+    executor = MultiThreadedExecutor(num_threads=2)
+    return node, executor
+'''
+
+
+def test_a_worker_reported_by_a_forged_subject(session):
+    """The subject's reply gave a right answer's executor, groups and counts although the
+    function returns a single-threaded executor: against the check before it, that passed
+    (checked by hand); the file, read as text, decides."""
+    mutated(session, PROMISES, RESPONSIVE, '''    from rclpy.executors import SingleThreadedExecutor
+    return Worker('responsive_worker'), SingleThreadedExecutor()
+''')
+    (session.workspace / PROMISES).write_text((session.workspace / PROMISES).read_text()
+                                              + FORGED_WORKER)
+    try:
+        with pytest.raises(CheckFailed, match=r'^a SingleThreadedExecutor runs one callback at '
+                                              r'a time'):
+            checks.check_responsive_worker()
+    finally:
+        restore(session, PROMISES)
+
+
+@pytest.mark.parametrize('label, answer', [
+    ('one reentrant group, an executor from a helper', '''    from rclpy.callback_groups import ReentrantCallbackGroup
+    both = ReentrantCallbackGroup()
+    return Worker('responsive_worker', both, both), _executor()
+
+
+def _executor():
+    return MultiThreadedExecutor(num_threads=2)
+'''),
+    ('a group for the slow timer only', '''    executor = MultiThreadedExecutor()
+    node = Worker('responsive_worker', slow_group=MutuallyExclusiveCallbackGroup())
+    return (node, executor)
+'''),
+])
+def test_a_worker_written_another_way_passes(session, capsys, label, answer):
+    """Honest twins of the forged worker, written as the text reader must still follow."""
+    mutated(session, PROMISES, RESPONSIVE, answer)
+    try:
+        checks.check_responsive_worker()
+    finally:
+        restore(session, PROMISES)
+    assert 'Check passed:' in capsys.readouterr().out
+
+
+def test_a_worker_whose_answer_the_grader_cannot_read_is_told_how_to_write_it(session):
+    mutated(session, PROMISES, RESPONSIVE, '''    made = [Worker('responsive_worker', slow_group=MutuallyExclusiveCallbackGroup(),
+                   heartbeat_group=MutuallyExclusiveCallbackGroup()),
+            MultiThreadedExecutor(num_threads=2)]
+    return tuple(made)
+''')
+    try:
+        with pytest.raises(CheckFailed, match=r'reads responsive_worker\(\) in your file as '
+                                              r'text and cannot tell what it returns: build'):
+            checks.check_responsive_worker()
+    finally:
+        restore(session, PROMISES)
+

@@ -9,6 +9,8 @@ counts the subject reports only name a mistake.
 
 from __future__ import annotations
 
+import ast
+
 from std_msgs.msg import Bool, Float32
 
 from .. import course
@@ -16,7 +18,7 @@ from ..errors import CheckFailed
 from .base import ARRIVAL_TIMEOUT_S, Judge, judged, learner_error
 from .mains import run_main
 from .nodes import new_node, reach
-from .source import ClassSource
+from .source import ClassSource, called_name, made_by, module_function, read_module
 from .verdicts import endpoint_verdict, node_name_verdict
 
 #: Readings the fan check sends (°C): both sides of the High threshold.
@@ -212,7 +214,67 @@ def _responsive_worker(judge: Judge) -> str:
         raise CheckFailed(f'{course.WORKER_FUNCTION}() returned {reply["returned"]["value"]}; '
                           'return two things, the Worker node and the executor to spin it: '
                           'return node, executor.')
-    return _worker_verdict(reply)
+    verdict = _worker_verdict(reply)
+    _worker_source_verdict(judge)
+    return verdict
+
+
+#: The keyword and the position of each timer's group in ``Worker(name, slow_group,
+#: heartbeat_group)``.
+_WORKER_GROUPS = (('slow_group', 1), ('heartbeat_group', 2))
+
+
+def _worker_source_verdict(judge: Judge) -> None:
+    """``responsive_worker()`` returns a Worker whose timers may overlap and a multi-threaded
+    executor, as the file (read as text) says.
+
+    The executor, the groups and the counts are the subject's word, and a subject runs the
+    learner's code, which may rewrite what it reports: they only name a mistake (the lines
+    of :func:`_worker_verdict`), the source decides.
+    """
+    module = read_module(judge.workspace, course.PROMISES_FILE)
+    function = module_function(module, course.WORKER_FUNCTION) if module else None
+    unread = (f'The grader reads {course.WORKER_FUNCTION}() in your file as text and cannot '
+              'tell {what}: build the Worker and the MultiThreadedExecutor in the function '
+              'itself (node = Worker(...); executor = MultiThreadedExecutor(...)) and end with '
+              'return node, executor.')
+    returns = [r.value for r in ast.walk(function) if isinstance(r, ast.Return)] \
+        if function else []
+    returned = made_by(module, function, returns[-1]) if returns and returns[-1] else None
+    if not isinstance(returned, ast.Tuple) or len(returned.elts) != 2:
+        raise CheckFailed(unread.format(what='what it returns'))
+    node, executor = (made_by(module, function, e) for e in returned.elts)
+    kind = called_name(executor)
+    if kind == 'SingleThreadedExecutor':
+        raise CheckFailed('a SingleThreadedExecutor runs one callback at a time, so slow_work '
+                          'holds up heartbeat; return a MultiThreadedExecutor.')
+    if kind != 'MultiThreadedExecutor':
+        raise CheckFailed(unread.format(what='which executor it returns'))
+    given = {k.arg: k.value for k in executor.keywords}
+    threads = given.get('num_threads', executor.args[0] if executor.args else None)
+    if isinstance(threads, ast.Constant) and isinstance(threads.value, int) \
+            and threads.value < 2:
+        raise CheckFailed(f'A MultiThreadedExecutor with num_threads={threads.value} runs one '
+                          'callback at a time: give it at least num_threads=2.')
+    if called_name(node) != course.WORKER_CLASS:
+        raise CheckFailed(unread.format(what=f'that the node it returns is a '
+                                             f'{course.WORKER_CLASS}'))
+    groups = []
+    for keyword, position in _WORKER_GROUPS:
+        given = {k.arg: k.value for k in node.keywords}
+        group = given.get(keyword, node.args[position] if len(node.args) > position else None)
+        if group is None or (isinstance(group, ast.Constant) and group.value is None):
+            groups.append(None)  # the node's default group, one for both timers
+            continue
+        made = made_by(module, function, group)
+        if called_name(made) not in ('MutuallyExclusiveCallbackGroup', 'ReentrantCallbackGroup'):
+            raise CheckFailed(unread.format(what=f'which callback group {keyword} is'))
+        groups.append(made)
+    slow, heartbeat = groups
+    if slow is heartbeat and called_name(slow) != 'ReentrantCallbackGroup':
+        raise CheckFailed('both timers are in one MutuallyExclusiveCallbackGroup (the node\'s '
+                          'default, or one you made for both), which runs one of its callbacks '
+                          'at a time; give each timer a group of its own.')
 
 
 def check_responsive_worker() -> None:

@@ -3,7 +3,8 @@
 Part of :mod:`ros2nb.checks`.  The judge creates the learner's ``PlotFeeder`` (from
 ``live_plot.py``) in a subject on simulated time, moves its clock on between readings it
 publishes from its own node, and reads back what the node kept: the times, the readings
-and how often it asked for a redraw.
+and how often it asked for a redraw.  Those values come from a process that ran the
+learner's code, so they only name a mistake: the file, read as text, decides.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from .. import course
 from ..errors import CheckFailed
 from .base import ARRIVAL_TIMEOUT_S, Judge, judged, learner_error
 from .nodes import new_node, reach
+from .source import ClassSource
 from .verdicts import endpoint_verdict, node_name_verdict
 
 #: Readings the check publishes (°C), one simulated second apart; exact in Float32.
@@ -54,7 +56,30 @@ def _plot_callback(judge: Judge) -> str:
         if not reply['ok']:
             raise CheckFailed(f'The reading {value} °C never reached temperature_callback.')
         times.append(reply['t'])
-    return _plot_verdict(subject, times)
+    verdict = _plot_verdict(subject, times)
+    _plot_source_verdict(judge)
+    return verdict
+
+
+def _plot_source_verdict(judge: Judge) -> None:
+    """The subscription's callback adds to ``times_s`` and ``temps_c`` and asks for a redraw,
+    as the file (read as text) says.
+
+    The lists and the counter are the subject's word, and a subject runs the learner's code,
+    which may rewrite what it reports: their values only name a mistake, the source decides.
+    """
+    source = ClassSource.read(judge.workspace, course.LIVE_PLOT_FILE, course.PLOT_CLASS)
+    callbacks = source.callbacks('create_subscription', 2) if source else []
+    called = ', '.join(sorted(set(callbacks))) or 'nothing'
+    for attribute, what in (('times_s', "the node's time, self.get_clock().now().nanoseconds "
+                                        '/ 1e9'),
+                            ('temps_c', 'msg.data')):
+        if source is None or not any(source.reaches_change(c, attribute) for c in callbacks):
+            raise CheckFailed(f'The subscription calls {called}, which never adds to '
+                              f'self.{attribute}: append {what} to it there.')
+    if not any(source.reaches_assignment(c, 'redraws') for c in callbacks):
+        raise CheckFailed(f'The subscription calls {called}, which never calls self.redraw() '
+                          '(the method that counts self.redraws): call it once per message.')
 
 
 def _plot_verdict(subject, times: list[float]) -> str:
@@ -91,7 +116,8 @@ def check_plot_callback() -> None:
 
     The judge publishes 4 readings one simulated second apart to your ``PlotFeeder`` and
     reads ``times_s``, ``temps_c`` and ``redraws``: every reading with the node's simulated
-    time, and one redraw per message.
+    time, and one redraw per message.  It also reads in your file that the subscription's
+    callback appends to both lists and calls ``self.redraw()``.
 
     Introduced in ``07-live-plot.ipynb``.
 

@@ -18,6 +18,8 @@ from ..errors import CheckFailed
 
 #: What :meth:`ClassSource.value` returns for an expression it cannot work out as text.
 UNKNOWN: Any = object()
+#: The list methods that add to a list in place (what :meth:`ClassSource.reaches_change` counts).
+LIST_GROWERS = frozenset({'append', 'extend', 'insert'})
 #: How many names deep :meth:`ClassSource.value` follows ``A = B`` (a guard against loops).
 MAX_DEPTH = 8
 _OPERATORS = {ast.Add: lambda a, b: a + b, ast.Sub: lambda a, b: a - b,
@@ -53,6 +55,62 @@ def _assigned(function: Optional[ast.AST], target: str) -> list[ast.expr]:
     return values
 
 
+def read_module(workspace: Path, relative: str) -> Optional[ast.Module]:
+    """The file ``relative`` to ``workspace``, parsed; None when it cannot be read or parsed
+    (the subject's import says why, in the learner's words).
+
+    :raises CheckFailed: when the file is a link to outside the workspace (the judge
+        reads what the learner wrote there, never a file a subject may rewrite).
+    """
+    path = workspace / relative
+    target = path.resolve()
+    if not target.is_relative_to(workspace.resolve()):
+        raise CheckFailed(f'{relative} is a link to {target}, outside your '
+                          'workspace: the grader reads your files in the workspace only; '
+                          'put the file itself there.')
+    try:
+        return ast.parse(path.read_text())
+    except (OSError, SyntaxError, ValueError, UnicodeDecodeError):
+        return None
+
+
+def module_function(module: ast.Module, name: str) -> Optional[ast.FunctionDef]:
+    """The last top-level ``def name`` of ``module``, or None."""
+    found = [s for s in module.body if isinstance(s, ast.FunctionDef) and s.name == name]
+    return found[-1] if found else None
+
+
+def made_by(module: ast.Module, function: Optional[ast.AST], node: ast.expr,
+            depth: int = 0) -> Optional[ast.expr]:
+    """What makes the value of ``node`` in ``function``: local names are followed to their
+    last assignment, and calls of the file's own top-level functions to what they return
+    (when they have one ``return``).  The result is a call (``MultiThreadedExecutor(...)``),
+    a tuple, a constant, or None when the text does not say."""
+    if depth > MAX_DEPTH:
+        return None
+    if isinstance(node, ast.Name):
+        local = _assigned(function, node.id)
+        return made_by(module, function, local[-1], depth + 1) if local else None
+    if isinstance(node, ast.Call) and isinstance(node.func, ast.Name):
+        callee = module_function(module, node.func.id)
+        if callee is not None:
+            returns = [r.value for r in ast.walk(callee)
+                       if isinstance(r, ast.Return) and r.value is not None]
+            return made_by(module, callee, returns[0], depth + 1) if len(returns) == 1 else None
+    if isinstance(node, (ast.Call, ast.Tuple, ast.Constant)):
+        return node
+    return None
+
+
+def called_name(node: Optional[ast.expr]) -> Optional[str]:
+    """The name a call calls: ``X`` for ``X(...)`` and ``m.X(...)``; None for anything else."""
+    if not isinstance(node, ast.Call):
+        return None
+    func = node.func
+    return func.id if isinstance(func, ast.Name) else (
+        func.attr if isinstance(func, ast.Attribute) else None)
+
+
 class ClassSource:
     """One class of the learner's file, as the judge reads it (text only)."""
 
@@ -68,17 +126,9 @@ class ClassSource:
         :raises CheckFailed: when the file is a link to outside the workspace (the judge
             reads what the learner wrote there, never a file a subject may rewrite).
         """
-        path = workspace / relative
-        target = path.resolve()
-        if not target.is_relative_to(workspace.resolve()):
-            raise CheckFailed(f'{relative} is a link to {target}, outside your '
-                              'workspace: the grader reads your files in the workspace only; '
-                              'put the file itself there.')
-        try:
-            module = ast.parse(path.read_text())
-        except (OSError, SyntaxError, ValueError, UnicodeDecodeError):
-            return None
-        found = [s for s in module.body if isinstance(s, ast.ClassDef) and s.name == name]
+        module = read_module(workspace, relative)
+        found = [s for s in module.body if isinstance(s, ast.ClassDef) and s.name == name] \
+            if module is not None else []
         return cls(module, found[-1]) if found else None
 
     def method(self, name: str) -> Optional[ast.FunctionDef]:
@@ -194,6 +244,17 @@ class ClassSource:
                 and ast.unparse(node.args[1]) in (repr(attribute), f'"{attribute}"')
 
         return self._reaches(method, assigns)
+
+    def reaches_change(self, method: str, attribute: str) -> bool:
+        """True when ``method`` changes ``self.<attribute>``: assigns it (as
+        :meth:`reaches_assignment` says) or calls a list method that grows it
+        (``self.<attribute>.append(...)``, ``extend``, ``insert``), itself or through
+        ``self.m()`` calls of the class."""
+        target = f'self.{attribute}'
+        return self.reaches_assignment(method, attribute) or self._reaches(
+            method, lambda node: isinstance(node, ast.Call)
+            and isinstance(node.func, ast.Attribute) and node.func.attr in LIST_GROWERS
+            and ast.unparse(node.func.value) == target)
 
     def _reaches(self, method: str, hit: Any) -> bool:
         """True when ``hit(node)`` holds for a node of ``method`` (a method's name, or a
