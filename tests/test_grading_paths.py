@@ -236,3 +236,71 @@ def test_a_learners_build_scripts_never_run_in_the_judge(scratch, monkeypatch):
     saw = [p.read_text().split() for p in folder.rglob('saw-the-judge')]
     assert (ran, saw) == (['subjects'], []), \
         f'a hook of the learner\'s ran with the home of {ran}, in sight of the judge: {saw}'
+
+
+def test_the_judge_hands_its_inputs_over_without_following_a_link(tmp_path, monkeypatch):
+    """A learner's thread can swap the judge's scratch folder (subjects may write where it
+    lies) for a link to a folder of the judge's own. A write by path then lands in that
+    folder; what the judge hands over goes to the folder it made, whatever the path holds."""
+    from ros2nb.errors import CheckFailed
+    from ros2nb.judge.session import Session
+
+    judges_own = tmp_path / 'judges-own'
+    judges_own.mkdir()
+    session = Session(tmp_path)
+    try:
+        made = session.scratch
+        made.rename(tmp_path / 'moved-aside')
+        made.symlink_to(judges_own)
+        (made / 'by-path.xml').write_text('x')  # what the judge did before: it follows the link
+        assert [p.name for p in judges_own.iterdir()] == ['by-path.xml']
+
+        folder = session.hand_over('ros2nb-package-', {'graded_reader/package.xml': b'<p/>'})
+        assert [p.name for p in judges_own.iterdir()] == ['by-path.xml']
+        kept = tmp_path / 'moved-aside' / folder.name / 'graded_reader' / 'package.xml'
+        assert kept.read_bytes() == b'<p/>'
+
+        # A learner who guesses the next name and puts a link there first: never written through
+        monkeypatch.setattr('secrets.token_hex', lambda _n: 'guessed')
+        (tmp_path / 'moved-aside' / 'ros2nb-package-guessed').symlink_to(judges_own)
+        with pytest.raises(CheckFailed, match="The check's own folder .* changed while the "
+                                              r'grader wrote it \(File exists\)'):
+            session.hand_over('ros2nb-package-', {'graded_reader/package.xml': b'<p/>'})
+        assert [p.name for p in judges_own.iterdir()] == ['by-path.xml']
+    finally:
+        made.unlink()
+        (tmp_path / 'moved-aside').rename(made)
+        session.close()
+
+
+def test_the_judge_reads_a_learners_bag_from_its_own_copy_links_refused(tmp_path):
+    """A bag whose metadata.yaml is a link to a file only the judge may read: read by path,
+    the judge read that file (and its words could reach the feedback); its own copy has
+    the learner's files only, and a link gets one line."""
+    from ros2nb.errors import CheckFailed
+    from ros2nb.judge.session import Session
+
+    secret = tmp_path / 'judge-only.yaml'
+    secret.write_text('the hidden tests\n')
+    session = Session(tmp_path)
+    try:
+        bag = session.scratch / 'ros2nb-bag-x' / 'hour'
+        bag.mkdir(parents=True)
+        (bag / 'hour_0.mcap').write_bytes(b'mcap')
+        with session.taken_back(bag) as copy:
+            assert sorted(p.name for p in copy.iterdir()) == ['hour_0.mcap']
+            assert not copy.is_relative_to(session.scratch)  # where no subject sees it
+        (bag / 'metadata.yaml').symlink_to(secret)
+        assert (bag / 'metadata.yaml').read_text() == 'the hidden tests\n'  # by path
+        with pytest.raises(CheckFailed, match=r'metadata.yaml cannot be read \(Too many levels '
+                                              r'of symbolic links\): the grader reads files'):
+            with session.taken_back(bag):
+                pass
+        (bag / 'metadata.yaml').unlink()
+        bag.rename(bag.with_name('elsewhere'))
+        bag.symlink_to(tmp_path)  # the bag folder itself a link
+        with pytest.raises(CheckFailed, match=r'hour is not a folder'):
+            with session.taken_back(bag):
+                pass
+    finally:
+        session.close()

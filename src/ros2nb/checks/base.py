@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Optional, Protocol
+from typing import Any, Callable, ContextManager, Optional, Protocol
 
 from ..errors import CheckFailed, LearnerCodeError
 from .dispatch import in_judge, run_in_judge
@@ -42,6 +42,8 @@ class Judge(Protocol):
     def run(self, argv: list[str], *, seconds: float, cwd: Path,
             env: Optional[dict[str, str]] = None) -> tuple[int, str]: ...
     def subject_env(self) -> dict[str, str]: ...
+    def hand_over(self, prefix: str, files: dict[str, bytes]) -> Path: ...
+    def taken_back(self, folder: Path) -> ContextManager[Path]: ...
 
 
 _judge: Optional[Judge] = None

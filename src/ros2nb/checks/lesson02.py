@@ -9,7 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Optional
 
-from catkin_pkg.package import InvalidPackage, parse_package
+from catkin_pkg.package import InvalidPackage, parse_package, parse_package_string
 
 from .. import course
 from ..errors import CheckFailed, Ros2nbError
@@ -32,6 +32,11 @@ def package_dependencies(package_xml: Path) -> list[str]:
         package = parse_package(str(package_xml))
     except (InvalidPackage, OSError) as error:
         raise Ros2nbError(f'{package_xml} is not a valid package.xml: {error}') from None
+    return _depends(package)
+
+
+def _depends(package: Any) -> list[str]:
+    """The ``<depend>`` entries of a catkin_pkg Package, in order."""
     exported = {d.name for d in package.build_export_depends}
     run = {d.name for d in package.exec_depends}
     return [d.name for d in package.build_depends if d.name in exported and d.name in run]
@@ -68,13 +73,15 @@ def check_dependencies(reader: Any, package_xml: Optional[Path] = None) -> None:
     files = [Path(package_xml) if package_xml else current_workspace() / course.PACKAGE_XML_FILE]
     if not files[0].is_file():
         raise CheckFailed(f'{files[0]} does not exist: run the pkg_create cell above first.')
-    if isinstance(reader, AnswerRef):
-        extra = current_judge().scratch / 'graded_reader' / 'package.xml'
-        extra.parent.mkdir(parents=True, exist_ok=True)
-        extra.write_text(_EXTRA_PACKAGE_XML)
-        files.append(extra)
     # What each file declares, read before the learner's reader runs: it may write them.
-    wanted = [package_dependencies(file) for file in files]
+    wanted = [package_dependencies(files[0])]
+    if isinstance(reader, AnswerRef):
+        # The grader's own file: what it declares comes from its text, never from the copy
+        # the learner's code can reach.
+        folder = current_judge().hand_over('ros2nb-package-', {
+            'graded_reader/package.xml': _EXTRA_PACKAGE_XML.encode()})
+        files.append(folder / 'graded_reader' / 'package.xml')
+        wanted.append(_depends(parse_package_string(_EXTRA_PACKAGE_XML)))
     if isinstance(reader, AnswerRef):
         outputs = answer_results(reader, [[{'path': str(f)}] for f in files])
         results = [decoded(o, f'{reader.name}(package_xml)') for o in outputs]

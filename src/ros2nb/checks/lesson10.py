@@ -52,6 +52,30 @@ def _fresh_path(name: str) -> Iterator[Path]:
         shutil.rmtree(folder, ignore_errors=True)
 
 
+@contextlib.contextmanager
+def _check_bag(name: str) -> Iterator[Path]:
+    """The check's own bag of :data:`CHECK_READINGS`, as a folder ``name`` the learner's
+    function may read; removed once the check is done.
+
+    The judge writes it in a temporary folder of its own that no subject sees, then hands
+    a copy over (:meth:`ros2nb.judge.Session.hand_over`): it never writes to a path in the
+    folder subjects may write, where the learner's code could have put a link.
+    """
+    if not in_judge():
+        with _fresh_path(name) as path:
+            write_check_bag(path, CHECK_READINGS)
+            yield path
+        return
+    with tempfile.TemporaryDirectory(prefix='ros2nb-bag-') as private:
+        write_check_bag(Path(private) / name, CHECK_READINGS)
+        files = {f'{name}/{f.name}': f.read_bytes() for f in (Path(private) / name).iterdir()}
+    folder = current_judge().hand_over('ros2nb-bag-', files)
+    try:
+        yield folder / name
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+
+
 def _call(function: Any, label: str, *args: Any) -> Any:
     """Call the learner's function (in the kernel, or from source in a subject)."""
     if isinstance(function, AnswerRef):
@@ -120,6 +144,17 @@ def _recording(record_hour: Any) -> str:
 def _recording_in(path: Path, record_hour: Any) -> str:
     label = f'{record_hour.__name__}(bag_path)'
     _call(record_hour, label, path)
+    if not in_judge():
+        return _recording_verdict(path, label)
+    if not path.is_dir():
+        _bag_verdict(path, label)  # the line for "no bag at all"
+    # The bag lies where subjects may write: the judge reads its own copy, links refused.
+    with current_judge().taken_back(path) as copy:
+        return _recording_verdict(copy, label)
+
+
+def _recording_verdict(path: Path, label: str) -> str:
+    """What the bag at ``path`` holds, against an hour of the sensor and the monitor."""
     counts = _bag_verdict(path, label)
     readings = [float(m.data) for _s, m in _messages(path, TEMPERATURE)]
     hour = round(course.RECORD_S / course.PUBLISH_PERIOD_S)
@@ -204,12 +239,11 @@ class _Watch:
 
 
 def _replay(replay: Any) -> str:
-    with _fresh_path('sixty') as path:
+    with _check_bag('sixty') as path:
         return _replay_in(path, replay)
 
 
 def _replay_in(path: Path, replay: Any) -> str:
-    write_check_bag(path, CHECK_READINGS)
     watch = _Watch()
     _call(replay, f'{replay.__name__}(bag_path, rate)', path, CHECK_RATE)
     logs = watch.heard(len(CHECK_READINGS))
@@ -244,12 +278,11 @@ def check_replay(replay: Any) -> None:
 
 
 def _readings(read_temperatures: Any) -> str:
-    with _fresh_path('sixty') as path:
+    with _check_bag('sixty') as path:
         return _readings_in(path, read_temperatures)
 
 
 def _readings_in(path: Path, read_temperatures: Any) -> str:
-    write_check_bag(path, CHECK_READINGS)
     got = _call(read_temperatures, f'{read_temperatures.__name__}(bag_path)', path)
     name = f'{getattr(read_temperatures, "__name__", "your function")}()'
     if not (isinstance(got, (list, tuple)) and len(got) == 2
