@@ -358,3 +358,28 @@ def test_a_worker_whose_answer_the_grader_cannot_read_is_told_how_to_write_it(se
     finally:
         restore(session, PROMISES)
 
+
+#: At import, the file has the subject answer every 'attribute' with a reply of no known shape.
+NONSENSE_REPLY = FIND_SUBJECT + '''
+if _SUBJECT is not None:
+    _HANDLERS['attribute'] = lambda name: {'ok': True, 'value': 'nonsense'}
+'''
+
+
+def test_a_reply_of_no_known_shape_fails_that_check_alone(session):
+    """A check that meets a reply it cannot read raises an error of its own (TypeError here);
+    before, that ended the judge and every check of the notebook went with it. Now it fails
+    that check with one line, and the notebook's other checks are graded."""
+    from ros2nb.checks.dispatch import captured
+
+    (session.workspace / PLOT).write_text((session.workspace / PLOT).read_text() + NONSENSE_REPLY)
+    session.drop(('file', PLOT))
+    try:
+        with pytest.raises(TypeError):  # what ended the judge
+            checks.check_plot_callback()
+        outcome = captured(checks.check_plot_callback)
+    finally:
+        restore(session, PLOT)
+    assert outcome['passed'] is False and '\n' not in outcome['message']
+    assert outcome['message'].startswith('The grader could not finish this check (TypeError: '
+                                         'string indices must be integers'), outcome

@@ -75,8 +75,19 @@ def show_result(result: dict) -> None:
     raise CheckFailed(result['message'])
 
 
+#: The line of a check that ended on an error of its own: one check's points, never the
+#: notebook's (the others are graded as usual).
+UNFINISHED = ('The grader could not finish this check ({error}); the other checks are '
+              'graded as usual. If your code changes ros2nb or its processes, undo that; '
+              'otherwise tell your instructor.')
+
+
 def captured(call: Callable[[], Any]) -> dict:
-    """Run one check (in the judge); return its outcome as JSON-safe data for the kernel."""
+    """Run one check (in the judge); return its outcome as JSON-safe data for the kernel.
+
+    An error the check did not expect (a subject's reply of the wrong shape, say) fails
+    that check with one line (:data:`UNFINISHED`), so a notebook's other checks still count.
+    """
     out = io.StringIO()
     try:
         with contextlib.redirect_stdout(out):
@@ -90,4 +101,8 @@ def captured(call: Callable[[], Any]) -> dict:
     except Ros2nbError as error:
         return {'passed': False, 'type': 'CheckFailed', 'message': str(error),
                 'lines': out.getvalue().splitlines()}
+    except Exception as error:  # what a process that ran learner code said made no sense
+        return {'passed': False, 'type': 'CheckFailed', 'lines': out.getvalue().splitlines(),
+                'message': UNFINISHED.format(error=f'{type(error).__name__}: '
+                                                   f'{(str(error).splitlines() or [""])[0][:160]}')}
     return {'passed': True, 'lines': out.getvalue().splitlines()}

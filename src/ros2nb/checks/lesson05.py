@@ -147,8 +147,13 @@ def _entry_points(judge: Judge) -> str:
                            f'{course.PACKAGE}*-info/entry_points.txt'))
     scripts: dict[str, str] = {}
     if found:
-        config = configparser.ConfigParser()
-        config.read(found[0])
+        config = configparser.ConfigParser(interpolation=None)  # data, never %(name)s
+        try:
+            config.read(found[0])
+        except configparser.Error as error:
+            raise CheckFailed(f'The entry points setuptools installed cannot be read: '
+                              f'{str(error).splitlines()[0][:160]}; write each as '
+                              f"'name = {course.PACKAGE}.module:main'.") from None
         if config.has_section('console_scripts'):
             scripts = {k: v.strip() for k, v in config.items('console_scripts')}
     for executable in (course.PUBLISHER_EXECUTABLE, course.SUBSCRIBER_EXECUTABLE):
@@ -187,7 +192,7 @@ def _setup_cfg(judge: Judge) -> str:
     if PLACEHOLDER in text:
         raise CheckFailed('setup.cfg still holds the placeholder "raise NotImplementedError()": '
                           'write the two settings in its place.')
-    config = configparser.ConfigParser()
+    config = configparser.ConfigParser(interpolation=None)  # the two values as written
     try:
         config.read_string(text)
     except configparser.Error as error:

@@ -8,6 +8,7 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import importlib.util
+import itertools
 import json
 import shutil
 import sys
@@ -22,6 +23,8 @@ from .workspace import PathLike, current_workspace, shown, workspace_file
 WRITTEN_RECORD = '.ros2nb-written.json'
 #: Where ``%%part`` keeps the parts of each file, so a kernel restart loses none.
 PARTS_RECORD = '.ros2nb-parts.json'
+#: Most missing part numbers a message names.
+MAX_GAPS_NAMED = 10
 #: nbgrader's marker lines around an answer in the course's own notebooks; not part of a file.
 AUTHOR_MARKERS = ('### BEGIN SOLUTION', '### END SOLUTION')
 #: What nbgrader leaves in an answer cell the learner has not written yet.
@@ -144,10 +147,17 @@ def missing_parts(workspace: Path, relative: str) -> list[int]:
     record_file = workspace / PARTS_RECORD
     try:
         record = json.loads(record_file.read_text()) if record_file.is_file() else {}
-    except ValueError:
+        saved = {int(n) for n in record.get(relative, {})}
+    except (OSError, ValueError, TypeError, AttributeError):  # not a record %%part wrote
         return []
-    saved = {int(n) for n in record.get(relative, {})}
-    return [n for n in range(1, max(saved, default=0)) if n not in saved]
+    return _gaps(saved)
+
+
+def _gaps(saved: set[int]) -> list[int]:
+    """The first :data:`MAX_GAPS_NAMED` part numbers below the highest in ``saved`` that are
+    not in it (a part numbered 1000000000 names ten, and takes no time)."""
+    below = (n for n in range(1, max(saved, default=0)) if n not in saved)
+    return list(itertools.islice(below, MAX_GAPS_NAMED))
 
 
 def write_part(path: PathLike, number: int, text: str, *, overwrite: bool = False) -> Path:
@@ -193,7 +203,7 @@ def write_part(path: PathLike, number: int, text: str, *, overwrite: bool = Fals
         parts.clear()
         parts.update(new_parts)
     lines = written.read_text().count('\n')
-    gaps = [n for n in range(1, max(parts)) if n not in parts]
+    gaps = _gaps(set(parts))
     gap = (f'; part{"s" if len(gaps) > 1 else ""} {", ".join(map(str, gaps))} not saved yet: '
            f'run {"its cell" if len(gaps) == 1 else "their cells"} too' if gaps else '')
     print(f'{shown(written)}: part {number} saved (parts {", ".join(map(str, sorted(parts)))}; '
