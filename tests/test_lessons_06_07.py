@@ -40,6 +40,30 @@ def mutated(session, relative: str, old: str, new: str) -> None:
     session.drop(('file', relative))
 
 
+def passes_with(session, capsys, relative: str, old: str, new: str, check) -> None:
+    """``check`` passes on the course's file with ``old`` written as ``new``."""
+    mutated(session, relative, old, new)
+    try:
+        check()
+    finally:
+        restore(session, relative)
+    assert 'Check passed:' in capsys.readouterr().out
+
+
+def fails_forged(session, relative: str, old: str, new: str, forge: str, check,
+                 pattern: str) -> None:
+    """``check`` fails with ``pattern`` on the course's file with ``old`` written as ``new``
+    and the forging code ``forge`` at its end."""
+    mutated(session, relative, old, new)
+    path = session.workspace / relative
+    path.write_text(path.read_text() + forge)
+    try:
+        with pytest.raises(CheckFailed, match=pattern):
+            check()
+    finally:
+        restore(session, relative)
+
+
 def test_reference_files_pass(session, capsys):
     for check in (checks.check_fan_controller, checks.check_fan_main,
                   checks.check_counting_monitor, checks.check_responsive_worker,
@@ -185,27 +209,17 @@ if _SUBJECT is not None:
 def test_a_count_reported_by_a_forged_subject(session):
     """The subject's reply said received == 5 although the callback counts nothing: against
     the check before it, that passed (checked by hand); the file, read as text, decides."""
-    mutated(session, PROMISES, 'self.received += 1', 'pass')
-    (session.workspace / PROMISES).write_text((session.workspace / PROMISES).read_text()
-                                              + FORGED_COUNT)
-    try:
-        with pytest.raises(CheckFailed, match=r'The subscription calls count, which never adds '
-                                              r'to self.received'):
-            checks.check_counting_monitor()
-    finally:
-        restore(session, PROMISES)
+    fails_forged(session, PROMISES, 'self.received += 1', 'pass', FORGED_COUNT,
+                 checks.check_counting_monitor,
+                 r'The subscription calls count, which never adds to self.received')
 
 
 def test_a_count_through_a_lambda_passes(session, capsys):
     """The honest twin of the forged count, written another way: the subscription's callback
     is a lambda that calls the counting method; the file shows it counts, so it passes."""
-    mutated(session, PROMISES, 'Float32, TOPIC, self.count, QUEUE_DEPTH',
-            'Float32, TOPIC, lambda msg: self.count(msg), QUEUE_DEPTH')
-    try:
-        checks.check_counting_monitor()
-    finally:
-        restore(session, PROMISES)
-    assert 'Check passed:' in capsys.readouterr().out
+    passes_with(session, capsys, PROMISES, 'Float32, TOPIC, self.count, QUEUE_DEPTH',
+                'Float32, TOPIC, lambda msg: self.count(msg), QUEUE_DEPTH',
+                checks.check_counting_monitor)
 
 
 #: The plot feeder's callback does nothing; at import, the file finds the subject's request
@@ -249,20 +263,15 @@ def test_a_plot_reported_by_a_forged_subject(session):
         self.temps_c.append(msg.data)
         self.redraw()
 '''
-    mutated(session, PLOT, right, '        pass\n')
-    (session.workspace / PLOT).write_text((session.workspace / PLOT).read_text() + FORGED_PLOT)
-    try:
-        with pytest.raises(CheckFailed, match=r'The subscription calls temperature_callback, '
-                                              r'which never adds to self.times_s'):
-            checks.check_plot_callback()
-    finally:
-        restore(session, PLOT)
+    fails_forged(session, PLOT, right, '        pass\n', FORGED_PLOT, checks.check_plot_callback,
+                 r'The subscription calls temperature_callback, which never adds to '
+                 r'self.times_s')
 
 
 def test_a_plot_fed_through_a_helper_method_passes(session, capsys):
     """The honest twin of the forged plot, written another way: the callback hands the
     reading to a method of the class, which appends both and redraws."""
-    mutated(session, PLOT, '''    def temperature_callback(self, msg):''', '''    def temperature_callback(self, msg):
+    passes_with(session, capsys, PLOT, '''    def temperature_callback(self, msg):''', '''    def temperature_callback(self, msg):
         self.keep(msg.data)
 
     def keep(self, reading):
@@ -270,12 +279,7 @@ def test_a_plot_fed_through_a_helper_method_passes(session, capsys):
         self.temps_c += [reading]
         self.redraw()
 
-    def unused(self, msg):''')
-    try:
-        checks.check_plot_callback()
-    finally:
-        restore(session, PLOT)
-    assert 'Check passed:' in capsys.readouterr().out
+    def unused(self, msg):''', checks.check_plot_callback)
 
 
 #: The worker spins on a SingleThreadedExecutor with both timers in the node's default group;
@@ -308,17 +312,10 @@ def test_a_worker_reported_by_a_forged_subject(session):
     """The subject's reply gave a right answer's executor, groups and counts although the
     function returns a single-threaded executor: against the check before it, that passed
     (checked by hand); the file, read as text, decides."""
-    mutated(session, PROMISES, RESPONSIVE, '''    from rclpy.executors import SingleThreadedExecutor
+    fails_forged(session, PROMISES, RESPONSIVE, '''    from rclpy.executors import SingleThreadedExecutor
     return Worker('responsive_worker'), SingleThreadedExecutor()
-''')
-    (session.workspace / PROMISES).write_text((session.workspace / PROMISES).read_text()
-                                              + FORGED_WORKER)
-    try:
-        with pytest.raises(CheckFailed, match=r'^a SingleThreadedExecutor runs one callback at '
-                                              r'a time'):
-            checks.check_responsive_worker()
-    finally:
-        restore(session, PROMISES)
+''', FORGED_WORKER, checks.check_responsive_worker,
+                 r'^a SingleThreadedExecutor runs one callback at a time')
 
 
 @pytest.mark.parametrize('label, answer', [
@@ -337,12 +334,7 @@ def _executor():
 ])
 def test_a_worker_written_another_way_passes(session, capsys, label, answer):
     """Honest twins of the forged worker, written as the text reader must still follow."""
-    mutated(session, PROMISES, RESPONSIVE, answer)
-    try:
-        checks.check_responsive_worker()
-    finally:
-        restore(session, PROMISES)
-    assert 'Check passed:' in capsys.readouterr().out
+    passes_with(session, capsys, PROMISES, RESPONSIVE, answer, checks.check_responsive_worker)
 
 
 def test_a_worker_whose_answer_the_grader_cannot_read_is_told_how_to_write_it(session):
