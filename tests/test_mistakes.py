@@ -203,6 +203,29 @@ def test_stop_during_a_simulated_spin_is_one_line(ros):
     assert len(lines) == 1 and lines[0].startswith('Interrupted after '), result
 
 
+def test_stop_during_a_wall_clock_spin_is_the_cells_last_line(kernel):
+    # On the wall clock the nodes keep running after a spin, and this cell goes on for half a
+    # second after it: before, their lines of that half second came after "Interrupted ...".
+    # The node presses Stop itself (its 20th tick), so that it lands while the spin runs.
+    kernel.run('ros2nb.shutdown()\n_ = ros2nb.start(sim_time=False)')
+    try:
+        kernel.run("import os, signal\n"
+                   "class Ticker(Node):\n    def __init__(self):\n        super().__init__('wall')\n"
+                   "        self.ticks = 0\n        self.create_timer(0.01, self.tick)\n\n"
+                   "    def tick(self):\n        self.ticks += 1\n"
+                   "        self.get_logger().info('tick')\n"
+                   "        if self.ticks == 20:\n            os.kill(os.getpid(), signal.SIGINT)\n\n"
+                   "ticker = ros2nb.add(Ticker())")
+        result = kernel.run('_ = ros2nb.spin(10 ** 7)\nimport time\ntime.sleep(0.5)')
+        lines = result['stdout'].strip().splitlines()
+        assert result['error'] is None and lines[-1].startswith('Interrupted after '), result
+        assert lines[-1].endswith(' s; the nodes keep running (ros2nb.stop() stops them).'), lines
+        assert set(lines[:-1]) <= {'[INFO] [wall]: tick'}, lines  # the lines shown before it
+        assert int(kernel.run('print(ticker.ticks)')['stdout']) > 20  # and the node ran on
+    finally:
+        kernel.run('ros2nb.shutdown()')
+
+
 def test_a_check_that_fails_is_one_line(ros):
     result = ros.run('import ros2nb.checks\n'
                      'ros2nb.checks.check_expanded_path(lambda: "/Documents/W", ends_with="W")')

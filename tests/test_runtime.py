@@ -355,6 +355,61 @@ def test_stop_in_the_middle_of_rclpy_taking_a_callback_leaves_the_node_alive(ros
     assert capsys.readouterr().out.count('[INFO] [ticker]: Publishing:') == 2
 
 
+#: A spin whose Stop button is pressed (a real SIGINT) at the 50th call of FUNCTION in FILE,
+#: from code the Stop button counts as rclpy's, not the learner's.
+PRESS_INSIDE = '''
+import signal, sys, sysconfig, threading
+import ros2nb
+from rclpy.node import Node
+
+class Ticker(Node):
+    def __init__(self):
+        super().__init__('ticker')
+        self.create_timer(1.0, lambda: self.get_logger().info('tick'))
+
+ros2nb.start(sim_time=True)
+ros2nb.add(Ticker())
+file, function = sys.argv[1:]
+calls = 0
+
+def press(frame, event, _arg):
+    global calls
+    if event == 'call' and frame.f_code.co_name == function and frame.f_code.co_filename.endswith(file):
+        calls += 1
+        if calls == 50:
+            sys.setprofile(None)
+            signal.pthread_kill(threading.main_thread().ident, signal.SIGINT)
+
+press.__code__ = press.__code__.replace(co_filename=sysconfig.get_paths()['stdlib'] + '/press.py')
+sys.setprofile(press)
+ros2nb.spin(3000)
+sys.setprofile(None)
+ros2nb.spin(2, show_logs=False)  # and the kernel goes on
+'''
+
+
+@pytest.mark.parametrize('file, function', [
+    ('rclpy/task.py', '__init__'),  # rclpy makes a task for a callback
+    ('builtin_interfaces/msg/_time.py', 'sec'),  # ros2nb makes /clock's message
+    ('rcl_interfaces/msg/_log.py', 'msg'),  # rclpy's C code makes a /rosout message
+    ('ros2nb/runtime/logs.py', '<genexpr>'),  # the runtime reads the log lines
+])
+def test_the_stop_button_inside_rclpy_ends_the_spin_with_its_one_line(file, function):
+    """The Stop button lands wherever the kernel's main thread is. Pressed inside rclpy (or
+    a message's constructor), it once went lost with a message rclpy's C code was making (the
+    spin went on for ever: seen in test_browser_lab.py beside two CPU burners), or it left a
+    task half made (a warning after the spin's line). A press is now acted on between callbacks
+    (ros2nb.runtime.stop_button), except inside the learner's own callback (other tests)."""
+    done = subprocess.run([sys.executable, '-c', PRESS_INSIDE, file, function], text=True,
+                          capture_output=True, timeout=PATIENCE_S)
+    lines = [line for line in done.stdout.splitlines() if not line.startswith('ROS 2 is up')]
+    assert done.returncode == 0 and len(lines) == 2, (done.stdout, done.stderr[-2000:])
+    assert re.fullmatch(r'Interrupted after \d+\.0 of 3000 simulated s \(its log lines are not '
+                        r'shown\); the nodes wait until the next spin \(ros2nb.stop\(\) stops '
+                        r'them\)\.', lines[0]), lines
+    assert lines[1] == '(2 log lines hidden)' and done.stderr == '', done.stderr[-2000:]
+
+
 def test_lines_made_while_no_cell_ran_are_counted_not_shown(capsys):
     rt = ros2nb.start(sim_time=False)
     try:

@@ -15,7 +15,7 @@ import math
 import sys
 import os
 import time
-from typing import Optional
+from typing import Callable, Optional
 
 import rclpy
 from rclpy.node import Node
@@ -207,7 +207,8 @@ def spin(seconds: float, *, sim_time: Optional[bool] = None, show_logs: bool = T
     Log lines use the ROS console format without timestamps
     (``[INFO] [temperature_sensor]: Publishing: 22.31C``).  A callback that raises is
     reported here with its node, callback and line, and only that node is stopped.
-    The Stop button ends the spin with one line; the nodes then wait.
+    The Stop button ends the spin with one line; then the nodes wait (simulated time) or
+    keep running (the wall clock).
 
     Introduced in ``00-setup-and-the-pubsub-idea.ipynb``.
 
@@ -238,23 +239,22 @@ def spin(seconds: float, *, sim_time: Optional[bool] = None, show_logs: bool = T
         with contextlib.redirect_stdout(held.stdout), contextlib.redirect_stderr(held.stderr):
             flush()
 
+    rt.begin_spin()
     flush()
     ran, started_ns, started_wall = 0.0, rt.sim_now_ns, time.monotonic()
     try:
-        with rt.clock(use_sim):
+        # The Stop button is acted on between callbacks and between two looks at the log
+        # lines, never inside rclpy or the kernel's output stream (ros2nb.runtime.stop_button).
+        with rt.stop_button.held(), rt.clock(use_sim):
             if use_sim:
                 ran = rt.advance_sim_time(seconds, on_step=flush_held)
                 held.replay()
             else:
-                deadline = time.monotonic() + seconds
-                while (left := deadline - time.monotonic()) > 0:
-                    time.sleep(min(0.1, left))
-                    flush()
-                ran = float(seconds)
+                ran = _run_on_the_wall_clock(rt, seconds, flush)
     except KeyboardInterrupt:
         ran = ((rt.sim_now_ns - started_ns) / 1e9 if use_sim
                else time.monotonic() - started_wall)
-        flush_held()
+        (flush_held if use_sim else flush)()  # on the wall clock, lines show as they come
         _say_interrupted(rt, held, ran, seconds, use_sim)
         return ran
     flush()
@@ -262,14 +262,30 @@ def spin(seconds: float, *, sim_time: Optional[bool] = None, show_logs: bool = T
     return ran
 
 
+def _run_on_the_wall_clock(rt: Runtime, seconds: float, flush: Callable[[], None]) -> float:
+    """Let the background thread run the nodes for ``seconds``, showing their lines as they
+    come; the Stop button is acted on between two looks (:raises KeyboardInterrupt:)."""
+    deadline = time.monotonic() + seconds
+    while (left := deadline - time.monotonic()) > 0:
+        time.sleep(min(0.1, left))
+        rt.stop_button.point()
+        flush()
+    return float(seconds)
+
+
 def _say_interrupted(rt: Runtime, held: '_HeldOutput', ran: float, seconds: float,
                      use_sim: bool) -> None:
-    """The one line of a spin ended by the Stop button (a simulated spin's log lines dropped)."""
+    """The one line of a spin ended by the Stop button (a simulated spin's log lines dropped).
+
+    No log line follows it in the cell: lines still on their way over /rosout are dropped,
+    and so, on a kernel on the wall clock (whose nodes keep running between spins), are the
+    lines its nodes make until the cell's next spin.
+    """
     hidden = ' (its log lines are not shown)' if held.replay(errors_only=True) else ''
-    if use_sim:
-        rt.mute_cell()  # lines still on their way over /rosout would follow the line below
+    rt.mute_cell(until_next_spin=not rt.sim_time)
+    after = 'wait until the next spin' if rt.sim_time else 'keep running'
     print(f'Interrupted after {ran:.1f} of {seconds:g} {"simulated " if use_sim else ""}'
-          f's{hidden}; the nodes wait until the next spin (ros2nb.stop() stops them).')
+          f's{hidden}; the nodes {after} (ros2nb.stop() stops them).')
 
 
 def _say_done(rt: Runtime, taken: int, seconds: float, show_logs: bool) -> None:

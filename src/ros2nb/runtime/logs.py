@@ -17,6 +17,8 @@ from dataclasses import dataclass
 MAX_PENDING_LOG_LINES = 2000
 #: rcl_interfaces/msg/Log levels -> the console's severity names.
 SEVERITY_NAMES = {10: 'DEBUG', 20: 'INFO', 30: 'WARN', 40: 'ERROR', 50: 'FATAL'}
+#: A stamp later than any line's: muted until the next spin starts (LogLines.mute_cell).
+_UNTIL_NEXT_SPIN = 2 ** 63
 
 
 @dataclass(frozen=True)
@@ -71,11 +73,20 @@ class LogLines:
         with self._lock:
             self._our_loggers &= running
 
-    def mute_cell(self) -> None:
-        """Show none of the running cell's log lines made until now (an interrupted simulated
-        spin): those still on their way over /rosout are dropped, a later spin's are shown.
-        /rosout stamps every line with the wall clock, in simulated time too."""
-        self._muted = (self._epoch, time.time_ns())
+    def mute_cell(self, *, until_next_spin: bool = False) -> None:
+        """Show none of the running cell's log lines made until now (an interrupted spin):
+        those still on their way over /rosout are dropped, a later spin's are shown.
+        /rosout stamps every line with the wall clock, in simulated time too.
+
+        :param until_next_spin: also drop the cell's lines made from now until its next spin
+            starts (:meth:`begin_spin`): nodes on the wall clock keep running after a spin.
+        """
+        self._muted = (self._epoch, _UNTIL_NEXT_SPIN if until_next_spin else time.time_ns())
+
+    def begin_spin(self) -> None:
+        """A spin starts: lines muted until it (:meth:`mute_cell`) are shown from now on."""
+        if self._muted == (self._epoch, _UNTIL_NEXT_SPIN):
+            self._muted = (self._epoch, time.time_ns())
 
     def begin_cell(self) -> None:
         """A new cell starts: lines made before it are no longer news (IPython pre_run_cell)."""

@@ -19,6 +19,7 @@ from ..errors import Ros2nbError
 from ..explain.exceptions import explain_exception, learner_line
 from . import current
 from .logs import CallbackFailure
+from .stop_button import StopButton
 
 #: How long the background thread waits for work before checking for a pause (s); a
 #: pause (every spin, add, stop) waits this long at most.
@@ -46,6 +47,8 @@ class Spinning:
         self._thread = threading.Thread(target=self._spin_in_background,
                                         name='ros2nb-executor', daemon=True)
         self._background = background  # without it, callbacks run only in drain()
+        #: The Stop button while this thread spins (acted on between callbacks).
+        self.stop_button = StopButton(callback_entry=Spinning._run_one.__code__)
 
     def start_spinning(self) -> None:
         """Start the background thread (a check's subject has none: it drains only)."""
@@ -143,7 +146,8 @@ class Spinning:
                 self._paused.clear()
                 self._pause_requested.set()
                 self.executor.wake()
-            self._paused.wait()
+            with self.stop_button.waiting():  # the thread may be in a callback that never ends
+                self._paused.wait()
         self._exclusive_depth += 1
 
     def _unpause(self) -> None:
@@ -160,13 +164,18 @@ class Spinning:
 
         :raises Ros2nbError: when callbacks keep making work for each other without end
             (e.g. a node that answers every message on its own topic).
+        :raises KeyboardInterrupt: the Stop button, before the next callback.
         """
         counts: collections.Counter[str] = collections.Counter()
         while True:
             # With a zero timeout rclpy ends every wait round with TimeoutException, even
             # one that ran callbacks, so "idle" is a round in which nothing ran.
             in_round = 0
-            while (label := self._run_one(0.0)) is not None:
+            while True:
+                self.stop_button.point()
+                label = self._run_one(0.0)
+                if label is None:
+                    break
                 in_round += 1
                 counts[label] += 1
                 if sum(counts.values()) > MAX_CALLBACKS_PER_DRAIN:
@@ -180,9 +189,14 @@ class Spinning:
 
     @contextlib.contextmanager
     def exclusive(self) -> Iterator['Spinning']:
-        """Context manager: pause the spin thread so this thread may spin the executor."""
-        self._pause()
-        try:
-            yield self
-        finally:
-            self._unpause()
+        """Context manager: pause the spin thread so this thread may spin the executor.
+
+        The Stop button is held meanwhile (:class:`~ros2nb.runtime.stop_button.StopButton`):
+        a press raises ``KeyboardInterrupt`` between two callbacks, or at the block's end.
+        """
+        with self.stop_button.held():
+            self._pause()
+            try:
+                yield self
+            finally:
+                self._unpause()
