@@ -71,7 +71,7 @@ graph-tool:
 # Three steps, always all three (tests/run_steps.sh): tests/ with pytest-xdist, and nbval
 # over solutions/ and notebooks/ alongside it; one failure never hides the others, the
 # results come together at the end, and make fails if any step failed.
-TEST_WORKERS ?= 3
+TEST_WORKERS ?= 4
 
 test: $(STAMP) bytecode sandbox-tool browser-tool graph-tool
 	@tests/run_steps.sh $(PY) $(TEST_WORKERS)
