@@ -41,8 +41,10 @@ KINDS = ('sandboxed.runner', 'ipykernel', 'ros2nb.subject', 'ros2nb.judge', 'col
 def kind_of(argv: list[str]) -> str:
     """The kind of a process, from its command line (``other: PROGRAM`` when none matches)."""
     line = ' '.join(argv)
+    # chromium rewrites its argv[0] into one long line of options: its first word names it
+    program = Path(argv[0].split(' ')[0]).name[:40] if argv and argv[0] else ''
     return next((kind for kind in KINDS if kind in line),
-                f'other: {Path(argv[0]).name}' if argv else 'other')
+                f'other: {program}' if program else 'other')
 
 
 def busy_cpu_s() -> float:

@@ -1,0 +1,62 @@
+#!/usr/bin/env python3
+"""Where ``make test``'s CPU goes: each test file (and each nbval pass) run alone, its CPU by kind.
+
+``python benchmarks/test_profile.py [FILE ...]`` runs ``pytest FILE`` for every file of
+``tests/`` (or those named; ``solutions`` and ``notebooks`` name the two nbval passes), one
+after the other, each in one pytest process, and meanwhile reads every new process's CPU
+time from ``/proc`` (:class:`grading_profile.Sampler`).  It prints, per file, the wall
+seconds, the CPU seconds of every process started (pytest's own included) and the three
+kinds that took most; then the total.  ``make test`` is CPU-bound on two cores (its wall
+time is its CPU time over the cores it gets), so the total is what a cut must lower.
+
+Run it on an otherwise idle machine: every process started meanwhile is counted.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from grading_profile import Sampler, busy_cpu_s  # noqa: E402
+
+NBVAL = {
+    'solutions': ['--nbval', 'solutions', '--nbval-current-env', '--nbval-sanitize-with',
+                  'tests/sanitize.cfg'],
+    'notebooks': ['--nbval-lax', 'notebooks', '--nbval-current-env'],
+}
+
+
+def profile(name: str) -> tuple[float, float, list[tuple[str, float, int]], int]:
+    """Run one file (or nbval pass) alone: wall s, busy CPU s, CPU by kind, pytest's exit code."""
+    arguments = NBVAL.get(name, [f'tests/{name}'])
+    with Sampler() as sampler:
+        busy, started = busy_cpu_s(), time.monotonic()
+        done = subprocess.run([sys.executable, '-m', 'pytest', '-q', '-p', 'no:cacheprovider',
+                               *arguments], cwd=ROOT, capture_output=True, text=True)
+        wall, busy = time.monotonic() - started, busy_cpu_s() - busy
+    return wall, busy, sampler.by_kind(), done.returncode
+
+
+def main(names: list[str]) -> int:
+    names = names or [*sorted(p.name for p in (ROOT / 'tests').glob('test_*.py')), *NBVAL]
+    sys.stdout.reconfigure(line_buffering=True)
+    print('| file | wall s | CPU-s (processes) | busy CPU-s | most CPU-s, by kind | exit |')
+    print('|---|---|---|---|---|---|')
+    total_cpu = total_wall = 0.0
+    for name in names:
+        wall, busy, kinds, code = profile(name)
+        cpu = sum(seconds for _, seconds, _ in kinds)
+        total_cpu, total_wall = total_cpu + cpu, total_wall + wall
+        top = ', '.join(f'{kind} {seconds:.0f} ({count})' for kind, seconds, count in kinds[:3])
+        print(f'| {name} | {wall:.0f} | {cpu:.0f} ({sum(c for *_, c in kinds)}) | {busy:.0f} '
+              f'| {top} | {code} |')
+    print(f'| total | {total_wall:.0f} | {total_cpu:.0f} | | | |')
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main(sys.argv[1:]))
