@@ -14,6 +14,8 @@ from pathlib import Path
 
 import nbformat
 
+from judging import FIND_SUBJECT
+
 ROOT = Path(__file__).resolve().parent.parent
 SOLUTION = {p.stem: p for p in (ROOT / 'solutions').glob('*.ipynb')}
 LEARNER = {p.stem: p for p in (ROOT / 'notebooks').glob('*.ipynb')}
@@ -90,9 +92,10 @@ EXPECTED = {
                             {NB01: 'an attachment of 200 MB'}),
     # ---- nothing a learner's code touched is trusted (honest twin: complete's 02)
     'rewrites-package-xml': Case({NB02: 0}, {NB02: 'but it declares'}),
+    # a sensor without a timer (main() alone earns its 1 of 6), and its honest twin
+    'forges-its-timer': Case({NB03: 1}, {NB03: 'TemperatureSensor has no timer'}),
+    'no-timer': Case({NB03: 1}, {NB03: 'TemperatureSensor has no timer'}),
 }
-#: Learners whose feedback pages the browser test opens (a learner script must not run there).
-FEEDBACK_ATTACKERS = ('feedback-attacks', 'script-in-feedback', 'pasted-image')
 #: What a learner script in a feedback page would set (page title and a window flag).
 PWNED = 'pwned-by-a-learner'
 
@@ -322,6 +325,33 @@ def package_dependencies(package_xml: Path) -> list[str]:
 #: spinning, it waits for ever. (The hangs wait rather than compute: a hung cell keeps its
 #: sandbox for the whole cell limit, and a loop burning a CPU for those two minutes took a
 #: third of the sample class's CPU time from the learners graded beside it.)
+#: The timer's work done by the request handler: new_node reports a timer of 1 s, and
+#: each ``advance`` calls publish_temperature once per simulated second itself.
+FORGED_TIMER = FIND_SUBJECT + '''
+def _forge(_new_node=_HANDLERS.get('new_node'), _advance=_HANDLERS.get('advance')):
+    def new_node(**request):
+        reply = _new_node(**request)
+        if reply.get('ok'):
+            reply['timers'] = [[1_000_000_000, 'publish_temperature']]
+        return reply
+
+    def advance(seconds, seed=None):
+        if seed is not None:
+            random.seed(seed)
+        for _ in range(round(seconds)):
+            _SUBJECT.node.publish_temperature()
+        return _advance(seconds=seconds)
+
+    _HANDLERS.update(new_node=new_node, advance=advance)
+
+
+if _SUBJECT is not None:
+    _forge()
+'''
+
+TIMER_LINE = '        self.timer = self.create_timer(PUBLISH_PERIOD_S, self.publish_temperature)\n'
+MAIN_GUARD = "\nif __name__ == '__main__':"
+
 HANG_IN_CALLBACK = '''
 import time
 from rclpy.node import Node
@@ -452,6 +482,10 @@ def _hostile_class_two(folder: Path, put) -> None:
     answer = next(c for c in rewriter.cells if 'def package_dependencies' in c.source)
     answer.source = REWRITING_READER
     put('rewrites-package-xml', NB02, rewriter)
+    put('no-timer', NB03, _replaced(nbformat.read(SOLUTION[NB03], as_version=4), TIMER_LINE, ''))
+    put('forges-its-timer', NB03, _replaced(_replaced(  # its import rewrites its subject's replies
+        nbformat.read(SOLUTION[NB03], as_version=4), TIMER_LINE, ''),
+        MAIN_GUARD, FORGED_TIMER + MAIN_GUARD))
 
 
 def _with_attachment(source: Path, data: bytes) -> nbformat.NotebookNode:

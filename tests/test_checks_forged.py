@@ -16,37 +16,13 @@ import pytest
 from ros2nb import checks, course
 from ros2nb.checks.base import AnswerRef
 
-from grading_samples import REWRITING_READER
+from grading_samples import FORGED_TIMER, MAIN_GUARD, REWRITING_READER, TIMER_LINE
 from nodes import name_without_endpoints
 from waiting import wait_for
 from judging import FIND_SUBJECT
 from test_checks import PUB, SUB, fails, mutated, restore, session  # noqa: F401 (fixture)
 
 pytestmark = pytest.mark.timeout(300)
-
-#: The timer's work done by the request handler: new_node reports a timer of 1 s, and
-#: each ``advance`` calls publish_temperature once per simulated second itself.
-FORGED_TIMER = FIND_SUBJECT + '''
-def _forge(_new_node=_HANDLERS.get('new_node'), _advance=_HANDLERS.get('advance')):
-    def new_node(**request):
-        reply = _new_node(**request)
-        if reply.get('ok'):
-            reply['timers'] = [[1_000_000_000, 'publish_temperature']]
-        return reply
-
-    def advance(seconds, seed=None):
-        if seed is not None:
-            random.seed(seed)
-        for _ in range(round(seconds)):
-            _SUBJECT.node.publish_temperature()
-        return _advance(seconds=seconds)
-
-    _HANDLERS.update(new_node=new_node, advance=advance)
-
-
-if _SUBJECT is not None:
-    _forge()
-'''
 
 #: The callback's work done by the request handler: each ``advance`` steps the walk,
 #: publishes and logs the reading itself, while publish_temperature does nothing.
@@ -69,9 +45,6 @@ def _forge(_advance=_HANDLERS.get('advance')):
 if _SUBJECT is not None:
     _forge()
 '''
-
-TIMER_LINE = '        self.timer = self.create_timer(PUBLISH_PERIOD_S, self.publish_temperature)\n'
-MAIN_GUARD = "\nif __name__ == '__main__':"
 
 
 def test_a_sensor_without_a_timer_whose_subject_reports_one(session):
