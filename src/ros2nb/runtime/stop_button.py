@@ -17,26 +17,11 @@ from __future__ import annotations
 
 import contextlib
 import signal
-import sysconfig
 import threading
-from pathlib import Path
 from types import CodeType, FrameType
 from typing import Iterator, Optional
 
-#: Code that is not the learner's: the standard library, the installed packages (rclpy, the
-#: message classes, ipykernel) and ros2nb.  Anything else on the stack is the learner's (a
-#: cell, a file of their workspace).
-MACHINERY_FOLDERS = tuple(sorted({
-    f'{folder}/' for path in [*(sysconfig.get_paths()[key] for key in
-                                ('stdlib', 'platstdlib', 'purelib', 'platlib')),
-                              Path(__file__).parents[1]]
-    for folder in (Path(path), Path(path).resolve())}))
-
-
-def is_learner_code(code: CodeType) -> bool:
-    """True for code outside :data:`MACHINERY_FOLDERS` (frozen standard modules are not)."""
-    name = code.co_filename
-    return not name.startswith(MACHINERY_FOLDERS) and not name.startswith('<frozen ')
+from ..explain.exceptions import is_library_file
 
 
 class StopButton:
@@ -104,6 +89,6 @@ class StopButton:
         while frame is not None:
             if frame.f_code is self._entry:
                 return learner
-            learner = learner or is_learner_code(frame.f_code)
+            learner = learner or not is_library_file(frame.f_code.co_filename)
             frame = frame.f_back
         return False
