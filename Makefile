@@ -1,5 +1,5 @@
 # Two commands for everyone: `make lab` (JupyterLab on the course) and `make test`.
-# Everything lives in this folder: the venv, pip's cache, Jupyter's and ROS's files.
+# Everything lives in this folder: the venv, pip's and uv's caches, Jupyter's and ROS's files.
 
 PYTHON ?= python3
 VENV   := .venv
@@ -8,6 +8,7 @@ STAMP  := $(VENV)/.installed
 HERE   := $(CURDIR)
 
 export PIP_CACHE_DIR       := $(HERE)/.cache/pip
+export UV_CACHE_DIR        := $(HERE)/.cache/uv
 export JUPYTER_CONFIG_DIR  := $(HERE)/.jupyter/config
 export JUPYTER_DATA_DIR    := $(HERE)/.jupyter/data
 export JUPYTER_RUNTIME_DIR := $(HERE)/.jupyter/runtime
@@ -21,15 +22,15 @@ export PIP_DISABLE_PIP_VERSION_CHECK := 1
 
 setup: $(STAMP)
 
-$(STAMP): environment/requirements.txt pyproject.toml
+$(STAMP): environment/requirements.txt environment/installer.txt pyproject.toml
 	@$(PYTHON) -c 'import sys, platform; v = sys.version_info; \
 	  ok = (3, 10) <= v[:2] <= (3, 13) and platform.system() == "Linux" and platform.machine() == "x86_64"; \
 	  sys.exit(0 if ok else "The pip route needs Linux x86_64 and Python 3.10-3.13 (found %s %s, Python %d.%d); see README for RoboStack." % (platform.system(), platform.machine(), v[0], v[1]))'
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet --no-compile -r environment/requirements.txt
-	$(PY) -m pip install --quiet --no-deps --editable .
-	@# pip compiles one file after another; compileall uses every CPU (half the wall time on two)
+	$(PY) -m pip install --quiet -r environment/installer.txt
+	$(VENV)/bin/uv pip install --quiet --python $(PY) -r environment/requirements.txt
+	$(VENV)/bin/uv pip install --quiet --python $(PY) --no-deps --editable .
+	@# compileall uses every CPU (pip and uv compile one file after another)
 	@$(PY) -m compileall -q -j 0 $(VENV)/lib >/dev/null 2>&1 || true
 	@touch $(STAMP)
 
