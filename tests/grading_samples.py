@@ -71,6 +71,8 @@ EXPECTED = {
     # ---- every legal folder name and file name is graded or named
     'Zoë': Case({NB01: 1}),
     'two words': Case({NB01: 1}),
+    # nbgrader reads the ids it leaves out of a batch as one comma-separated string
+    'Lovelace, Ada': Case({NB01: 1}, {}, {'_folder': 'graded under the id learner-'}),
     'browser-copy': Case({NB01: 1}, {}, {NB01: f'graded {NB01} (1).ipynb as {NB01}.ipynb'}),
     'glob[*]chars': Case({NB01: 1}, {}, {'_folder': 'graded under the id learner-'}),
     # ---- the course's graded cells cannot be removed or re-weighted
@@ -435,6 +437,7 @@ def build(folder: Path, *, grading_out: Path, submissions: Path, decoy_gradebook
     put('corrupt-file', NB01, '{"cells": [{"cell_type": "code", "sou')
     put('Zoë', NB01, SOLUTION[NB01])
     put('two words', NB01, SOLUTION[NB01])
+    put('Lovelace, Ada', NB01, SOLUTION[NB01])
     put('browser-copy', NB01, SOLUTION[NB01], name=f'{NB01} (1).ipynb')
     put('glob[*]chars', NB01, SOLUTION[NB01])
     deleted = nbformat.read(SOLUTION[NB01], as_version=4)

@@ -28,11 +28,13 @@ from __future__ import annotations
 
 import argparse
 import concurrent.futures
+import itertools
 import json
 import os
 import shutil
 import sys
 import tempfile
+import threading
 import time
 import zipfile
 from pathlib import Path
@@ -79,24 +81,46 @@ def _refusal(submissions: Path, out: Path, args: argparse.Namespace) -> Optional
 
 def _grade_all(course: Path, learners: list[Learner], notebooks: list[str],
                settings: Settings, jobs: int) -> None:
-    """Grade every learner, ``jobs`` at a time, each notebook's judge beside the next run."""
+    """Grade every learner, ``jobs`` at a time, each notebook's judge beside the next run.
+
+    nbgrader scores them in two batches: once the last learner has started, those already
+    graded are scored while the others still run; then the rest.  A class's longest
+    learner (every notebook, one after another) is then followed by nbgrader scoring that
+    learner and a few others, not the whole class.
+    """
     with tempfile.TemporaryDirectory(prefix='ros2nb-grading-') as scratch_root:
         Path(scratch_root).chmod(0o711)
         judges = Judges(jobs)
+        # Most notebooks first, so the longest learner does not start last.
+        ordered = sorted(learners, key=lambda learner: -len(learner.files))
+        started, all_started = itertools.count(1), threading.Event()
+
+        def grade(learner: Learner) -> None:
+            if next(started) == len(ordered):
+                all_started.set()
+            grade_learner(course, Path(scratch_root), learner, notebooks, settings, judges)
+
         try:
             with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
-                # Most notebooks first, so the longest learner does not start last.
-                ordered = sorted(learners, key=lambda learner: -len(learner.files))
-                jobs_of = {pool.submit(grade_learner, course, Path(scratch_root), learner,
-                                       notebooks, settings, judges): learner for learner in ordered}
+                jobs_of = {pool.submit(grade, learner): learner for learner in ordered}
+                all_started.wait()
+                first = {learner.id for job, learner in jobs_of.items() if job.done()}
+                _score(course, learners, first)
                 for job, learner in jobs_of.items():
                     try:
                         job.result()
                     except Exception as error:  # noqa: BLE001 - that learner's, in a note
                         learner.note('_folder', f'the grader could not grade this learner '
                                                 f'({type(error).__name__}: {str(error)[:200]})')
+            _score(course, learners, {learner.id for learner in learners} - first)
         finally:
             judges.close()
+
+
+def _score(course: Path, learners: list[Learner], batch: set[str]) -> None:
+    """nbgrader scores the learners whose ids are in ``batch`` and writes their feedback."""
+    if any(learner.files for learner in learners if learner.id in batch):
+        score_and_feedback(course, exclude=[l.id for l in learners if l.id not in batch])
 
 
 def _report(out: Path, learners: list[Learner], rows: list[list[str]],
@@ -162,8 +186,6 @@ def _grade(args: argparse.Namespace, submissions: Path, out: Path, started: floa
         return 2
     settings = Settings(args.cell_timeout, args.notebook_timeout, not args.no_sandbox)
     _grade_all(course, learners, notebooks, settings, args.jobs)
-    if any(learner.files for learner in learners):
-        score_and_feedback(course)
     _report(out, learners, write_results(course, out, learners, notebooks), refused)
     print(f'wrote {args.out.resolve() / "grades.csv"} and {args.out.resolve() / "feedback"} in '
           f'{time.monotonic() - started:.0f} s')

@@ -17,6 +17,7 @@ import sys
 import tempfile
 from importlib import metadata
 from pathlib import Path
+from typing import Iterable
 
 from nbgrader.api import Gradebook, MissingEntry
 
@@ -159,15 +160,21 @@ def write_results(course: Path, out: Path, learners: list[Learner],
     return rows
 
 
-def score_and_feedback(course: Path) -> None:
-    """nbgrader scores what was filed (executing nothing), then writes the feedback."""
+def score_and_feedback(course: Path, exclude: Iterable[str] = ()) -> None:
+    """nbgrader scores what was filed (executing nothing), then writes the feedback.
+
+    :param exclude: nbgrader ids of learners left out (not yet graded, or scored before);
+        ids never hold a comma (:func:`.submissions.find_learners`).
+    """
     log = course / 'grading.log'
     config = course / 'nbgrader_config.py'
+    left_out = ([f'--CourseDirectory.student_id_exclude={",".join(sorted(exclude))}']
+                if exclude else [])
     # nbgrader reads the course's nbgrader_config.py (its command line has no --config);
     # the score-only settings are there only for this one run.
     config.write_text(COURSE_CONFIG + SCORE_ONLY_CONFIG)
     try:
-        nbgrader(course, 'autograde', ASSIGNMENT, '--force', log=log)
+        nbgrader(course, 'autograde', ASSIGNMENT, '--force', *left_out, log=log)
     finally:
         config.write_text(COURSE_CONFIG)
-    nbgrader(course, 'generate_feedback', ASSIGNMENT, '--force', log=log)
+    nbgrader(course, 'generate_feedback', ASSIGNMENT, '--force', *left_out, log=log)

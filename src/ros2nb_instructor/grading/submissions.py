@@ -16,8 +16,9 @@ from typing import Optional
 
 import nbformat
 
-#: Characters nbgrader cannot have in a student id (it builds glob patterns from ids).
-_GLOB = re.compile(r'[*?\[\]{}\\]')
+#: Characters nbgrader cannot have in a student id: it builds glob patterns from ids, and
+#: reads a list of ids to leave out as one comma-separated string.
+_GLOB = re.compile(r'[*?\[\]{}\\,]')
 #: What browsers and file managers add to a name they save twice.
 _COPY = re.compile(r'^(?P<stem>.+?)(?: ?\(\d+\)| - Copy(?: \(\d+\))?| copy(?: \d+)?|-Copy\d*)$')
 #: Files a platform's download may hold that are archives themselves.
