@@ -51,7 +51,8 @@ import requests
 from notebook_outputs import comparable_outputs, compared
 from waiting import PATIENCE_S, wait_for as poll
 from tornado.httpclient import HTTPRequest
-from tornado.websocket import WebSocketClientConnection, websocket_connect
+from tornado.websocket import (WebSocketClientConnection, WebSocketClosedError,
+                               websocket_connect)
 
 ROOT = Path(__file__).resolve().parent.parent
 PROXY = ROOT / '.cache' / 'node' / 'node_modules' / '.bin' / 'configurable-http-proxy'
@@ -269,15 +270,34 @@ def stop_hub(hub: Hub) -> None:
 class Kernel:
     """One kernel on a learner's server, driven over its websocket channels."""
 
-    def __init__(self, learner: str, connection: WebSocketClientConnection) -> None:
-        self.learner = learner
+    def __init__(self, learner: str, url: str, token: str,
+                 connection: WebSocketClientConnection) -> None:
+        self.learner, self.url, self.token = learner, url, token
         self.connection = connection
         self.session = uuid.uuid4().hex
+
+    async def _send(self, message: str) -> None:
+        """Send on the websocket; one that was closed before the send is opened again once.
+
+        JupyterLab does the same when its kernel's websocket closes: it reconnects to the
+        same kernel, which keeps its state.  (Beside a loaded make test, a server once closed
+        a fresh kernel websocket before its first request was sent.)
+        """
+        try:
+            await self.connection.write_message(message)
+        except WebSocketClosedError:
+            closed = (f'{self.learner}: the kernel websocket was closed before a request '
+                      f'(code {self.connection.close_code}, {self.connection.close_reason!r})')
+            self.connection = (await connect(self.learner, self.url, self.token)).connection
+            try:
+                await self.connection.write_message(message)
+            except WebSocketClosedError:
+                raise AssertionError(f'{closed}, and again after reconnecting') from None
 
     async def execute(self, code: str, seconds: float = CELL_S) -> list[dict]:
         """Run ``code`` and return its outputs (streams, errors, displays) in nbformat's shape."""
         msg_id = uuid.uuid4().hex
-        await self.connection.write_message(json.dumps({
+        await self._send(json.dumps({
             'channel': 'shell', 'buffers': [], 'metadata': {}, 'parent_header': {},
             'header': {'msg_id': msg_id, 'msg_type': 'execute_request', 'version': '5.3',
                        'session': self.session, 'username': self.learner},
@@ -325,7 +345,7 @@ def open_kernel(hub: Hub, learner: str, token: str) -> tuple[str, str]:
 async def connect(learner: str, url: str, token: str) -> Kernel:
     """Open the kernel's websocket channels with the learner's token."""
     request = HTTPRequest(url, headers={'Authorization': f'token {token}'}, request_timeout=API_S)
-    return Kernel(learner, await websocket_connect(request))
+    return Kernel(learner, url, token, await websocket_connect(request))
 
 
 # ------------------------------------------------------------ nbval's comparison rules
@@ -406,7 +426,11 @@ def class_run():
                      f"{learner}'s server ready", hub, seen=lambda: server_state(hub, learner))
         tokens = {learner: learner_token(hub, learner) for learner in LEARNERS}
         cells = code_cells(NOTEBOOK)
-        probes, outputs = asyncio.run(run_class(hub, tokens, cells))
+        try:
+            probes, outputs = asyncio.run(run_class(hub, tokens, cells))
+        except Exception as error:  # noqa: BLE001 - said with what the hub logged
+            pytest.fail(f'running the notebook on the hub: {type(error).__name__}: {error}; '
+                        f'the hub log ends:\n{hub.log_tail()}')
         yield ClassRun(hub, probes, outputs, cells, time.monotonic() - began)
     finally:
         if hub is not None:
