@@ -323,10 +323,6 @@ def package_dependencies(package_xml: Path) -> list[str]:
     return names
 '''
 
-#: A callback that waits for a flag only another callback could set: with one thread
-#: spinning, it waits for ever. (The hangs wait rather than compute: a hung cell keeps its
-#: sandbox for the whole cell limit, and a loop burning a CPU for those two minutes took a
-#: third of the sample class's CPU time from the learners graded beside it.)
 #: The timer's work done by the request handler: new_node reports a timer of 1 s, and
 #: each ``advance`` calls publish_temperature once per simulated second itself.
 FORGED_TIMER = FIND_SUBJECT + '''
@@ -354,6 +350,10 @@ if _SUBJECT is not None:
 TIMER_LINE = '        self.timer = self.create_timer(PUBLISH_PERIOD_S, self.publish_temperature)\n'
 MAIN_GUARD = "\nif __name__ == '__main__':"
 
+#: A callback that waits for a flag only another callback could set: with one thread
+#: spinning, it waits for ever. (The hangs wait rather than compute: a hung cell keeps its
+#: sandbox for the whole cell limit, and a loop burning a CPU for those two minutes took a
+#: third of the sample class's CPU time from the learners graded beside it.)
 HANG_IN_CALLBACK = '''
 import time
 from rclpy.node import Node
