@@ -654,3 +654,29 @@ def test_the_stop_button_while_a_pause_waits_leaves_no_hang(ros):
     threading.Thread(target=pause_again, daemon=True).start()
     assert wait_until(done.is_set), 'the next pause waited forever: the kernel would hang'
     ros2nb.stop()
+
+
+@pytest.mark.timeout(2 * PATIENCE_S)
+def test_a_pause_wakes_the_background_wait_at_once(monkeypatch):
+    """The background thread waits for work up to BACKGROUND_WAIT_S; a pause (every spin,
+    add, stop) must not wait that long. rclpy's own timed wait ends only at its timeout: a
+    wake that did not end it would make each of these pauses wait the whole bound (here
+    longer than the test waits), and an idle kernel polled 50 times a second instead."""
+    spinning = importlib.import_module('ros2nb.runtime.spinning')
+    monkeypatch.setattr(spinning, 'BACKGROUND_WAIT_S', 2 * PATIENCE_S)
+    rt = ros2nb.start(sim_time=True)
+    try:
+        ros2nb.add(Sensor())
+        done = threading.Event()
+
+        def pause_often() -> None:  # a daemon thread: if a pause hangs, the test still ends
+            for _ in range(5):
+                assert wait_until(lambda: not rt._resume.is_set())  # resumed: back to its wait
+                with rt.exclusive():
+                    pass
+            done.set()
+
+        threading.Thread(target=pause_often, daemon=True).start()
+        assert wait_until(done.is_set), 'a pause waited for the background wait to time out'
+    finally:
+        ros2nb.shutdown()
