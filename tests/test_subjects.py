@@ -6,11 +6,14 @@ gets about a third of a CPU, as a subject does beside two CPU-bound programs: a 
 wall clock alone (the judge's old one) would have called it hung.
 """
 
+import threading
 import time
 
 import pytest
 
+from ros2nb.judge import observer
 from ros2nb.judge.subjects import SubjectHung, SubjectProcess
+from waiting import PATIENCE_S, wait_until
 
 #: Seconds the subject is given in these tests.
 LIMIT_S = 2.0
@@ -69,3 +72,15 @@ def test_a_call_that_waits_for_ever_is_cut_after_the_limit_on_the_wall_clock(sub
     with pytest.raises(SubjectHung, match=r'^Your code did not finish within 2 s'):
         call(subject, 'waits_for_ever')
     assert time.monotonic() - began >= LIMIT_S
+
+
+@pytest.mark.timeout(2 * PATIENCE_S)
+def test_the_judges_observer_closes_at_once_however_long_its_wait(monkeypatch):
+    """The judge's spin thread waits for work up to SPIN_WAIT_S; close() wakes it. With
+    rclpy's spin_once the wait ended only at its timeout: every judge would have waited it
+    out on close (here longer than the test waits), and an idle judge polled 20 times a second."""
+    monkeypatch.setattr(observer, 'SPIN_WAIT_S', 2 * PATIENCE_S)
+    watching = observer.Observer()
+    closed = threading.Event()
+    threading.Thread(target=lambda: (watching.close(), closed.set()), daemon=True).start()
+    assert wait_until(closed.is_set), "close() waited for the spin thread's wait to time out"
