@@ -125,11 +125,14 @@ class Patience:
 
     :param pid: the process at the top of the tree (a sandbox's own process is fine).
     :param limit_s: seconds of CPU time, or of waiting, the tree is given.
+    :param started: when the tree was asked (``time.monotonic()``; default now).  CPU time
+        counts from now: reading /proc costs a few milliseconds on a busy machine, so a
+        caller whose answers mostly come at once may start measuring late.
     """
 
-    def __init__(self, pid: int, limit_s: float) -> None:
+    def __init__(self, pid: int, limit_s: float, started: Optional[float] = None) -> None:
         self.pid, self.limit_s = pid, limit_s
-        self.started = time.monotonic()
+        self.started = time.monotonic() if started is None else started
         self.cpu_at_start = tree_cpu_seconds(pid)
         self._samples: deque[tuple[float, float]] = deque([(self.started, self.cpu_at_start)])
 

@@ -15,6 +15,7 @@ import select
 import subprocess
 import sys
 import threading
+import time
 from pathlib import Path
 from typing import Any, Optional
 
@@ -133,19 +134,25 @@ class SubjectProcess:
             os.write(self._commands, (json.dumps({'op': op, **arguments}) + '\n').encode())
         except BrokenPipeError:
             raise self._died() from None
-        patience = Patience(self.proc.pid, timeout)
+        sent, patience = time.monotonic(), None
         while b'\n' not in self._buffer:
-            if patience.exhausted():
-                kill_process_group(self.proc)
-                raise SubjectHung(f'Your code did not finish within {timeout:g} s (an endless '
-                                  'loop, or a call that waits for ever?): look for a loop that '
-                                  'never ends in the part you wrote.')
             ready, _, _ = select.select([self._replies], [], [], POLL_S)
             if ready:
                 chunk = os.read(self._replies, 65536)
                 if not chunk:
                     raise self._died()
                 self._buffer += chunk
+                continue
+            # No reply within POLL_S: from now on the subject's CPU time counts.  (Most
+            # replies come sooner, and reading /proc for each cost the judge more than the
+            # reply: an hour of a sensor asks 720 times.)
+            if patience is None:
+                patience = Patience(self.proc.pid, timeout, started=sent)
+            elif patience.exhausted():
+                kill_process_group(self.proc)
+                raise SubjectHung(f'Your code did not finish within {timeout:g} s (an endless '
+                                  'loop, or a call that waits for ever?): look for a loop that '
+                                  'never ends in the part you wrote.')
         line, self._buffer = self._buffer.split(b'\n', 1)
         return json.loads(line)
 
