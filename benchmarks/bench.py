@@ -18,10 +18,14 @@ else the machine does falls on both alike.
 Targets (issue "Fast and steady"): simulated hour >= 0.9 x bare rclpy and >= 1000x real
 time; grading <= 10 s per notebook for a complete learner.
 
-4. Only when asked (``--only class``): a whole class of ``--learners`` complete learners
+4. An idle runtime: a kernel's between cells (two nodes on simulated time) and a bare
+   rclpy program's blocked in ``spin()``, in per cent of one CPU (dozens of kernels and
+   judges sit idle at once in a class or in ``make test``).
+
+5. Only when asked (``--only class``): a whole class of ``--learners`` complete learners
    graded at once (``tools/grade.py``'s default jobs), minutes in all and seconds per notebook.
 
-Usage: ``make bench`` or ``python benchmarks/bench.py [--reps N] [--only sim|first|grading]``;
+Usage: ``make bench`` or ``python benchmarks/bench.py [--reps N] [--only sim|first|grading|idle]``;
 ``make bench BENCH_ARGS='--only class --learners 30'`` for a class.
 """
 
@@ -121,7 +125,7 @@ def row(label: str, seconds: list[float], note: str = '') -> str:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('--reps', type=int, default=5)
-    parser.add_argument('--only', choices=('sim', 'first', 'grading', 'class'))
+    parser.add_argument('--only', choices=('sim', 'first', 'grading', 'idle', 'class'))
     parser.add_argument('--learners', type=int, default=30, help='class size for --only class')
     args = parser.parse_args()
     sys.stdout.reconfigure(line_buffering=True)  # each row as measured: a run cut short keeps it
@@ -157,6 +161,12 @@ def main() -> None:
         print(row('grading, complete learner, per notebook', graded['complete'],
                   'target <= 10 s'))
         print(row('grading, untouched learner, per notebook', graded['untouched']))
+    if args.only in (None, 'idle'):
+        idle = interleaved({'kernel': lambda: 100 * both('idle-kernel')[1],
+                            'bare': lambda: 100 * both('idle-bare')[1]}, args.reps)
+        print(row('idle kernel, two nodes on simulated time, % of one CPU', idle['kernel'],
+                  'between cells'))
+        print(row('idle bare rclpy, the same nodes in spin(), % of one CPU', idle['bare']))
     if args.only == 'class':
         elapsed, count, full = grade_class(args.learners)
         print(f'| a class of {args.learners} complete learners | {elapsed:.0f} | | 1 | '

@@ -12,6 +12,9 @@ peers and repeats them.
   the first reading received by a monitor node in the same process.
 - ``first-message-processes``: from starting the sensor and the monitor as two processes
   (what ``ros2 run`` starts) to the monitor printing its first reading.
+- ``idle-kernel``: a kernel's runtime between cells (the sensor and the monitor added, on
+  simulated time, nothing to do): CPU seconds it uses per second of wall clock.
+- ``idle-bare``: the same nodes in a bare rclpy program blocked in ``executor.spin()``.
 """
 
 from __future__ import annotations
@@ -150,9 +153,59 @@ def first_message_processes() -> float:
             proc.wait()
 
 
+#: Wall-clock seconds an idle runtime is watched.
+IDLE_S = 5.0
+
+
+def _idle_cpu_share() -> tuple[float, float]:
+    """(IDLE_S, CPU seconds per wall second of this process over IDLE_S seconds)."""
+    time.sleep(0.5)  # what starting the nodes left to do
+    started = time.process_time()
+    time.sleep(IDLE_S)
+    return IDLE_S, (time.process_time() - started) / IDLE_S
+
+
+def idle_kernel() -> tuple[float, float]:
+    import ros2nb
+    sensor = reference_module('temperature_publisher')
+    monitor = reference_module('temperature_subscriber')
+    with contextlib.redirect_stdout(io.StringIO()):
+        ros2nb.start(sim_time=True)
+        ros2nb.add(sensor.TemperatureSensor())
+        ros2nb.add(monitor.TemperatureMonitor())
+        measured = _idle_cpu_share()
+        ros2nb.shutdown()
+    return measured
+
+
+def idle_bare() -> tuple[float, float]:
+    import threading
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.parameter import Parameter
+    sensor = reference_module('temperature_publisher')
+    monitor = reference_module('temperature_subscriber')
+    rclpy.init()
+    executor = SingleThreadedExecutor()
+    nodes = [sensor.TemperatureSensor(), monitor.TemperatureMonitor()]
+    for node in nodes:
+        node.set_parameters([Parameter('use_sim_time', Parameter.Type.BOOL, True)])
+        executor.add_node(node)
+    spinning = threading.Thread(target=executor.spin)
+    spinning.start()
+    measured = _idle_cpu_share()
+    executor.shutdown()  # spin() returns
+    spinning.join()
+    for node in nodes:
+        node.destroy_node()
+    rclpy.shutdown()
+    return measured
+
+
 MEASURES = {'sim-hour-ros2nb': sim_hour_ros2nb, 'sim-hour-bare': sim_hour_bare,
             'first-message-kernel': first_message_kernel,
-            'first-message-processes': first_message_processes}
+            'first-message-processes': first_message_processes,
+            'idle-kernel': idle_kernel, 'idle-bare': idle_bare}
 
 if __name__ == '__main__':
     if len(sys.argv) != 2 or sys.argv[1] not in MEASURES:
