@@ -134,7 +134,8 @@ class Patience:
         self.pid, self.limit_s = pid, limit_s
         self.started = time.monotonic() if started is None else started
         self.cpu_at_start = tree_cpu_seconds(pid)
-        self._samples: deque[tuple[float, float]] = deque([(self.started, self.cpu_at_start)])
+        # (when, CPU seconds then): the busy share is measured between real samples
+        self._samples: deque[tuple[float, float]] = deque([(time.monotonic(), self.cpu_at_start)])
 
     def exhausted(self) -> bool:
         """True once the tree has had its limit (call it every fraction of a second)."""
