@@ -277,10 +277,16 @@ class Subject:
         return {'ok': True, **self._counts()}
 
     def wait_publishers(self, topic: str, seconds: float) -> dict:
-        """Wait until the node's graph shows a publisher on ``topic`` (the judge's, discovered)."""
+        """Wait until the node's subscriptions on ``topic`` have matched a publisher (the
+        judge's).  Their own match, not the graph's list: in a subject that made a node
+        before, the graph already lists the judge's publisher while the new subscription
+        has not matched it yet, and a reading sent then was lost."""
         deadline = time.monotonic() + seconds
-        while self.node is not None and time.monotonic() < deadline:
-            if self.node.count_publishers(topic) >= 1:
+        node = self.node
+        subscriptions = [s for s in node.subscriptions
+                         if node.resolve_topic_name(s.topic_name) == topic] if node else []
+        while time.monotonic() < deadline:
+            if subscriptions and all(s.get_publisher_count() >= 1 for s in subscriptions):
                 return {'ok': True}
             time.sleep(0.01)
         return {'ok': False}
