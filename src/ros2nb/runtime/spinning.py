@@ -25,7 +25,7 @@ from .stop_button import StopButton
 #: Longest wait of the background thread for work (s).  A pause (every spin, add, stop)
 #: wakes the wait at once (:meth:`Spinning._wanted_elsewhere`), so this only bounds a wake
 #: that never came.  An idle kernel wakes this often: at 0.02 s (rclpy's own timed wait can
-#: only end at its timeout) each idle kernel took 2.6 % of a core, 0.1 % now.
+#: only end at its timeout) each idle kernel took 2.9 % of a CPU, 0.16 % now (``make bench``).
 BACKGROUND_WAIT_S = 0.5
 #: Callbacks one idle-wait may run before ros2nb calls it a loop that never ends (a burst
 #: of a few thousand messages to many subscriptions stays well below).
@@ -81,12 +81,12 @@ class Spinning:
             self._thread.join()
 
     def _run_one(self, timeout_sec: float,
-                 until: Optional[Callable[[], bool]] = None) -> Optional[str]:
+                 until: Callable[[], bool] = _never) -> Optional[str]:
         """Run one ready callback; return its name, or None when none became ready in time
         (or ``until()`` became true while waiting: the executor's ``wake()`` checks it)."""
         try:
             handler, entity, node = self.executor.wait_for_ready_callbacks(
-                timeout_sec=timeout_sec, condition=until or _never)
+                timeout_sec=timeout_sec, condition=until)
             handler()
         except (TimeoutException, ConditionReachedException):
             return None

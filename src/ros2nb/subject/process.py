@@ -285,8 +285,8 @@ class Subject:
         node = self.node
         subscriptions = [s for s in node.subscriptions
                          if node.resolve_topic_name(s.topic_name) == topic] if node else []
-        while time.monotonic() < deadline:
-            if subscriptions and all(s.get_publisher_count() >= 1 for s in subscriptions):
+        while subscriptions and time.monotonic() < deadline:  # none: nothing can match
+            if all(s.get_publisher_count() >= 1 for s in subscriptions):
                 return {'ok': True}
             time.sleep(0.01)
         return {'ok': False}
