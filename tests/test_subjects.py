@@ -6,6 +6,9 @@ gets about a third of a CPU, as a subject does beside two CPU-bound programs: a 
 wall clock alone (the judge's old one) would have called it hung.
 """
 
+import os
+import subprocess
+import sys
 import threading
 import time
 
@@ -84,3 +87,35 @@ def test_the_judges_observer_closes_at_once_however_long_its_wait(monkeypatch):
     closed = threading.Event()
     threading.Thread(target=lambda: (watching.close(), closed.set()), daemon=True).start()
     assert wait_until(closed.is_set), "close() waited for the spin thread's wait to time out"
+
+
+ENDS_WITH_AN_EXIT_HANDLER = """
+import atexit, sys
+from ros2nb.processes import end_this_process
+atexit.register(lambda: print('exit handler ran'))
+print('x' * 100_000, end='')  # most of it waits in stdout's buffer: stdout is a pipe
+end_this_process(3)
+"""
+
+
+def test_a_process_ended_early_still_runs_its_exit_handlers_and_says_everything():
+    """The judge and its subjects skip the interpreter's teardown (end_this_process); what a
+    normal exit does first still happens: with os._exit alone the exit handler would not
+    run and most of the buffered output would be lost."""
+    env = {k: v for k, v in os.environ.items() if k != 'PYTHONUNBUFFERED'}
+    done = subprocess.run([sys.executable, '-c', ENDS_WITH_AN_EXIT_HANDLER], env=env,
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode == 3, done.stderr
+    assert done.stdout == 'x' * 100_000 + 'exit handler ran\n'
+
+
+def test_a_subject_ends_by_itself_and_its_exit_handlers_run(tmp_path):
+    """A subject asked to quit ends by itself, exit status 0, having run what the learner's
+    code registered to run at exit, as before it skipped the interpreter's teardown."""
+    marker = tmp_path / 'exit-handler-ran'
+    process = SubjectProcess(tmp_path)
+    cells = f"import atexit, pathlib\natexit.register(pathlib.Path({str(marker)!r}).touch)"
+    assert process.request('exec_cells', sources=[cells])['cell_errors'] == []
+    process.close()
+    assert process.proc.returncode == 0, process.output.text()
+    assert marker.exists()

@@ -8,12 +8,14 @@ when a process has had long enough (:class:`Patience`).  No mention of ROS here.
 
 from __future__ import annotations
 
+import atexit
 import os
 import signal
 import subprocess
+import sys
 import time
 from collections import deque
-from typing import Optional, Sequence
+from typing import NoReturn, Optional, Sequence
 
 #: Seconds a process gets to exit after Ctrl+C (SIGINT) before SIGTERM, then SIGKILL.
 STOP_GRACE_S = 5.0
@@ -183,3 +185,27 @@ def interrupt(proc: subprocess.Popen, sig: int = signal.SIGINT) -> None:
             os.kill(pid, sig)
         except ProcessLookupError:
             pass
+
+
+def end_this_process(code: int) -> NoReturn:
+    """End the calling process with exit status ``code``, as ``sys.exit`` would, but sooner.
+
+    The exit handlers (:mod:`atexit`) run and standard output and error are flushed, as at
+    a normal exit; what is skipped is the interpreter's teardown of every module and object,
+    which in a process that ran ROS costs a tenth of a CPU-second (Fast DDS's libraries, a
+    thousand modules).  The judge and its subjects end this way, after they have closed
+    what they opened: ``make test`` starts hundreds of them.  multiprocessing ends its child
+    processes with ``os._exit`` for the same reason.  Not for the learner's kernel, whose
+    exit handlers other code registers.
+
+    :param code: the exit status (0-255).
+    """
+    try:
+        atexit._run_exitfuncs()  # what a normal exit runs first, in the same order
+    finally:
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except (OSError, ValueError):  # closed, or its reader gone: nothing more to say
+                pass
+        os._exit(code)

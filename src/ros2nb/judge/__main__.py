@@ -15,6 +15,7 @@ from typing import Any
 from .. import checks
 from ..checks.base import bind_judge
 from ..checks.dispatch import IN_JUDGE_ENV, captured
+from ..processes import end_this_process
 from ..terminal.workspace import default_workspace
 from .grading import grade
 from .session import Session
@@ -44,4 +45,4 @@ def main(argv: list[str]) -> int:
 
 
 if __name__ == '__main__':
-    sys.exit(main(sys.argv[1:]))
+    end_this_process(main(sys.argv[1:]))

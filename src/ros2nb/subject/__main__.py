@@ -8,6 +8,7 @@ from __future__ import annotations
 import os
 import sys
 
+from ..processes import end_this_process
 from .process import PROTOCOL_ERROR, serve
 
 
@@ -23,4 +24,4 @@ def main(argv: list[str]) -> int:
 
 
 if __name__ == '__main__':
-    sys.exit(main(sys.argv[1:]))
+    end_this_process(main(sys.argv[1:]))
