@@ -30,28 +30,21 @@ from .submissions import Learner, screen_zip
 SET_UP_CACHE = ROOT / '.cache' / 'grading-courses'
 #: nbgrader settings of the course under grading/: feedback shows learners' content as text.
 COURSE_CONFIG = 'c = get_config()  # noqa: F821\n'
-SCORE_ONLY_CONFIG = '''\
-# Score notebooks that were already run and judged: execute nothing, keep the outputs.
-from nbgrader.converters.autograde import Autograde
-from nbgrader.preprocessors import ClearOutput, Execute
-
-defaults = Autograde.class_traits()
-c.Autograde.sanitize_preprocessors = [
-    p for p in defaults['sanitize_preprocessors'].default() if p is not ClearOutput]
-c.Autograde.autograde_preprocessors = [
-    p for p in defaults['autograde_preprocessors'].default() if p is not Execute]
-'''
 
 
 def nbgrader(course: Path, *args: str, log: Path) -> int:
     """Run ``nbgrader ARGS`` for the course folder (trusted: it executes nothing of learners')."""
     argv = [*nbgrader_argv(*args), f'--CourseDirectory.root={course}',
             f'--CourseDirectory.db_url=sqlite:///{course / "gradebook.db"}', '--log-level=INFO']
-    env = dict(os.environ, JUPYTER_CONFIG_DIR=str(course / '.jupyter'),
-               PATH=os.pathsep.join([str(Path(sys.executable).parent), os.environ['PATH']]))
     with open(log, 'a') as out:
-        return subprocess.run(argv, cwd=course, env=env, stdout=out, stderr=subprocess.STDOUT,
-                              stdin=subprocess.DEVNULL).returncode
+        return subprocess.run(argv, cwd=course, env=_nbgrader_env(course), stdout=out,
+                              stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL).returncode
+
+
+def _nbgrader_env(course: Path) -> dict[str, str]:
+    """nbgrader's environment: the course's own Jupyter settings, the course's Python first."""
+    return dict(os.environ, JUPYTER_CONFIG_DIR=str(course / '.jupyter'),
+                PATH=os.pathsep.join([str(Path(sys.executable).parent), os.environ['PATH']]))
 
 
 def set_up_course(course: Path) -> list[str]:
@@ -163,18 +156,12 @@ def write_results(course: Path, out: Path, learners: list[Learner],
 def score_and_feedback(course: Path, exclude: Iterable[str] = ()) -> None:
     """nbgrader scores what was filed (executing nothing), then writes the feedback.
 
+    Both in one process (:mod:`.scoring`), its log appended to ``course/grading.log``.
+
     :param exclude: nbgrader ids of learners left out (not yet graded, or scored before);
         ids never hold a comma (:func:`.submissions.find_learners`).
     """
-    log = course / 'grading.log'
-    config = course / 'nbgrader_config.py'
-    left_out = ([f'--CourseDirectory.student_id_exclude={",".join(sorted(exclude))}']
-                if exclude else [])
-    # nbgrader reads the course's nbgrader_config.py (its command line has no --config);
-    # the score-only settings are there only for this one run.
-    config.write_text(COURSE_CONFIG + SCORE_ONLY_CONFIG)
-    try:
-        nbgrader(course, 'autograde', ASSIGNMENT, '--force', *left_out, log=log)
-    finally:
-        config.write_text(COURSE_CONFIG)
-    nbgrader(course, 'generate_feedback', ASSIGNMENT, '--force', *left_out, log=log)
+    with open(course / 'grading.log', 'a') as out:
+        subprocess.run([sys.executable, '-m', 'ros2nb_instructor.grading.scoring', str(course),
+                        ','.join(sorted(exclude))], cwd=course, env=_nbgrader_env(course),
+                       stdout=out, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
