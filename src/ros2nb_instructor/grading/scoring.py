@@ -6,7 +6,7 @@ nothing of the learners').  nbgrader's own converters do the work its ``autograd
 ``generate_feedback`` commands do, one after the other, as nbgrader's API (the
 Formgrader's) runs them: one start of nbgrader per batch instead of two (1.1 CPU-s each).
 Autograde only scores: every notebook was run in a sandbox and judged before, so its
-Execute and ClearOutput steps are off.  Exit code 0 when both steps worked.
+Execute and ClearOutput steps are off.
 """
 
 from __future__ import annotations
@@ -42,14 +42,15 @@ def score_only_config(course: Path, excluded: str) -> Config:
 
 
 def main(argv: list[str]) -> int:
-    """Score, then write the feedback; 0 when both worked (their log: COURSE/grading.log)."""
+    """Score, then write the feedback; 0 when both worked.  nbgrader's log goes to standard
+    error, which the grader appends to ``COURSE/grading.log`` (as its command lines' did)."""
     if len(argv) not in (1, 2):
         print('Usage: python -m ros2nb_instructor.grading.scoring COURSE [EXCLUDED_IDS]',
               file=sys.stderr)
         return 2
     course = Path(argv[0])
     config = score_only_config(course, argv[1] if len(argv) == 2 else '')
-    logging.basicConfig(filename=course / 'grading.log', level=logging.INFO,
+    logging.basicConfig(stream=sys.stderr, level=logging.INFO,
                         format='[%(name)s | %(levelname)s] %(message)s')
     coursedir = CourseDirectory(config=config)
     failed = False
