@@ -330,6 +330,22 @@ def test_the_deliberate_mkdir_error_of_01_is_one_line(kernel, tmp_path):
                     'mkdir(parents=True, exist_ok=True) is mkdir -p', 'cell line 1: ws.mkdir()')
 
 
+def test_a_part_not_written_yet_says_so_in_one_line(kernel, tmp_path):
+    """A demo cell run before its part is written met the bare placeholder (an empty
+    NotImplementedError, nothing said): now it names the part and what to do."""
+    placeholder = tmp_path / 'unwritten_sensor.py'
+    placeholder.write_text('class TemperatureSensor:\n    def __init__(self):\n'
+                           '        # YOUR CODE HERE\n        raise NotImplementedError()\n')
+    kernel.run(f'import sys\nsys.path.insert(0, {str(tmp_path)!r})\nimport unwritten_sensor')
+    kernel.one_line('sensor = unwritten_sensor.TemperatureSensor()',
+                    'NotImplementedError (unwritten_sensor.py line 4: raise NotImplementedError()): '
+                    'TemperatureSensor() is not written yet: write your code where it says YOUR '
+                    'CODE HERE')
+    kernel.one_line('raise NotImplementedError()', 'this cell is not written yet')
+    shown = kernel.run('raise NotImplementedError("not for ROS 1")')['error']['traceback']
+    assert 'not for ROS 1' in shown[-1] and 'not written yet' not in ''.join(shown)
+
+
 def test_a_long_simulated_spin_interrupted_is_one_line_not_its_log_lines(ros):
     ros.run("import os, signal\n"
             "class Sensor(Node):\n    def __init__(self):\n        super().__init__('loud')\n"

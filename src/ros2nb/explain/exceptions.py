@@ -201,6 +201,8 @@ def explain_exception(exc: BaseException, *, ros_started: bool = False) -> Optio
     if isinstance(exc, FileExistsError) and _raised_in(exc, 'mkdir'):
         return (f'{exc.filename} already exists, and mkdir() without exist_ok refuses an existing '
                 'folder, like mkdir without -p: mkdir(parents=True, exist_ok=True) is mkdir -p.')
+    if type(exc) is NotImplementedError and not text:
+        return _placeholder(exc)
     if isinstance(exc, NotInitializedException):
         if ros_started:
             return SHUT_DOWN_MESSAGE
@@ -229,6 +231,18 @@ def explain_exception(exc: BaseException, *, ros_started: bool = False) -> Optio
     if isinstance(exc, TypeError):
         return _message_not_a_value(exc)
     return None
+
+
+def _placeholder(exc: BaseException) -> Optional[str]:
+    """The line for a part the learner has not written yet (its ``raise NotImplementedError()``)."""
+    frame = _learner_frame(exc)
+    if frame is None:
+        return None
+    name = frame.f_code.co_qualname if hasattr(frame.f_code, 'co_qualname') \
+        else frame.f_code.co_name
+    called = 'this cell' if name == '<module>' else f'{name.replace(".__init__", "")}()'
+    return (f'{called} is not written yet: write your code where it says YOUR CODE HERE, in '
+            'place of this placeholder, run that cell, then this one again.')
 
 
 def _invalid_name(exc: BaseException) -> str:
