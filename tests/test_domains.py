@@ -1,5 +1,7 @@
 """One ROS world per kernel: domain claims between real processes, also of another user."""
 
+import contextlib
+import fcntl
 import os
 import subprocess
 import sys
@@ -91,22 +93,63 @@ def test_when_every_domain_is_taken_one_line_says_what_to_do(locks):
         holder.wait()
 
 
-def test_a_domain_used_by_a_ros_program_outside_the_course_is_skipped(locks):
-    """A terminal's `ros2 run` on domain 1 holds no lock, but its discovery port is taken."""
-    program = textwrap.dedent('''
-        import rclpy, time
-        rclpy.init(domain_id=1)
-        node = rclpy.create_node('outside_the_course')
-        print('up', flush=True)
-        time.sleep(60)
-    ''')
-    outside = subprocess.Popen([sys.executable, '-c', program], stdout=subprocess.PIPE, text=True,
-                               env={**os.environ, 'ROS_AUTOMATIC_DISCOVERY_RANGE': 'LOCALHOST'})
+#: A ROS program outside the course: a node named argv[1] on the domain argv[2], or on a
+#: domain it takes the way a course kernel does (then it prints that domain).
+OUTSIDE = textwrap.dedent('''
+    import sys, rclpy
+    from ros2nb import domains
+    domain = int(sys.argv[2]) if len(sys.argv) > 2 else domains.domain_id()
+    rclpy.init(domain_id=domain)
+    node = rclpy.create_node(sys.argv[1])
+    print(domain, flush=True)
+    rclpy.spin(node)
+''')
+
+
+def outside_program(name, domain=None):
+    """A ROS program beside the course, up once it prints its domain: ``(process, domain)``.
+
+    With no ``domain`` it takes its domain's lock in the machine's shared folder, as the
+    kernels of the other test workers do: none of them is on its domain or comes to it (a
+    kernel that was already on domain 1 used to list the program among its nodes).  The
+    claims under test look in their own empty folder, where it holds nothing, as a
+    terminal's ``ros2 run`` holds nothing.
+    """
+    env = {k: v for k, v in os.environ.items() if k != 'ROS_DOMAIN_ID'}
+    env['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    proc = subprocess.Popen([sys.executable, '-c', OUTSIDE, name,
+                             *([] if domain is None else [str(domain)])],
+                            stdout=subprocess.PIPE, text=True, env=env)
+    line = proc.stdout.readline().strip()
+    assert line.isdigit(), f'the program outside the course did not start (it printed {line!r})'
+    return proc, int(line)
+
+
+@contextlib.contextmanager
+def taken_before(locks, domain):
+    """Every domain a claim in ``locks`` tries before ``domain`` is locked meanwhile, so that
+    ``domain`` is the claim's first choice (and a claim blind to it would take it)."""
+    locks.mkdir(parents=True, exist_ok=True)
+    fds = []
     try:
-        assert outside.stdout.readline().strip() == 'up'  # its participant exists now
-        proc, line = claimer(locks, seconds=0)
-        proc.wait()
-        assert line not in ('', '1')
+        for earlier in domains.CLAIM_ORDER[:domains.CLAIM_ORDER.index(domain)]:
+            fd = os.open(locks / f'{earlier}.lock', os.O_RDONLY | os.O_CREAT, 0o644)
+            fds.append(fd)
+            fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        for fd in fds:
+            os.close(fd)
+
+
+def test_a_domain_used_by_a_ros_program_outside_the_course_is_skipped(locks):
+    """A terminal's `ros2 run` on a domain holds no lock, but its discovery port is taken."""
+    outside, domain = outside_program('outside_the_course')
+    try:
+        with taken_before(locks, domain):
+            proc, line = claimer(locks, seconds=0)
+            proc.wait()
+        assert line.isdigit() and line != str(domain)
     finally:
         outside.kill()
         outside.wait()
@@ -116,24 +159,15 @@ def test_a_ros_program_that_is_not_the_first_on_its_domain_is_seen_too(locks):
     """Fast DDS numbers the participants of a domain on one machine; when the first one
     ends, the second keeps its number and port. The claim used to look at the first port
     only, and would put a kernel on the second program's domain."""
-    program = textwrap.dedent('''
-        import rclpy, sys
-        rclpy.init(domain_id=1)
-        node = rclpy.create_node(sys.argv[1])
-        print('up', flush=True)
-        rclpy.spin(node)
-    ''')
-    env = {**os.environ, 'ROS_AUTOMATIC_DISCOVERY_RANGE': 'LOCALHOST'}
-    first, second = (subprocess.Popen([sys.executable, '-c', program, name], env=env, text=True,
-                                      stdout=subprocess.PIPE) for name in ('first', 'second'))
+    first, domain = outside_program('first')
+    second, _ = outside_program('second', domain)
     try:
-        assert first.stdout.readline().strip() == 'up'
-        assert second.stdout.readline().strip() == 'up'
         first.kill()
-        first.wait()  # its port is free again; the second program is still on domain 1
-        proc, line = claimer(locks, seconds=0)
-        proc.wait()
-        assert line not in ('', '1')
+        first.wait()  # its port is free again; the second program is still on the domain
+        with taken_before(locks, domain):
+            proc, line = claimer(locks, seconds=0)
+            proc.wait()
+        assert line.isdigit() and line != str(domain)
     finally:
         for proc in (first, second):
             proc.kill()
