@@ -121,7 +121,10 @@ def outside_program(name, domain=None):
                              *([] if domain is None else [str(domain)])],
                             stdout=subprocess.PIPE, text=True, env=env)
     line = proc.stdout.readline().strip()
-    assert line.isdigit(), f'the program outside the course did not start (it printed {line!r})'
+    if not line.isdigit():
+        proc.kill()
+        proc.wait()
+        raise AssertionError(f'the program outside the course did not start (it printed {line!r})')
     return proc, int(line)
 
 
@@ -160,8 +163,9 @@ def test_a_ros_program_that_is_not_the_first_on_its_domain_is_seen_too(locks):
     ends, the second keeps its number and port. The claim used to look at the first port
     only, and would put a kernel on the second program's domain."""
     first, domain = outside_program('first')
-    second, _ = outside_program('second', domain)
+    second = None
     try:
+        second, _ = outside_program('second', domain)
         first.kill()
         first.wait()  # its port is free again; the second program is still on the domain
         with taken_before(locks, domain):
@@ -170,8 +174,9 @@ def test_a_ros_program_that_is_not_the_first_on_its_domain_is_seen_too(locks):
         assert line.isdigit() and line != str(domain)
     finally:
         for proc in (first, second):
-            proc.kill()
-            proc.wait()
+            if proc is not None:
+                proc.kill()
+                proc.wait()
 
 
 SYSTEM_PYTHON = '/usr/bin/python3'
