@@ -16,3 +16,8 @@ SOLUTIONS = ROOT / 'solutions'
 NOTEBOOKS = ROOT / 'notebooks'
 #: nbgrader's name for the set of notebooks a learner submits.
 ASSIGNMENT = 'ros2-pubsub'
+
+
+def gradebook_url(course: Path) -> str:
+    """The database URL of the nbgrader gradebook of the course folder ``course``."""
+    return f'sqlite:///{course / "gradebook.db"}'

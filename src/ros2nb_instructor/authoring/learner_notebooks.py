@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Optional
 
 from ..nbgrader_cli import nbgrader_argv
-from ..paths import ASSIGNMENT, NOTEBOOKS, ROOT, SOLUTIONS
+from ..paths import ASSIGNMENT, NOTEBOOKS, ROOT, SOLUTIONS, gradebook_url
 
 
 def generate(out: Path) -> list[Path]:
@@ -39,7 +39,7 @@ def generate(out: Path) -> list[Path]:
         done = subprocess.run(
             nbgrader_argv('generate_assignment', ASSIGNMENT,
                           f'--CourseDirectory.root={course}', '--force', '--log-level=ERROR',
-                          f'--CourseDirectory.db_url=sqlite:///{course / "gradebook.db"}'),
+                          f'--CourseDirectory.db_url={gradebook_url(course)}'),
             cwd=course, env=env, capture_output=True, text=True)
         if done.returncode != 0:
             sys.exit(f'nbgrader generate_assignment failed:\n{done.stdout}{done.stderr}')

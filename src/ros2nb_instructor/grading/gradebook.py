@@ -22,7 +22,7 @@ from typing import Iterable
 from nbgrader.api import Gradebook, MissingEntry
 
 from ..nbgrader_cli import nbgrader_argv
-from ..paths import ASSIGNMENT, ROOT, SOLUTIONS
+from ..paths import ASSIGNMENT, ROOT, SOLUTIONS, gradebook_url
 from . import feedback
 from .submissions import Learner, screen_zip
 
@@ -35,7 +35,7 @@ COURSE_CONFIG = 'c = get_config()  # noqa: F821\n'
 def nbgrader(course: Path, *args: str, log: Path) -> int:
     """Run ``nbgrader ARGS`` for the course folder (trusted: it executes nothing of learners')."""
     argv = [*nbgrader_argv(*args), f'--CourseDirectory.root={course}',
-            f'--CourseDirectory.db_url=sqlite:///{course / "gradebook.db"}', '--log-level=INFO']
+            f'--CourseDirectory.db_url={gradebook_url(course)}', '--log-level=INFO']
     with open(log, 'a') as out:
         return subprocess.run(argv, cwd=course, env=_nbgrader_env(course), stdout=out,
                               stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL).returncode
@@ -126,7 +126,7 @@ def write_results(course: Path, out: Path, learners: list[Learner],
                   notebooks: list[str]) -> list[list[str]]:
     """grades.csv from nbgrader's gradebook, and the feedback files; return the CSV rows."""
     rows = []
-    with Gradebook(f'sqlite:///{course / "gradebook.db"}') as gb:
+    with Gradebook(gradebook_url(course)) as gb:
         maxima = {nb.name: nb.max_score for nb in gb.find_assignment(ASSIGNMENT).notebooks}
         for learner in learners:
             total = 0.0

@@ -20,7 +20,7 @@ from nbgrader.coursedir import CourseDirectory
 from nbgrader.preprocessors import ClearOutput, Execute
 from traitlets.config import Config
 
-from ..paths import ASSIGNMENT
+from ..paths import ASSIGNMENT, gradebook_url
 
 
 def score_only_config(course: Path, excluded: str) -> Config:
@@ -28,7 +28,7 @@ def score_only_config(course: Path, excluded: str) -> Config:
     ``excluded`` ids) without executing anything."""
     config = Config()
     config.CourseDirectory.root = str(course)
-    config.CourseDirectory.db_url = f'sqlite:///{course / "gradebook.db"}'
+    config.CourseDirectory.db_url = gradebook_url(course)
     config.CourseDirectory.student_id_exclude = excluded
     config.CourseDirectory.assignment_id = ASSIGNMENT
     config.BaseConverter.force = True
