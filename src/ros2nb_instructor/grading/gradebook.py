@@ -36,15 +36,18 @@ def nbgrader(course: Path, *args: str, log: Path) -> int:
     """Run ``nbgrader ARGS`` for the course folder (trusted: it executes nothing of learners')."""
     argv = [*nbgrader_argv(*args), f'--CourseDirectory.root={course}',
             f'--CourseDirectory.db_url={gradebook_url(course)}', '--log-level=INFO']
+    return _run_logged(course, argv, log)
+
+
+def _run_logged(course: Path, argv: list[str], log: Path) -> int:
+    """Run ``argv`` (nbgrader, or the course's code that drives it) in the course folder, with
+    the course's own Jupyter settings and the course's Python first on PATH; its output is
+    appended to ``log``.  Return its exit code."""
+    env = dict(os.environ, JUPYTER_CONFIG_DIR=str(course / '.jupyter'),
+               PATH=os.pathsep.join([str(Path(sys.executable).parent), os.environ['PATH']]))
     with open(log, 'a') as out:
-        return subprocess.run(argv, cwd=course, env=_nbgrader_env(course), stdout=out,
-                              stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL).returncode
-
-
-def _nbgrader_env(course: Path) -> dict[str, str]:
-    """nbgrader's environment: the course's own Jupyter settings, the course's Python first."""
-    return dict(os.environ, JUPYTER_CONFIG_DIR=str(course / '.jupyter'),
-                PATH=os.pathsep.join([str(Path(sys.executable).parent), os.environ['PATH']]))
+        return subprocess.run(argv, cwd=course, env=env, stdout=out, stderr=subprocess.STDOUT,
+                              stdin=subprocess.DEVNULL).returncode
 
 
 def set_up_course(course: Path) -> list[str]:
@@ -161,7 +164,5 @@ def score_and_feedback(course: Path, exclude: Iterable[str] = ()) -> None:
     :param exclude: nbgrader ids of learners left out (not yet graded, or scored before);
         ids never hold a comma (:func:`.submissions.find_learners`).
     """
-    with open(course / 'grading.log', 'a') as out:
-        subprocess.run([sys.executable, '-m', 'ros2nb_instructor.grading.scoring', str(course),
-                        ','.join(sorted(exclude))], cwd=course, env=_nbgrader_env(course),
-                       stdout=out, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
+    _run_logged(course, [sys.executable, '-m', 'ros2nb_instructor.grading.scoring', str(course),
+                         ','.join(sorted(exclude))], log=course / 'grading.log')
