@@ -1,7 +1,6 @@
 """One ROS world per kernel: domain claims between real processes, also of another user."""
 
 import contextlib
-import fcntl
 import os
 import subprocess
 import sys
@@ -132,17 +131,17 @@ def outside_program(name, domain=None):
 def taken_before(locks, domain):
     """Every domain a claim in ``locks`` tries before ``domain`` is locked meanwhile, so that
     ``domain`` is the claim's first choice (and a claim blind to it would take it)."""
-    locks.mkdir(parents=True, exist_ok=True)
+    domains._ensure_folder(locks)
     fds = []
     try:
         for earlier in domains.CLAIM_ORDER[:domains.CLAIM_ORDER.index(domain)]:
-            fd = os.open(locks / f'{earlier}.lock', os.O_RDONLY | os.O_CREAT, 0o644)
-            fds.append(fd)
-            fcntl.flock(fd, fcntl.LOCK_EX)
+            fds.append(domains._try_lock(locks, earlier))  # the lock a kernel's claim takes
+            assert fds[-1] is not None, f'domain {earlier} is locked in {locks} already'
         yield
     finally:
         for fd in fds:
-            os.close(fd)
+            if fd is not None:
+                os.close(fd)
 
 
 def test_a_domain_used_by_a_ros_program_outside_the_course_is_skipped(locks):
