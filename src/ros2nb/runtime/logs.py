@@ -150,5 +150,8 @@ class LogLines:
             print(f'({earlier} log lines made while no cell was running were not shown)')
         if show_logs and lines:
             print('\n'.join(lines))
-        sys.stdout.flush()
+        if show_logs and (earlier or lines):
+            # Only after a print: a kernel's flush hands the text to its output thread and
+            # waits for it, and a simulated hour asks once per simulated second (a third of it).
+            sys.stdout.flush()
         return taken
