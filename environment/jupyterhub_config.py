@@ -87,7 +87,9 @@ c.Spawner.cmd = [str(COURSE_PYTHON), '-m', 'ros2nb_instructor.hub.singleuser']
 c.Spawner.notebook_dir = LEARNER_FOLDER
 c.Spawner.default_url = '/lab/tree/notebooks'
 c.Spawner.env_keep = KEPT_VARIABLES
-c.Spawner.environment = {'ROS_AUTOMATIC_DISCOVERY_RANGE': 'LOCALHOST'}
+# OPENBLAS_NUM_THREADS: numpy's BLAS threads spin at import in every ROS process (rclpy's message
+# types import numpy), on cores the whole class shares; the course does no linear algebra.
+c.Spawner.environment = {'ROS_AUTOMATIC_DISCOVERY_RANGE': 'LOCALHOST', 'OPENBLAS_NUM_THREADS': '1'}
 c.Spawner.args = [f'--MappingKernelManager.cull_idle_timeout={KERNEL_IDLE_TIMEOUT_S}',
                   '--MappingKernelManager.cull_interval=300']
 c.Spawner.start_timeout = START_TIMEOUT_S

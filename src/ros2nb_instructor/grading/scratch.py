@@ -122,4 +122,6 @@ def sandbox_env(home: Path, **extra: str) -> dict[str, str]:
             'JUPYTER_CONFIG_DIR': str(home / '.jupyter'),
             'JUPYTER_DATA_DIR': str(home / '.local/share/jupyter'),
             'JUPYTER_RUNTIME_DIR': str(home / '.local/share/jupyter/runtime'),
-            'ROS_HOME': str(home / '.ros'), 'ROS_LOG_DIR': str(home / '.ros/log'), **extra}
+            'ROS_HOME': str(home / '.ros'), 'ROS_LOG_DIR': str(home / '.ros/log'),
+            'OPENBLAS_NUM_THREADS': '1',  # as the Makefile says why: no spinning BLAS threads
+            **extra}
