@@ -8,6 +8,7 @@ else the machine does falls on both alike.
 1. One simulated hour of the course's sensor, recorded: ros2nb (as notebook 03 does it) and
    a bare rclpy program doing the same work (benchmarks/peers.py); their ratio (bare's
    seconds over ros2nb's: 1.0 is as fast as bare rclpy) and ros2nb's speed in real time.
+   Then the same hour in a real Jupyter kernel, where a learner runs it.
 2. From starting the sensor to the first reading heard: in a kernel's runtime, and as two
    separate processes (what ``ros2 run`` starts).
 3. Grading, in seconds per notebook: one learner who handed in every notebook complete
@@ -132,7 +133,8 @@ def main() -> None:
     print('| measure | median s | spread s | runs | |\n|---|---|---|---|---|')
     if args.only in (None, 'sim'):
         runs = interleaved({'ros2nb': lambda: both('sim-hour-ros2nb'),
-                            'bare': lambda: both('sim-hour-bare')}, args.reps)
+                            'bare': lambda: both('sim-hour-bare'),
+                            'kernel': lambda: both('sim-hour-kernel')}, args.reps)
         wall = {k: [w for w, _ in v] for k, v in runs.items()}
         cpu = {k: [c for _, c in v] for k, v in runs.items()}
         ours, bare = (statistics.median(wall[k]) for k in ('ros2nb', 'bare'))
@@ -147,6 +149,10 @@ def main() -> None:
         print(row('simulated hour, bare rclpy, CPU s of the process', cpu['bare']))
         print(f'| CPU ratio, bare / ros2nb | {bare_cpu / ours_cpu:.2f} | | | less '
               'sensitive to a busy machine than wall time |')
+        print(row('simulated hour in a Jupyter kernel, the cell', wall['kernel'],
+                  f'{SIMULATED_S / statistics.median(wall["kernel"]):.0f}x real time'))
+        print(row('simulated hour in a Jupyter kernel, CPU s of the kernel', cpu['kernel'],
+                  "every thread: ipykernel's output thread too"))
     if args.only in (None, 'first'):
         first = interleaved({'kernel': lambda: peer('first-message-kernel'),
                              'processes': lambda: peer('first-message-processes')}, args.reps)

@@ -8,6 +8,9 @@ peers and repeats them.
   (``ros2nb.start(sim_time=True)``, ``ros2nb.add``, ``ros2nb.record``), as notebook 03 does.
 - ``sim-hour-bare``: the same work in a bare rclpy program: the same sensor file, a recorder
   node, a ``/clock`` publisher and a ``SingleThreadedExecutor`` spun until each reading is in.
+- ``sim-hour-kernel``: the same hour in a real Jupyter kernel, as a learner runs notebook 03:
+  the wall seconds of the cell and the CPU seconds of the kernel process (all its threads:
+  ipykernel's output thread too, which an in-process run never sees).
 - ``first-message-kernel``: from creating the sensor in a kernel's runtime (wall clock) to
   the first reading received by a monitor node in the same process.
 - ``first-message-processes``: from starting the sensor and the monitor as two processes
@@ -66,6 +69,37 @@ def sim_hour_ros2nb() -> tuple[float, float]:
         ros2nb.shutdown()
     assert len(values) == SIMULATED_S, len(values)
     return elapsed
+
+
+def _process_cpu_s(pid: int) -> float:
+    """CPU seconds (user + system, every thread) process ``pid`` used so far."""
+    fields = Path(f'/proc/{pid}/stat').read_text().rsplit(')', 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
+
+
+def sim_hour_kernel() -> tuple[float, float]:
+    from jupyter_client.manager import start_new_kernel
+    sensor = reference_module('temperature_publisher')
+    manager, client = start_new_kernel(kernel_name='python3')
+    try:
+        def run(code: str) -> None:
+            reply = client.execute_interactive(code, timeout=600, output_hook=lambda _msg: None)
+            if reply['content']['status'] != 'ok':
+                raise RuntimeError(f'the kernel failed: {reply["content"].get("evalue")}')
+
+        run(f'import random, sys\nsys.path.insert(0, {str(Path(sensor.__file__).parent)!r})\n'
+            'import ros2nb, temperature_publisher\n'
+            'ros2nb.start(sim_time=True)\n'
+            f'random.seed({SEED})\n'
+            '_ = ros2nb.add(temperature_publisher.TemperatureSensor())')
+        pid = manager.provisioner.process.pid
+        started = time.perf_counter(), _process_cpu_s(pid)
+        run(f'_, values = ros2nb.record({course.TOPIC!r}, {SIMULATED_S})\n'
+            f'assert len(values) == {SIMULATED_S}, len(values)')
+        return time.perf_counter() - started[0], _process_cpu_s(pid) - started[1]
+    finally:
+        client.stop_channels()
+        manager.shutdown_kernel(now=True)
 
 
 def sim_hour_bare() -> tuple[float, float]:
@@ -203,6 +237,7 @@ def idle_bare() -> tuple[float, float]:
 
 
 MEASURES = {'sim-hour-ros2nb': sim_hour_ros2nb, 'sim-hour-bare': sim_hour_bare,
+            'sim-hour-kernel': sim_hour_kernel,
             'first-message-kernel': first_message_kernel,
             'first-message-processes': first_message_processes,
             'idle-kernel': idle_kernel, 'idle-bare': idle_bare}
