@@ -15,7 +15,6 @@ import rclpy
 from rcl_interfaces.msg import Log
 from rcl_interfaces.srv import ListParameters
 from rclpy.executors import SingleThreadedExecutor
-from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 from std_msgs.msg import Float32
@@ -23,6 +22,7 @@ from std_msgs.msg import Float32
 from .. import domains
 from ..checks.base import ARRIVAL_TIMEOUT_S
 from ..errors import CheckFailed
+from ..runtime import node_serving_nothing
 from ..runtime.services import call_until_answered
 
 
@@ -43,7 +43,7 @@ class Observer:
         self.context = rclpy.Context()
         rclpy.init(context=self.context, domain_id=self.domain_id,
                    signal_handler_options=SignalHandlerOptions.NO)
-        self.node = Node('_ros2nb_judge', context=self.context)
+        self.node = node_serving_nothing('_ros2nb_judge', context=self.context)
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
         self.changed = threading.Condition()

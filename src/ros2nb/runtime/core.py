@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import os
 import sys
-from typing import Optional
+from typing import Any, Optional
 
 import rclpy
 from rcl_interfaces.msg import Log
@@ -35,6 +35,22 @@ INTERNAL_NODE_NAME = '_ros2nb'
 #: For ros2nb's own subscriptions: no QoS event handlers (rclpy's default warns of
 #: incompatible QoS, which the kernel's own subscriptions choose to accept).
 QUIET_SUBSCRIPTION = SubscriptionEventCallbacks(use_default_callbacks=False)
+
+
+def node_serving_nothing(name: str, **kwargs: Any) -> Node:
+    """A node of ros2nb's own that offers no services: neither rclpy's six parameter services
+    nor its type-description service.  Those seven services are fourteen DDS endpoints that
+    every participant of the domain must discover, and seven more entities in each wait of
+    the executor, which waits thousands of times a second on simulated time.
+
+    For the kernel's hidden node and the judge's node (not for learners).
+
+    :param name: the node's name.
+    :param kwargs: passed on to :class:`rclpy.node.Node` (e.g. ``context``, ``enable_rosout``).
+    """
+    return Node(name, start_parameter_services=False,
+                parameter_overrides=[Parameter('start_type_description_service',
+                                               Parameter.Type.BOOL, False)], **kwargs)
 
 
 def enable_field_checks() -> None:
@@ -68,11 +84,8 @@ class Runtime(LogLines, Spinning, NodeKeeping, SimulatedClock):
         self.context = rclpy.get_default_context()
         self.domain_id = self.context.get_domain_id()
         self.executor = SingleThreadedExecutor()
-        # The kernel's own node serves nothing and logs nothing: every entity a node has is
-        # one more in every wait of the executor, and it waits thousands of times a second.
-        self.node = Node(INTERNAL_NODE_NAME, start_parameter_services=False, enable_rosout=False,
-                         parameter_overrides=[Parameter('start_type_description_service',
-                                                        Parameter.Type.BOOL, False)])
+        # The kernel's own node serves nothing and logs nothing.
+        self.node = node_serving_nothing(INTERNAL_NODE_NAME, enable_rosout=False)
         self._clock_publisher = self.node.create_publisher(
             Clock, '/clock', 10, event_callbacks=PublisherEventCallbacks(use_default_callbacks=False))
         rosout_qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE,
