@@ -32,6 +32,7 @@ from std_msgs.msg import Int32
 
 from . import domains
 from .errors import Ros2nbError
+from .runtime.core import node_serving_nothing
 
 #: Seconds a trial waits for discovery (matching) and acknowledgements; the wait ends as
 #: soon as the state is reached, so only a very busy machine or a mismatch costs this long.
@@ -107,8 +108,7 @@ class _Trial:
         self.context = Context()
         rclpy.init(context=self.context, domain_id=domains.domain_id(),
                    signal_handler_options=SignalHandlerOptions.NO)
-        self.nodes = [rclpy.create_node(name, context=self.context, enable_rosout=False,
-                                        start_parameter_services=False)
+        self.nodes = [node_serving_nothing(name, context=self.context, enable_rosout=False)
                       for name in ('qos_trial_publisher', 'qos_trial_subscription')]
         self.executor = SingleThreadedExecutor(context=self.context)
         for node in self.nodes:
