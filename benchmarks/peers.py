@@ -9,8 +9,8 @@ peers and repeats them.
 - ``sim-hour-bare``: the same work in a bare rclpy program: the same sensor file, a recorder
   node, a ``/clock`` publisher and a ``SingleThreadedExecutor`` spun until each reading is in.
 - ``sim-hour-kernel``: the same hour in a real Jupyter kernel, as a learner runs notebook 03:
-  the wall seconds of the cell and the CPU seconds of the kernel process (all its threads:
-  ipykernel's output thread too, which an in-process run never sees).
+  the wall seconds of the cell and the CPU seconds of the kernel (``processes.tree_cpu_seconds``:
+  every thread, ipykernel's output thread too, which an in-process run never sees).
 - ``first-message-kernel``: from creating the sensor in a kernel's runtime (wall clock) to
   the first reading received by a monitor node in the same process.
 - ``first-message-processes``: from starting the sensor and the monitor as two processes
@@ -71,14 +71,9 @@ def sim_hour_ros2nb() -> tuple[float, float]:
     return elapsed
 
 
-def _process_cpu_s(pid: int) -> float:
-    """CPU seconds (user + system, every thread) process ``pid`` used so far."""
-    fields = Path(f'/proc/{pid}/stat').read_text().rsplit(')', 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
-
-
 def sim_hour_kernel() -> tuple[float, float]:
     from jupyter_client.manager import start_new_kernel
+    from ros2nb.processes import tree_cpu_seconds
     sensor = reference_module('temperature_publisher')
     manager, client = start_new_kernel(kernel_name='python3')
     try:
@@ -93,10 +88,10 @@ def sim_hour_kernel() -> tuple[float, float]:
             f'random.seed({SEED})\n'
             '_ = ros2nb.add(temperature_publisher.TemperatureSensor())')
         pid = manager.provisioner.process.pid
-        started = time.perf_counter(), _process_cpu_s(pid)
+        started = time.perf_counter(), tree_cpu_seconds(pid)
         run(f'_, values = ros2nb.record({course.TOPIC!r}, {SIMULATED_S})\n'
             f'assert len(values) == {SIMULATED_S}, len(values)')
-        return time.perf_counter() - started[0], _process_cpu_s(pid) - started[1]
+        return time.perf_counter() - started[0], tree_cpu_seconds(pid) - started[1]
     finally:
         client.stop_channels()
         manager.shutdown_kernel(now=True)
