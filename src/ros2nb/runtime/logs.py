@@ -146,11 +146,10 @@ class LogLines:
                 taken += 1
                 lines.append(text if name is None else
                              f'[{SEVERITY_NAMES.get(level, level)}] [{name}]: {text}')
-        if earlier and show_logs:
-            print(f'({earlier} log lines made while no cell was running were not shown)')
+        if earlier:
+            lines.insert(0, f'({earlier} log lines made while no cell was running were not shown)')
         if show_logs and lines:
             print('\n'.join(lines))
-        if show_logs and (earlier or lines):
             # Only after a print: a kernel's flush hands the text to its output thread and
             # waits for it, and a simulated hour asks once per simulated second (a third of it).
             sys.stdout.flush()
