@@ -43,7 +43,7 @@ def node_serving_nothing(name: str, **kwargs: Any) -> Node:
     every participant of the domain must discover, and seven more entities in each wait of
     the executor, which waits thousands of times a second on simulated time.
 
-    For the kernel's hidden node and the judge's node (not for learners).
+    For the kernel's hidden node, the judge's node and the QoS trials' nodes (not for learners).
 
     :param name: the node's name.
     :param kwargs: passed on to :class:`rclpy.node.Node` (e.g. ``context``, ``enable_rosout``).
