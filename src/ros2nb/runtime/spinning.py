@@ -116,10 +116,15 @@ class Spinning:
         leaves them set, and that node's timers and subscriptions never run again.  Only
         this thread runs callbacks here, so after an interrupt none is running: every
         entity is free again, and unfinished work is dropped (a message not taken stays in
-        its queue, a timer not called stays due, so the next wait finds them again).
+        its queue, a timer not called stays due, so the next wait finds them again).  So is
+        the rest of the interrupted wait's round: rclpy would hand it out on the next call
+        and then end the round, and a drain that met only that end would stop before the
+        interrupted callback, due still, ran again (the spin thread then ran it after the
+        cell).
         """
         with contextlib.suppress(AttributeError):
             self.executor._tasks = []
+            self.executor._cb_iter = None
         for node in [self.node, *self._nodes.values()]:
             for entity in (*node.timers, *node.subscriptions, *node.services, *node.clients,
                            *node.guards, *node.waitables):
