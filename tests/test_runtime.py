@@ -12,6 +12,8 @@ import time
 
 import pytest
 import rclpy
+from rclpy.node import Node
+from rosgraph_msgs.msg import Clock
 
 import ros2nb
 from ros2nb.errors import Ros2nbError, UsageError
@@ -282,6 +284,21 @@ def test_sim_time_is_deterministic():
     assert first.count('Publishing:') == 30
     assert first.count('Temperature:') == 30
     assert _sim_run(8) != first
+
+
+def test_clock_reaches_every_listener_beside_the_time_sources_of_the_kernels_nodes(ros):
+    """ros2nb tells its nodes the simulated time directly and sends ``/clock`` only when
+    someone else listens: here a node's own subscription, which must hear every tick."""
+    sensor = ros2nb.add(Sensor())
+    heard: list[int] = []
+    listener = Node('clock_listener')
+    subscription = listener.create_subscription(
+        Clock, '/clock', lambda msg: heard.append(msg.clock.sec), 10)
+    ros2nb.add(listener)
+    assert wait_until(lambda: subscription.get_publisher_count() > 0), '/clock never matched'
+    ros2nb.spin(3)
+    assert heard[-3:] == [1, 2, 3]
+    assert sensor.get_clock().now().nanoseconds == 3 * 10**9
 
 
 def test_wall_clock_spin_runs_in_real_time_then_the_kernel_clock_again(ros):
