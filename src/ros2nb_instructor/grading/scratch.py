@@ -113,10 +113,23 @@ def _not_for_the_judge(workspace: Path):
     return ignored
 
 
+#: What the ROS 2 wheels' bootstrapper (a ``.pth`` file of the venv) sets before it runs a
+#: new Python process again, once, from the start (20 ms of CPU each): the libraries' path,
+#: and the mark that it was done.  The grader's own process has both.
+ROS_WHEELS_ENV = ('LD_LIBRARY_PATH', '_ROS_WHEELS_BOOTSTRAP_COMPLETE')
+
+
 def sandbox_env(home: Path, **extra: str) -> dict[str, str]:
-    """The environment inside a sandbox: everything in the learner's home, grading mode."""
+    """The environment inside a sandbox: everything in the learner's home, grading mode.
+
+    It carries the ROS 2 wheels' bootstrap of the grader's process when there is one
+    (:data:`ROS_WHEELS_ENV`), so that the runner and the judge each start once, not twice.
+    """
     venv_bin = str(Path(sys.executable).parent)
-    return {'PATH': f'{venv_bin}:/usr/bin:/bin', 'HOME': str(home), 'LANG': 'C.UTF-8',
+    bootstrapped = ({name: os.environ.get(name, '') for name in ROS_WHEELS_ENV}
+                    if os.environ.get('_ROS_WHEELS_BOOTSTRAP_COMPLETE') else {})
+    return {**bootstrapped,
+            'PATH': f'{venv_bin}:/usr/bin:/bin', 'HOME': str(home), 'LANG': 'C.UTF-8',
             'PYTHONUNBUFFERED': '1', 'ROS2NB_GRADING': '1', 'TMPDIR': '/tmp',
             'IPYTHONDIR': str(home / '.ipython'), 'MPLCONFIGDIR': str(home / '.matplotlib'),
             'JUPYTER_CONFIG_DIR': str(home / '.jupyter'),
