@@ -45,7 +45,7 @@ class SimulatedClock:
         message goes out when anyone else listens: a process, a subscription of a node, a
         node on simulated time that ros2nb did not put there.  Each node told here listens
         too, through its time source's one subscription, whose callback would only set the
-        same time again: a simulated hour of notebook 03 spent a tenth of its CPU time so.
+        same time again: a simulated hour of notebook 03 spent an eighth of its CPU time so.
         """
         now = Time(nanoseconds=self.sim_now_ns)
         told = 0
