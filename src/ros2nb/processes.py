@@ -100,6 +100,11 @@ def _children() -> dict[int, list[int]]:
     return _processes()[0]
 
 
+def child_pids(pid: int) -> list[int]:
+    """The processes ``pid`` started that are still there (running or not yet reaped)."""
+    return _children().get(pid, [])
+
+
 def tree_cpu_seconds(pid: int) -> float:
     """CPU seconds (user + system) used so far by ``pid`` and every process under it.
 

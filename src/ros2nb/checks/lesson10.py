@@ -18,7 +18,7 @@ import re
 import shutil
 import tempfile
 from pathlib import Path
-from typing import Any, Callable, Iterator
+from typing import Any, Callable, Iterator, Optional
 
 from rcl_interfaces.msg import Log
 
@@ -223,13 +223,19 @@ class _Watch:
             self.subscription = self.rt.node.create_subscription(
                 Log, ROSOUT, lambda m: self.logs.append((m.name, m.msg)), bag.KEEP_ALL)
 
-    def heard(self, expected: int) -> list[tuple[str, str]]:
-        """Log lines heard since the watch began (waiting for ``expected`` statuses)."""
+    def heard(self, expected: int, made: Optional[int] = None) -> list[tuple[str, str]]:
+        """Log lines heard since the watch began: waiting for ``expected`` statuses, or for
+        the ``made`` lines the monitor made in the subject (so a monitor that logged nothing
+        is known at once, not after ``ARRIVAL_TIMEOUT_S``)."""
         if self.observer is not None:
             # A subscription of its own, transient local: the monitor's lines reach it even
             # when it matched the monitor only after the replay (the monitor is kept).
-            self.observer.wait_until(lambda: len(_statuses(list(self.logs))) >= expected,
-                                     ARRIVAL_TIMEOUT_S)
+            def arrived() -> bool:
+                logs = list(self.logs)
+                return (len(_statuses(logs)) >= expected or made is not None
+                        and sum(name == course.MONITOR_NODE for name, _ in logs) >= made)
+
+            self.observer.wait_until(arrived, ARRIVAL_TIMEOUT_S)
             self._close()
             return list(self.logs)
         with self.rt.exclusive():
@@ -246,7 +252,11 @@ def _replay(replay: Any) -> str:
 def _replay_in(path: Path, replay: Any) -> str:
     watch = _Watch()
     _call(replay, f'{replay.__name__}(bag_path, rate)', path, CHECK_RATE)
-    logs = watch.heard(len(CHECK_READINGS))
+    made = None  # how many lines the monitor made, when the subject can vouch for them all
+    if isinstance(replay, AnswerRef):
+        made = current_judge().answer_subject(replay).request(
+            'lines_logged', logger=course.MONITOR_NODE)['lines']
+    logs = watch.heard(len(CHECK_READINGS), made)
     sent = len(CHECK_READINGS)
     statuses = _statuses(logs)
     expected = [(round(r, 2), course.monitor_status(r)) for r in CHECK_READINGS]

@@ -37,7 +37,7 @@ from ..endpoints import node_endpoints
 from ..errors import Ros2nbError
 from ..explain.exceptions import explain_exception, is_library_file, learner_line
 from ..qos import profile_fields
-from ..runtime import Runtime, enable_field_checks
+from ..runtime import Runtime, current, enable_field_checks
 from ..runtime.nodes import KEEP_STOPPED_ENV
 from ..runtime.rates import callback_groups, timer_runs
 
@@ -270,6 +270,11 @@ class Subject:
         os.environ[KEEP_STOPPED_ENV] = '1'
         return {'ok': True}
 
+    def lines_logged(self, logger: str) -> dict:
+        """:meth:`~ros2nb.runtime.Runtime.lines_made` by the learner's ROS here (notebook 10)."""
+        rt = current.kernel_runtime()
+        return {'ok': True, 'lines': rt.lines_made(logger) if rt is not None else None}
+
     def serve(self) -> dict:
         """Spin the node in the background from now on: it answers service calls (its
         parameters) whenever the judge makes them."""
@@ -374,6 +379,7 @@ def serve(commands: Any, replies: Any) -> None:
         'timer_runs': subject.timer_runs, 'room_nodes': subject.room_nodes,
         'wait_publishers': subject.wait_publishers,
         'keep_stopped_nodes': subject.keep_stopped_nodes,
+        'lines_logged': subject.lines_logged,
     }
     for line in commands:
         request = json.loads(line)
