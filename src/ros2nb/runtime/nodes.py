@@ -9,7 +9,7 @@ from __future__ import annotations
 import contextlib
 import gc
 import os
-from typing import Optional, Union
+from typing import Iterator, Optional, Union
 
 import rclpy
 from rclpy.node import Node
@@ -134,6 +134,11 @@ class NodeKeeping:
         self._retired.clear()
 
 
+def _live_nodes() -> Iterator[Node]:
+    """Every rclpy node Python still holds in this process, of any context, half-built too."""
+    return (candidate for candidate in gc.get_objects() if isinstance(candidate, Node))
+
+
 def destroy_stray_nodes(context: rclpy.context.Context) -> None:
     """Destroy every node still alive on ``context``: made in a cell, never handed over, or kept
     in a variable after ``rclpy.shutdown()``.
@@ -143,9 +148,9 @@ def destroy_stray_nodes(context: rclpy.context.Context) -> None:
     unregisters its name's publisher, which by then belongs to the new node of that name:
     the new node's log lines would stop reaching the cell part-way through a spin.
     """
-    for candidate in gc.get_objects():
+    for candidate in _live_nodes():
         # a half-built node (its __init__ never called super().__init__) has no context
-        if isinstance(candidate, Node) and getattr(candidate, '_context', None) is context:
+        if getattr(candidate, '_context', None) is context:
             with contextlib.suppress(Exception):  # already destroyed, or half-built
                 candidate.destroy_node()
 
@@ -153,8 +158,8 @@ def destroy_stray_nodes(context: rclpy.context.Context) -> None:
 def logs_elsewhere(context: rclpy.context.Context, logger: str) -> bool:
     """True when a node of another context in this process logs as ``logger``: its /rosout
     lines reach ``context``'s subscriptions over DDS, later, not at the next drain."""
-    for candidate in gc.get_objects():
-        if isinstance(candidate, Node) and getattr(candidate, '_context', None) is not context:
+    for candidate in _live_nodes():
+        if getattr(candidate, '_context', None) is not context:
             with contextlib.suppress(Exception):  # a half-built node has no logger yet
                 if candidate.get_logger().name == logger:
                     return True
