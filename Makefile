@@ -31,10 +31,10 @@ $(STAMP): environment/requirements.txt environment/installer.txt pyproject.toml
 	  sys.exit(0 if ok else "The pip route needs Linux x86_64 and Python 3.10-3.13 (found %s %s, Python %d.%d); see README for RoboStack." % (platform.system(), platform.machine(), v[0], v[1]))'
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet -r environment/installer.txt
-	$(VENV)/bin/uv pip install --quiet --python $(PY) -r environment/requirements.txt
+	@# --compile-bytecode: uv compiles site-packages once, on every CPU; where
+	@# PYTHONDONTWRITEBYTECODE is set, every process would otherwise compile what it imports
+	$(VENV)/bin/uv pip install --quiet --compile-bytecode --python $(PY) -r environment/requirements.txt
 	$(VENV)/bin/uv pip install --quiet --python $(PY) --no-deps --editable .
-	@# compileall uses every CPU (pip and uv compile one file after another)
-	@$(PY) -m compileall -q -j 0 $(VENV)/lib >/dev/null 2>&1 || true
 	@touch $(STAMP)
 
 # The course's own Python compiled once, here: where PYTHONDONTWRITEBYTECODE is set (as on
