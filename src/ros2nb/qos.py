@@ -32,7 +32,7 @@ from std_msgs.msg import Int32
 
 from . import domains
 from .errors import Ros2nbError
-from .runtime.core import node_serving_nothing
+from .runtime import node_serving_nothing
 
 #: Seconds a trial waits for discovery (matching) and acknowledgements; the wait ends as
 #: soon as the state is reached, so only a very busy machine or a mismatch costs this long.
