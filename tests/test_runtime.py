@@ -14,6 +14,7 @@ import pytest
 import rclpy
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
+from std_msgs.msg import Float32
 
 import ros2nb
 from ros2nb.errors import Ros2nbError, UsageError
@@ -206,6 +207,49 @@ def test_spin_prints_logs_in_console_format(ros, capsys):
     assert lines[0] == '[INFO] [temperature_sensor]: started'
     assert len(lines) == 3
     assert all(line.startswith('[INFO] [temperature_sensor]: Publishing: ') for line in lines[1:])
+
+
+def test_a_simulated_step_waits_only_for_work_of_the_nodes(ros, capsys):
+    """A sensor's step waits twice: its timer, then idle. What its callback sent ros2nb's own
+    node (its log line, and with ``record`` the reading) is taken between the two; a wait
+    round of its own made it three (a third more CPU for every simulated hour). Every line
+    and reading still arrives, in order."""
+    random.seed(3)
+    sensor = ros2nb.add(Sensor())
+    capsys.readouterr()
+    waits = 0
+    rclpys_wait = ros.executor._wait_for_ready_callbacks
+
+    def counted(*args, **kwargs):
+        nonlocal waits
+        waits += 1
+        return rclpys_wait(*args, **kwargs)
+
+    ros.executor._wait_for_ready_callbacks = counted
+    try:
+        ros2nb.spin(10)
+        spun, waits = waits, 0
+        _times_s, readings = ros2nb.record('temperature', 10)
+        recorded = waits
+    finally:
+        del ros.executor._wait_for_ready_callbacks
+    lines = capsys.readouterr().out.splitlines()
+    assert len(lines) == 11 and all(line.startswith('[INFO] [temperature_sensor]: Publishing: ')
+                                    for line in lines[:10]), lines
+    assert readings[-1] == pytest.approx(sensor.value) and len(readings) == 10
+    assert (spun, recorded) == (2 * 10 + 1, 2 * 10 + 1)  # + the idle round before the first step
+
+
+def test_a_callback_of_ros2nbs_own_node_that_raises_is_reported_and_the_spin_goes_on(
+        ros, capsys):
+    ros2nb.add(Sensor())
+    with ros.exclusive():
+        ros.node.create_subscription(Float32, 'temperature', lambda msg: 1 / 0, 10)
+    ros2nb.spin(3)
+    captured = capsys.readouterr()
+    assert captured.err.count('[ERROR] [_ros2nb]: callback ') == 3, captured.err
+    assert 'ZeroDivisionError' in captured.err
+    assert captured.out.count('Publishing: ') == 3  # the sensor ran on
 
 
 def test_spin_without_nodes_says_so(ros, capsys):
