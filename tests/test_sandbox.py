@@ -284,6 +284,29 @@ def test_wall_time_kills_the_sandbox():
     assert (control.timed_out, control.returncode) == (False, 0)
 
 
+class _BwrapWithoutDeathSignal(Sandbox):
+    """bwrap as bubblewrap#633 leaves it when it is killed while setting up: its child has
+    no parent-death signal yet, so it lives on after bwrap, running the program."""
+
+    def command(self, argv, source=str):
+        return [arg for arg in super().command(argv, source) if arg != '--die-with-parent']
+
+
+def test_wall_time_kills_the_program_even_when_it_outlives_bwrap():
+    running = _BwrapWithoutDeathSignal(env=ENV).start(
+        ['sleep', '3600'], Limits(wall_s=0.5), stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        if not running._cgroups:
+            pytest.skip('no cgroup for the sandbox here: only bwrap is killed at its wall time')
+        # Killing bwrap alone left `sleep` holding the pipes: this waited forever.
+        running.process.communicate(timeout=PATIENCE_S)
+    except subprocess.TimeoutExpired:
+        pytest.fail(f'the program still held its pipes {PATIENCE_S} s after its wall time')
+    finally:
+        code = running.stop()
+    assert running.timed_out and code == -signal.SIGKILL
+
+
 WRITE = 'import sys; open(sys.argv[1], "wb").write(bytes(2 << 20)); print("wrote")'
 
 

@@ -76,9 +76,31 @@ def _try_cgroup(path: Path, files: dict[str, int]) -> bool:
         return False
 
 
+#: Seconds :func:`kill` and :func:`remove` keep at it before giving up.
+PATIENCE_S = 10.0
+
+
+def kill(cgroups: list[Path]) -> None:
+    """SIGKILL every process in the cgroups, again until none is left running.
+
+    Processes that are dead but not yet reaped (zombies) count as gone.  Whatever a process
+    forks meanwhile is born in the same cgroup and is killed in the next round.  Gives up
+    silently after :data:`PATIENCE_S` (then :func:`remove` kills what is left and raises).
+    """
+    deadline = time.monotonic() + PATIENCE_S
+    for cgroup in cgroups:
+        while running := [pid for pid in _read(cgroup / 'cgroup.procs').split()
+                          if _state(pid) not in ('Z', 'X', '')]:
+            for pid in running:
+                _kill(int(pid))
+            if time.monotonic() > deadline:
+                return
+            time.sleep(0.01)
+
+
 def remove(cgroups: list[Path]) -> None:
     """Kill whatever is left in the cgroups (nothing, normally) and remove them."""
-    deadline = time.monotonic() + 10
+    deadline = time.monotonic() + PATIENCE_S
     for cgroup in cgroups:
         while cgroup.exists():
             for pid in _read(cgroup / 'cgroup.procs').split():
@@ -89,6 +111,12 @@ def remove(cgroups: list[Path]) -> None:
                 if time.monotonic() > deadline:
                     raise
                 time.sleep(0.02)
+
+
+def _state(pid: str) -> str:
+    """A process's state letter from /proc (``Z``: a zombie), or '' when it is gone."""
+    stat = _read(Path('/proc') / pid / 'stat')
+    return stat.rpartition(')')[2].split()[0] if ')' in stat else ''
 
 
 def _kill(pid: int) -> None:

@@ -306,6 +306,10 @@ class Running:
         if self.process.poll() is None:
             self.timed_out = True
             self.process.kill()
+            # Not bwrap alone: killed while it sets up, its child can outlive it, still
+            # running the program and holding its pipes (bubblewrap#633), so that a reader
+            # waiting for their end would wait forever.  The cgroup holds them all.
+            cgroups_of.kill(self._cgroups)
 
     def wait(self, timeout: float | None = None) -> int:
         """Wait for the program to end, then clean up as :meth:`stop` does.
