@@ -33,12 +33,13 @@ MISTAKES = [
      r"^The bag holds /temperature but not /rosout \(the monitor's statuses\): record both "
      r'/temperature and /rosout\.$'),
     ('record_hour', 'a minute', 'spin(HOUR_S,', 'spin(60,',
-     r'^The bag holds 60 readings on /temperature; one simulated hour of the sensor is 3600'),
+     r'^60 readings went out on /temperature while record_hour\(bag_path\) ran; one simulated '
+     r'hour of the sensor is 3600'),
     ('record_hour', 'another folder', 'bag_record(bag_path,',
      "bag_record(Path(tempfile.mkdtemp()) / 'elsewhere',",
      r'^record_hour\(bag_path\) wrote no bag at the path it was given: pass bag_path'),
     ('record_hour', 'no monitor', '    ros2nb.add(sub.TemperatureMonitor())\n', '',
-     r'^The bag holds 0 status lines of temperature_monitor on /rosout, expected 3600'),
+     r'^temperature_monitor logged no status while record_hour\(bag_path\) ran: add your monitor'),
     ('replay', 'no monitor', '    ros2nb.add(sub.TemperatureMonitor())\n', '',
      r'^temperature_monitor logged no status during the replay: add your monitor before '
      r'bag_play'),

@@ -95,8 +95,8 @@ EXPECTED = {
     # ---- nothing a learner's code touched is trusted (honest twin: complete's 02)
     'rewrites-package-xml': Case({NB02: 0}, {NB02: 'but it declares'}),
     # a sensor without a timer (main() alone earns its 1 of 6), and its honest twin
-    'forges-its-timer': Case({NB03: 1}, {NB03: 'TemperatureSensor has no timer'}),
-    'no-timer': Case({NB03: 1}, {NB03: 'TemperatureSensor has no timer'}),
+    'forges-its-timer': Case({NB03: 4}, {NB03: 'TemperatureSensor has no timer'}),
+    'no-timer': Case({NB03: 4}, {NB03: 'TemperatureSensor has no timer'}),
 }
 #: What a learner script in a feedback page would set (page title and a window flag).
 PWNED = 'pwned-by-a-learner'

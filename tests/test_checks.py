@@ -100,9 +100,9 @@ SENSOR_MISTAKES = [
     ('message type', 'from std_msgs.msg import Float32', 'from std_msgs.msg import Float64 as Float32',
      checks.check_sensor_constructor, r'uses std_msgs/msg/Float64, but the topic carries std_msgs/msg/Float32'),
     ('period', 'PUBLISH_PERIOD_S = 1.0 ', 'PUBLISH_PERIOD_S = 2.0 ',
-     checks.check_sensor_constructor, r'The timer fires every 2 s; the sensor publishes every 1.0 s'),
+     checks.check_sensor_constructor, r'Readings came 2 s apart on the grader.s clock; the sensor publishes every 1.0 s: give the timer PUBLISH_PERIOD_S'),
     ('start value', 'self.temperature = START_TEMPERATURE_C', 'self.temperature = 0.0',
-     checks.check_sensor_constructor, r'self.temperature starts at 0.0; the walk starts at START_TEMPERATURE_C = 22.0'),
+     checks.check_sensor_constructor, r'The first reading is 18.00 °C: the walk starts at START_TEMPERATURE_C = 22.0 °C \(set self.temperature to it in __init__\)'),
     ('callback called before part 4 exists',
      ('self.create_timer(PUBLISH_PERIOD_S, self.publish_temperature)', 'def publish_temperature(self):'),
      ('self.create_timer(PUBLISH_PERIOD_S, self.publish_temperature())', 'def not_yet_written(self):'),
@@ -130,7 +130,7 @@ SENSOR_MISTAKES = [
      "self.get_logger().info('Publishing a reading')",
      checks.check_sensor_callback, r'publish_temperature logged "Publishing a reading" for a reading of \d+\.\d\d °C: show the reading in its line'),
     ('main() crashes before its spin', '    rclpy.init(args=args)\n', '',
-     checks.check_sensor_main, r"crashed before Ctrl\+C at line \d+ \(super\(\).__init__\('temperature_sensor'\)\) \(NotInitializedException: .*\): fix that line"),
+     checks.check_sensor_main, r"crashed before Ctrl\+C at line \d+ \(node = TemperatureSensor\(\)\) \(NotInitializedException: .*\): fix that line"),
     ('shutdown instead of try_shutdown', 'rclpy.try_shutdown()  # rclpy.shutdown() would raise', 'rclpy.shutdown()  # rclpy.shutdown() would raise',
      checks.check_sensor_main, r'exited with code 1 after Ctrl\+C \(Ctrl\+C had already shut rclpy down\): shut down with rclpy.try_shutdown\(\) instead of rclpy.shutdown\(\)'),
     ("the tutorial's main", '''    except (KeyboardInterrupt, ExternalShutdownException):
@@ -177,10 +177,13 @@ MONITOR_MISTAKES = [
      checks.check_monitor_callback, r'logged 2 lines; log exactly one per message'),
     ('wrong topic', "TOPIC = 'temperature'", "TOPIC = 'temp'",
      checks.check_monitor_constructor, r'no subscription on /temperature \(it has: /temp \[std_msgs/msg/Float32\]\)'),
-    ("the tutorial's main", '''    finally:
+    ("the tutorial's main", ('''    except (KeyboardInterrupt, ExternalShutdownException):
+        pass  # Ctrl+C or a shutdown from outside: leave quietly
+    finally:
         node.destroy_node()   # the tutorial's subscriber never did this
-        rclpy.try_shutdown()  # nor this''', '',
-     checks.check_monitor_main, r'main\(\) never destroys its node'),
+        rclpy.try_shutdown()  # nor this'''), ('''    except KeyboardInterrupt:
+        pass'''),
+     checks.check_monitor_main, r'exited with code 1 after a shutdown from outside \(SIGTERM\) \(.*ExternalShutdownException.*\): catch ExternalShutdownException around the spin'),
 ]
 
 
@@ -231,7 +234,9 @@ def test_package_checks(session, capsys):
         entries('# YOUR CODE HERE', 'raise NotImplementedError()')
         fails(checks.check_entry_points, r'setup.py still holds the placeholder')
         entries()
-        fails(checks.check_entry_points, r'console_scripts has no entry named temperature_publisher')
+        fails(checks.check_entry_points, r'ros2 run sensor_simulator temperature_publisher: No '
+                                         r'executable found: console_scripts has no entry named '
+                                         r'temperature_publisher')
         entries(publisher, subscriber + ',')  # no comma after the first
         fails(checks.check_entry_points, r'is two entries run together: end each string in the '
                                          r'console_scripts list with a comma')
@@ -239,12 +244,17 @@ def test_package_checks(session, capsys):
         fails(checks.check_entry_points, r'is not written NAME = package.module:function: the '
                                          r'module is written with dots')
         entries("'temperature_publisher = sensor_simulator.publisher:main',", subscriber + ',')
-        fails(checks.check_entry_points, r'temperature_publisher = sensor_simulator.publisher:main: '
+        fails(checks.check_entry_points, r'did not start main\(\) of '
+                                         r'sensor_simulator.temperature_publisher: .*'
+                                         r'temperature_publisher = sensor_simulator.publisher:main: '
                                          r'it should start main\(\) in sensor_simulator/temperature_publisher.py')
         entries(publisher + ',', subscriber + ',')
         setup_cfg.write_text(generated_cfg.replace('$base/lib/sensor_simulator', '$base/bin'))
         fails(checks.check_setup_cfg, r'\[develop\] script_dir is \$base/bin; ros2 run looks in '
                                       r'\$base/lib/sensor_simulator')
+        setup_cfg.write_text(generated_cfg.replace('=$base/lib/sensor_simulator',
+                                                   '=$base/lib/sensor_simulator/'))
+        checks.check_setup_cfg()  # a trailing slash: the same folder, ros2 run finds them
         setup_cfg.unlink()
         fails(checks.check_setup_cfg, r'setup.cfg is missing')
         setup_cfg.write_text(generated_cfg)
@@ -344,17 +354,18 @@ def test_checks_say_when_ros_was_shut_down():
 
 def test_links_out_of_the_workspace_are_never_followed(session, tmp_path):
     """A workspace file may be a link to a file a subject can rewrite, or that only the
-    judge may read. The checks that read the learner's source as text refuse such a link
-    (before, they read whatever it pointed to); a build copies it as a link (before, it
-    copied the target's text where the learner's setup.py runs)."""
+    judge may read. The judge reads the learner's source as text only to word a failure,
+    and refuses such a link then too (before, it read whatever it pointed to); a build copies
+    it as a link (before, it copied the target's text where the learner's setup.py runs)."""
     outside = tmp_path / 'elsewhere.py'
-    outside.write_text(course.reference_source(Path(PUB).name))
+    outside.write_text(course.reference_source(Path(PUB).name).replace(
+        '        self.timer = self.create_timer(PUBLISH_PERIOD_S, self.publish_temperature)\n', ''))
     (session.workspace / PUB).unlink()
     (session.workspace / PUB).symlink_to(outside)
     try:
-        fails(checks.check_sensor_callback, r'temperature_publisher.py is a link to .*, outside '
-                                            r'your workspace: the grader reads your files in the '
-                                            r'workspace only')
+        fails(checks.check_sensor_constructor, r'temperature_publisher.py is a link to .*, '
+                                               r'outside your workspace: the grader reads your '
+                                               r'files in the workspace only')
     finally:
         (session.workspace / PUB).unlink()
         restore(session, PUB)

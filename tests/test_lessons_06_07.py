@@ -71,7 +71,7 @@ def test_reference_files_pass(session, capsys):
         check()
     out = capsys.readouterr().out
     assert out.count('Check passed:') == 6, out
-    assert 'heartbeat kept at least 60% of its 20 runs in 2 s on a MultiThreadedExecutor' in out
+    assert 'a heartbeat came while slow_work was busy, on a MultiThreadedExecutor' in out
 
 
 MISTAKES = [
@@ -84,22 +84,18 @@ MISTAKES = [
      checks.check_fan_controller, r'no publisher on /fan_command \(it has: /fan_comand'),
     ('fan: node name', FAN, "super().__init__('fan_controller')", "super().__init__('fan')",
      checks.check_fan_controller, r'The node is called fan; name it fan_controller'),
-    ('fan main: no finally', FAN, '''    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()''', '''    node.destroy_node()
-    rclpy.try_shutdown()''',
-     checks.check_fan_main, r'cleans up only when the spin ends normally'),
     ('counting: name ignored', PROMISES, 'super().__init__(name)',
      "super().__init__('counting_monitor')", checks.check_counting_monitor,
      r"CountingMonitor\('monitor_7'\) made a node called counting_monitor: pass the name"),
     ('counting: never counts', PROMISES, 'self.received += 1', 'pass',
-     checks.check_counting_monitor, r'After 5 readings self.received is 0: add one'),
+     checks.check_counting_monitor, r'logged "received 0": add one to self.received'),
     ('counting: no attribute', PROMISES, '        self.received = 0\n', '',
-     checks.check_counting_monitor, r'has no attribute received: set self.received = 0'),
+     checks.check_counting_monitor, r"object has no attribute 'received'"),
     ('worker: single-threaded', PROMISES, 'executor = MultiThreadedExecutor(num_threads=2)',
      'from rclpy.executors import SingleThreadedExecutor\n    executor = SingleThreadedExecutor()',
-     checks.check_responsive_worker, r'heartbeat cannot keep its 10 Hz while slow_work runs: a '
-                                     r'SingleThreadedExecutor runs one callback at a time'),
+     checks.check_responsive_worker, r'No heartbeat came while slow_work was busy \(\d+ runs of '
+                                     r'slow_work watched\): a SingleThreadedExecutor runs one '
+                                     r'callback at a time'),
     ('worker: one group', PROMISES, '''slow_group=MutuallyExclusiveCallbackGroup(),
                   heartbeat_group=MutuallyExclusiveCallbackGroup())''', ')',
      checks.check_responsive_worker, r'both timers are in one MutuallyExclusiveCallbackGroup'),
@@ -120,12 +116,12 @@ MISTAKES = [
      '    raise NotImplementedError()', checks.check_room_arguments,
      r"room_arguments\('kitchen'\) still raises NotImplementedError"),
     ('plot: wall-clock time', PLOT, 'self.get_clock().now().nanoseconds / 1e9', "__import__('time').time()",
-     checks.check_plot_callback, r"got the time \d+\.\d+: use the node's clock in seconds"),
+     checks.check_plot_callback, r"was plotted at [\d.e+]+ s: use the node's clock in seconds"),
     ('plot: no redraw', PLOT, '        self.redraw()\n', '',
-     checks.check_plot_callback, r'After 4 readings the plot was redrawn 0 times: call '
-                                 r'self.redraw\(\) once per message'),
+     checks.check_plot_callback, r'nothing was plotted: append the time and the reading, then '
+                                 r'call self.redraw\(\) once per message'),
     ('plot: the message, not its data', PLOT, 'self.temps_c.append(msg.data)',
-     'self.temps_c.append(msg)', checks.check_plot_callback, r'temps_c holds .* append msg.data'),
+     'self.temps_c.append(msg)', checks.check_plot_callback, r'unsupported format string passed to Float32'),
 ]
 
 
@@ -208,10 +204,11 @@ if _SUBJECT is not None:
 
 def test_a_count_reported_by_a_forged_subject(session):
     """The subject's reply said received == 5 although the callback counts nothing: against
-    the check before it, that passed (checked by hand); the file, read as text, decides."""
+    the check before it, that passed (checked by hand); now the judge reads the count the
+    monitor logs."""
     fails_forged(session, PROMISES, 'self.received += 1', 'pass', FORGED_COUNT,
                  checks.check_counting_monitor,
-                 r'The subscription calls count, which never adds to self.received')
+                 r'logged "received 0": add one to self.received')
 
 
 def test_a_count_through_a_lambda_passes(session, capsys):
@@ -257,15 +254,15 @@ if _SUBJECT is not None:
 
 def test_a_plot_reported_by_a_forged_subject(session):
     """The subject's replies gave the lists and the redraw count of a right callback although
-    the callback does nothing: against the check before it, that passed (checked by hand);
-    the file, read as text, decides."""
+    the callback does nothing: against the check before it, that passed (checked by hand).
+    The subject's first command loads the file before any request loop exists, so the frame
+    walk finds none, and the judge decides from the /rosout lines redraw() logs."""
     right = '''        self.times_s.append(self.get_clock().now().nanoseconds / 1e9)
         self.temps_c.append(msg.data)
         self.redraw()
 '''
     fails_forged(session, PLOT, right, '        pass\n', FORGED_PLOT, checks.check_plot_callback,
-                 r'The subscription calls temperature_callback, which never adds to '
-                 r'self.times_s')
+                 r'nothing was plotted')
 
 
 def test_a_plot_fed_through_a_helper_method_passes(session, capsys):
@@ -311,11 +308,11 @@ RESPONSIVE = '''    node = Worker('responsive_worker', slow_group=MutuallyExclus
 def test_a_worker_reported_by_a_forged_subject(session):
     """The subject's reply gave a right answer's executor, groups and counts although the
     function returns a single-threaded executor: against the check before it, that passed
-    (checked by hand); the file, read as text, decides."""
+    (checked by hand); now the judge hears no heartbeat while slow_work is busy."""
     fails_forged(session, PROMISES, RESPONSIVE, '''    from rclpy.executors import SingleThreadedExecutor
     return Worker('responsive_worker'), SingleThreadedExecutor()
 ''', FORGED_WORKER, checks.check_responsive_worker,
-                 r'^a SingleThreadedExecutor runs one callback at a time')
+                 r'a SingleThreadedExecutor runs one callback at a time')
 
 
 @pytest.mark.parametrize('label, answer', [
@@ -337,41 +334,34 @@ def test_a_worker_written_another_way_passes(session, capsys, label, answer):
     passes_with(session, capsys, PROMISES, RESPONSIVE, answer, checks.check_responsive_worker)
 
 
-def test_a_worker_whose_answer_the_grader_cannot_read_is_told_how_to_write_it(session):
-    mutated(session, PROMISES, RESPONSIVE, '''    made = [Worker('responsive_worker', slow_group=MutuallyExclusiveCallbackGroup(),
+def test_a_worker_built_in_a_list_passes(session, capsys):
+    """Before, the judge read responsive_worker() as text and failed this honest answer
+    ("cannot tell what it returns"); now the worker's lines on /rosout decide."""
+    passes_with(session, capsys, PROMISES, RESPONSIVE, '''    made = [Worker('responsive_worker', slow_group=MutuallyExclusiveCallbackGroup(),
                    heartbeat_group=MutuallyExclusiveCallbackGroup()),
             MultiThreadedExecutor(num_threads=2)]
     return tuple(made)
-''')
-    try:
-        with pytest.raises(CheckFailed, match=r'reads responsive_worker\(\) in your file as '
-                                              r'text and cannot tell what it returns: build'):
-            checks.check_responsive_worker()
-    finally:
-        restore(session, PROMISES)
+''', checks.check_responsive_worker)
 
 
-#: At import, the file has the subject answer every 'attribute' with a reply of no known shape.
-NONSENSE_REPLY = FIND_SUBJECT + '''
-if _SUBJECT is not None:
-    _HANDLERS['attribute'] = lambda name: {'ok': True, 'value': 'nonsense'}
-'''
-
-
-def test_a_reply_of_no_known_shape_fails_that_check_alone(session):
-    """A check that meets a reply it cannot read raises an error of its own (TypeError here);
+def test_a_reply_of_no_known_shape_fails_that_check_alone(session, monkeypatch):
+    """A check that meets a reply it cannot read raises an error of its own (KeyError here);
     before, that ended the judge and every check of the notebook went with it. Now it fails
     that check with one line, and the notebook's other checks are graded."""
     from ros2nb.checks.dispatch import captured
+    from ros2nb.judge.subjects import SubjectProcess
 
-    (session.workspace / PLOT).write_text((session.workspace / PLOT).read_text() + NONSENSE_REPLY)
+    request = SubjectProcess.request
+
+    def nonsense(self, op, **arguments):
+        reply = request(self, op, **arguments)
+        return {'ok': True} if op == 'new_node' else reply
+
+    monkeypatch.setattr(SubjectProcess, 'request', nonsense)
     session.drop(('file', PLOT))
-    try:
-        with pytest.raises(TypeError):  # what ended the judge
-            checks.check_plot_callback()
-        outcome = captured(checks.check_plot_callback)
-    finally:
-        restore(session, PLOT)
+    with pytest.raises(KeyError):  # what ended the judge
+        checks.check_plot_callback()
+    outcome = captured(checks.check_plot_callback)
     assert outcome['passed'] is False and '\n' not in outcome['message']
-    assert outcome['message'].startswith('The grader could not finish this check (TypeError: '
-                                         'string indices must be integers'), outcome
+    assert outcome['message'].startswith('The grader could not finish this check (KeyError'), \
+        outcome

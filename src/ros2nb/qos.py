@@ -8,8 +8,10 @@ publisher finishes before the subscription's callback runs (a burst before spinn
 waiting ends on a state (every message acknowledged, the endpoints matched), never on a
 guessed time.  A burst *while* spinning loses a number that changes from run to run.
 
-The checks of notebook 09 run the same trials on the learner's profiles; the judge
-rebuilds a profile from :func:`profile_fields` (plain names and numbers).
+The checks of notebook 09 run the same trials on the learner's profiles.  Whether two
+profiles can talk is rclpy's to say (:func:`incompatibility`, with ``qos_check_compatible``,
+which knows every DDS rule), on the profiles as discovery reports them for both endpoints
+(:func:`discovered`), as ``ros2 topic info --verbose`` shows them.
 """
 
 from __future__ import annotations
@@ -25,8 +27,8 @@ import rclpy
 from rclpy.context import Context
 from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
 from rclpy.executors import SingleThreadedExecutor
-from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSPolicyKind, QoSProfile,
-                       ReliabilityPolicy)
+from rclpy.qos import (HistoryPolicy, QoSCompatibility, QoSPolicyKind, QoSProfile,
+                       qos_check_compatible)
 from rclpy.signals import SignalHandlerOptions
 from std_msgs.msg import Int32
 
@@ -42,43 +44,62 @@ IDLE_S = 0.05
 _topics = itertools.count()
 
 
-def profile_fields(profile: QoSProfile) -> dict[str, Any]:
-    """Return a profile's history, depth, reliability and durability as plain names/numbers."""
-    return {'history': profile.history.name, 'depth': int(profile.depth),
-            'reliability': profile.reliability.name, 'durability': profile.durability.name}
-
-
-def profile_from_fields(fields: dict[str, Any]) -> QoSProfile:
-    """Rebuild a :class:`QoSProfile` from :func:`profile_fields` (what the judge receives)."""
-    return QoSProfile(history=HistoryPolicy[fields['history']], depth=int(fields['depth']),
-                      reliability=ReliabilityPolicy[fields['reliability']],
-                      durability=DurabilityPolicy[fields['durability']])
-
-
 def describe(profile: QoSProfile) -> str:
     """One line: ``RELIABLE, KEEP_LAST (10), VOLATILE``."""
-    history = profile.history.name
+    if profile.history not in (HistoryPolicy.KEEP_LAST, HistoryPolicy.KEEP_ALL):
+        return f'{profile.reliability.name}, {profile.durability.name}'  # as discovered
     depth = f' ({profile.depth})' if profile.history == HistoryPolicy.KEEP_LAST else ''
-    return f'{profile.reliability.name}, {history}{depth}, {profile.durability.name}'
+    return f'{profile.reliability.name}, {profile.history.name}{depth}, {profile.durability.name}'
+
+
+#: What to change for each kind of incompatibility rclpy names (a word of its reason).
+_ADVICE = (('reliab', 'a best-effort publisher never resends, so it cannot serve a reliable '
+                      'subscription; make the subscription BEST_EFFORT (or the publisher RELIABLE)'),
+           ('durab', 'a volatile publisher keeps nothing for late joiners; make the subscription '
+                     'VOLATILE (or the publisher TRANSIENT_LOCAL)'),
+           ('deadline', 'a subscription may only ask for a deadline the publisher promises; '
+                        'leave the deadline out of the subscription\'s profile'),
+           ('lease', 'a subscription may only ask for a liveliness lease the publisher '
+                     'promises; leave the lease duration out of the subscription\'s profile'),
+           ('liveliness', 'a subscription may only ask for the liveliness the publisher '
+                          'offers; leave liveliness at its default (AUTOMATIC)'))
 
 
 def incompatibility(offered: QoSProfile, requested: QoSProfile) -> Optional[str]:
     """Explain in one line why a publisher's profile cannot serve a subscription's, or None.
 
-    The two DDS rules the course meets: a best-effort publisher cannot serve a reliable
-    subscription, and a volatile publisher cannot serve a transient-local subscription.
+    rclpy's own ``qos_check_compatible`` decides (every DDS rule: reliability, durability,
+    deadline, liveliness and its lease); its reason comes first, then what to change.  A
+    pair it only warns about (a policy left to the system default) is None: whether it
+    matches is then the middleware's to show.
     """
-    if (offered.reliability == ReliabilityPolicy.BEST_EFFORT
-            and requested.reliability == ReliabilityPolicy.RELIABLE):
-        return ('the publisher offers Reliability BEST_EFFORT but the subscription requests '
-                'RELIABLE: a best-effort publisher never resends, so it cannot serve a reliable '
-                'subscription; make the subscription BEST_EFFORT (or the publisher RELIABLE).')
-    if (offered.durability == DurabilityPolicy.VOLATILE
-            and requested.durability == DurabilityPolicy.TRANSIENT_LOCAL):
-        return ('the publisher offers Durability VOLATILE but the subscription requests '
-                'TRANSIENT_LOCAL: a volatile publisher keeps nothing for late joiners; make the '
-                'subscription VOLATILE (or the publisher TRANSIENT_LOCAL).')
-    return None
+    compatibility, reason = qos_check_compatible(offered, requested)
+    if compatibility != QoSCompatibility.ERROR:
+        return None
+    said = reason.strip().rstrip(';').removeprefix('ERROR:').strip()
+    advice = next((text for word, text in _ADVICE if word in said.lower()),
+                  'make the subscription ask for no more than the publisher offers')
+    return f'rclpy says: {said}; {advice}.'
+
+
+def discovered(node: Any, topic: str, kind: str, *, seconds: float = MATCH_TIMEOUT_S,
+               wait: Optional[Callable[[float], None]] = None) -> list[Any]:
+    """The endpoints of ``topic`` of one kind (``'publisher'`` or ``'subscription'``), as
+    discovery reports them to ``node`` (each with its node's name and its QoS profile, as
+    ``ros2 topic info --verbose`` shows them); waits until there is one, up to ``seconds``.
+
+    :param wait: how to wait a moment (default ``time.sleep``); a node that is spun by the
+        caller passes a spin.
+    :return: the endpoints' infos (empty when none appeared in time).
+    """
+    find = node.get_publishers_info_by_topic if kind == 'publisher' \
+        else node.get_subscriptions_info_by_topic
+    deadline = time.monotonic() + seconds
+    while True:
+        found = list(find(topic))
+        if found or time.monotonic() > deadline:
+            return found
+        (wait or time.sleep)(0.01)
 
 
 @dataclass
@@ -172,6 +193,16 @@ def _trial(body: Callable[[_Trial], None]) -> Deliveries:
         trial.close()
 
 
+def _discovered_incompatibility(node: Any, topic: str) -> Optional[str]:
+    """:func:`incompatibility` of the first publisher and subscription of ``topic`` with
+    their profiles as discovery reports them (the middleware's defaults filled in)."""
+    publishers = discovered(node, topic, 'publisher')
+    subscriptions = discovered(node, topic, 'subscription')
+    if not publishers or not subscriptions:
+        return None
+    return incompatibility(publishers[0].qos_profile, subscriptions[0].qos_profile)
+
+
 def _publish(publisher: Any, count: int) -> None:
     for number in range(count):
         publisher.publish(Int32(data=number))
@@ -210,7 +241,8 @@ def burst(subscription_qos: QoSProfile, *, count: int = 30,
             _publish(publisher, count)
             trial.drain()
         else:
-            trial.out.explanation = incompatibility(publisher_qos, subscription_qos)
+            trial.out.explanation = _discovered_incompatibility(trial.nodes[1], trial.topic) \
+                or incompatibility(publisher_qos, subscription_qos)
 
     return _trial(body)
 
@@ -271,7 +303,8 @@ def pair(publisher_qos: QoSProfile, subscription_qos: QoSProfile, *,
             for info in infos:
                 trial.out.endpoints += endpoint_lines(info) + ['']
         if not matched:
-            trial.out.explanation = incompatibility(publisher_qos, subscription_qos)
+            trial.out.explanation = _discovered_incompatibility(graph, trial.topic) \
+                or incompatibility(publisher_qos, subscription_qos)
             return
         for number in range(count):
             publisher.publish(Int32(data=number))

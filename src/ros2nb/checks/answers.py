@@ -1,7 +1,7 @@
 """The learner's answer cells (notebooks 00-02, 09), called in a subject: what comes back.
 
 Part of :mod:`ros2nb.checks`.  Only plain values travel back from the learner's function
-(a path, a list of names, a number, a QoS profile's policies); anything else is known by its type and its repr.
+(a path, a list of names, a number); anything else is known by its type and its repr.
 """
 
 from __future__ import annotations
@@ -10,7 +10,6 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import CheckFailed
-from ..qos import profile_from_fields
 from .base import AnswerRef, current_judge, learner_error
 
 
@@ -37,8 +36,6 @@ def decoded(output: dict, label: str) -> Any:
     if result['type'] in ('list', 'tuple'):
         return [item['value'] if item.get('type') in _PLAIN else Opaque(item['type'], item['value'])
                 for item in result['value']]
-    if result['type'] == 'QoSProfile':
-        return profile_from_fields(result['value'])
     if result['type'] in _PLAIN:
         return result['value']
     return Opaque(result['type'], result['value'])

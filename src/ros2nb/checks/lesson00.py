@@ -62,7 +62,7 @@ def _kernel_node_endpoints(node_class: Any) -> tuple[str, list]:
 def _answer_node_endpoints(ref: AnswerRef) -> tuple[str, list]:
     judge = current_judge()
     subject = judge.answer_subject(ref)
-    reply = subject.request('new_node', cls=ref.name, placeholders=[], seed=None)
+    reply = subject.request('new_node', cls=ref.name, stand_ins=[], seed=None)
     if reply.get('no_class'):
         raise CheckFailed(f'{ref.name} is not defined in your answer cell as a Node subclass.')
     if reply.get('refused'):

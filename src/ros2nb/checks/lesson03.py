@@ -1,184 +1,214 @@
 """Checks of notebook 03, write the publisher: the sensor's constructor, callback and main().
 
 Part of :mod:`ros2nb.checks`.  The judge creates the learner's ``TemperatureSensor`` in a
-subject, runs it on simulated time and decides from what reaches its own node over ROS.
+subject, runs it on the judge's own clock (:mod:`ros2nb.judge.clock`) and decides from what
+reaches its own node over ROS: the graph, each reading on ``/temperature`` with the
+judge's time of its arrival, and the lines on ``/rosout``.  Each part is graded on its own:
+while one part is checked, the course's stand-in may take the place of another
+(:mod:`ros2nb.subject.stand_ins`).  The file, read as text, only picks the words of a
+failure the judge has already seen.
 """
 
 from __future__ import annotations
 
 import math
 import re
+from dataclasses import dataclass, field
 from typing import Any, Optional
+
+from std_msgs.msg import Float32
 
 from .. import course
 from ..errors import CheckFailed
 from .base import ARRIVAL_TIMEOUT_S, Judge, judged, learner_error, passed
 from .mains import run_main
-from .nodes import caught_up, new_node, started_log_verdict
-from .source import UNKNOWN, ClassSource
+from .nodes import caught_up, new_node
+from .source import ClassSource
 from .verdicts import endpoint_verdict, node_name_verdict
 
 #: Tolerance for values that went through a 32-bit float (°C).
 FLOAT32_TOLERANCE_C = 1e-4
 #: How far a logged number may be from its reading (°C): two decimals, rounded either way.
 LOGGED_READING_TOLERANCE_C = 0.011
-#: Simulated seconds the callback check runs the sensor, then each clamp probe.
-CALLBACK_RUN_S, CLAMP_RUN_S = 20, 40
+#: Simulated seconds the judge runs the sensor: for the constructor, the callback, each clamp
+#: probe, and the hidden hour.
+CONSTRUCTOR_RUN_S, CALLBACK_RUN_S, CLAMP_RUN_S, HOUR_S = 6, 20, 40, 3600
+#: Steps of the judge's clock (s): four to a period, so a timer of another period shows; the
+#: hour in steps of one period.
+FINE_STEP_S, HOUR_STEP_S = 0.25, 1.0
 #: Seeds of ``random`` for the sensor checks (a clamp-less walk crosses both limits).
 SENSOR_SEED, CEILING_SEED, FLOOR_SEED = 7, 2, 1
 #: Where the clamp probes start the walk (°C): just inside the limits.
 CLAMP_PROBES_C = (course.MAX_TEMPERATURE_C - 0.05, course.MIN_TEMPERATURE_C + 0.05)
+TOPIC = '/' + course.TOPIC
 
 
-def _sensor_verdict(judge: Judge, info: dict, found: list) -> None:
-    """Name and publisher (the ROS graph), timer and start value (the file, read as text).
+@dataclass
+class SensorRun:
+    """What the judge saw of one sensor made in a subject, run on the judge's clock.
 
-    Nothing here comes from the subject's word: the graph is the judge's own view, and
-    the timer and start value are read from the learner's file with ``ast``; their effect
-    (one reading a second, the first next to the start value) is what the callback checks
-    observe on ``/temperature``.
+    :ivar subject: the subject process the node runs in.
+    :ivar info: the subject's reply to ``new_node`` (name, namespace).
+    :ivar found: the node's endpoints as the judge's graph shows them.
+    :ivar started_lines: the lines it logged while it was made.
+    :ivar readings: ``(seconds since the run began on the judge's clock, °C)``.
+    :ivar lines: the node's /rosout lines during the run.
+    :ivar problem: what stopped the run early (a callback that raised), or None.
     """
-    node_name_verdict(info, course.SENSOR_NODE)
-    endpoint_verdict(info['name'], found, 'publisher', '/' + course.TOPIC, course.MESSAGE_TYPE)
-    source = ClassSource.read(judge.workspace, course.PUBLISHER_FILE, course.SENSOR_CLASS)
-    if source is None:  # the subject imported another file than the judge can read
-        raise CheckFailed(f'The grader cannot read the class {course.SENSOR_CLASS} in '
-                          f'{course.PUBLISHER_FILE}: run the %%part cells that write it again.')
-    _timer_verdict(source)
-    _start_verdict(source)
+
+    subject: Any
+    info: dict
+    found: list
+    started_lines: list[str]
+    readings: list[tuple[float, float]] = field(default_factory=list)
+    lines: list[str] = field(default_factory=list)
+    problem: Optional[CheckFailed] = None
+
+    @property
+    def values(self) -> list[float]:
+        return [value for _t, value in self.readings]
 
 
-def _timer_verdict(source: ClassSource) -> None:
-    timers = source.timers()
-    if not timers:
-        raise CheckFailed(f'{course.SENSOR_CLASS} has no timer: create one in __init__ that calls '
-                          f'self.publish_temperature every PUBLISH_PERIOD_S = '
-                          f'{course.PUBLISH_PERIOD_S} s.')
-    if len(timers) > 1:
-        raise CheckFailed(f'{course.SENSOR_CLASS} has {len(timers)} timers; one timer calling '
-                          'publish_temperature is all it needs.')
-    period, callback = timers[0].period, timers[0].callback
-    if callback != 'publish_temperature':
-        raise CheckFailed(f'The timer calls {callback}; it must call self.publish_temperature '
-                          '(the method itself, without parentheses).')
-    if period is not UNKNOWN and not (_is_number(period) and math.isclose(
-            period, course.PUBLISH_PERIOD_S)):  # else the readings' spacing decides
-        shown = f'{period:g}' if _is_number(period) else repr(period)
-        raise CheckFailed(f'The timer fires every {shown} s; the sensor publishes '
-                          f'every {course.PUBLISH_PERIOD_S} s (PUBLISH_PERIOD_S).')
-
-
-def _start_verdict(source: ClassSource) -> None:
-    if source.computes('temperature'):
-        raise CheckFailed(f'temperature of {course.SENSOR_CLASS} is a property (or a method): '
-                          'make it a plain attribute of the node, set in __init__ with '
-                          'self.temperature = START_TEMPERATURE_C.')
-    start = source.attribute('temperature')
-    if not source.assignments('temperature') and not source.assigned_anywhere('temperature'):
-        raise CheckFailed(f'{course.SENSOR_CLASS} has no attribute temperature: start the walk '
-                          'in __init__ with self.temperature = START_TEMPERATURE_C.')
-    if start is not UNKNOWN and not (_is_number(start) and math.isclose(
-            start, course.START_TEMPERATURE_C)):  # else the first reading decides
-        raise CheckFailed(f'self.temperature starts at {start!r}; the walk starts at '
-                          f'START_TEMPERATURE_C = {course.START_TEMPERATURE_C} °C.')
-
-
-def _publishes_verdict(judge: Judge) -> None:
-    """The readings that arrived came from publish_temperature, as the file (text) says.
-
-    The judge hears readings, not which code sent them, and what a subject says about that
-    counts for nothing: the method the timer calls must publish.
-    """
-    source = ClassSource.read(judge.workspace, course.PUBLISHER_FILE, course.SENSOR_CLASS)
-    if source is None or not source.reaches_call('publish_temperature', 'publish'):
-        raise CheckFailed('publish_temperature never publishes, yet readings arrived from '
-                          'elsewhere: put the new reading into a Float32 message and publish it '
-                          'with the publisher from __init__, in publish_temperature.')
-
-
-def _is_number(value: Any) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
-
-
-def _sensor_constructor(judge: Judge) -> str:
-    mark = len(judge.observer.logs)
-    _subject, info = new_node(judge, course.PUBLISHER_FILE, course.SENSOR_CLASS,
-                               placeholders=('publish_temperature',))
-    found = judge.observer.endpoints(info['name'], info['namespace'], info['endpoints'])
-    _sensor_verdict(judge, info, found)
-    started_log_verdict(judge, info, mark, course.SENSOR_CLASS)
-    return (f'{info["name"]} publishes {course.MESSAGE_TYPE} on /{course.TOPIC} every '
-            f'{course.PUBLISH_PERIOD_S} s, starting at {course.START_TEMPERATURE_C} °C.')
-
-
-def check_sensor_constructor() -> None:
-    """Check part 3 of ``temperature_publisher.py``: the sensor's ``__init__``.
-
-    Creates your ``TemperatureSensor`` (a stand-in replaces ``publish_temperature`` if part
-    4 is not written yet) and checks its name, its publisher (topic and type, as the ROS
-    graph shows them), its timer (period and callback), the start value of
-    ``self.temperature`` and its start-up log line.
-
-    Introduced in ``03-write-the-publisher.ipynb``.
-
-    :raises CheckFailed: naming your value and the expected one.
-    """
-    judged('check_sensor_constructor', _sensor_constructor)
-
-
-def _run_sensor(judge: Judge, subject: Any, info: dict, seconds: int, *,
-                step_s: float = 1.0, seed: Optional[int] = None) -> tuple[list[float], list[str], int]:
-    """Run the sensor ``seconds`` simulated seconds; return readings, log lines, firings.
-
-    The readings and log lines are what arrived at the judge's own subscriptions, over
-    ROS; the subject's counts only tell the judge how long to wait for them.
-    """
+def _make_sensor(judge: Judge, stand_ins: tuple[str, ...], seed: int) -> SensorRun:
+    """The learner's sensor (with the course's ``stand_ins``), made in a subject."""
     observer = judge.observer
-    topic = '/' + course.TOPIC
-    observer.watch_readings(topic)
-    if not subject.request('wait_matched', topic=topic, seconds=ARRIVAL_TIMEOUT_S)['ok']:
-        raise CheckFailed(f'The publisher on {topic} never reached the grader\'s subscription: '
-                          f'check its topic name and its type ({course.MESSAGE_TYPE}).')
-    base = subject.request('counts')
-    first, log_mark = len(observer.readings), len(observer.logs)
-    reply = base
-    for number in range(math.ceil(seconds / step_s)):
-        reply = subject.request('advance', seconds=step_s, seed=seed if number == 0 else None)
-        if reply['failure']:
-            failure = reply['failure']
-            raise learner_error(failure['callback'], failure)
-        want = reply['published'].get(topic, 0) - base['published'].get(topic, 0)
-        if not observer.wait_until(lambda: len(observer.readings) - first >= want,
-                                   ARRIVAL_TIMEOUT_S):
-            raise CheckFailed(f'The node published {want} readings, but only '
-                              f'{len(observer.readings) - first} arrived: is something else '
-                              'wrong with the publisher (its queue depth)?')
-    lines = caught_up(judge, info, log_mark, reply['logged'] - base['logged'])
-    return observer.readings[first:], lines, reply['fired'] - base['fired']
+    observer.watch(TOPIC, Float32, lambda m: float(m.data))  # before it can publish
+    mark = len(observer.logs)
+    subject, info = new_node(judge, course.PUBLISHER_FILE, course.SENSOR_CLASS,
+                             stand_ins=stand_ins, seed=seed)
+    found = observer.endpoints(info['name'], info['namespace'], info['endpoints'])
+    return SensorRun(subject, info, found, caught_up(judge, info, mark, info['started_lines']))
 
 
-def _log_format_verdict(readings: list[float], lines: list[str]) -> None:
-    """Each reading has a log line that shows it (two decimals, as 'Publishing: 22.31C').
+def _run(judge: Judge, sensor: SensorRun, seconds: float, *, step_s: float, seed: int,
+         start_c: Optional[float] = None) -> SensorRun:
+    """Run ``sensor`` ``seconds`` of the judge's clock (the walk from ``start_c`` if given);
+    return what the judge heard meanwhile, as a run of its own."""
+    observer, subject = judge.observer, sensor.subject
+    readings = observer.watch(TOPIC, Float32, lambda m: float(m.data))
+    run = SensorRun(subject, sensor.info, sensor.found, sensor.started_lines)
+    if (course.MESSAGE_TYPE, 'publisher') not in {(t, k) for k, topic, t in run.found
+                                                  if topic == TOPIC}:
+        return run  # nothing the judge could hear: the constructor's verdict says why
+    if start_c is not None:
+        subject.request('set_attribute', name='temperature', value=start_c)
+    if not subject.request('wait_matched', topic=TOPIC, seconds=ARRIVAL_TIMEOUT_S)['ok']:
+        raise CheckFailed(f'The publisher on {TOPIC} never reached the grader\'s subscription '
+                          '(is the machine very busy?): run this check again.')
+    first, log_mark, began = len(readings), len(observer.logs), judge.clock.now_ns
+    try:
+        reply = judge.clock.drive(subject, 'run', seconds=seconds, seed=seed, step_s=step_s,
+                                  limit_s=seconds + step_s, what=course.SENSOR_CLASS)
+        if reply.get('failure'):
+            raise learner_error(reply['failure']['callback'], reply['failure'])
+    except CheckFailed as problem:
+        run.problem = problem
+    run.readings = [((heard.t_ns - began) / 1e9, heard.value) for heard in readings[first:]]
+    run.lines = [line.text for line in observer.logs[log_mark:] if line.name == run.info['name']]
+    return run
 
-    The start-up line may arrive among them (over /rosout): lines are matched to readings
-    by the number they show, not by position.
-    """
+
+def _sensor_run(judge: Judge, stand_ins: tuple[str, ...], seconds: float, *, step_s: float,
+                seed: int) -> SensorRun:
+    """A new sensor of the learner's (with ``stand_ins``), run ``seconds``."""
+    return _run(judge, _make_sensor(judge, stand_ins, seed), seconds, step_s=step_s, seed=seed)
+
+
+# ------------------------------------------------------------------ what each part must do
+def _constructor_problem(judge: Judge, run: SensorRun, seconds: float) -> Optional[CheckFailed]:
+    """What the constructor (part 3) got wrong, as the judge saw it: None when nothing."""
+    try:
+        node_name_verdict(run.info, course.SENSOR_NODE)
+        endpoint_verdict(run.info['name'], run.found, 'publisher', TOPIC, course.MESSAGE_TYPE)
+    except CheckFailed as problem:
+        return problem
+    if run.problem is not None:
+        return run.problem
+    if not run.readings:
+        return CheckFailed(_no_readings(judge))
+    problem = _period_problem(run.readings, seconds)
+    if problem is not None:
+        return problem
+    first = run.readings[0][1]
+    if abs(first - course.START_TEMPERATURE_C) > course.MAX_STEP_C + FLOAT32_TOLERANCE_C:
+        return CheckFailed(f'The first reading is {first:.2f} °C: the walk starts at '
+                           f'START_TEMPERATURE_C = {course.START_TEMPERATURE_C} °C (set '
+                           'self.temperature to it in __init__), and each reading is one step '
+                           f'of at most ±{course.MAX_STEP_C} °C from the one before.')
+    if not run.started_lines:
+        return CheckFailed(f'{course.SENSOR_CLASS} logged nothing when it started: log a line '
+                           "such as 'Temperature Sensor Node Started' with the node's logger.")
+    return None
+
+
+def _no_readings(judge: Judge) -> str:
+    """Why no reading arrived, in the words the learner's file suggests (read after the fact)."""
+    source = ClassSource.read(judge.workspace, course.PUBLISHER_FILE, course.SENSOR_CLASS)
+    timers = source.timers() if source is not None else []
+    if source is not None and not timers:
+        return (f'No reading arrived on {TOPIC} in {CONSTRUCTOR_RUN_S} s: {course.SENSOR_CLASS} '
+                'has no timer; create one in __init__ that calls self.publish_temperature '
+                f'every PUBLISH_PERIOD_S = {course.PUBLISH_PERIOD_S} s.')
+    return (f'No reading arrived on {TOPIC} in {CONSTRUCTOR_RUN_S} s of the grader\'s clock: '
+            'make a timer in __init__ that calls self.publish_temperature (the method itself, '
+            f'without parentheses) every PUBLISH_PERIOD_S = {course.PUBLISH_PERIOD_S} s.')
+
+
+def _period_problem(readings: list[tuple[float, float]], seconds: float) -> Optional[CheckFailed]:
+    """One reading per period, on the judge's clock: the timer's period and count."""
+    period = course.PUBLISH_PERIOD_S
+    if not readings:
+        return CheckFailed(f'No reading arrived on {TOPIC} in {seconds:g} s of the grader\'s '
+                           'clock: publish_temperature must publish each reading with the '
+                           'publisher made in __init__.')
+    times = [t for t, _v in readings]
+    gaps = [b - a for a, b in zip(times, times[1:])]
+    together = next((t for t, gap in zip(times, gaps) if gap < 1e-6), None)
+    if together is not None:
+        count = times.count(together)
+        return CheckFailed(f'{count} readings arrived at the same moment ({together:g} s of the '
+                           'grader\'s clock): publish one message per timer call, from one timer.')
+    odd = next((gap for gap in gaps if not math.isclose(gap, period, abs_tol=1e-6)), None)
+    if odd is not None:
+        return CheckFailed(f'Readings came {odd:g} s apart on the grader\'s clock; the sensor '
+                           f'publishes every {period} s: give the timer PUBLISH_PERIOD_S.')
+    if times and times[0] > 2 * period + 1e-6:  # a step's delivery may stamp it one step late
+        return CheckFailed(f'The first reading came after {times[0]:g} s; the timer fires every '
+                           f'{period} s: give the timer PUBLISH_PERIOD_S.')
+    if abs(len(readings) - seconds / period) > 1:
+        return CheckFailed(f'{len(readings)} readings in {seconds:g} s; expected one every '
+                           f'{period} s: check the timer period.')
+    return None
+
+
+def _log_format_problem(run: SensorRun) -> Optional[CheckFailed]:
+    """Each reading has a log line that shows it (two decimals, as 'Publishing: 22.31C')."""
+    values, lines = run.values, run.lines
+
     def shows(line: str, reading: float) -> bool:
         return any(abs(float(n) - reading) <= LOGGED_READING_TOLERANCE_C
                    for n in re.findall(r'-?\d+(?:\.\d+)?', line))
 
-    unshown = [r for r in readings if not any(shows(line, r) for line in lines)]
+    if len(lines) < len(values):
+        return CheckFailed(f'{len(values)} readings were published but {len(lines)} logged: log '
+                           "each reading with the node's logger, e.g. 'Publishing: 22.31C'.")
+    unshown = [r for r in values if not any(shows(line, r) for line in lines)]
     if unshown:
-        odd = [line for line in lines if not any(shows(line, r) for r in readings)]
+        odd = [line for line in lines if not any(shows(line, r) for r in values)]
         said = f'"{odd[-1]}"' if odd else 'lines without it'
-        raise CheckFailed(f'publish_temperature logged {said} for a reading of {unshown[0]:.2f} '
-                          f"°C: show the reading in its line, e.g. 'Publishing: {unshown[0]:.2f}C'.")
+        return CheckFailed(f'publish_temperature logged {said} for a reading of {unshown[0]:.2f} '
+                           f"°C: show the reading in its line, e.g. 'Publishing: {unshown[0]:.2f}C'.")
+    return None
 
 
 def _samples_verdict(samples: list[float], *, seconds: float,
                      start_c: float = course.START_TEMPERATURE_C) -> None:
-    """Raise CheckFailed for the first rule a run of readings breaks."""
+    """Raise CheckFailed for the first rule of the walk a run of readings breaks."""
     low, high = course.MIN_TEMPERATURE_C, course.MAX_TEMPERATURE_C
+    if not samples:
+        raise CheckFailed(f'No reading arrived on {TOPIC} in {seconds:g} s of the grader\'s '
+                          'clock: publish_temperature must publish each reading with the '
+                          'publisher made in __init__.')
     if abs(len(samples) - seconds / course.PUBLISH_PERIOD_S) > 1:
         raise CheckFailed(f'{len(samples)} readings in {seconds:g} s; expected one every '
                           f'{course.PUBLISH_PERIOD_S} s: check the timer period.')
@@ -219,63 +249,122 @@ def check_publisher_samples(samples: list[float], *, seconds: float) -> None:
            f'{course.MAX_TEMPERATURE_C}] °C.')
 
 
+# ------------------------------------------------------------------ part 3: the constructor
+def _attempt(judge: Judge, stand_ins: tuple[str, ...]) -> tuple[Optional[SensorRun],
+                                                                 Optional[CheckFailed]]:
+    """A constructor run with ``stand_ins``, and what part 3 got wrong in it (None: nothing)."""
+    try:
+        run = _sensor_run(judge, stand_ins, CONSTRUCTOR_RUN_S, step_s=FINE_STEP_S,
+                          seed=SENSOR_SEED)
+    except CheckFailed as problem:
+        return None, problem
+    return run, _constructor_problem(judge, run, CONSTRUCTOR_RUN_S)
+
+
+def _sensor_constructor(judge: Judge) -> str:
+    """Part 3 alone: the learner's __init__, with the course's callback (their own when the
+    course's cannot work with their constructor)."""
+    run, problem = _attempt(judge, ('sensor_callback',))
+    if problem is not None:
+        own, own_problem = _attempt(judge, ())
+        if own_problem is None:
+            run, problem = own, None
+        elif run is not None and (run.problem is not None or not run.readings):
+            problem = own_problem  # the course's callback could not run there: theirs says more
+    if problem is not None:
+        raise problem
+    assert run is not None
+    return (f'{run.info["name"]} publishes {course.MESSAGE_TYPE} on {TOPIC} every '
+            f'{course.PUBLISH_PERIOD_S} s of the grader\'s clock, starting next to '
+            f'{course.START_TEMPERATURE_C} °C.')
+
+
+def check_sensor_constructor() -> None:
+    """Check part 3 of ``temperature_publisher.py``: the sensor's ``__init__``.
+
+    Creates your ``TemperatureSensor`` (with the course's ``publish_temperature``, so that
+    only your constructor counts) and runs it on the grader's clock: its name and publisher
+    (topic and type, as the ROS graph shows them), one reading every second, the first next
+    to 22.0 °C, and a start-up log line.
+
+    Introduced in ``03-write-the-publisher.ipynb``.
+
+    :raises CheckFailed: naming what was seen and what was expected.
+    """
+    judged('check_sensor_constructor', _sensor_constructor)
+
+
+# ------------------------------------------------------------------ part 4: the callback
+def _callback_run(judge: Judge, seconds: float, step_s: float, seed: int) -> SensorRun:
+    """The learner's callback running ``seconds``: in their own sensor, or, when its
+    constructor is at fault, in the course's (a mistake in part 3 costs part 3 only)."""
+    whole = seconds <= CALLBACK_RUN_S  # else a short probe decides whose constructor runs
+    probe_s = seconds if whole else CONSTRUCTOR_RUN_S
+    run = _sensor_run(judge, (), probe_s, step_s=FINE_STEP_S, seed=seed)
+    stand_ins: tuple[str, ...] = ()
+    if _constructor_problem(judge, run, probe_s) is not None:
+        stand_ins = ('sensor_init',)
+        run = _sensor_run(judge, stand_ins, probe_s, step_s=FINE_STEP_S, seed=seed)
+    if whole:
+        return run
+    return _sensor_run(judge, stand_ins, seconds, step_s=step_s, seed=seed)
+
+
+def _callback_problem(run: SensorRun, seconds: float) -> None:
+    """Raise for what the callback (part 4) got wrong in ``run``."""
+    if run.problem is not None:
+        raise run.problem
+    if not run.readings:
+        raise CheckFailed(f'publish_temperature ran but nothing arrived on {TOPIC}: put the new '
+                          'reading into a Float32 message and publish it with the publisher '
+                          'from __init__.')
+    _samples_verdict(run.values, seconds=seconds)
+    problem = _log_format_problem(run)
+    if problem is not None:
+        raise problem
+
+
 def _sensor_callback(judge: Judge) -> str:
-    subject, info = new_node(judge, course.PUBLISHER_FILE, course.SENSOR_CLASS,
-                              seed=SENSOR_SEED)
-    _sensor_verdict(judge, info, judge.observer.endpoints(info['name'], info['namespace'],
-                                                          info['endpoints']))
-    readings, logged, fired = _run_sensor(judge, subject, info, CALLBACK_RUN_S, seed=SENSOR_SEED)
-    if not readings:
-        raise CheckFailed('publish_temperature ran but nothing arrived on /temperature: put the '
-                          'new reading into a Float32 message and publish it with the publisher '
-                          'from __init__.' if fired else
-                          'The timer never called publish_temperature: check the timer in part 3.')
-    _publishes_verdict(judge)
-    if len(logged) < len(readings):
-        raise CheckFailed(f'{len(readings)} readings were published but {len(logged)} logged: log '
-                          "each reading with the node's logger, e.g. 'Publishing: 22.31C'.")
-    _log_format_verdict(readings, logged)
-    _samples_verdict(readings, seconds=CALLBACK_RUN_S)
+    run = _callback_run(judge, CALLBACK_RUN_S, FINE_STEP_S, SENSOR_SEED)
+    _callback_problem(run, CALLBACK_RUN_S)
     for start_c, seed in zip(CLAMP_PROBES_C, (CEILING_SEED, FLOOR_SEED)):
-        subject.request('set_attribute', name='temperature', value=start_c)
-        probe, _, _ = _run_sensor(judge, subject, info, CLAMP_RUN_S, seed=seed)
-        _samples_verdict(probe, seconds=CLAMP_RUN_S, start_c=start_c)
-    return (f'{len(readings)} readings, one every {course.PUBLISH_PERIOD_S} s, from '
+        probe = _run(judge, run, CLAMP_RUN_S, step_s=HOUR_STEP_S, seed=seed, start_c=start_c)
+        if probe.problem is not None:
+            raise probe.problem
+        _samples_verdict(probe.values, seconds=CLAMP_RUN_S, start_c=start_c)
+    return (f'{len(run.readings)} readings, one every {course.PUBLISH_PERIOD_S} s, from '
             f'{course.START_TEMPERATURE_C} °C in steps of at most ±{course.MAX_STEP_C} °C, held '
-            f'inside [{course.MIN_TEMPERATURE_C}, {course.MAX_TEMPERATURE_C}] °C.')
+            f'inside [{course.MIN_TEMPERATURE_C}, {course.MAX_TEMPERATURE_C}] °C, each logged.')
 
 
 def check_sensor_callback() -> None:
     """Check part 4 of ``temperature_publisher.py``: the timer callback.
 
-    Runs your sensor for 20 simulated seconds and watches ``/temperature`` over ROS: one
-    reading per second, the first within 0.5 °C of 22.0, steps of at most ±0.5 °C, one
-    log line per reading; then starts the walk just inside each limit and checks that the
-    clamp holds it in [18.0, 28.0] °C.
+    Runs your sensor for 20 s of the grader's clock and watches ``/temperature`` over ROS:
+    one reading per second, the first within 0.5 °C of 22.0, steps of at most ±0.5 °C, one
+    log line showing each reading; then starts the walk just inside each limit and checks
+    that the clamp holds it in [18.0, 28.0] °C.  When your constructor is at fault, the
+    course's stands in for it, so that only your callback counts.
 
     Introduced in ``03-write-the-publisher.ipynb``.
 
-    :raises CheckFailed: naming your value and the expected one.
+    :raises CheckFailed: naming what was seen and what was expected.
     """
     judged('check_sensor_callback', _sensor_callback)
 
 
 def _sensor_hour(judge: Judge) -> str:
-    subject, info = new_node(judge, course.PUBLISHER_FILE, course.SENSOR_CLASS,
-                              seed=SENSOR_SEED + 1)
-    _sensor_verdict(judge, info, judge.observer.endpoints(info['name'], info['namespace'],
-                                                          info['endpoints']))
-    seconds = 3600
-    readings, _, _ = _run_sensor(judge, subject, info, seconds, step_s=5.0)
-    _samples_verdict(readings, seconds=seconds)
-    _publishes_verdict(judge)
-    return (f'an hour of simulated time: {len(readings)} readings, steps within '
+    run = _callback_run(judge, HOUR_S, HOUR_STEP_S, SENSOR_SEED + 1)
+    if run.problem is not None:
+        raise run.problem
+    _samples_verdict(run.values, seconds=HOUR_S)
+    return (f'an hour of simulated time: {len(run.readings)} readings, steps within '
             f'±{course.MAX_STEP_C} °C, all inside [{course.MIN_TEMPERATURE_C}, '
             f'{course.MAX_TEMPERATURE_C}] °C.')
 
 
 def check_sensor_hour() -> None:
-    """Hidden test of notebook 03: your sensor over one simulated hour (3600 readings).
+    """Hidden test of notebook 03: your sensor over one hour of the grader's clock (3600 readings).
 
     Introduced in ``03-write-the-publisher.ipynb``.
 
@@ -287,13 +376,13 @@ def check_sensor_hour() -> None:
 def check_sensor_main() -> None:
     """Check part 5 of ``temperature_publisher.py``: ``main()`` and Ctrl+C.
 
-    Starts the file as a program (``python temperature_publisher.py``), presses Ctrl+C
-    once its node spins and checks for exit code 0 and no traceback; then that ``main()`` destroys
-    the node and shuts rclpy down in a ``finally:`` block.
+    Runs your ``main()`` as ``ros2 run`` does, presses Ctrl+C once its node spins (it
+    answers the grader) and expects exit code 0 with no traceback.  When your node class is
+    at fault, the course's stands in for it, so that only ``main()`` counts.
 
     Introduced in ``03-write-the-publisher.ipynb``.
 
     :raises CheckFailed: with the process's last line.
     """
     judged('check_sensor_main', run_main, relative=course.PUBLISHER_FILE,
-           node_name=course.SENSOR_NODE)
+           node_name=course.SENSOR_NODE, node_class=course.SENSOR_CLASS)

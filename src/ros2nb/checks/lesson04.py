@@ -2,12 +2,15 @@
 
 Part of :mod:`ros2nb.checks`.  The judge creates the learner's ``TemperatureMonitor`` in a
 subject, publishes readings to it from its own node and reads its log lines on ``/rosout``.
+Each part is graded on its own: while one part is checked, the course's stand-in may take
+the place of another (:mod:`ros2nb.subject.stand_ins`).
 """
 
 from __future__ import annotations
 
 import random
 import re
+from typing import Any
 
 from std_msgs.msg import Float32
 
@@ -15,14 +18,11 @@ from .. import course
 from ..errors import CheckFailed
 from .base import ARRIVAL_TIMEOUT_S, Judge, judged, learner_error
 from .mains import run_main
-from .nodes import caught_up, new_node, started_log_verdict
-from .source import ClassSource
+from .nodes import caught_up, new_node, reach, started_log_verdict
 from .verdicts import endpoint_verdict, node_name_verdict
 
 #: Readings the monitor callback check sends: both boundaries and their neighbours (°C).
 BOUNDARY_READINGS_C = (19.99, 20.0, 23.0, 26.0, 26.01, 18.5, 27.5)
-#: A logger's methods that put a line on /rosout.
-LOG_CALLS = frozenset({'debug', 'info', 'warning', 'warn', 'error', 'fatal'})
 
 
 def check_monitor_main() -> None:
@@ -35,51 +35,34 @@ def check_monitor_main() -> None:
     :raises CheckFailed: with the process's last line.
     """
     judged('check_monitor_main', run_main, relative=course.SUBSCRIBER_FILE,
-           node_name=course.MONITOR_NODE)
+           node_name=course.MONITOR_NODE, node_class=course.MONITOR_CLASS)
 
 
 # ------------------------------------------------------------------ the monitor
 def _monitor_verdict(info: dict, found: list) -> None:
     node_name_verdict(info, course.MONITOR_NODE)
     endpoint_verdict(info['name'], found, 'subscription', '/' + course.TOPIC,
-                      course.MESSAGE_TYPE)
+                     course.MESSAGE_TYPE)
 
 
-def _monitor_constructor(judge: Judge) -> str:
-    mark = len(judge.observer.logs)
-    _subject, info = new_node(judge, course.SUBSCRIBER_FILE, course.MONITOR_CLASS,
-                               placeholders=('temperature_callback',))
-    _monitor_verdict(info, judge.observer.endpoints(info['name'], info['namespace'],
-                                                    info['endpoints']))
-    started_log_verdict(judge, info, mark, course.MONITOR_CLASS)
-    return f'{info["name"]} subscribes to /{course.TOPIC} [{course.MESSAGE_TYPE}].'
-
-
-def check_monitor_constructor() -> None:
-    """Check part 3 of ``temperature_subscriber.py``: the monitor's ``__init__``.
-
-    Creates your ``TemperatureMonitor`` and checks its name, its subscription (topic and
-    type, from the ROS graph) and its start-up log line.
-
-    Introduced in ``04-write-the-subscriber.ipynb``.
-
-    :raises CheckFailed: naming your value and the expected one.
-    """
-    judged('check_monitor_constructor', _monitor_constructor)
-
-
-def _feed_monitor(judge: Judge, readings: tuple[float, ...] | list[float]) -> list[list[str]]:
-    """Publish readings to the learner's monitor (from the judge); return its lines per reading."""
+def _monitor(judge: Judge, stand_ins: tuple[str, ...] = ()) -> tuple[Any, dict]:
+    """Make the learner's monitor (with ``stand_ins``); raise for what its constructor got
+    wrong (name, subscription, start-up line) as the judge sees it."""
     observer = judge.observer
     mark = len(observer.logs)
-    subject, info = new_node(judge, course.SUBSCRIBER_FILE, course.MONITOR_CLASS)
+    subject, info = new_node(judge, course.SUBSCRIBER_FILE, course.MONITOR_CLASS,
+                             stand_ins=stand_ins)
     _monitor_verdict(info, observer.endpoints(info['name'], info['namespace'], info['endpoints']))
-    caught_up(judge, info, mark, info['started_lines'])
-    publisher = judge.probe_publisher
-    if not observer.wait_until(lambda: publisher.get_subscription_count() >= 1,
-                               ARRIVAL_TIMEOUT_S):
-        raise CheckFailed(f'The grader\'s publisher on /{course.TOPIC} never reached your '
-                          'subscription: check its topic name and type.')
+    started_log_verdict(judge, info, mark, course.MONITOR_CLASS)
+    reach(judge, subject, info['name'])
+    return subject, info
+
+
+def _feed(judge: Judge, subject: Any, info: dict,
+          readings: tuple[float, ...] | list[float]) -> list[list[str]]:
+    """Publish readings to the learner's monitor from the judge's node; return the lines it
+    logged for each (the subject's counts only say how many to wait for)."""
+    observer, publisher = judge.observer, judge.probe_publisher
     per_reading = []
     before = subject.request('counts')
     for value in readings:
@@ -91,31 +74,56 @@ def _feed_monitor(judge: Judge, readings: tuple[float, ...] | list[float]) -> li
             failure = reply['failure']
             raise learner_error(failure['callback'], failure, context=f' for {value} °C')
         if not reply['ok']:
-            raise CheckFailed(f'The reading {value} °C never reached temperature_callback: is it '
-                              'the subscription\'s callback?')
+            raise CheckFailed(f'The reading {value} °C never reached the subscription\'s '
+                              'callback: keep the subscription in an attribute of the node.')
         per_reading.append(caught_up(judge, info, mark, reply['logged'] - before['logged']))
         before = reply
     return per_reading
 
 
-def _callback_source_verdict(judge: Judge) -> None:
-    """The lines on /rosout came from temperature_callback, as the file (read as text) says.
+def _monitor_constructor(judge: Judge) -> str:
+    """Part 3 alone: the learner's __init__, with the course's callback (their own when the
+    course's cannot run with their constructor)."""
+    reading = [23.0]
+    try:
+        subject, info = _monitor(judge, ('monitor_callback',))
+        lines = _feed(judge, subject, info, reading)
+    except CheckFailed as problem:
+        try:
+            subject, info = _monitor(judge)
+            lines = _feed(judge, subject, info, reading)
+        except CheckFailed:
+            raise problem from None
+    if not lines[0]:
+        raise CheckFailed(f'A reading of {reading[0]} °C reached {info["name"]}, which logged '
+                          'nothing: the subscription\'s callback must be '
+                          'self.temperature_callback (the method itself, without parentheses).')
+    return (f'{info["name"]} subscribes to /{course.TOPIC} [{course.MESSAGE_TYPE}] and hears the '
+            'grader\'s readings.')
 
-    The lines are the judge's observation; which method wrote them it cannot hear, and a
-    subject's word about it counts for nothing: the subscription must call
-    ``self.temperature_callback`` and that method must log.
+
+def check_monitor_constructor() -> None:
+    """Check part 3 of ``temperature_subscriber.py``: the monitor's ``__init__``.
+
+    Creates your ``TemperatureMonitor`` (with the course's ``temperature_callback``, so that
+    only your constructor counts) and checks its name, its subscription (topic and type, from
+    the ROS graph), its start-up log line, and that a reading the grader publishes reaches it.
+
+    Introduced in ``04-write-the-subscriber.ipynb``.
+
+    :raises CheckFailed: naming your value and the expected one.
     """
-    source = ClassSource.read(judge.workspace, course.SUBSCRIBER_FILE, course.MONITOR_CLASS)
-    callbacks = source.callbacks('create_subscription', 2) if source else []
-    if callbacks and set(callbacks) != {'temperature_callback'}:
-        raise CheckFailed(f'The subscription calls {", ".join(sorted(set(callbacks)))}; it must '
-                          'call self.temperature_callback (the method itself, without '
-                          'parentheses).')
-    if source is None or not callbacks or not source.reaches_call('temperature_callback',
-                                                                  LOG_CALLS):
-        raise CheckFailed('temperature_callback never logs, yet lines arrived from elsewhere: '
-                          "log each reading and its status with the node's logger in "
-                          'temperature_callback.')
+    judged('check_monitor_constructor', _monitor_constructor)
+
+
+def _own_or_course_constructor(judge: Judge, readings: list[float]) -> list[list[str]]:
+    """The learner's callback fed ``readings``: in their own monitor, or, when its constructor
+    is at fault, in the course's (a mistake in part 3 costs part 3 only)."""
+    try:
+        subject, info = _monitor(judge)
+    except CheckFailed:
+        subject, info = _monitor(judge, ('monitor_init',))
+    return _feed(judge, subject, info, readings)
 
 
 def _statuses_verdict(readings: tuple[float, ...] | list[float], lines: list[list[str]], *,
@@ -149,9 +157,8 @@ def _statuses_verdict(readings: tuple[float, ...] | list[float], lines: list[lis
 
 
 def _monitor_callback(judge: Judge) -> str:
-    lines = _feed_monitor(judge, BOUNDARY_READINGS_C)
+    lines = _own_or_course_constructor(judge, list(BOUNDARY_READINGS_C))
     _statuses_verdict(BOUNDARY_READINGS_C, lines, with_value=False)
-    _callback_source_verdict(judge)
     return (f'one line with the right status for each of {len(BOUNDARY_READINGS_C)} readings, '
             f'including {course.LOW_BELOW_C} and {course.HIGH_ABOVE_C} °C (both Normal).')
 
@@ -174,9 +181,8 @@ def _monitor_readings(judge: Judge) -> str:
     chooser = random.Random(2024)
     readings = [round(chooser.uniform(17.0, 29.0), 2) for _ in range(30)]
     readings += [course.LOW_BELOW_C, course.HIGH_ABOVE_C, 19.995, 26.005]
-    lines = _feed_monitor(judge, readings)
+    lines = _own_or_course_constructor(judge, readings)
     _statuses_verdict(readings, lines, with_value=True)
-    _callback_source_verdict(judge)
     return f'the right status and the reading in one line for each of {len(readings)} readings.'
 
 

@@ -1,8 +1,12 @@
 """Checks of notebook 05, entry points and run: setup.py, setup.cfg, a build, ``ros2 run``.
 
-Part of :mod:`ros2nb.checks`.  The judge builds a copy of the learner's package with the
-real colcon, with its own stand-in nodes in place of the learner's (so only this
-notebook's work counts), and reads what setuptools installed.
+Part of :mod:`ros2nb.checks`.  The judge builds a copy of the learner's package with colcon
+and its own stand-in nodes in place of the learner's, finds each executable the way ``ros2
+run`` does and starts it.  An entry point counts when ``ros2 run`` starts the stand-in: the
+sensor publishes a number the judge chose (a parameter on the command line), the monitor
+logs a number the judge published, and both stop cleanly on Ctrl+C.  What setuptools wrote
+is never evidence; the learner's files, read as text, only word a failure.  The course's
+``setup.cfg`` stands in while ``setup.py`` is graded, and the other way round.
 """
 
 from __future__ import annotations
@@ -11,6 +15,7 @@ import ast
 import configparser
 import json
 import os
+import random
 import shutil
 import subprocess
 import sys
@@ -19,18 +24,23 @@ from importlib.metadata import EntryPoint
 from pathlib import Path
 from typing import Any, Optional
 
+from std_msgs.msg import Float32
+
 from .. import course
 from ..errors import CheckFailed, Ros2nbError
 from ..processes import interrupt, kill_process_group
 from ..terminal.colcon import build_cause, venv_tool
+from ..terminal.pkg_templates import SETUP_CFG, render_setup_py
 from ..terminal.run import find_executable
 from .base import ARRIVAL_TIMEOUT_S, Judge, judged
 from .mains import EXIT_AFTER_CTRL_C_S, last_line
+from .source import TEXT
 
 # ------------------------------------------------------------------ the package
 #: The grader's own stand-in nodes, so notebook 05 is graded on its own: they take the
 #: place of temperature_publisher.py and temperature_subscriber.py in the judge's build.
-#: Each is this program with its node's name and what the node does.
+#: The sensor publishes the number given as its parameter ``reading`` five times a second;
+#: the monitor logs every reading it hears.
 STAND_IN = '''\
 """Grader's stand-in {name}: a node that only {does}."""
 import rclpy
@@ -52,14 +62,33 @@ def main(args=None):
         rclpy.try_shutdown()
 '''
 STAND_IN_PUBLISHER = STAND_IN.format(
-    name=course.SENSOR_NODE, does='publishes a constant reading five times a second',
-    setup="publisher = node.create_publisher(Float32, 'temperature', 10)\n"
-          "    node.create_timer(0.2, lambda: publisher.publish(Float32(data=21.5)))")
+    name=course.SENSOR_NODE, does='publishes the reading it is given, five times a second',
+    setup="reading = node.declare_parameter('reading', 0.0).value\n"
+          "    publisher = node.create_publisher(Float32, 'temperature', 10)\n"
+          "    node.create_timer(0.2, lambda: publisher.publish(Float32(data=reading)))")
 STAND_IN_SUBSCRIBER = STAND_IN.format(
     name=course.MONITOR_NODE, does='logs every reading it hears',
     setup="node.create_subscription(Float32, 'temperature',\n"
-          "                             lambda m: node.get_logger().info(f'heard {m.data:.2f}'), 10)")
+          "                             lambda m: node.get_logger().info(f'heard {m.data:.3f}'), 10)")
 PLACEHOLDER = 'raise NotImplementedError'
+#: The two executables, the module of each, and the grader's stand-in for it.
+EXECUTABLES = ((course.PUBLISHER_EXECUTABLE, STAND_IN_PUBLISHER),
+               (course.SUBSCRIBER_EXECUTABLE, STAND_IN_SUBSCRIBER))
+
+
+def course_setup_py() -> str:
+    """The course's setup.py: what ``pkg_create`` writes, with notebook 05's two entry points."""
+    text = render_setup_py(course.PACKAGE, 'TODO: Package description',
+                           course.MAINTAINER_NAME, course.MAINTAINER_EMAIL,
+                           'TODO: License declaration', None)
+    entries = ''.join(f"            '{name} = {course.PACKAGE}.{name}:main',\n"
+                      for name, _text in EXECUTABLES)
+    return text.replace("'console_scripts': [\n", "'console_scripts': [\n" + entries, 1)
+
+
+def course_setup_cfg() -> str:
+    """The course's setup.cfg: scripts into ``lib/<package>``, where ``ros2 run`` looks."""
+    return SETUP_CFG.format(name=course.PACKAGE)
 
 
 def _package_source(judge: Judge) -> Path:
@@ -72,10 +101,13 @@ def _package_source(judge: Judge) -> Path:
 
 def _console_scripts(setup_py: Path) -> Optional[list[Any]]:
     """The ``console_scripts`` list of ``setup(entry_points=...)`` as written, or None."""
+    text = TEXT.read(setup_py)
     try:
-        tree = ast.parse(setup_py.read_text())
-    except (SyntaxError, OSError):
+        tree = ast.parse(text) if text is not None else None
+    except (SyntaxError, ValueError):
         return None  # the build says where
+    if tree is None:
+        return None
     for node in ast.walk(tree):
         if isinstance(node, ast.Dict):
             for key, value in zip(node.keys, node.values):
@@ -85,25 +117,29 @@ def _console_scripts(setup_py: Path) -> Optional[list[Any]]:
     return None
 
 
-def _entry_point_syntax_verdict(setup_py: Path) -> None:
-    """Each console_scripts string must read ``NAME = package.module:function``."""
+def _entry_point_syntax_cause(setup_py: Path) -> Optional[str]:
+    """What is wrong with the way a console_scripts string is written (read to word a
+    failure the judge saw), or None."""
     for element in _console_scripts(setup_py) or []:
         if not (isinstance(element, ast.Constant) and isinstance(element.value, str)):
             continue
         entry = element.value
         if entry.count('=') > 1:
-            raise CheckFailed(f'"{entry[:70]}..." is two entries run together: end each string '
-                              'in the console_scripts list with a comma.')
+            return (f'"{entry[:70]}..." is two entries run together: end each string in the '
+                    'console_scripts list with a comma.')
         name, _, target = entry.partition('=')
         match = EntryPoint.pattern.match(target.strip()) if name.strip() else None
         if match is None or not match.group('attr'):
-            raise CheckFailed(f'"{entry}" is not written NAME = package.module:function: the '
-                              'module is written with dots, like an import, without .py, and '
-                              'the function follows a colon.')
+            return (f'"{entry}" is not written NAME = package.module:function: the module is '
+                    'written with dots, like an import, without .py, and the function follows '
+                    'a colon.')
+    return None
 
 
-def _built(judge: Judge) -> Path:
-    """Build a copy of the learner's package, with the grader's stand-in nodes; cached.
+def _built(judge: Judge, *, setup_py: Optional[str] = None,
+           setup_cfg: Optional[str] = None) -> Path:
+    """Build a copy of the learner's package with the grader's stand-in nodes (and the
+    course's setup.py or setup.cfg, when given); cached by what went in.
 
     :return: the copy's workspace (with ``install/``).
     :raises CheckFailed: with the build's cause in one line.
@@ -115,112 +151,37 @@ def _built(judge: Judge) -> Path:
                    and (p.is_symlink() or p.is_file()))
     digest = sha256(b''.join(p.relative_to(source).as_posix().encode()
                              + (os.readlink(p).encode() if p.is_symlink() else p.read_bytes())
-                             for p in files)).hexdigest()[:12]
+                             for p in files) + repr((setup_py, setup_cfg)).encode()
+                    ).hexdigest()[:12]
     if digest in judge.builds:
         return judge.builds[digest]
-    for name in ('setup.py', 'setup.cfg'):
-        if (source / name).is_file() and PLACEHOLDER in (source / name).read_text():
-            raise CheckFailed(f'{name} still holds the placeholder "raise NotImplementedError()": '
-                              'replace it with your lines and run that cell again.')
-    _entry_point_syntax_verdict(source / 'setup.py')
     ws = judge.scratch / f'build-{digest}'
     package = ws / 'src' / course.PACKAGE
     shutil.copytree(source, package, symlinks=True,
                     ignore=shutil.ignore_patterns('__pycache__', '*.egg-info'))
-    for module, text in ((course.PUBLISHER_EXECUTABLE, STAND_IN_PUBLISHER),
-                         (course.SUBSCRIBER_EXECUTABLE, STAND_IN_SUBSCRIBER)):
-        (package / course.PACKAGE / f'{module}.py').write_text(text)
+    for name, given in (('setup.py', setup_py), ('setup.cfg', setup_cfg)):
+        if given is not None:
+            (package / name).unlink(missing_ok=True)
+            (package / name).write_text(given)
+    for module, text in EXECUTABLES:
+        target = package / course.PACKAGE / f'{module}.py'
+        target.unlink(missing_ok=True)
+        target.write_text(text)
     colcon = venv_tool('colcon')
     if colcon is None:
         raise Ros2nbError('colcon is not installed: run `make lab` or `make test`.')
     code, output = judge.run([colcon, 'build'], seconds=300, cwd=ws)
-    if code != 0:
+    if code != 0:  # a console_scripts string setuptools cannot read says more than its error
+        held = [n for n, given in (('setup.py', setup_py), ('setup.cfg', setup_cfg))
+                if given is None and PLACEHOLDER in (TEXT.read(source / n) or '')]
+        if held:
+            raise CheckFailed(f'{held[0]} still holds the placeholder "raise NotImplementedError()"'
+                              ': replace it with your lines and run that cell again.')
+        syntax = _entry_point_syntax_cause(source / 'setup.py') if setup_py is None else None
         raise CheckFailed(f'colcon build of your package failed: '
-                          f'{build_cause(output.splitlines())}')
+                          f'{syntax or build_cause(output.splitlines())}')
     judge.builds[digest] = ws
     return ws
-
-
-def _entry_points(judge: Judge) -> str:
-    ws = _built(judge)
-    found = sorted(ws.glob(f'install/{course.PACKAGE}/lib/python*/site-packages/'
-                           f'{course.PACKAGE}*-info/entry_points.txt'))
-    scripts: dict[str, str] = {}
-    if found:
-        config = configparser.ConfigParser(interpolation=None)  # data, never %(name)s
-        try:
-            config.read(found[0])
-        except configparser.Error as error:
-            raise CheckFailed(f'The entry points setuptools installed cannot be read: '
-                              f'{str(error).splitlines()[0][:160]}; write each as '
-                              f"'name = {course.PACKAGE}.module:main'.") from None
-        if config.has_section('console_scripts'):
-            scripts = {k: v.strip() for k, v in config.items('console_scripts')}
-    for executable in (course.PUBLISHER_EXECUTABLE, course.SUBSCRIBER_EXECUTABLE):
-        want = f'{course.PACKAGE}.{executable}:main'
-        if executable not in scripts:
-            have = ', '.join(f'{k} = {v}' for k, v in sorted(scripts.items())) or 'none'
-            raise CheckFailed(f'console_scripts has no entry named {executable} (it has: {have}); '
-                              'the name left of = is what you pass to ros2 run.')
-        if scripts[executable].replace(' ', '') != want:
-            raise CheckFailed(f'{executable} = {scripts[executable]}: it should start main() in '
-                              f'{course.PACKAGE}/{executable}.py, written {want}.')
-    return (f'console_scripts gives {course.PUBLISHER_EXECUTABLE} and '
-            f'{course.SUBSCRIBER_EXECUTABLE}, each starting main() of its module.')
-
-
-def check_entry_points() -> None:
-    """Check the ``console_scripts`` entry points in ``setup.py`` (notebook 05).
-
-    Builds a copy of your package with colcon (the grader's stand-in nodes take the place
-    of your two node files, so only this notebook's work counts) and reads the entry
-    points setuptools installed.
-
-    Introduced in ``05-entry-points-and-run.ipynb``.
-
-    :raises CheckFailed: naming the missing or wrong entry, or the build's cause.
-    """
-    judged('check_entry_points', _entry_points)
-
-
-def _setup_cfg(judge: Judge) -> str:
-    file = _package_source(judge) / 'setup.cfg'
-    if not file.is_file():
-        raise CheckFailed('setup.cfg is missing: without it ros2 run finds no executable; '
-                          'write it (the cell above).')
-    text = file.read_text()
-    if PLACEHOLDER in text:
-        raise CheckFailed('setup.cfg still holds the placeholder "raise NotImplementedError()": '
-                          'write the two settings in its place.')
-    config = configparser.ConfigParser(interpolation=None)  # the two values as written
-    try:
-        config.read_string(text)
-    except configparser.Error as error:
-        raise CheckFailed(f'setup.cfg cannot be read: {str(error).splitlines()[0]}') from None
-    want = f'$base/lib/{course.PACKAGE}'
-    for section, key in (('develop', 'script_dir'), ('install', 'install_scripts')):
-        got = config.get(section, key, fallback=None)
-        if got is None:
-            raise CheckFailed(f'setup.cfg has no {key} in its [{section}] section; ros2 run '
-                              f'looks in {want}.')
-        if got.strip() != want:
-            raise CheckFailed(f'[{section}] {key} is {got.strip()}; ros2 run looks in {want}.')
-    ws = _built(judge)
-    for executable in (course.PUBLISHER_EXECUTABLE, course.SUBSCRIBER_EXECUTABLE):
-        if not (ws / 'install' / course.PACKAGE / 'lib' / course.PACKAGE / executable).is_file():
-            raise CheckFailed(f'After the build there is no lib/{course.PACKAGE}/{executable}: '
-                              'check the entry points in setup.py.')
-    return f'setup.cfg installs the executables into lib/{course.PACKAGE}, where ros2 run looks.'
-
-
-def check_setup_cfg() -> None:
-    """Check ``setup.cfg``: executables go to ``lib/sensor_simulator``, where ros2 run looks.
-
-    Introduced in ``05-entry-points-and-run.ipynb``.
-
-    :raises CheckFailed: naming the setting and the expected value.
-    """
-    judged('check_setup_cfg', _setup_cfg)
 
 
 #: What a subject runs in a built workspace: the environment ``source install/setup.bash``
@@ -244,56 +205,196 @@ def _sourced(judge: Judge, ws: Path) -> dict[str, str]:
     if not isinstance(env, dict) or not all(isinstance(v, str) for v in env.values()):
         raise CheckFailed(f'source install/setup.bash failed in the build of your package '
                           f'(exit code {code}): {last_line(output)}')
-    return env
-
-
-def _package_runs(judge: Judge) -> str:
-    ws = _built(judge)
-    env = _sourced(judge, ws)
-    argvs = []
-    for executable in (course.PUBLISHER_EXECUTABLE, course.SUBSCRIBER_EXECUTABLE):
-        try:
-            argvs.append([str(find_executable(course.PACKAGE, executable, env))])
-        except Ros2nbError as error:
-            raise CheckFailed(f'ros2 run {course.PACKAGE} {executable}: {error}') from None
     env.update({k: v for k, v in judge.subject_env().items()  # the judge's domain and transports,
                 if k.startswith(('ROS_', 'RCUTILS', 'FASTDDS', 'PYTHONUNBUFFERED'))  # the
                 or k in ('HOME', 'TMPDIR')})  # subjects' home and temporary folder
-    observer = judge.observer
-    mark = len(observer.logs)
-    started = [judge.start(argv, cwd=ws, env=env) for argv in argvs]
-    procs, outputs = [proc for proc, _ in started], [output for _, output in started]
+    return env
+
+
+def _ros2_run(judge: Judge, ws: Path, env: dict[str, str], executable: str,
+              *args: str) -> tuple[Any, Any]:
+    """``ros2 run sensor_simulator EXECUTABLE ARGS`` in the build ``ws``: started, not waited for.
+
+    :raises CheckFailed: with the CLI's own error (``No executable found``, ...).
+    """
     try:
-        heard = observer.wait_until(lambda: observer.lines_of(course.MONITOR_NODE, mark),
-                                    ARRIVAL_TIMEOUT_S)
-        for proc in procs:
-            interrupt(proc)
-        codes = []
-        for proc in procs:
-            try:
-                codes.append(proc.wait(EXIT_AFTER_CTRL_C_S))
-            except subprocess.TimeoutExpired:
-                codes.append(kill_process_group(proc))
-    finally:
-        for proc in procs:
+        path = find_executable(course.PACKAGE, executable, env)
+    except Ros2nbError as error:
+        raise CheckFailed(f'ros2 run {course.PACKAGE} {executable}: {error}') from None
+    return judge.start([str(path), *args], cwd=ws, env=env)
+
+
+def _stop(procs: list[Any]) -> list[Optional[int]]:
+    """Ctrl+C for each process; their exit codes (None: one had to be killed)."""
+    for proc in procs:
+        interrupt(proc)
+    codes: list[Optional[int]] = []
+    for proc in procs:
+        try:
+            codes.append(proc.wait(EXIT_AFTER_CTRL_C_S))
+        except subprocess.TimeoutExpired:
             kill_process_group(proc)
-    if not heard:
-        raise CheckFailed('ros2 run started both executables, but the monitor heard no reading: '
-                          f'{last_line(outputs[0].text())}')
+            codes.append(None)
+    return codes
+
+
+def _runs(judge: Judge, ws: Path) -> Optional[str]:
+    """Start both executables of the build ``ws`` as ``ros2 run`` does and watch them work:
+    the sensor publishes the reading the judge gave it on its command line, and the monitor
+    logs that reading when it hears it; then Ctrl+C.  Return what went wrong, in one line
+    (None: both ran as they should)."""
+    env = _sourced(judge, ws)
+    observer = judge.observer
+    readings = observer.watch('/' + course.TOPIC, Float32, lambda m: float(m.data))
+    given = round(random.uniform(19.0, 25.0), 3)
+    heard = f'heard {given:.3f}'
+    first, mark = len(readings), len(observer.logs)
+    procs: list[Any] = []
+    try:
+        try:
+            procs.append(_ros2_run(judge, ws, env, course.PUBLISHER_EXECUTABLE,
+                                   '--ros-args', '-p', f'reading:={given}'))
+            procs.append(_ros2_run(judge, ws, env, course.SUBSCRIBER_EXECUTABLE))
+        except CheckFailed as problem:
+            return str(problem)
+        (sensor, sensor_out), (monitor, monitor_out) = procs
+        observer.wait_until(lambda: heard in observer.lines_of(course.MONITOR_NODE, mark)
+                            or sensor.poll() is not None or monitor.poll() is not None,
+                            ARRIVAL_TIMEOUT_S)
+        if heard not in observer.lines_of(course.MONITOR_NODE, mark):
+            if not any(round(h.value, 3) == given for h in readings[first:]):
+                name, out = course.PUBLISHER_EXECUTABLE, sensor_out
+                would = f'published {given}'
+            else:
+                name, out = course.SUBSCRIBER_EXECUTABLE, monitor_out
+                would = f'logged the reading {given} it heard'
+            return (f'ros2 run {course.PACKAGE} {name} did not start main() of '
+                    f'{course.PACKAGE}.{name}: the grader\'s stand-in there would have {would} '
+                    f'({last_line(out.text())}).')
+        codes = _stop([sensor, monitor])
+        procs.clear()
+    finally:
+        for proc, _out in procs:
+            kill_process_group(proc)
     if codes != [0, 0]:
-        raise CheckFailed(f'After Ctrl+C the executables exited with {codes}, expected [0, 0].')
+        return f'After Ctrl+C the executables exited with {codes}, expected [0, 0].'
+    return None
+
+
+def _entries_cause(setup_py: Path) -> Optional[str]:
+    """What the console_scripts of setup.py, read as text, lack or get wrong (to word a
+    failure the judge saw), or None."""
+    syntax = _entry_point_syntax_cause(setup_py)
+    if syntax is not None:
+        return syntax
+    written = [e.value for e in _console_scripts(setup_py) or []
+               if isinstance(e, ast.Constant) and isinstance(e.value, str)]
+    scripts = {name.strip(): target.strip() for name, _, target in
+               (entry.partition('=') for entry in written)}
+    for executable, _text in EXECUTABLES:
+        want = f'{course.PACKAGE}.{executable}:main'
+        if executable not in scripts:
+            have = ', '.join(f'{k} = {v}' for k, v in sorted(scripts.items())) or 'none'
+            return (f'console_scripts has no entry named {executable} (it has: {have}); the name '
+                    'left of = is what you pass to ros2 run.')
+        if scripts[executable].replace(' ', '') != want:
+            return (f'{executable} = {scripts[executable]}: it should start main() in '
+                    f'{course.PACKAGE}/{executable}.py, written {want}.')
+    return None
+
+
+def _entry_points(judge: Judge) -> str:
+    problem = _runs(judge, _built(judge))
+    if problem is not None:  # with the course's setup.cfg, setup.py alone counts
+        problem = _runs(judge, _built(judge, setup_cfg=course_setup_cfg()))
+    if problem is not None:
+        cause = _entries_cause(_package_source(judge) / 'setup.py')
+        raise CheckFailed(f'{problem.rstrip(".")}: {cause}' if cause else problem)
+    return (f'ros2 run starts main() of {course.PUBLISHER_EXECUTABLE} and of '
+            f'{course.SUBSCRIBER_EXECUTABLE} from your console_scripts.')
+
+
+def check_entry_points() -> None:
+    """Check the ``console_scripts`` entry points in ``setup.py`` (notebook 05).
+
+    Builds a copy of your package with colcon (the grader's stand-in nodes take the place
+    of your two node files, so only this notebook's work counts) and starts each executable
+    as ``ros2 run`` does: each must start its stand-in's ``main()``, which the grader sees at
+    work, and stop on Ctrl+C.
+
+    Introduced in ``05-entry-points-and-run.ipynb``.
+
+    :raises CheckFailed: naming the executable that did not start, or the build's cause.
+    """
+    judged('check_entry_points', _entry_points)
+
+
+def _setup_cfg_cause(judge: Judge) -> Optional[str]:
+    """What setup.cfg, read as text, sets differently (to word a failure the judge saw)."""
+    file = _package_source(judge) / 'setup.cfg'
+    if not file.is_file():
+        return 'setup.cfg is missing: without it ros2 run finds no executable; write it (the cell above).'
+    config = configparser.ConfigParser(interpolation=None)  # the two values as written
+    try:
+        config.read_string(TEXT.read(file) or '')
+    except configparser.Error as error:
+        return f'setup.cfg cannot be read: {str(error).splitlines()[0]}'
+    want = f'$base/lib/{course.PACKAGE}'
+    for section, key in (('develop', 'script_dir'), ('install', 'install_scripts')):
+        got = config.get(section, key, fallback=None)
+        if got is None:
+            return f'setup.cfg has no {key} in its [{section}] section; ros2 run looks in {want}.'
+        if got.strip().rstrip('/') != want:
+            return f'[{section}] {key} is {got.strip()}; ros2 run looks in {want}.'
+    return None
+
+
+def _setup_cfg(judge: Judge) -> str:
+    try:  # the learner's setup.py may be at fault
+        problem = _runs(judge, _built(judge))
+    except CheckFailed as failure:
+        problem = str(failure)
+    if problem is not None:  # with the course's setup.py, setup.cfg alone counts
+        problem = _runs(judge, _built(judge, setup_py=course_setup_py()))
+    if problem is not None:
+        if PLACEHOLDER in (TEXT.read(_package_source(judge) / 'setup.cfg') or ''):
+            raise CheckFailed('setup.cfg still holds the placeholder "raise '
+                              'NotImplementedError()": write the two settings in its place.')
+        raise CheckFailed(_setup_cfg_cause(judge) or
+                          f'{problem} setup.cfg puts the executables where ros2 run looks: '
+                          f'$base/lib/{course.PACKAGE}.')
+    return f'setup.cfg installs the executables into lib/{course.PACKAGE}, where ros2 run finds them.'
+
+
+def check_setup_cfg() -> None:
+    """Check ``setup.cfg``: executables go to ``lib/sensor_simulator``, where ros2 run looks.
+
+    Builds your package (with the course's setup.py when yours is at fault, so that only
+    setup.cfg counts) and starts both executables as ``ros2 run`` does.
+
+    Introduced in ``05-entry-points-and-run.ipynb``.
+
+    :raises CheckFailed: naming the setting and the expected value.
+    """
+    judged('check_setup_cfg', _setup_cfg)
+
+
+def _package_runs(judge: Judge) -> str:
+    problem = _runs(judge, _built(judge))
+    if problem is not None:
+        raise CheckFailed(problem)
     return 'ros2 run starts both entry points; they talk over /temperature and stop on Ctrl+C.'
 
 
 def check_package_runs() -> None:
     """Hidden test of notebook 05: the built package runs with ``ros2 run``.
 
-    Builds your package (with the grader's stand-in nodes), finds both executables the way
-    ``ros2 run`` does, starts them, waits until the monitor hears the sensor, then sends
-    Ctrl+C and expects exit code 0 from both.
+    Builds your package (with the grader's stand-in nodes), starts both executables the
+    way ``ros2 run`` does, checks that each runs its stand-in, then sends Ctrl+C and expects
+    exit code 0 from both.
 
     Introduced in ``05-entry-points-and-run.ipynb``.
 
-    :raises CheckFailed: with the CLI's error or the exit codes.
+    :raises CheckFailed: with the CLI's error or what went wrong.
     """
     judged('check_package_runs', _package_runs)

@@ -3,13 +3,14 @@ a worker that stays responsive, and the arguments that make two rooms of one pac
 
 Part of :mod:`ros2nb.checks`.  Every part is in a file of the learner's package
 (``fan_controller.py``, ``promises.py``); the judge runs it in a subject and decides from
-what its own node sees (the ROS graph, ``/fan_command``) and from the file read as text; the
-counts the subject reports only name a mistake.
+what its own node sees: the ROS graph, the commands on ``/fan_command``, the counting
+monitor's and the worker's lines on ``/rosout``.  What the subject reports (its counts, the
+executor it was given) only says how long to wait, or why a failure happened.
 """
 
 from __future__ import annotations
 
-import ast
+import re
 
 from std_msgs.msg import Bool, Float32
 
@@ -17,17 +18,13 @@ from .. import course
 from ..errors import CheckFailed
 from .base import ARRIVAL_TIMEOUT_S, Judge, judged, learner_error
 from .mains import run_main
-from .nodes import new_node, reach
-from .source import ClassSource, called_name, made_by, module_function, read_module
+from .nodes import caught_up, new_node, reach
 from .verdicts import endpoint_verdict, node_name_verdict
 
 #: Readings the fan check sends (°C): both sides of the High threshold.
 FAN_READINGS_C = (22.0, 26.0, 26.01, 27.5, 25.99, 19.0)
 #: Readings the counting monitor check sends.
 COUNTED_READINGS = 5
-#: Wall-clock seconds the worker is spun, and the share of its heartbeats that must run.
-WORKER_SPIN_S = 2.0
-HEARTBEAT_SHARE = 0.6
 
 
 def _send(judge: Judge, subject, value: float, received: int, callback: str) -> dict:
@@ -46,13 +43,13 @@ def _send(judge: Judge, subject, value: float, received: int, callback: str) -> 
 # ------------------------------------------------------------------ modularity
 def _fan_controller(judge: Judge) -> str:
     judge.drop(('file', course.PROMISES_FILE))  # the fan is the only subscription here
+    commands = judge.observer.watch('/' + course.FAN_TOPIC, Bool, lambda m: bool(m.data))
     subject, info = new_node(judge, course.FAN_FILE, course.FAN_CLASS)
     node_name_verdict(info, course.FAN_NODE)
     found = judge.observer.endpoints(info['name'], info['namespace'], info['endpoints'])
     endpoint_verdict(info['name'], found, 'subscription', '/' + course.TOPIC, course.MESSAGE_TYPE)
     endpoint_verdict(info['name'], found, 'publisher', '/' + course.FAN_TOPIC,
                      course.FAN_MESSAGE_TYPE)
-    commands = judge.observer.watch_messages('/' + course.FAN_TOPIC, Bool)
     if not subject.request('wait_matched', topic='/' + course.FAN_TOPIC,
                            seconds=ARRIVAL_TIMEOUT_S)['ok']:
         raise CheckFailed(f'The fan controller\'s publisher never reached the grader\'s '
@@ -64,7 +61,7 @@ def _fan_controller(judge: Judge) -> str:
         before = len(commands)
         received = _send(judge, subject, value, received, 'temperature_callback')['received']
         judge.observer.wait_until(lambda: len(commands) > before, ARRIVAL_TIMEOUT_S)
-        said = commands[before:]
+        said = [heard.value for heard in commands[before:]]
         want = course.monitor_status(value) == 'High'
         if not said:
             raise CheckFailed(f'For a reading of {value} °C the fan controller published nothing '
@@ -106,60 +103,50 @@ def check_fan_main() -> None:
     :raises CheckFailed: with the process's last line.
     """
     judged('check_fan_main', run_main, relative=course.FAN_FILE, node_name=course.FAN_NODE,
-           part=3)
+           part=3, node_class=course.FAN_CLASS)
 
 
 # ------------------------------------------------------------------ scalability
 def _counting_monitor(judge: Judge) -> str:
     judge.drop(('file', course.FAN_FILE))  # the counting monitor is the only subscription here
     name = 'monitor_7'
+    observer = judge.observer
+    mark = len(observer.logs)
     subject, info = new_node(judge, course.PROMISES_FILE, course.COUNTING_CLASS, args=(name,))
     if info['name'] != name:
         raise CheckFailed(f"{course.COUNTING_CLASS}('{name}') made a node called {info['name']}: "
                           'pass the name it is given on to super().__init__(name).')
-    found = judge.observer.endpoints(info['name'], info['namespace'], info['endpoints'])
+    found = observer.endpoints(info['name'], info['namespace'], info['endpoints'])
     endpoint_verdict(name, found, 'subscription', '/' + course.TOPIC, course.MESSAGE_TYPE)
-    start = subject.request('attribute', name='received')
-    if start.get('missing'):
-        raise CheckFailed(f'{course.COUNTING_CLASS} has no attribute received: set '
-                          'self.received = 0 in __init__.')
-    if start['value']['value'] != 0:
-        raise CheckFailed(f'A new {course.COUNTING_CLASS} starts with received = '
-                          f"{start['value']['value']}; start counting at 0.")
+    caught_up(judge, info, mark, info['started_lines'])
     reach(judge, subject, name)
-    received = info['received']
-    for index in range(COUNTED_READINGS):
-        received = _send(judge, subject, 21.0 + index, received, 'its callback')['received']
-    count = subject.request('attribute', name='received')['value']['value']
-    if count != COUNTED_READINGS:
-        raise CheckFailed(f'After {COUNTED_READINGS} readings self.received is {count!r}: add '
-                          'one in the callback for every message.')
-    _counting_source_verdict(judge)
+    received, logged = info['received'], info['logged']
+    for index in range(1, COUNTED_READINGS + 1):
+        mark = len(observer.logs)
+        reply = _send(judge, subject, 20.0 + index, received, 'its callback')
+        lines = caught_up(judge, info, mark, reply['logged'] - logged)
+        received, logged = reply['received'], reply['logged']
+        counts = [int(n) for line in lines for n in re.findall(r'(?<![\d.])\d+(?![\d.])', line)]
+        if not lines:
+            raise CheckFailed(f'{name} logged nothing for reading {index}: log the count in '
+                              'count(), after adding one, e.g. '
+                              "self.get_logger().info(f'received {self.received}').")
+        if len(lines) > 1:
+            raise CheckFailed(f'{name} logged {len(lines)} lines for reading {index}; log one, '
+                              'with the count.')
+        if index not in counts:
+            raise CheckFailed(f'After {index} reading{"s" if index > 1 else ""} {name} logged '
+                              f'"{lines[0]}": add one to self.received for every message, and '
+                              'log the new count.')
     return (f"{course.COUNTING_CLASS}('{name}') is called {name} and counted "
-            f'{COUNTED_READINGS} of {COUNTED_READINGS} readings.')
-
-
-def _counting_source_verdict(judge: Judge) -> None:
-    """The subscription's callback adds to ``self.received``, as the file (read as text) says.
-
-    The count is the subject's word, and a subject runs the learner's code, which may
-    rewrite what it reports: the count only names a mistake, the source decides.
-    """
-    source = ClassSource.read(judge.workspace, course.PROMISES_FILE, course.COUNTING_CLASS)
-    callbacks = source.callbacks('create_subscription', 2) if source else []
-    if source is None or not any(source.reaches_assignment(c, 'received') for c in callbacks):
-        called = ', '.join(sorted(set(callbacks))) or 'nothing'
-        raise CheckFailed(f"The subscription calls {called}, which never adds to "
-                          'self.received: give it a method of the class that does, '
-                          'self.received += 1 (the method itself, without parentheses).')
+            f'{COUNTED_READINGS} of {COUNTED_READINGS} readings, as its lines on /rosout say.')
 
 
 def check_counting_monitor() -> None:
     """Check part 2 of ``promises.py``: a monitor that only counts, named as it is told.
 
     Creates ``CountingMonitor('monitor_7')``, checks its name and subscription in the ROS
-    graph, publishes 5 readings and reads ``received``, and reads in your file that the
-    subscription's callback adds to ``self.received``.
+    graph, publishes 5 readings and reads on ``/rosout`` the count it logs for each: 1 to 5.
 
     Introduced in ``06-five-promises.ipynb``.
 
@@ -169,42 +156,49 @@ def check_counting_monitor() -> None:
 
 
 # ------------------------------------------------------------------ concurrency
-def _worker_verdict(reply: dict) -> str:
-    """Say why the heartbeat was held up (from the executor and groups), or that it was not."""
-    runs, groups = reply['runs'], {name: (kind, number) for name, kind, number in reply['groups']}
-    if not {'slow_work', 'heartbeat'} <= set(runs):
-        raise CheckFailed(f'{course.WORKER_FUNCTION}() returned a node with the timers '
-                          f'{sorted(runs) or "none"}; return the Worker of part 3, with its '
-                          'slow_work and heartbeat timers.')
-    expected = round(WORKER_SPIN_S / course.HEARTBEAT_PERIOD_S)
-    # Same code, same words: how often the heartbeat ran depends on the machine, so the lines
-    # that follow from the executor and its groups do not quote the count.
-    beats = (f'heartbeat cannot keep its {1 / course.HEARTBEAT_PERIOD_S:g} Hz while slow_work '
-             'runs')
-    if reply['executor'] == 'SingleThreadedExecutor':
-        raise CheckFailed(f'{beats}: a SingleThreadedExecutor runs one callback at a time, so '
-                          'slow_work holds up heartbeat; return a MultiThreadedExecutor.')
-    shared = groups['slow_work'] == groups['heartbeat']
-    if shared and groups['heartbeat'][0] == 'MutuallyExclusiveCallbackGroup':
-        raise CheckFailed(f'{beats}: both timers are in one MutuallyExclusiveCallbackGroup (the '
-                          "node's default), which runs one of its callbacks at a time; give "
-                          'each timer a group of its own.')
-    if runs['slow_work'] == 0:
-        raise CheckFailed(f'slow_work never ran in {WORKER_SPIN_S:g} s: keep both timers of the '
-                          'Worker running.')
-    if runs['heartbeat'] < HEARTBEAT_SHARE * expected:
-        raise CheckFailed(f'heartbeat ran {runs["heartbeat"]} times in {WORKER_SPIN_S:g} s '
-                          f'({expected} expected) although the executor and groups allow it: '
-                          'give the MultiThreadedExecutor at least num_threads=2.')
-    return (f'with slow_work busy {course.SLOW_WORK_S:g} s of every {course.SLOW_PERIOD_S:g} s, '
-            f'heartbeat kept at least {HEARTBEAT_SHARE:.0%} of its {expected} runs in '
-            f'{WORKER_SPIN_S:g} s on a {reply["executor"]}.')
+#: The worker's lines (part 3, given): slow_work starts, slow_work is done, a heartbeat.
+SLOW_STARTS, SLOW_DONE, BEAT = 'slow work: start', 'slow work: done', 'heartbeat'
+#: slow_work runs the judge waits for, at most, before it says no heartbeat came meanwhile.
+SLOW_RUNS_WATCHED = 3
+
+
+def _overlapped(lines: list[str]) -> tuple[bool, int]:
+    """Whether a heartbeat line came while slow_work worked (between one of its start lines
+    and the done line after it), and how many slow_work runs were done."""
+    working, done = False, 0
+    for line in lines:
+        if line == SLOW_STARTS:
+            working = True
+        elif line == SLOW_DONE:
+            working, done = False, done + 1
+        elif line == BEAT and working:
+            return True, done
+    return False, done
+
+
+def _worker_cause(reply: dict) -> str:
+    """Why no heartbeat came during slow_work, from the executor and groups the subject
+    says it was given (only to name the cause of what the judge saw)."""
+    groups = {name: (kind, number) for name, kind, number in reply.get('groups', [])}
+    if reply.get('executor') == 'SingleThreadedExecutor':
+        return ('a SingleThreadedExecutor runs one callback at a time, so slow_work holds up '
+                'heartbeat; return a MultiThreadedExecutor')
+    if reply.get('threads') == 1:
+        return ('a MultiThreadedExecutor with num_threads=1 runs one callback at a time: give '
+                'it num_threads=2')
+    if groups.get('slow_work') == groups.get('heartbeat') and \
+            groups.get('heartbeat', ('', 0))[0] == 'MutuallyExclusiveCallbackGroup':
+        return ("both timers are in one MutuallyExclusiveCallbackGroup (the node's default), "
+                'which runs one of its callbacks at a time; give each timer a group of its own')
+    return ('let the timers overlap: a MultiThreadedExecutor(num_threads=2), and a callback '
+            'group of its own for each timer')
 
 
 def _responsive_worker(judge: Judge) -> str:
     subject = judge.file_subject(course.PROMISES_FILE)
-    reply = subject.request('timer_runs', name=course.WORKER_FUNCTION, seconds=WORKER_SPIN_S,
-                            timeout=WORKER_SPIN_S + 30)
+    observer = judge.observer
+    mark = len(observer.logs)
+    reply = subject.request('worker', name=course.WORKER_FUNCTION)
     if reply.get('undefined'):
         raise CheckFailed(f'promises.py defines no function {course.WORKER_FUNCTION}: write '
                           'part 4 (and run its cell).')
@@ -214,80 +208,45 @@ def _responsive_worker(judge: Judge) -> str:
         raise CheckFailed(f'{course.WORKER_FUNCTION}() returned {reply["returned"]["value"]}; '
                           'return two things, the Worker node and the executor to spin it: '
                           'return node, executor.')
-    verdict = _worker_verdict(reply)
-    _worker_source_verdict(judge)
-    return verdict
+    name = 'responsive_worker'
 
+    def seen() -> bool:
+        overlap, done = _overlapped(observer.lines_of(name, mark))
+        return overlap or done >= SLOW_RUNS_WATCHED
 
-#: The keyword and the position of each timer's group in ``Worker(name, slow_group,
-#: heartbeat_group)``.
-_WORKER_GROUPS = (('slow_group', 1), ('heartbeat_group', 2))
-
-
-def _worker_source_verdict(judge: Judge) -> None:
-    """``responsive_worker()`` returns a Worker whose timers may overlap and a multi-threaded
-    executor, as the file (read as text) says.
-
-    The executor, the groups and the counts are the subject's word, and a subject runs the
-    learner's code, which may rewrite what it reports: they only name a mistake (the lines
-    of :func:`_worker_verdict`), the source decides.
-    """
-    module = read_module(judge.workspace, course.PROMISES_FILE)
-    function = module_function(module, course.WORKER_FUNCTION) if module else None
-    unread = (f'The grader reads {course.WORKER_FUNCTION}() in your file as text and cannot '
-              'tell {what}: build the Worker and the MultiThreadedExecutor in the function '
-              'itself (node = Worker(...); executor = MultiThreadedExecutor(...)) and end with '
-              'return node, executor.')
-    returns = [r.value for r in ast.walk(function) if isinstance(r, ast.Return)] \
-        if function else []
-    returned = made_by(module, function, returns[-1]) if returns and returns[-1] else None
-    if not isinstance(returned, ast.Tuple) or len(returned.elts) != 2:
-        raise CheckFailed(unread.format(what='what it returns'))
-    node, executor = (made_by(module, function, e) for e in returned.elts)
-    kind = called_name(executor)
-    if kind == 'SingleThreadedExecutor':
-        raise CheckFailed('a SingleThreadedExecutor runs one callback at a time, so slow_work '
-                          'holds up heartbeat; return a MultiThreadedExecutor.')
-    if kind != 'MultiThreadedExecutor':
-        raise CheckFailed(unread.format(what='which executor it returns'))
-    given = {k.arg: k.value for k in executor.keywords}
-    threads = given.get('num_threads', executor.args[0] if executor.args else None)
-    if isinstance(threads, ast.Constant) and isinstance(threads.value, int) \
-            and threads.value < 2:
-        raise CheckFailed(f'A MultiThreadedExecutor with num_threads={threads.value} runs one '
-                          'callback at a time: give it at least num_threads=2.')
-    if called_name(node) != course.WORKER_CLASS:
-        raise CheckFailed(unread.format(what=f'that the node it returns is a '
-                                             f'{course.WORKER_CLASS}'))
-    groups = []
-    for keyword, position in _WORKER_GROUPS:
-        given = {k.arg: k.value for k in node.keywords}
-        group = given.get(keyword, node.args[position] if len(node.args) > position else None)
-        if group is None or (isinstance(group, ast.Constant) and group.value is None):
-            groups.append(None)  # the node's default group, one for both timers
-            continue
-        made = made_by(module, function, group)
-        if called_name(made) not in ('MutuallyExclusiveCallbackGroup', 'ReentrantCallbackGroup'):
-            raise CheckFailed(unread.format(what=f'which callback group {keyword} is'))
-        groups.append(made)
-    slow, heartbeat = groups
-    if slow is heartbeat and called_name(slow) != 'ReentrantCallbackGroup':
-        raise CheckFailed('both timers are in one MutuallyExclusiveCallbackGroup (the node\'s '
-                          'default, or one you made for both), which runs one of its callbacks '
-                          'at a time; give each timer a group of its own.')
+    try:
+        observer.wait_until(seen, ARRIVAL_TIMEOUT_S)
+    finally:
+        stopped = subject.request('worker_stop', timeout=60)
+        judge.drop(('file', course.PROMISES_FILE))
+    overlap, done = _overlapped(observer.lines_of(name, mark))
+    if stopped.get('failure'):
+        raise learner_error(stopped['failure']['callback'], stopped['failure'])
+    if overlap:
+        return (f'a heartbeat came while slow_work was busy, on a {reply["executor"]}: the two '
+                'timers run side by side.')
+    if reply.get('name') != name:
+        raise CheckFailed(f"{course.WORKER_FUNCTION}() returned a Worker called "
+                          f"{reply.get('name')}; name it '{name}' (its lines on /rosout are "
+                          'how the grader sees it work).')
+    if done == 0:
+        raise CheckFailed(f'slow_work never finished in {ARRIVAL_TIMEOUT_S:g} s: keep both timers '
+                          'of the Worker running.')
+    raise CheckFailed(f'No heartbeat came while slow_work was busy ({done} runs of slow_work '
+                      f'watched): {_worker_cause(reply)}.')
 
 
 def check_responsive_worker() -> None:
     """Check part 4 of ``promises.py``: a slow callback no longer holds up the heartbeat.
 
-    Calls your ``responsive_worker()`` for its node and executor and spins them for 2 s of
-    wall-clock time, counting each timer's runs.  The heartbeat (10 Hz) must keep most of
-    its rate while ``slow_work`` is busy; when it does not, the line says why, from the
-    executor's type and the timers' callback groups.
+    Calls your ``responsive_worker()`` for its node and executor and spins them on the wall
+    clock, listening to the worker's lines on ``/rosout``: a heartbeat must come while
+    ``slow_work`` is busy (between its start and done lines).  When none does, the line says
+    why, from the executor and the timers' callback groups.
 
     Introduced in ``06-five-promises.ipynb``.
 
-    :raises CheckFailed: with the heartbeat's count and its cause.
+    :raises CheckFailed: naming the cause.
     """
     judged('check_responsive_worker', _responsive_worker)
 

@@ -1,53 +1,62 @@
 """Checks of notebook 07, a live plot: the subscription callback that feeds the plot.
 
 Part of :mod:`ros2nb.checks`.  The judge creates the learner's ``PlotFeeder`` (from
-``live_plot.py``) in a subject on simulated time, moves its clock on between readings it
-publishes from its own node, and reads back what the node kept: the times, the readings
-and how often it asked for a redraw.  Those values come from a process that ran the
-learner's code, so they only name a mistake: the file, read as text, decides.
+``live_plot.py``) in a subject, moves its own clock on between readings it publishes from
+its own node, and reads what the node says on ``/rosout``: its ``redraw()`` (part 1, given)
+logs each point it plots, with its time and its reading.  So the judge hears, for every
+reading it sent, whether a point was plotted, with which time and value.  The file, read
+as text, only picks the words of a failure the judge has seen.
 """
 
 from __future__ import annotations
 
 import math
+import re
+from typing import Optional
 
 from std_msgs.msg import Float32
 
 from .. import course
 from ..errors import CheckFailed
 from .base import ARRIVAL_TIMEOUT_S, Judge, judged, learner_error
-from .nodes import new_node, reach
+from .nodes import caught_up, new_node, reach
 from .source import ClassSource
 from .verdicts import endpoint_verdict, node_name_verdict
 
 #: Readings the check publishes (°C), one simulated second apart; exact in Float32.
 PLOT_READINGS_C = (21.5, 26.25, 19.75, 23.0)
-#: Simulated seconds between two readings.
+#: Simulated seconds of the judge's clock between two readings.
 READING_GAP_S = 1.0
+#: The line ``redraw()`` logs for each point (part 1 of live_plot.py).
+PLOTTED = re.compile(r'Plotted (-?[\d.]+) °C at (-?[\d.]+) s, point (\d+)')
 
 
-def _attribute(subject, name: str) -> list:
-    reply = subject.request('attribute', name=name)
-    if reply.get('missing'):
-        raise CheckFailed(f'{course.PLOT_CLASS} has no attribute {name} any more: keep the lists '
-                          'and the counter that part 1 makes.')
-    value = reply['value']
-    if value['type'] == 'list':
-        return [item['value'] for item in value['value']]
-    return value['value']
+def _plotted(lines: list[str]) -> list[tuple[float, float, int]]:
+    """(reading, time, number) of each point a list of log lines says was plotted."""
+    found = []
+    for line in lines:
+        match = PLOTTED.fullmatch(line)
+        if match:
+            found.append((float(match.group(1)), float(match.group(2)), int(match.group(3))))
+    return found
 
 
 def _plot_callback(judge: Judge) -> str:
+    observer = judge.observer
+    mark = len(observer.logs)
     subject, info = new_node(judge, course.LIVE_PLOT_FILE, course.PLOT_CLASS)
     node_name_verdict(info, course.PLOT_NODE)
-    found = judge.observer.endpoints(info['name'], info['namespace'], info['endpoints'])
+    found = observer.endpoints(info['name'], info['namespace'], info['endpoints'])
     endpoint_verdict(info['name'], found, 'subscription', '/' + course.TOPIC, course.MESSAGE_TYPE)
+    caught_up(judge, info, mark, info['started_lines'])
     reach(judge, subject, info['name'])
     publisher = judge.probe_publisher
-    times = []
-    for value in PLOT_READINGS_C:
-        # The node's clock subscription counts as received too: count from after the step.
-        received = subject.request('advance', seconds=READING_GAP_S)['received']
+    received, logged = info['received'], info['logged']
+    for number, value in enumerate(PLOT_READINGS_C, start=1):
+        judge.clock.drive(subject, 'run', seconds=READING_GAP_S, step_s=READING_GAP_S,
+                          limit_s=READING_GAP_S, what=course.PLOT_CLASS)
+        sent_s = judge.clock.now_s
+        mark = len(observer.logs)
         publisher.publish(Float32(data=value))
         reply = subject.request('wait_received', count=received + 1, seconds=ARRIVAL_TIMEOUT_S)
         if reply['failure']:
@@ -55,72 +64,58 @@ def _plot_callback(judge: Judge) -> str:
                                 context=f' for {value} °C')
         if not reply['ok']:
             raise CheckFailed(f'The reading {value} °C never reached temperature_callback.')
-        times.append(reply['t'])
-    verdict = _plot_verdict(subject, times)
-    _plot_source_verdict(judge)
-    return verdict
+        lines = caught_up(judge, info, mark, reply['logged'] - logged)
+        received, logged = reply['received'], reply['logged']
+        _point_verdict(judge, value, sent_s, number, _plotted(lines))
+    return (f'each of {len(PLOT_READINGS_C)} readings was plotted once, at the time it arrived '
+            'on the node\'s clock (the grader\'s simulated time), with its value.')
 
 
-def _plot_source_verdict(judge: Judge) -> None:
-    """The subscription's callback adds to ``times_s`` and ``temps_c`` and asks for a redraw,
-    as the file (read as text) says.
-
-    The lists and the counter are the subject's word, and a subject runs the learner's code,
-    which may rewrite what it reports: their values only name a mistake, the source decides.
-    """
-    source = ClassSource.read(judge.workspace, course.LIVE_PLOT_FILE, course.PLOT_CLASS)
-    callbacks = source.callbacks('create_subscription', 2) if source else []
-    called = ', '.join(sorted(set(callbacks))) or 'nothing'
-    for attribute, what in (('times_s', "the node's time, self.get_clock().now().nanoseconds "
-                                        '/ 1e9'),
-                            ('temps_c', 'msg.data')):
-        if source is None or not any(source.reaches_change(c, attribute) for c in callbacks):
-            raise CheckFailed(f'The subscription calls {called}, which never adds to '
-                              f'self.{attribute}: append {what} to it there.')
-    if not any(source.reaches_assignment(c, 'redraws') for c in callbacks):
-        raise CheckFailed(f'The subscription calls {called}, which never calls self.redraw() '
-                          '(the method that counts self.redraws): call it once per message.')
-
-
-def _plot_verdict(subject, times: list[float]) -> str:
-    count = len(PLOT_READINGS_C)
-    temps = _attribute(subject, 'temps_c')
-    if len(temps) != count:
-        raise CheckFailed(f'After {count} readings temps_c holds {len(temps)} values: append '
-                          'msg.data once for every message.')
-    if any(not isinstance(t, (int, float)) or not math.isclose(t, want, abs_tol=1e-4)
-           for t, want in zip(temps, PLOT_READINGS_C)):
-        raise CheckFailed(f'temps_c holds {temps} for the readings {list(PLOT_READINGS_C)}: '
-                          'append msg.data, the number the message carries.')
-    stamps = _attribute(subject, 'times_s')
-    if len(stamps) != count:
-        raise CheckFailed(f'After {count} readings times_s holds {len(stamps)} values: append '
-                          'one time for every message, next to its reading.')
-    wrong = next(((got, want) for got, want in zip(stamps, times)
-                  if not isinstance(got, (int, float)) or not math.isclose(got, want,
-                                                                           abs_tol=1e-3)), None)
-    if wrong is not None:
-        raise CheckFailed(f'A reading that arrived at {wrong[1]:g} s of simulated time got the '
-                          f'time {wrong[0]!r}: use the node\'s clock in seconds, '
+def _point_verdict(judge: Judge, value: float, sent_s: float, number: int,
+                   points: list[tuple[float, float, int]]) -> None:
+    """One point per reading: this reading, at the time it arrived, the next in the plot."""
+    if not points:
+        raise CheckFailed(f'For the reading {value} °C nothing was plotted: '
+                          f'{_unplotted_cause(judge)}')
+    if len(points) > 1:
+        raise CheckFailed(f'For the reading {value} °C the plot was redrawn {len(points)} times: '
+                          'call self.redraw() once per message, after appending.')
+    reading, time_s, count = points[0]
+    if count != number:
+        raise CheckFailed(f'After {number} readings the plot holds {count} points: append one '
+                          'time and one reading per message, no more.')
+    if not math.isclose(reading, value, abs_tol=0.006):
+        raise CheckFailed(f'For the reading {value} °C the plot shows {reading} °C: append '
+                          'msg.data, the number the message carries.')
+    if not math.isclose(time_s, sent_s, abs_tol=1e-3):
+        raise CheckFailed(f'A reading that arrived at {sent_s:g} s of simulated time was plotted '
+                          f'at {time_s:g} s: use the node\'s clock in seconds, '
                           'self.get_clock().now().nanoseconds / 1e9 (it follows simulated time).')
-    redraws = _attribute(subject, 'redraws')
-    if redraws != count:
-        raise CheckFailed(f'After {count} readings the plot was redrawn {redraws} times: call '
-                          'self.redraw() once per message, after appending.')
-    return (f'each of {count} readings went into the plot with its simulated time, one redraw '
-            'per message.')
+
+
+def _unplotted_cause(judge: Judge) -> str:
+    """What the callback leaves out, as the learner's file reads (only to word the line)."""
+    source = ClassSource.read(judge.workspace, course.LIVE_PLOT_FILE, course.PLOT_CLASS)
+    method: Optional[object] = source.method('temperature_callback') if source else None
+    if source is not None and method is not None:
+        for attribute, what in (('times_s', "the node's time, "
+                                            'self.get_clock().now().nanoseconds / 1e9'),
+                                ('temps_c', 'msg.data')):
+            if not source.reaches_change('temperature_callback', attribute):
+                return f'append {what} to self.{attribute} in temperature_callback.'
+    return ('append the time and the reading, then call self.redraw() once per message '
+            '(redraw() plots the newest point and logs it).')
 
 
 def check_plot_callback() -> None:
     """Check part 2 of ``live_plot.py``: the callback that feeds the live plot.
 
-    The judge publishes 4 readings one simulated second apart to your ``PlotFeeder`` and
-    reads ``times_s``, ``temps_c`` and ``redraws``: every reading with the node's simulated
-    time, and one redraw per message.  It also reads in your file that the subscription's
-    callback appends to both lists and calls ``self.redraw()``.
+    The judge publishes 4 readings one second of its clock apart to your ``PlotFeeder`` and
+    listens to what it plots (``redraw()`` logs each point on ``/rosout``): every reading
+    plotted once, with its value and the node's simulated time when it arrived.
 
     Introduced in ``07-live-plot.ipynb``.
 
-    :raises CheckFailed: naming what the lists hold and what they should.
+    :raises CheckFailed: naming what was plotted and what should have been.
     """
     judged('check_plot_callback', _plot_callback)

@@ -3,43 +3,50 @@
 Part of :mod:`ros2nb.checks`.  The judge creates the learner's ``TemperatureMonitor`` in a
 subject that spins it in the background, and talks to the node's real parameter services
 from its own node with rclpy's ``AsyncParameterClient`` (what ``ros2 param`` does): it lists,
-gets and describes the parameters, and sets values the callback must accept or refuse.
-The source text is never read.
+gets and describes the parameters, and sets values.  A parameter counts by its effect: after
+each change the judge publishes a reading from its own node and reads, on ``/rosout``, the
+status the monitor gives it, so a threshold that was declared but is not used, or a change
+answered but not made, shows.  Each part is graded on its own: the course's stand-in takes
+the place of the other part (:mod:`ros2nb.subject.stand_ins`) when needed.
 """
 
 from __future__ import annotations
 
 import re
-import time
-from typing import Any, Callable
+from typing import Any, Callable, Optional
 
 from rcl_interfaces.msg import ParameterType
 from rclpy.parameter import Parameter, parameter_value_to_python
 from rclpy.parameter_client import AsyncParameterClient
+from std_msgs.msg import Float32
 
 from .. import course
 from ..errors import CheckFailed
 from ..runtime.services import call_until_answered
 from .base import ARRIVAL_TIMEOUT_S, Judge, judged, learner_error
-from .nodes import new_node
+from .nodes import caught_up, new_node, reach
 
 #: The on-set callback the learner writes (part 4); the constructor registers it.
 CALLBACK = 'on_set_thresholds'
 THRESHOLDS = (course.HIGH_PARAMETER, course.LOW_PARAMETER)
 #: rclpy's reason when an on-set callback returns anything but a SetParametersResult.
 INVALID_RETURN = 'Callback returned an invalid type'
+#: The monitor's status line (notebook 04's, and the given callback of notebook 08).
+STATUS = re.compile(r'\b(High|Low|Normal)\b')
 
 
-class _Parameters:
-    """The learner's monitor in a fresh subject, and a parameter client of the judge's."""
+class _Monitor:
+    """The learner's monitor in a fresh subject, a parameter client of the judge's, and the
+    judge's publisher to ask it for a status."""
 
-    def __init__(self, judge: Judge) -> None:
+    def __init__(self, judge: Judge, stand_ins: tuple[str, ...]) -> None:
         # A fresh process each time: one node of this name, ever, so that the judge's client
         # reaches no services of an earlier node (they linger in the graph).
         judge.drop(('file', course.SUBSCRIBER_FILE))
+        mark = len(judge.observer.logs)
         try:
-            self.subject, info = new_node(judge, course.SUBSCRIBER_FILE, course.MONITOR_CLASS,
-                                          placeholders=('temperature_callback', CALLBACK))
+            self.subject, self.info = new_node(judge, course.SUBSCRIBER_FILE,
+                                               course.MONITOR_CLASS, stand_ins=stand_ins)
         except CheckFailed as error:
             undeclared = re.search(r"undeclared parameter\(s\)\W*(\w+)", str(error))
             if undeclared is None:
@@ -48,10 +55,13 @@ class _Parameters:
                               f'{undeclared.group(1)}, which it never declares: declare it in '
                               '__init__ with self.declare_parameter() (names must match '
                               'exactly).') from None
-        self.name = info['name']
-        self.full = info['namespace'].rstrip('/') + '/' + info['name']
+        self.judge, self.observer = judge, judge.observer
+        self.name = self.info['name']
+        self.full = self.info['namespace'].rstrip('/') + '/' + self.name
+        caught_up(judge, self.info, mark, self.info['started_lines'])
+        reach(judge, self.subject, self.name)
+        self.received, self.logged = self.info['received'], self.info['logged']
         self.subject.request('serve')
-        self.observer = judge.observer
         self.client = AsyncParameterClient(self.observer.node, self.full)
         if not self.client.wait_for_services(ARRIVAL_TIMEOUT_S):
             raise CheckFailed(f'The grader could not reach the parameter services of {self.full} '
@@ -91,6 +101,24 @@ class _Parameters:
         return self.answer(lambda: self.client.set_parameters([Parameter(name, value=value)]),
                            f'ros2 param set {name} {value}').results[0]
 
+    def status(self, reading: float) -> Optional[str]:
+        """The status the monitor logs for ``reading``, published by the judge (None: no
+        status in what it logged)."""
+        mark = len(self.observer.logs)
+        self.judge.probe_publisher.publish(Float32(data=reading))
+        reply = self.subject.request('wait_received', count=self.received + 1,
+                                     seconds=ARRIVAL_TIMEOUT_S)
+        if reply['failure']:
+            raise learner_error(reply['failure']['callback'], reply['failure'],
+                                context=f' for {reading} °C')
+        if not reply['ok']:
+            raise CheckFailed(f'The reading {reading} °C never reached {self.name}: keep its '
+                              'subscription (given in part 3).')
+        lines = caught_up(self.judge, self.info, mark, reply['logged'] - self.logged)
+        self.received, self.logged = reply['received'], reply['logged']
+        found = [word for line in lines for word in STATUS.findall(line)]
+        return found[-1] if found else None
+
 
 def _callback_failure(failure: dict, what: str) -> None:
     """Raise for the learner's on-set callback raising inside the node's parameter service."""
@@ -101,7 +129,20 @@ def _callback_failure(failure: dict, what: str) -> None:
     raise learner_error(f'{course.MONITOR_CLASS}.{CALLBACK}', failure, context=f' for {what}')
 
 
-def _declared_verdict(node: _Parameters) -> None:
+def _status_verdict(node: _Monitor, reading: float, thresholds: dict[str, float],
+                    after: str) -> None:
+    """The status the monitor gives ``reading`` must follow ``thresholds`` (the effect)."""
+    high, low = thresholds[course.HIGH_PARAMETER], thresholds[course.LOW_PARAMETER]
+    want = 'High' if reading > high else 'Low' if reading < low else 'Normal'
+    got = node.status(reading)
+    if got != want:
+        raise CheckFailed(f'{after}, {node.name} called {reading} °C {got or "nothing"}; with '
+                          f'{course.HIGH_PARAMETER} = {high} and {course.LOW_PARAMETER} = {low} '
+                          f'it is {want}: read both thresholds with self.get_parameter(...).value '
+                          'in the callback, at every message, and keep the given callback.')
+
+
+def _declared_verdict(node: _Monitor) -> None:
     names = node.names()
     for name in THRESHOLDS:
         if name not in names:
@@ -124,7 +165,7 @@ def _declared_verdict(node: _Parameters) -> None:
                               'constant of part 2.')
 
 
-def _descriptor_verdict(node: _Parameters) -> None:
+def _descriptor_verdict(node: _Monitor) -> None:
     low, high = course.MIN_TEMPERATURE_C, course.MAX_TEMPERATURE_C
     for descriptor in node.descriptors(list(THRESHOLDS)):
         name = descriptor.name
@@ -145,22 +186,53 @@ def _descriptor_verdict(node: _Parameters) -> None:
                               f'may go from {low} to {high} °C, the sensor\'s clamp range.')
 
 
+def _effect_verdict(node: _Monitor) -> None:
+    """Setting a threshold changes the status the monitor gives; out of range, it does not;
+    an inverted pair is refused by the on-set callback the constructor registered (here the
+    course's: only the registration is part 3's)."""
+    current = dict(course.THRESHOLD_DEFAULTS_C)
+    _status_verdict(node, 25.5, current, 'With the default thresholds')
+    for name, value in ((course.HIGH_PARAMETER, 25.0), (course.LOW_PARAMETER, 21.0)):
+        result = node.set(name, value)
+        if not result.successful:
+            why = result.reason or 'no reason'
+            raise CheckFailed(f'Setting {name} to {value} was refused ({why}): a value inside '
+                              'the range must be accepted.')
+        current[name] = value
+        _status_verdict(node, 25.5 if name == course.HIGH_PARAMETER else 20.5, current,
+                        f'After ros2 param set {name} {value}')
+    result = node.set(course.HIGH_PARAMETER, course.MAX_TEMPERATURE_C + 7.0)
+    if result.successful:
+        raise CheckFailed(f'Setting {course.HIGH_PARAMETER} to {course.MAX_TEMPERATURE_C + 7.0} '
+                          f'was accepted: its floating_point_range must stop at '
+                          f'{course.MAX_TEMPERATURE_C} °C.')
+    _status_verdict(node, 25.5, current, 'After a refused change')
+    result = node.set(course.LOW_PARAMETER, 25.5)
+    if result.successful:
+        raise CheckFailed(f'Setting {course.LOW_PARAMETER} to 25.5 while {course.HIGH_PARAMETER} '
+                          f'is 25.0 was accepted: register the on-set callback in __init__ with '
+                          f'self.add_on_set_parameters_callback(self.{CALLBACK}).')
+
+
 def _monitor_parameters(judge: Judge) -> str:
-    node = _Parameters(judge)
+    node = _Monitor(judge, ('thresholds_on_set',))
     _declared_verdict(node)
     _descriptor_verdict(node)
+    _effect_verdict(node)
     high, low = course.HIGH_PARAMETER, course.LOW_PARAMETER
     return (f'{node.name} declares {high} = {course.HIGH_ABOVE_C} and {low} = '
             f'{course.LOW_BELOW_C}, described, in [{course.MIN_TEMPERATURE_C}, '
-            f'{course.MAX_TEMPERATURE_C}] °C.')
+            f'{course.MAX_TEMPERATURE_C}] °C; setting them changes the statuses it logs.')
 
 
 def check_monitor_parameters() -> None:
     """Check part 3 of notebook 08: the monitor declares its two thresholds as parameters.
 
-    Creates your ``TemperatureMonitor`` and asks its parameter services, as ``ros2 param
-    list/get/describe`` do: both thresholds declared, doubles with their defaults, each
-    with a description and a floating-point range of [18.0, 28.0] °C, not read-only.
+    Creates your ``TemperatureMonitor`` (with the course's on-set callback, so that only your
+    constructor counts) and asks its parameter services, as ``ros2 param list/get/describe/
+    set`` do: both thresholds declared, doubles with their defaults, each with a description
+    and a floating-point range of [18.0, 28.0] °C, not read-only; then sets them and checks,
+    from the statuses it logs for the grader's readings, that the node uses what was set.
 
     Introduced in ``08-parameters.ipynb``.
 
@@ -169,10 +241,11 @@ def check_monitor_parameters() -> None:
     judged('check_monitor_parameters', _monitor_parameters)
 
 
-#: (name, value, must succeed, the current other threshold) in the order the check sets them.
-STEPS = ((course.HIGH_PARAMETER, 25.0, True), (course.LOW_PARAMETER, 25.5, False),
-         (course.LOW_PARAMETER, 25.0, False), (course.LOW_PARAMETER, 21.0, True),
-         (course.HIGH_PARAMETER, 20.5, False))
+#: (name, value, must succeed, the reading that shows the thresholds in force afterwards) in
+#: the order the check sets them.
+STEPS = ((course.HIGH_PARAMETER, 25.0, True, 25.5), (course.LOW_PARAMETER, 25.5, False, 24.0),
+         (course.LOW_PARAMETER, 25.0, False, 24.0), (course.LOW_PARAMETER, 21.0, True, 20.5),
+         (course.HIGH_PARAMETER, 20.5, False, 24.0))
 
 
 def _refusal_hint(name: str) -> str:
@@ -182,11 +255,21 @@ def _refusal_hint(name: str) -> str:
     return f'refuse unless {course.LOW_PARAMETER} stays strictly below {course.HIGH_PARAMETER}.'
 
 
+def _declared(judge: Judge) -> _Monitor:
+    """The learner's monitor with its own constructor, or the course's when theirs does not
+    declare both thresholds (a mistake in part 3 costs part 3 only)."""
+    try:
+        node = _Monitor(judge, ())
+        _declared_verdict(node)
+        return node
+    except CheckFailed:
+        return _Monitor(judge, ('thresholds_init',))
+
+
 def _threshold_callback(judge: Judge) -> str:
-    node = _Parameters(judge)
-    _declared_verdict(node)
+    node = _declared(judge)
     current = dict(course.THRESHOLD_DEFAULTS_C)
-    for name, value, valid in STEPS:
+    for name, value, valid, reading in STEPS:
         other = course.LOW_PARAMETER if name == course.HIGH_PARAMETER else course.HIGH_PARAMETER
         result = node.set(name, value)
         if result is None or not hasattr(result, 'successful'):
@@ -209,6 +292,8 @@ def _threshold_callback(judge: Judge) -> str:
                               'it).')
         if valid:
             current[name] = value
+        said = 'accepted' if valid else 'refused'
+        _status_verdict(node, reading, current, f'After {name} = {value} was {said}')
     got = [parameter_value_to_python(v) for v in node.values([course.HIGH_PARAMETER,
                                                                 course.LOW_PARAMETER])]
     if got != [current[course.HIGH_PARAMETER], current[course.LOW_PARAMETER]]:
@@ -217,7 +302,7 @@ def _threshold_callback(judge: Judge) -> str:
                           'do not change parameters inside the callback.')
     return (f'{CALLBACK} accepts valid thresholds and refuses, with a reason, '
             f'{len([s for s in STEPS if not s[2]])} changes that would put '
-            f'{course.LOW_PARAMETER} at or above {course.HIGH_PARAMETER}.')
+            f'{course.LOW_PARAMETER} at or above {course.HIGH_PARAMETER}; the statuses follow.')
 
 
 def check_threshold_callback() -> None:
@@ -225,7 +310,8 @@ def check_threshold_callback() -> None:
 
     Sets the thresholds of your running monitor through its ``set_parameters`` service, as
     ``ros2 param set`` does: valid pairs must be accepted, and every change that leaves
-    ``low_below_c`` at or above ``high_above_c`` refused with a reason.
+    ``low_below_c`` at or above ``high_above_c`` refused with a reason; after each change the
+    statuses the monitor logs for the grader's readings follow the thresholds in force.
 
     Introduced in ``08-parameters.ipynb``.
 

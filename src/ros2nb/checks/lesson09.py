@@ -1,23 +1,28 @@
-"""Checks of notebook 09, QoS: what subscriptions with the learner's profiles really receive.
+"""Checks of notebook 09, QoS: what endpoints made with the learner's profiles really do.
 
 Part of :mod:`ros2nb.checks`.  The learner writes functions that return a ``QoSProfile``.
-In the kernel the function is called there; the judge calls it from the learner's answer
-cell in a subject, which sends back only the profile's policies (plain names and numbers).
-Either way the check then runs a real publisher and subscription with that profile
-(:mod:`ros2nb.qos`, on a private context) and judges the numbers delivered, never the
-source text.
+In the kernel the function is called there and the trials of :mod:`ros2nb.qos` run on a
+private context.  The judge calls it from the learner's answer cell in a subject, which makes
+a subscription or a publisher with the very profile it returned; the judge then sees, itself,
+what that endpoint does: the profile discovery reports for it (as ``ros2 topic info
+--verbose`` shows it), whether the judge's publisher matches it (rclpy's
+``qos_check_compatible`` names why not), which numbers of the judge's burst it kept, and what
+a late joiner of the judge's receives from it.  Either way the same rules decide.
 """
 
 from __future__ import annotations
 
+import secrets
 from typing import Any
 
-from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, qos_profile_sensor_data
+from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy,
+                       qos_profile_sensor_data)
+from std_msgs.msg import Int32
 
 from .. import qos
 from ..errors import CheckFailed
-from .answers import answer_results, decoded, type_name_of
-from .base import AnswerRef, call_learner, current_judge, passed
+from .answers import type_name_of
+from .base import ARRIVAL_TIMEOUT_S, AnswerRef, call_learner, current_judge, learner_error, passed
 
 #: The burst of part 1 and what a display of the newest reading must be left with.
 BURST = 30
@@ -32,17 +37,11 @@ SENSOR_QOS = qos_profile_sensor_data
 
 
 def learner_profile(make_profile: Any) -> QoSProfile:
-    """The profile the learner's function returns (called in the kernel or in a subject).
+    """The profile the learner's function returns, called in the kernel (never in a judge).
 
     :raises CheckFailed: when it raises, or returns anything but a QoSProfile.
     """
-    if isinstance(make_profile, AnswerRef):
-        profile = decoded(answer_results(make_profile, [[]])[0], f'{make_profile.name}()')
-        # The trials run on the judge's domain: nothing of the learner's (a thread their
-        # answer cell started) may be left to publish on a trial's topic.
-        current_judge().drop_all()
-    else:
-        profile = call_learner(make_profile)
+    profile = call_learner(make_profile)
     if not isinstance(profile, QoSProfile):
         raise CheckFailed(f'{make_profile.__name__}() returned {type_name_of(profile)} '
                           f'{profile!r}; return a QoSProfile(...).')
@@ -55,19 +54,168 @@ def _span(received: list[int]) -> str:
     return f'[{received[0]}, {received[1]}, ..., {received[-1]}]'
 
 
+# ------------------------------------------------------------------ the judge's side
+class _Endpoint:
+    """An endpoint with the learner's profile, made in a subject on a topic of the judge's,
+    and the judge's view of it."""
+
+    def __init__(self, ref: AnswerRef, kind: str, numbers: tuple[int, ...] = ()) -> None:
+        judge = current_judge()
+        judge.drop_all()  # nothing of the learner's left to publish on a trial's topic
+        self.judge, self.observer = judge, judge.observer
+        self.topic = f'/ros2nb_qos_trial_{secrets.token_hex(4)}'
+        self.mark = len(self.observer.logs)
+        self.subject = judge.answer_subject(ref)
+        reply = self.subject.request('qos_endpoint', name=ref.name, topic=self.topic, kind=kind,
+                                     numbers=list(numbers))
+        if reply.get('undefined'):
+            raise CheckFailed(f'{ref.name} is not defined in your answer cell: define it there '
+                              '(and run the cell) without renaming it.')
+        if 'error' in reply:
+            raise learner_error(f'{ref.name}()', reply['error'])
+        if 'returned' in reply:
+            returned = reply['returned']
+            raise CheckFailed(f'{ref.name}() returned {returned["type"]} {returned["value"]}; '
+                              'return a QoSProfile(...).')
+        self.node = reply['node']
+        found = qos.discovered(self.observer.node, self.topic, kind,
+                               seconds=ARRIVAL_TIMEOUT_S)
+        if not found:
+            raise CheckFailed(f'The grader could not see the {kind} made with your profile within '
+                              f'{ARRIVAL_TIMEOUT_S:g} s (is the machine very busy?): run this '
+                              'check again.')
+        #: The endpoint's profile as discovery reports it (history and depth: not carried).
+        self.profile: QoSProfile = found[0].qos_profile
+
+    def took(self) -> list[int]:
+        """Let the learner's subscription take what it kept; the numbers it logged taking."""
+        reply = self.subject.request('qos_take')
+        lines = []
+
+        def heard() -> bool:
+            nonlocal lines
+            lines = [text for text in self.observer.lines_of(self.node, self.mark)
+                     if text.startswith('took ')]
+            return len(lines) >= reply.get('took', 0)
+
+        self.observer.wait_until(heard, ARRIVAL_TIMEOUT_S)
+        return [int(text.split()[1]) for text in lines if text.split()[1].isdigit()]
+
+    def close(self) -> None:
+        self.judge.drop_all()
+
+
+def _judged_burst(ref: AnswerRef) -> qos.Deliveries:
+    """The burst of part 1, from the judge's publisher to a subscription with the learner's
+    profile that takes nothing until the whole burst was acknowledged."""
+    endpoint = _Endpoint(ref, 'subscription')
+    node = endpoint.observer.node
+    publisher = node.create_publisher(Int32, endpoint.topic, QoSProfile(depth=BURST))
+    out = qos.Deliveries()
+    try:
+        sender = qos.discovered(node, endpoint.topic, 'publisher')
+        out.explanation = qos.incompatibility(sender[0].qos_profile, endpoint.profile) \
+            if sender else None
+        if out.explanation is None:
+            out.matched = endpoint.observer.wait_until(
+                lambda: publisher.get_subscription_count() >= 1, ARRIVAL_TIMEOUT_S)
+        if out.matched:
+            for number in range(BURST):
+                publisher.publish(Int32(data=number))
+            publisher.wait_for_all_acked()
+            out.received = endpoint.took()
+    finally:
+        node.destroy_publisher(publisher)
+        endpoint.close()
+    return out
+
+
+def _judged_pair(ref: AnswerRef) -> tuple[qos.Deliveries, QoSProfile]:
+    """Part 2: does the judge's sensor publisher match a subscription with the learner's
+    profile?  rclpy decides from both profiles as discovery reports them."""
+    endpoint = _Endpoint(ref, 'subscription')
+    node = endpoint.observer.node
+    publisher = node.create_publisher(Int32, endpoint.topic, SENSOR_QOS)
+    out = qos.Deliveries()
+    try:
+        sender = qos.discovered(node, endpoint.topic, 'publisher')
+        offered = sender[0].qos_profile if sender else SENSOR_QOS
+        out.explanation = qos.incompatibility(offered, endpoint.profile)
+        if out.explanation is None:
+            out.matched = endpoint.observer.wait_until(
+                lambda: publisher.get_subscription_count() >= 1, ARRIVAL_TIMEOUT_S)
+    finally:
+        node.destroy_publisher(publisher)
+        endpoint.close()
+    return out, endpoint.profile
+
+
+def _judged_late_joiner(ref: AnswerRef) -> tuple[qos.Deliveries, QoSProfile]:
+    """Part 3: a publisher with the learner's profile publishes 20 numbers; then the judge's
+    subscription joins, with that profile as discovery reports it (keeping all it is sent),
+    and the judge counts what it got once the publisher says everything was acknowledged."""
+    # Numbers only the judge knows, so that what the joiner gets is what this publisher
+    # kept: anything else on the topic (a thread of the answer cell's) is seen as such.
+    sent = tuple(secrets.randbelow(2**31 - 1) for _ in range(LATCHED_SENT))
+    endpoint = _Endpoint(ref, 'publisher', numbers=sent)
+    profile = endpoint.profile
+    joiner = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=profile.reliability,
+                        durability=profile.durability, deadline=profile.deadline,
+                        lifespan=profile.lifespan, liveliness=profile.liveliness,
+                        liveliness_lease_duration=profile.liveliness_lease_duration)
+    taker = endpoint.observer.quiet_node()  # takes only when told: nothing is missed
+    subscription = taker.create_subscription(Int32, endpoint.topic, lambda msg: None, joiner)
+    out = qos.Deliveries()
+    try:
+        out.matched = endpoint.observer.wait_until(
+            lambda: subscription.get_publisher_count() >= 1, ARRIVAL_TIMEOUT_S)
+        if out.matched:
+            endpoint.subject.request('qos_acked', seconds=ARRIVAL_TIMEOUT_S,
+                                     timeout=ARRIVAL_TIMEOUT_S + 10)
+            taken = _take_all(subscription)
+            if any(number not in sent for number in taken) or \
+                    len(endpoint.observer.node.get_publishers_info_by_topic(endpoint.topic)) != 1:
+                raise CheckFailed('Something other than the publisher made with your profile '
+                                  'published on the check\'s topic: an answer cell defines the '
+                                  'function only; start no node or thread in it.')
+            out.received = [sent.index(number) for number in taken]
+    finally:
+        taker.destroy_subscription(subscription)
+        endpoint.close()
+    return out, profile
+
+
+def _take_all(subscription: Any) -> list[int]:
+    """Every number waiting in a subscription's history, taken at once."""
+    taken = []
+    with subscription.handle:
+        while (got := subscription.handle.take_message(subscription.msg_type,
+                                                        subscription.raw)) is not None:
+            taken.append(got[0].data)
+    return taken
+
+
+# ------------------------------------------------------------------ the three parts
 def _newest_only(make_profile: Any) -> str:
-    profile = learner_profile(make_profile)
-    got = qos.burst(profile, count=BURST)
+    if isinstance(make_profile, AnswerRef):
+        got = _judged_burst(make_profile)
+        shown = 'your profile'
+        keeps_all = None
+    else:
+        profile = learner_profile(make_profile)
+        got = qos.burst(profile, count=BURST)
+        shown = qos.describe(profile)
+        keeps_all = profile.history == HistoryPolicy.KEEP_ALL
     if not got.matched:
-        raise CheckFailed(f'Your subscription ({qos.describe(profile)}) never matched the '
-                          f'reliable, volatile publisher: {got.explanation}')
+        raise CheckFailed(f'Your subscription ({shown}) never matched the reliable, volatile '
+                          f'publisher: {got.explanation or "they never matched."}')
     if got.received == NEWEST:
-        return (f'after a burst of {BURST}, a subscription with {qos.describe(profile)} '
-                f'is left with {NEWEST}: the newest reading only.')
-    if profile.history == HistoryPolicy.KEEP_ALL:
+        return (f'after a burst of {BURST}, a subscription with {shown} is left with '
+                f'{NEWEST}: the newest reading only.')
+    if keeps_all or (keeps_all is None and got.received == list(range(BURST))):
         raise CheckFailed(f'After a burst of {BURST} your subscription got all '
-                          f'{len(got.received)}: KEEP_ALL keeps every message; use KEEP_LAST '
-                          'with depth=1.')
+                          f'{len(got.received)}: KEEP_ALL (or a depth of {BURST} or more) keeps '
+                          'every message; use KEEP_LAST with depth=1.')
     raise CheckFailed(f'After a burst of {BURST} your subscription got '
                       f'{len(got.received)} messages {_span(got.received)}: its history '
                       'keeps that many; a display of the newest reading keeps depth=1.')
@@ -88,8 +236,11 @@ def check_newest_only(make_profile: Any) -> None:
 
 
 def _latched(make_profile: Any) -> str:
-    profile = learner_profile(make_profile)
-    got = qos.late_joiner(profile, count=LATCHED_SENT)
+    if isinstance(make_profile, AnswerRef):
+        got, profile = _judged_late_joiner(make_profile)
+    else:
+        profile = learner_profile(make_profile)
+        got = qos.late_joiner(profile, count=LATCHED_SENT)
     where = (f'A subscription that joined after {LATCHED_SENT} thresholds were published '
              f'(0 to {LATCHED_SENT - 1})')
     if got.received == LATCHED:
@@ -98,13 +249,16 @@ def _latched(make_profile: Any) -> str:
     if not got.received and profile.durability != DurabilityPolicy.TRANSIENT_LOCAL:
         raise CheckFailed(f'{where} got none: make durability TRANSIENT_LOCAL, so the publisher '
                           'keeps its last messages for late joiners.')
+    if not got.received and profile.reliability != ReliabilityPolicy.RELIABLE:
+        raise CheckFailed(f'{where} got none: a best-effort subscription is not sent what was '
+                          'published before it joined: make it RELIABLE.')
     if not got.received:
-        raise CheckFailed(f'{where} got none: it is {qos.describe(profile)}, and a best-effort '
-                          'subscription is not sent what was published before it joined: make '
-                          'it RELIABLE.')
-    if profile.history == HistoryPolicy.KEEP_ALL:
-        raise CheckFailed(f'{where} got all {len(got.received)}: KEEP_ALL keeps every message; '
-                          f'keep the last {LATCHED_KEPT} (KEEP_LAST, depth={LATCHED_KEPT}).')
+        raise CheckFailed(f'{where} got none: the publisher kept nothing for it (a lifespan '
+                          'lets old messages expire before anyone joins; leave it out).')
+    if len(got.received) == LATCHED_SENT:
+        raise CheckFailed(f'{where} got all {len(got.received)}: KEEP_ALL (or a depth of '
+                          f'{LATCHED_SENT} or more) keeps every message; keep the last '
+                          f'{LATCHED_KEPT} (KEEP_LAST, depth={LATCHED_KEPT}).')
     raise CheckFailed(f'{where} got {len(got.received)} {_span(got.received)}, expected the '
                       f'last {LATCHED_KEPT} {_span(LATCHED)}: depth={LATCHED_KEPT}.')
 
@@ -124,8 +278,11 @@ def check_latched_thresholds(make_profile: Any) -> None:
 
 
 def _sensor_subscription(make_profile: Any) -> str:
-    profile = learner_profile(make_profile)
-    got = qos.pair(SENSOR_QOS, profile, count=READINGS)
+    if isinstance(make_profile, AnswerRef):
+        got, profile = _judged_pair(make_profile)
+    else:
+        profile = learner_profile(make_profile)
+        got = qos.pair(SENSOR_QOS, profile, count=READINGS)
     sensor = qos.describe(SENSOR_QOS)
     if not got.matched:
         raise CheckFailed(f'Incompatible QoS: the sensor publishes with {sensor}, your '
@@ -139,8 +296,8 @@ def check_sensor_subscription(make_profile: Any) -> None:
     """Check part 2 of notebook 09: a subscription profile the best-effort sensor can serve.
 
     A publisher with rclpy's sensor-data preset (best effort, keep last 5, volatile) meets a
-    subscription with your profile: rclpy's incompatible-QoS event must not fire, and the two
-    must match.
+    subscription with your profile: rclpy's ``qos_check_compatible``, on both profiles as
+    discovery reports them, must find nothing incompatible, and the two must match.
 
     Introduced in ``09-qos.ipynb``.
 

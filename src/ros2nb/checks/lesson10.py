@@ -1,12 +1,14 @@
 """Checks of notebook 10, record and replay: the bag on disk and what a replay delivers.
 
 Part of :mod:`ros2nb.checks`.  The learner writes three functions.  In the kernel they are
-called there; the judge calls them from the learner's answer cells in a subject (ROS up on
-simulated time there too).  The verdict never comes from what they report: the check reads
-the bag folder itself with ``rosbags`` (metadata, types, counts, the statuses in the
-monitor's log messages), watches what a replay delivers with a ROS subscription of its own
-(the judge's node, or in the kernel a subscription of the check's), and compares what the
-reading function returns with a bag the check wrote itself.
+called there; the judge calls them from the learner's answer cells in a subject, whose ROS
+runs on the judge's clock.  The verdict never comes from what they report.  While a
+recording runs, the check hears ``/temperature`` and ``/rosout`` itself, each message with
+the time it arrived (the judge's clock, or in the kernel the kernel's); it then reads the bag
+itself with ``rosbags`` (a copy, once the learner's code is done) and compares: the bag must
+hold what was on the wire, with the times it was there.  A replay is heard the same way:
+the bag's readings, one second apart, and the monitor's status for each, in the same step.
+The reading function is given a bag the check wrote itself, with readings of its own.
 """
 
 from __future__ import annotations
@@ -15,76 +17,111 @@ import contextlib
 import io
 import math
 import re
-import shutil
-import tempfile
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterator, Optional
 
 from rcl_interfaces.msg import Log
+from std_msgs.msg import Float32
 
 from .. import course
 from ..errors import CheckFailed
 from ..runtime import current_runtime
 from ..terminal import bag
-from .answers import answer_results, decoded
-from .base import ARRIVAL_TIMEOUT_S, AnswerRef, call_learner, current_judge, learner_error, passed
+from .answers import decoded
+from .bags import (CHECK_LOGGER, ROSOUT, TEMPERATURE, check_bag, check_readings_c, fresh_path,
+                   bag_messages, read_back)
+from .base import AnswerRef, call_learner, current_judge, learner_error, passed
 from .dispatch import in_judge
 
-#: Topics of the recording: the readings, and /rosout where the monitor's statuses go.
-TEMPERATURE, ROSOUT = '/' + course.TOPIC, course.ROSOUT_TOPIC
 #: The monitor's log line, as notebook 04 writes it.
 STATUS_LINE = re.compile(r'Temperature: (-?[\d.]+)C - Status: (\w+)')
-#: Readings of the bags the check writes itself (parts b and c): a walk through all statuses.
-CHECK_READINGS = [round(22.0 + 6.5 * math.sin(k / 7.0), 2) for k in range(60)]
 #: Rate the check replays at (simulated s per wall s): fast, and below what play reaches.
 CHECK_RATE = 100.0
+#: Steps of the judge's clock while the learner's function records or replays (s).
+STEP_S = 1.0
+#: Simulated seconds a function may keep its nodes running beyond what the task needs.
+SPARE_S = 30.0
 
 
-@contextlib.contextmanager
-def _fresh_path(name: str) -> Iterator[Path]:
-    """A bag folder that does not exist yet, in the judge's scratch folder or a temporary
-    one; removed with what the learner's function put beside it once the check is done."""
-    parent = str(current_judge().scratch) if in_judge() else None
-    folder = Path(tempfile.mkdtemp(prefix='ros2nb-bag-', dir=parent))
-    try:
-        yield folder / name
-    finally:
-        shutil.rmtree(folder, ignore_errors=True)
+# ------------------------------------------------------------------ what the check hears
+@dataclass
+class Witness:
+    """What the check's own ROS hears while the learner's function runs: each reading on
+    /temperature and each /rosout line, with the time it arrived (ns of simulated time).
 
-
-@contextlib.contextmanager
-def _check_bag(name: str) -> Iterator[Path]:
-    """The check's own bag of :data:`CHECK_READINGS`, as a folder ``name`` the learner's
-    function may read; removed once the check is done.
-
-    The judge writes it in a temporary folder of its own that no subject sees, then hands
-    a copy over (:meth:`ros2nb.judge.Session.hand_over`): it never writes to a path in the
-    folder subjects may write, where the learner's code could have put a link.
+    :ivar readings: ``(t_ns, °C)`` in order of arrival.
+    :ivar lines: ``(t_ns, logger, text)`` in order of arrival.
     """
-    if not in_judge():
-        with _fresh_path(name) as path:
-            write_check_bag(path, CHECK_READINGS)
-            yield path
+
+    readings: list[tuple[int, float]] = field(default_factory=list)
+    lines: list[tuple[int, str, str]] = field(default_factory=list)
+
+    def statuses(self) -> list[tuple[int, float, str]]:
+        """``(t_ns, reading, status)`` of every status line of the monitor."""
+        found = []
+        for t_ns, name, text in self.lines:
+            match = STATUS_LINE.fullmatch(text) if name == course.MONITOR_NODE else None
+            if match:
+                found.append((t_ns, float(match.group(1)), match.group(2)))
+        return found
+
+
+@contextlib.contextmanager
+def _witnessing() -> Iterator[Witness]:
+    """Hear /temperature and /rosout while the block runs: the judge's node (stamped with
+    its clock), or in the kernel subscriptions of the check's own (the kernel's clock)."""
+    seen = Witness()
+    if in_judge():
+        observer = current_judge().observer
+        heard = observer.watch(TEMPERATURE, Float32, lambda m: float(m.data))
+        first, mark = len(heard), len(observer.logs)
+        try:
+            yield seen
+        finally:
+            seen.readings = [(h.t_ns, h.value) for h in heard[first:]]
+            seen.lines = [(line.t_ns, line.name, line.text) for line in observer.logs[mark:]]
         return
-    with tempfile.TemporaryDirectory(prefix='ros2nb-bag-') as private:
-        write_check_bag(Path(private) / name, CHECK_READINGS)
-        files = {f'{name}/{f.name}': f.read_bytes() for f in (Path(private) / name).iterdir()}
-    folder = current_judge().hand_over('ros2nb-bag-', files)
+    rt = current_runtime()
+    with rt.exclusive():
+        made = [rt.node.create_subscription(
+                    Float32, TEMPERATURE,
+                    lambda m: seen.readings.append((rt.sim_now_ns, float(m.data))), bag.KEEP_ALL),
+                rt.node.create_subscription(
+                    Log, ROSOUT, lambda m: seen.lines.append((rt.sim_now_ns, m.name, m.msg)),
+                    bag.KEEP_ALL)]
     try:
-        yield folder / name
+        yield seen
     finally:
-        shutil.rmtree(folder, ignore_errors=True)
+        with rt.exclusive():
+            rt.drain()
+            for subscription in made:
+                rt.node.destroy_subscription(subscription)
 
 
-def _call(function: Any, label: str, *args: Any) -> Any:
-    """Call the learner's function (in the kernel, or from source in a subject)."""
+# ------------------------------------------------------------------ calling the learner
+def _catch_up_workspace() -> Optional[Any]:
+    """The judge's workspace with the course's nodes where the learner's are missing (what
+    ``catch_up(10)`` promises a notebook run on its own); None in the kernel."""
+    return current_judge().caught_up(course.STEPS[10]) if in_judge() else None
+
+
+def _call(function: Any, label: str, *args: Any, spin_s: float = 0.0) -> Any:
+    """Call the learner's function (in the kernel, or from source in a subject whose nodes
+    run on the judge's clock for up to ``spin_s`` simulated seconds)."""
     if isinstance(function, AnswerRef):
-        # The monitor the learner stops at the end keeps its /rosout lines for the judge.
-        current_judge().answer_subject(function).request('keep_stopped_nodes')
+        judge = current_judge()
+        subject = judge.answer_subject(function, workspace=_catch_up_workspace())
         encoded = [{'path': str(a)} if isinstance(a, Path) else a for a in args]
-        output = answer_results(function, [encoded])[0]
+        reply = judge.clock.drive(subject, 'call', name=function.name, inputs=[encoded],
+                                  step_s=STEP_S, limit_s=spin_s + SPARE_S, what=label)
+        if reply.get('undefined'):
+            raise CheckFailed(f'{function.name} is not defined in your answer cell: define it '
+                              'there (and run the cell) without renaming it.')
+        output = reply['outputs'][0]
         if 'error' in output:
             raise learner_error(label, output['error'])
+        judge.drop_all()  # its nodes leave the graph: what they said is heard by now
         return _plain(output['result'])
     with contextlib.redirect_stdout(io.StringIO()):  # the verdict is the check's line alone
         return call_learner(function, *args)
@@ -97,25 +134,7 @@ def _plain(result: dict) -> Any:
     return decoded({'result': result}, '')
 
 
-def _messages(path: Path, topic: str) -> list[tuple[int, Any]]:
-    """(stamp ns, decoded message) of one topic of a bag, read by the check itself."""
-    store = bag.typestore()
-    with bag.rosbag2.Reader(path) as reader:
-        chosen = [c for c in reader.connections if c.topic == topic]
-        return [(stamp, store.deserialize_cdr(raw, connection.msgtype))
-                for connection, stamp, raw in reader.messages(chosen)]
-
-
-def _statuses(logs: list[tuple[str, str]]) -> list[tuple[float, str]]:
-    """(reading, status) of every status line the monitor logged."""
-    found = []
-    for name, text in logs:
-        match = STATUS_LINE.fullmatch(text) if name == course.MONITOR_NODE else None
-        if match:
-            found.append((float(match.group(1)), match.group(2)))
-    return found
-
-
+# ------------------------------------------------------------------ part 1: the recording
 def _bag_verdict(path: Path, label: str) -> dict[str, int]:
     """The bag's own facts, or the one line saying what is wrong with it."""
     if not path.is_dir():
@@ -137,46 +156,83 @@ def _bag_verdict(path: Path, label: str) -> dict[str, int]:
 
 
 def _recording(record_hour: Any) -> str:
-    with _fresh_path('hour') as path:
-        return _recording_in(path, record_hour)
-
-
-def _recording_in(path: Path, record_hour: Any) -> str:
     label = f'{record_hour.__name__}(bag_path)'
-    _call(record_hour, label, path)
-    if not in_judge():
-        return _recording_verdict(path, label)
-    if not path.is_dir():
-        _bag_verdict(path, label)  # the line for "no bag at all"
-    # The bag lies where subjects may write: the judge reads its own copy, links refused.
-    with current_judge().taken_back(path) as copy:
-        return _recording_verdict(copy, label)
+    with fresh_path('hour') as path:
+        with _witnessing() as seen:
+            _call(record_hour, label, path, spin_s=course.RECORD_S)
+        if not path.is_dir():
+            _bag_verdict(path, label)  # the line for "no bag at all"
+        with read_back(path) as copy:
+            return _recording_verdict(copy, label, seen)
 
 
-def _recording_verdict(path: Path, label: str) -> str:
-    """What the bag at ``path`` holds, against an hour of the sensor and the monitor."""
-    counts = _bag_verdict(path, label)
-    readings = [float(m.data) for _s, m in _messages(path, TEMPERATURE)]
+def _recording_verdict(path: Path, label: str, seen: Witness) -> str:
+    """The bag at ``path`` against an hour of the sensor and the monitor, and against what
+    the check heard on the wire meanwhile."""
+    _bag_verdict(path, label)
     hour = round(course.RECORD_S / course.PUBLISH_PERIOD_S)
-    if counts[TEMPERATURE] != hour or len(readings) != hour:
-        raise CheckFailed(f'The bag holds {counts[TEMPERATURE]} readings on {TEMPERATURE}; one '
-                          f'simulated hour of the sensor is {hour}: add both nodes, then record '
-                          f'while spinning {course.RECORD_S:g} s.')
-    statuses = _statuses([(m.name, m.msg) for _s, m in _messages(path, ROSOUT)])
-    if len(statuses) != hour:
-        raise CheckFailed(f'The bag holds {len(statuses)} status lines of '
-                          f'{course.MONITOR_NODE} on {ROSOUT}, expected {hour}, one per '
-                          'reading: add your monitor before recording, and keep it running.')
-    return (f'the bag is MCAP with metadata.yaml: {hour} readings ({course.MESSAGE_TYPE}) and '
-            f'{hour} statuses of {course.MONITOR_NODE} on {ROSOUT}.')
+    heard = seen.readings
+    if len(heard) != hour:
+        raise CheckFailed(f'{len(heard)} readings went out on {TEMPERATURE} while '
+                          f'{label} ran; one simulated hour of the sensor is {hour}: add both '
+                          f'nodes, then record while spinning {course.RECORD_S:g} s.')
+    recorded = [(stamp, float(m.data)) for stamp, m in bag_messages(path, TEMPERATURE)]
+    if len(recorded) != len(heard):
+        raise CheckFailed(f'The bag holds {len(recorded)} readings on {TEMPERATURE}, but '
+                          f'{len(heard)} went out while it recorded: record while the nodes '
+                          'spin, and stop recording after.')
+    for index, ((stamp, value), (t_ns, sent)) in enumerate(zip(recorded, heard), start=1):
+        if not math.isclose(value, sent, abs_tol=1e-4):
+            raise CheckFailed(f'Reading {index} of the bag is {value:.2f} °C, but {sent:.2f} °C '
+                              f'went out on {TEMPERATURE}: record the messages as they are, '
+                              'with ros2nb.bag_record.')
+        if stamp != t_ns:
+            raise CheckFailed(f'Reading {index} of the bag is stamped {stamp / 1e9:g} s, but it '
+                              f'went out at {t_ns / 1e9:g} s of simulated time: record while the '
+                              'nodes spin, with ros2nb.bag_record (it stamps each message with '
+                              'the clock).')
+    in_bag = [STATUS_LINE.fullmatch(m.msg) for _s, m in bag_messages(path, ROSOUT)
+              if m.name == course.MONITOR_NODE]
+    in_bag = [(float(m.group(1)), m.group(2)) for m in in_bag if m]
+    said = seen.statuses()
+    _statuses_follow_readings(said, heard, label)
+    if in_bag != [(r, s) for _t, r, s in said]:
+        raise CheckFailed(f'The bag holds {len(in_bag)} status lines of {course.MONITOR_NODE} on '
+                          f'{ROSOUT}, but the monitor said {len(said)} while it recorded: record '
+                          f'{ROSOUT} too, from before the spin to after it.')
+    return (f'the bag is MCAP with metadata.yaml: the {hour} readings ({course.MESSAGE_TYPE}) '
+            f'and the {hour} statuses of {course.MONITOR_NODE} on {ROSOUT} that went out, '
+            'each stamped with its time.')
+
+
+def _statuses_follow_readings(said: list[tuple[int, float, str]],
+                              heard: list[tuple[int, float]], label: str) -> None:
+    """One status per reading, the reading's own, in the same step of the clock: the
+    monitor heard each reading (a node that logs statuses of its own accord does not)."""
+    if not said:
+        raise CheckFailed(f'{course.MONITOR_NODE} logged no status while {label} ran: add your '
+                          'monitor, so it hears the readings.')
+    for index, (t_ns, value) in enumerate(heard, start=1):
+        mine = [(r, s) for t, r, s in said if t == t_ns]
+        want = (round(value, 2), course.monitor_status(value))
+        if len(mine) != 1 or (round(mine[0][0], 2), mine[0][1]) != want:
+            got = ', '.join(f'{r:.2f} {s}' for r, s in mine) or 'nothing'
+            raise CheckFailed(f'For reading {index} ({value:.2f} °C, at {t_ns / 1e9:g} s) '
+                              f'{course.MONITOR_NODE} said {got}; it should say '
+                              f'{want[1]} for it, once, as it hears it: add the monitor once, '
+                              f'and let it hear {TEMPERATURE}.')
+    if len(said) != len(heard):
+        raise CheckFailed(f'{course.MONITOR_NODE} logged {len(said)} statuses for the '
+                          f'{len(heard)} readings: one per reading, from one monitor.')
 
 
 def check_recording(record_hour: Any) -> None:
     """Check part 1 of notebook 10: one simulated hour recorded into an MCAP bag.
 
-    Calls your function with a folder that does not exist yet, then reads the bag there
-    itself: MCAP storage with a ``metadata.yaml``, 3600 ``std_msgs/msg/Float32`` readings on
-    ``/temperature`` and 3600 status lines of ``temperature_monitor`` on ``/rosout``.
+    Calls your function with a folder that does not exist yet and listens meanwhile to
+    ``/temperature`` and ``/rosout`` itself; then reads the bag: MCAP storage with a
+    ``metadata.yaml``, the 3600 readings (``std_msgs/msg/Float32``) that went out, each with
+    the time it went out, and the 3600 status lines ``temperature_monitor`` logged for them.
 
     Introduced in ``10-record-and-replay.ipynb``.
 
@@ -186,98 +242,46 @@ def check_recording(record_hour: Any) -> None:
     passed(_recording(record_hour))
 
 
-def write_check_bag(path: Path, readings: list[float]) -> None:
-    """A bag of the check's own: ``readings`` on /temperature 1 s apart, and a /rosout line."""
-    store = bag.typestore()
-    float32 = store.types[course.MESSAGE_TYPE]
-    log = store.types['rcl_interfaces/msg/Log']
-    stamp = store.types['builtin_interfaces/msg/Time']
-    writer = bag.rosbag2.Writer(path, version=bag.METADATA_VERSION,
-                                storage_plugin=bag.rosbag2.StoragePlugin.MCAP)
-    with writer:
-        readings_topic = writer.add_connection(TEMPERATURE, course.MESSAGE_TYPE, typestore=store)
-        logs = writer.add_connection(ROSOUT, 'rcl_interfaces/msg/Log', typestore=store)
-        line = log(stamp=stamp(sec=0, nanosec=0), level=20, name='bag_check', msg='recorded',
-                   file='', function='', line=0)
-        writer.write(logs, 500_000_000, store.serialize_cdr(line, 'rcl_interfaces/msg/Log'))
-        for k, value in enumerate(readings, start=1):
-            writer.write(readings_topic, k * 1_000_000_000,
-                         store.serialize_cdr(float32(data=value), course.MESSAGE_TYPE))
-
-
-class _Watch:
-    """What the check's own ROS node hears during a replay: the monitor's log lines."""
-
-    def __init__(self) -> None:
-        if in_judge():
-            judge = current_judge()
-            # Monitors of earlier checks (kept after the learner stopped them, with their
-            # /rosout history) leave first: only this replay's monitor can speak below.
-            judge.drop_all()
-            self.observer = judge.observer
-            self.logs, self._close = self.observer.listen_logs()
-            return
-        self.observer, self.logs = None, []
-        self.rt = current_runtime()
-        with self.rt.exclusive():
-            self.subscription = self.rt.node.create_subscription(
-                Log, ROSOUT, lambda m: self.logs.append((m.name, m.msg)), bag.KEEP_ALL)
-
-    def heard(self, expected: int, made: Optional[int] = None) -> list[tuple[str, str]]:
-        """Log lines heard since the watch began: waiting for ``expected`` statuses, or for
-        the ``made`` lines the monitor made in the subject (so a monitor that logged nothing
-        is known at once, not after ``ARRIVAL_TIMEOUT_S``)."""
-        if self.observer is not None:
-            # A subscription of its own, transient local: the monitor's lines reach it even
-            # when it matched the monitor only after the replay (the monitor is kept).
-            def arrived() -> bool:
-                logs = list(self.logs)
-                return (len(_statuses(logs)) >= expected or made is not None
-                        and sum(name == course.MONITOR_NODE for name, _ in logs) >= made)
-
-            self.observer.wait_until(arrived, ARRIVAL_TIMEOUT_S)
-            self._close()
-            return list(self.logs)
-        with self.rt.exclusive():
-            self.rt.drain()
-            self.rt.node.destroy_subscription(self.subscription)
-        return self.logs
-
-
+# ------------------------------------------------------------------ part 2: the replay
 def _replay(replay: Any) -> str:
-    with _check_bag('sixty') as path:
-        return _replay_in(path, replay)
+    readings = check_readings_c()
+    with check_bag('sixty', readings) as path:
+        with _witnessing() as seen:
+            _call(replay, f'{replay.__name__}(bag_path, rate)', path, CHECK_RATE,
+                  spin_s=len(readings) * course.PUBLISH_PERIOD_S)
+    return _replay_verdict(readings, seen, f'{replay.__name__}(bag_path, rate)')
 
 
-def _replay_in(path: Path, replay: Any) -> str:
-    watch = _Watch()
-    _call(replay, f'{replay.__name__}(bag_path, rate)', path, CHECK_RATE)
-    made = None  # how many lines the monitor made, when the subject can vouch for them all
-    if isinstance(replay, AnswerRef):
-        made = current_judge().answer_subject(replay).request(
-            'lines_logged', logger=course.MONITOR_NODE)['lines']
-    logs = watch.heard(len(CHECK_READINGS), made)
-    sent = len(CHECK_READINGS)
-    statuses = _statuses(logs)
-    expected = [(round(r, 2), course.monitor_status(r)) for r in CHECK_READINGS]
-    if not statuses:
+def _replay_verdict(readings: list[float], seen: Witness, label: str) -> str:
+    sent = len(readings)
+    if any(name == CHECK_LOGGER for _t, name, _text in seen.lines):
+        raise CheckFailed(f'{label} played the bag\'s {ROSOUT} too: play only {TEMPERATURE} '
+                          f"(topics=['{TEMPERATURE}']); old log lines are a record, not input.")
+    heard = seen.readings
+    if [round(v, 2) for _t, v in heard] != [round(v, 2) for v in readings]:
+        raise CheckFailed(f'{len(heard)} readings went out on {TEMPERATURE} during the replay; '
+                          f'the bag holds {sent}: play the bag\'s {TEMPERATURE}, all of it, '
+                          'once.')
+    gaps = {round((b - a) / 1e9, 6) for (a, _v), (b, _w) in zip(heard, heard[1:])}
+    if gaps != {course.PUBLISH_PERIOD_S}:
+        raise CheckFailed(f'The replayed readings came {sorted(gaps)} s apart on the clock; the '
+                          f'bag recorded them {course.PUBLISH_PERIOD_S} s apart: replay with '
+                          'ros2nb.bag_play, which keeps the recorded gaps.')
+    said = seen.statuses()
+    if not said:
         raise CheckFailed(f'{course.MONITOR_NODE} logged no status during the replay: add your '
                           'monitor before bag_play, so it hears the replayed readings.')
-    got = [(round(r, 2), s) for r, s in statuses]
-    if got != expected:
-        raise CheckFailed(f'{course.MONITOR_NODE} logged {len(got)} statuses for the {sent} '
-                          f'replayed readings, expected {sent}, one each: add the monitor once, '
-                          'before bag_play, and stop it after.')
-    return (f'{sent} replayed readings reached {course.MONITOR_NODE}, which logged the '
-            f'{sent} statuses the bag\'s readings call for.')
+    _statuses_follow_readings(said, heard, label)
+    return (f'{sent} replayed readings reached {course.MONITOR_NODE}, one second apart, and it '
+            f'logged the status each calls for, as it heard it.')
 
 
 def check_replay(replay: Any) -> None:
     """Check part 2 of notebook 10: a bag replayed into the monitor gives its statuses again.
 
     Writes a bag of 60 readings of its own, calls ``replay(bag_path, rate)`` and listens
-    itself: every reading must arrive on ``/temperature`` and your monitor must log the
-    status each one calls for, once.
+    itself: every reading must go out on ``/temperature``, one second apart, and your
+    monitor must log, as it hears each one, the status it calls for, once.
 
     Introduced in ``10-record-and-replay.ipynb``.
 
@@ -287,12 +291,14 @@ def check_replay(replay: Any) -> None:
     passed(_replay(replay))
 
 
+# ------------------------------------------------------------------ part 3: reading a bag
 def _readings(read_temperatures: Any) -> str:
-    with _check_bag('sixty') as path:
-        return _readings_in(path, read_temperatures)
+    readings = check_readings_c()
+    with check_bag('sixty', readings) as path:
+        return _readings_in(path, read_temperatures, readings)
 
 
-def _readings_in(path: Path, read_temperatures: Any) -> str:
+def _readings_in(path: Path, read_temperatures: Any, readings: list[float]) -> str:
     got = _call(read_temperatures, f'{read_temperatures.__name__}(bag_path)', path)
     name = f'{getattr(read_temperatures, "__name__", "your function")}()'
     if not (isinstance(got, (list, tuple)) and len(got) == 2
@@ -300,7 +306,7 @@ def _readings_in(path: Path, read_temperatures: Any) -> str:
         raise CheckFailed(f'{name} returned {type(got).__name__}; return two lists: '
                           '(times_s, temperatures_c).')
     times, values = (list(side) for side in got)
-    sent = len(CHECK_READINGS)
+    sent = len(readings)
     if len(values) != sent or len(times) != sent:
         raise CheckFailed(f'{name} returned {len(times)} times and {len(values)} readings; the '
                           f'bag holds {sent} on {TEMPERATURE} (and one message on {ROSOUT}: '
@@ -311,17 +317,18 @@ def _readings_in(path: Path, read_temperatures: Any) -> str:
         raise CheckFailed(f'{name} returned times {times[:3]}...; expected seconds since the '
                           f'first reading, [0.0, 1.0, 2.0, ...]: (stamp - first stamp) / 1e9.')
     if not all(isinstance(v, (int, float)) and abs(v - w) < 1e-4
-               for v, w in zip(values, CHECK_READINGS)):
+               for v, w in zip(values, readings)):
         raise CheckFailed(f'{name} returned readings {values[:3]}...; expected the messages\' '
-                          f'data, {CHECK_READINGS[:3]}...: deserialize each message.')
+                          f'data, {readings[:3]}...: deserialize each message.')
     return f'{name} returns the {sent} readings of the bag, with their times from 0 s.'
 
 
 def check_readings(read_temperatures: Callable[..., Any]) -> None:
     """Check part 3 of notebook 10: a bag's readings read back with rosbags.
 
-    Writes a bag of 60 readings one second apart (and one ``/rosout`` line), calls your
-    function and compares: times in seconds since the first reading, and every value.
+    Writes a bag of 60 readings of its own, one second apart (and one ``/rosout`` line),
+    calls your function and compares: times in seconds since the first reading, and every
+    value.
 
     Introduced in ``10-record-and-replay.ipynb``.
 

@@ -1,25 +1,38 @@
-"""The ``main()`` checks of notebooks 03 and 04: the file run as a program, then Ctrl+C.
+"""The ``main()`` checks of notebooks 03, 04 and 06: ``main()`` run as a program, then stopped.
 
-Part of :mod:`ros2nb.checks`.  The judge starts the learner's file as ``ros2 run`` would
-(a process of its own, sandboxed while grading), presses Ctrl+C once its node spins, and
-reads the exit code and the output; the learner's ``main()`` is read as text (``ast``).
+Part of :mod:`ros2nb.checks`.  The judge starts the learner's ``main()`` as ``ros2 run``
+would (:mod:`ros2nb.subject.program`, a process of its own, sandboxed while grading), presses
+Ctrl+C once its node spins (it answers the judge's own call), and reads the exit code and
+the output; then again with a shutdown from outside (SIGTERM).  When the node class is at fault, the course's stand-in node takes its place
+and ``main()`` runs again, so that ``main()`` is graded on its own.  The learner's
+``main()`` read as text only picks the advice of a failure the judge has seen.
 """
 
 from __future__ import annotations
 
 import ast
 import re
+import signal
 import subprocess
 import sys
 from pathlib import Path
-from typing import Optional
+from typing import Any, Optional
 
 from ..errors import CheckFailed
 from ..processes import interrupt, kill_process_group
 from .base import ARRIVAL_TIMEOUT_S, Judge
+from .source import TEXT
 
 #: Seconds a node process gets to exit after Ctrl+C (which comes once its node spins).
 EXIT_AFTER_CTRL_C_S = 20.0
+#: How a running node is stopped, in turn: Ctrl+C in its terminal, and a shutdown from
+#: outside (SIGTERM, as ``ros2 launch`` after its grace period, systemd or docker stop send).
+#: On Jazzy the first ends the spin with KeyboardInterrupt, the second with
+#: ExternalShutdownException, every time.
+STOPPING_SIGNALS = {signal.SIGINT: 'Ctrl+C',
+                    signal.SIGTERM: 'a shutdown from outside (SIGTERM)'}
+STOP_EXCEPTIONS = {signal.SIGINT: 'KeyboardInterrupt',
+                   signal.SIGTERM: 'ExternalShutdownException'}
 #: On Jazzy Ctrl+C shuts rclpy down itself; then, depending on where the signal lands, the spin
 #: ends with ExternalShutdownException or a later rclpy.shutdown() fails. One race, one cause:
 #: the learner is told the cause, in the same words whichever way the race went.
@@ -30,48 +43,41 @@ def _function(tree: ast.Module, name: str) -> Optional[ast.FunctionDef]:
     return next((s for s in tree.body if isinstance(s, ast.FunctionDef) and s.name == name), None)
 
 
-def _calls(nodes: list[ast.stmt]) -> set[str]:
-    names = set()
-    for statement in nodes:
-        for node in ast.walk(statement):
-            if isinstance(node, ast.Call):
-                func = node.func
-                names.add(func.attr if isinstance(func, ast.Attribute) else
-                          func.id if isinstance(func, ast.Name) else '')
-    return names
-
-
-def _cleanup_verdict(main: ast.FunctionDef) -> None:
-    """main() must destroy its node and shut rclpy down, in a ``finally:`` block."""
-    in_finally = _calls([s for node in ast.walk(main) if isinstance(node, ast.Try)
-                         for s in node.finalbody])
-    anywhere = _calls(main.body)
-    if 'destroy_node' not in anywhere:
-        raise CheckFailed('main() never destroys its node: call node.destroy_node() when the '
-                          'spin ends (the tutorial\'s subscriber forgot it).')
-    if not anywhere & {'try_shutdown', 'shutdown'}:
-        raise CheckFailed('main() never shuts rclpy down: call rclpy.try_shutdown() when the '
-                          'spin ends.')
-    if 'destroy_node' not in in_finally or not in_finally & {'try_shutdown', 'shutdown'}:
-        raise CheckFailed('main() cleans up only when the spin ends normally: destroy the node '
-                          'and call rclpy.try_shutdown() in a finally: block.')
-
-
-def run_main(judge: Judge, relative: str, node_name: str, part: int = 5) -> str:
-    """Run the learner's file, press Ctrl+C once its node spins; the verdict, or the sentence."""
+def run_main(judge: Judge, relative: str, node_name: str, part: int = 5,
+             node_class: Optional[str] = None) -> str:
+    """Run the learner's ``main()``, press Ctrl+C once its node spins; the verdict, or the
+    sentence.  With ``node_class``, a failure is tried again with the course's stand-in for
+    that class: when ``main()`` then stops cleanly, the class was at fault, not ``main()``."""
     path = judge.workspace / relative
     if not path.is_file():
         raise CheckFailed(f'{path.name} does not exist yet: run the %%part cells that write it.')
-    try:
-        tree = ast.parse(path.read_text())
-    except SyntaxError as error:
-        raise CheckFailed(f'{path.name} line {error.lineno}: SyntaxError: {error.msg}.') from None
-    main = _function(tree, 'main')
-    if main is None:
-        raise CheckFailed(f'{path.name} has no main() function yet: write part {part}.')
-    observer = judge.observer
     judge.drop(('file', relative))  # the node runs alone, as in a terminal: one of its name
-    proc, output = judge.start([sys.executable, str(path)], cwd=judge.workspace)
+    for sig in STOPPING_SIGNALS:
+        try:
+            _stop_run(judge, path, node_name, part, sig)
+        except CheckFailed:
+            if node_class is None:
+                raise
+            _stop_run(judge, path, node_name, part, sig, stand_in=node_class)  # main() alone
+    return (f'main() starts {node_name}, spins it, and stops cleanly on Ctrl+C and on a '
+            'shutdown from outside (exit code 0, no traceback).')
+
+
+def _stop_run(judge: Judge, path: Path, node_name: str, part: int, sig: int,
+              stand_in: Optional[str] = None) -> None:
+    """One run of ``main()`` stopped with ``sig`` (its node class replaced by the stand-in
+    when given)."""
+    argv = [sys.executable, '-m', 'ros2nb.subject.program', str(path)]
+    proc, output = judge.start(argv + ([stand_in] if stand_in else []), cwd=judge.workspace)
+    try:
+        _watch_stop(judge.observer, path, node_name, part, proc, output, sig)
+    finally:
+        kill_process_group(proc)
+
+
+def _watch_stop(observer: Any, path: Path, node_name: str, part: int, proc: Any,
+                output: Any, sig: int) -> None:
+    """Raise for what the running ``main()`` did wrong, as the judge sees it from outside."""
     # Ctrl+C once the node spins (it answers a parameter call), as a learner presses it
     # once the node runs: earlier, a busy machine would decide what the learner is told.
     # The graph is read once for the verdict: the read that ended the wait, not a second one.
@@ -82,22 +88,21 @@ def run_main(judge: Judge, relative: str, node_name: str, part: int = 5) -> str:
     if proc.poll() is not None:
         raise _ended_early(path, part, output.text(), proc.returncode)
     if not started:  # the judge's own graph: no node of that name appeared while it ran
-        kill_process_group(proc)
         raise CheckFailed(f'{path.name} never started its node {node_name} (none appeared in the '
-                          f'grader\'s ROS graph within {ARRIVAL_TIMEOUT_S:g} s): main() should bring rclpy up, '
-                          'create the node and spin it until Ctrl+C.')
-    interrupt(proc)
+                          f'grader\'s ROS graph within {ARRIVAL_TIMEOUT_S:g} s): main() should '
+                          'bring rclpy up, create the node and spin it until Ctrl+C.')
+    interrupt(proc, sig)
+    pressed = STOPPING_SIGNALS[sig]
     try:
         code = proc.wait(EXIT_AFTER_CTRL_C_S)
     except subprocess.TimeoutExpired:
-        kill_process_group(proc)
-        raise CheckFailed(f'{path.name} did not stop within {EXIT_AFTER_CTRL_C_S:g} s of Ctrl+C: '
-                          'let KeyboardInterrupt end the spin.') from None
+        raise CheckFailed(f'{path.name} did not stop within {EXIT_AFTER_CTRL_C_S:g} s of '
+                          f'{pressed}: let {STOP_EXCEPTIONS[sig]} end the spin.') from None
     text = output.text()
     stuck = _last_frame(text, path)
     if not spinning and stuck is not None and stuck[1] != 'main':
         raise CheckFailed(f'{path.name} never reached its spin: line {stuck[0]} in {stuck[1]} '
-                          f'({stuck[2]}) was still running at Ctrl+C; no loop in a constructor or '
+                          f'({stuck[2]}) was still running at {pressed}; no loop in a constructor or '
                           'callback: repeat work with a timer (create_timer) and let main() spin.')
     if not spinning:  # the node was there but never answered: main() did not spin it
         raise CheckFailed(f'{path.name} created its node {node_name} but never spun it (it did '
@@ -105,17 +110,19 @@ def run_main(judge: Judge, relative: str, node_name: str, part: int = 5) -> str:
                           'until Ctrl+C.')
     if code != 0 or 'Traceback' in text:
         last = _error_line(text)
-        already = any(mark in last for mark in ALREADY_SHUT_DOWN_MARKS)
-        what = 'Ctrl+C had already shut rclpy down' if already else last
-        raise CheckFailed(f'{path.name} exited with code {code} after Ctrl+C ({what}): '
-                          f'{_ctrl_c_advice(main, already)}.')
-    _cleanup_verdict(main)
-    return (f'{path.name} stops cleanly on Ctrl+C (exit code 0, no traceback) and cleans up in '
-            'finally.')
+        # Ctrl+C shuts rclpy down before the spin ends (the race ALREADY_SHUT_DOWN_MARKS
+        # names); a shutdown from outside ends the spin with ExternalShutdownException itself.
+        already = any(mark in last for mark in ALREADY_SHUT_DOWN_MARKS) and (
+            sig == signal.SIGINT or 'rcl_shutdown already called' in last)
+        what = f'{pressed} had already shut rclpy down' if already else last
+        raise CheckFailed(f'{path.name} exited with code {code} after {pressed} ({what}): '
+                          f'{_ctrl_c_advice(path, already)}.')
 
 
 def _ended_early(path: Path, part: int, text: str, code: int) -> CheckFailed:
     """Why the learner's program ended before Ctrl+C, from its output, as the check's line."""
+    if 'has no main() function' in text:  # ros2nb.subject.program found none to call
+        return CheckFailed(f'{path.name} has no main() function yet: write part {part}.')
     if 'NotImplementedError' in text:
         return CheckFailed(f'main() still raises NotImplementedError: write part {part} where '
                            'it says YOUR CODE HERE.')
@@ -137,9 +144,15 @@ def _caught(main: ast.FunctionDef) -> set[str]:
     return names
 
 
-def _ctrl_c_advice(main: ast.FunctionDef, already_shut_down: bool) -> str:
-    """What to change in main(), from whether Ctrl+C had shut rclpy down and what it catches."""
-    caught = _caught(main)
+def _ctrl_c_advice(path: Path, already_shut_down: bool) -> str:
+    """What to change in main(), from whether Ctrl+C had shut rclpy down and what main()
+    catches (its text, read only to word the advice)."""
+    text = TEXT.read(path)
+    try:
+        main = _function(ast.parse(text), 'main') if text is not None else None
+    except (SyntaxError, ValueError):
+        main = None
+    caught = _caught(main) if main is not None else set()
     if already_shut_down and {'KeyboardInterrupt', 'ExternalShutdownException'} <= caught:
         return ('shut down with rclpy.try_shutdown() instead of rclpy.shutdown(): on Jazzy '
                 'Ctrl+C has already shut rclpy down')
@@ -164,7 +177,7 @@ def _last_frame(text: str, path) -> Optional[tuple[int, str, str]]:
     if not frames:
         return None
     number, function = int(frames[-1][0]), frames[-1][1]
-    lines = path.read_text().splitlines()
+    lines = (TEXT.read(path) or '').splitlines()
     return number, function, lines[number - 1].strip() if 0 < number <= len(lines) else ''
 
 

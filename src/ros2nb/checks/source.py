@@ -1,10 +1,10 @@
-"""The learner's node class read as text (``ast``) by the judge, never executed here.
+"""The learner's files read as text by the judge, only to word a failure it saw.
 
-Part of :mod:`ros2nb.checks`.  A subject runs the learner's code, so anything it reports
-about that code is the learner's to forge (their import can reach the subject's request
-loop and rewrite its replies).  What no message on the wire shows (which timers a node
-creates, with which period and callback; what its start value is set to; whether its
-callback publishes at all) the judge reads from the file itself, with :mod:`ast`.
+Part of :mod:`ros2nb.checks`.  No point depends on anything here: every check decides from
+what the judge observes (messages, /rosout, the graph, exit codes, files after the subject
+ended).  Once a check has failed, the text may choose the line that explains it (no timer,
+a lambda, a misspelt name).  Every read of a learner's file goes through :data:`TEXT`, so a
+test can replace it with a reader that knows nothing and show the scores unchanged.
 """
 
 from __future__ import annotations
@@ -22,6 +22,21 @@ UNKNOWN: Any = object()
 LIST_GROWERS = frozenset({'append', 'extend', 'insert'})
 #: How many names deep :meth:`ClassSource.value` follows ``A = B`` (a guard against loops).
 MAX_DEPTH = 8
+
+
+class TextReader:
+    """Reads a learner's file as text (one place, so that a test can make it know nothing)."""
+
+    def read(self, path: Path) -> Optional[str]:
+        """The file's text (undecodable bytes replaced), or None when it cannot be read."""
+        try:
+            return path.read_text(errors='replace')
+        except OSError:
+            return None
+
+
+#: The one reader of the learner's text.
+TEXT = TextReader()
 _OPERATORS = {ast.Add: lambda a, b: a + b, ast.Sub: lambda a, b: a - b,
               ast.Mult: lambda a, b: a * b, ast.Div: lambda a, b: a / b}
 
@@ -68,9 +83,10 @@ def read_module(workspace: Path, relative: str) -> Optional[ast.Module]:
         raise CheckFailed(f'{relative} is a link to {target}, outside your '
                           'workspace: the grader reads your files in the workspace only; '
                           'put the file itself there.')
+    text = TEXT.read(path)
     try:
-        return ast.parse(path.read_text())
-    except (OSError, SyntaxError, ValueError, UnicodeDecodeError):
+        return ast.parse(text) if text is not None else None
+    except (SyntaxError, ValueError):
         return None
 
 

@@ -15,6 +15,7 @@ import os
 import re
 import site
 import sysconfig
+import traceback
 from pathlib import Path
 from types import TracebackType
 from typing import Any, Optional
@@ -70,6 +71,17 @@ def learner_line(exc: BaseException) -> str:
 
 _SIGNATURE = re.compile(r'^(?P<name>[\w.]+)\(\) (?:takes (?P<takes>\d+) positional arguments? '
                         r'but (?P<given>\d+) (?:was|were) given|missing \d+ required positional)')
+
+
+def learner_traceback(exc: BaseException) -> list[str]:
+    """The traceback of ``exc`` through the learner's own frames only (a cell, their file),
+    as Python prints it: empty when none of its frames is theirs."""
+    frames = [f for f in traceback.extract_tb(exc.__traceback__)
+              if not is_library_file(f.filename) and not f.filename.startswith('<ros2nb')]
+    lines = ['Traceback (most recent call last):'] if frames else []
+    for text in traceback.format_list(frames):
+        lines.extend(text.rstrip('\n').splitlines())
+    return lines
 
 
 def _called_code(exc: BaseException) -> Any:

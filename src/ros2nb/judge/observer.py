@@ -1,23 +1,26 @@
-"""The judge's own ROS node: it sees the graph, hears the readings and the logs, asks nodes.
+"""The judge's own ROS node: it sees the graph, hears messages and logs, asks nodes.
 
 Part of the judge (:mod:`ros2nb.judge`): every verdict comes from what this node observes
-itself over ROS, on the judge's own domain; a subject's word only says how long to wait.
+itself over ROS, on the judge's own domain, stamped with the judge's own clock
+(:attr:`Observer.now_ns`, moved on only by :class:`ros2nb.judge.clock.JudgeClock`); a
+subject's word only says how long to wait.
 """
 
 from __future__ import annotations
 
+import collections
 import contextlib
 import threading
 import time
+from dataclasses import dataclass
 from typing import Any, Callable
 
 import rclpy
 from rcl_interfaces.msg import Log
 from rcl_interfaces.srv import ListParameters
 from rclpy.executors import SingleThreadedExecutor
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
-from std_msgs.msg import Float32
 
 from .. import domains
 from ..checks.base import ARRIVAL_TIMEOUT_S
@@ -33,10 +36,44 @@ SPIN_WAIT_S = 0.5
 #: Bytes of an endpoint's gid that name its participant (the DDS GUID prefix): one per
 #: process that brought ROS up.
 PARTICIPANT_PREFIX_BYTES = 12
+#: What the judge's subscriptions keep: every message, reliably (a check counts them all).
+EVERY_MESSAGE = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE)
+#: /rosout as ``ros2 topic echo /rosout`` hears it: reliable, and what live nodes logged
+#: shortly before the judge matched them (rcl keeps each node's last lines).
+ROSOUT_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE,
+                        durability=DurabilityPolicy.TRANSIENT_LOCAL)
+
+
+@dataclass(frozen=True)
+class Heard:
+    """A message the judge's node received.
+
+    :ivar t_ns: the judge's clock when it arrived (ns of simulated time).
+    :ivar value: what the check keeps of it (e.g. a Float32's ``data``).
+    """
+
+    t_ns: int
+    value: Any
+
+
+@dataclass(frozen=True)
+class Line:
+    """A /rosout line the judge's node received.
+
+    :ivar t_ns: the judge's clock when it arrived (ns of simulated time).
+    :ivar name: the logger's name (a node's name).
+    :ivar level: 10 debug, 20 info, 30 warn, 40 error, 50 fatal.
+    :ivar text: the message.
+    """
+
+    t_ns: int
+    name: str
+    level: int
+    text: str
 
 
 class Observer:
-    """The judge's own ROS node on the judge's domain: graph, readings, logs, probes."""
+    """The judge's own ROS node on the judge's domain: graph, messages, logs, probes."""
 
     def __init__(self) -> None:
         self.domain_id = domains.domain_id()
@@ -47,14 +84,19 @@ class Observer:
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
         self.changed = threading.Condition()
-        self.readings: list[float] = []
-        self.logs: list[tuple[str, int, str]] = []
-        self._watching: set[str] = set()
-        self.messages: dict[str, list] = {}
+        #: The judge's clock now (ns); what arrives is stamped with it.
+        self.now_ns = 0
+        #: Every /rosout line heard, in order of arrival.
+        self.logs: list[Line] = []
+        #: /rosout lines heard per logger.
+        self.log_counts: collections.Counter[str] = collections.Counter()
+        #: Messages heard per watched topic, in order of arrival.
+        self.heard: dict[str, list[Heard]] = {}
+        self._quiet: Any = None
         self._stop = False
         self._thread = threading.Thread(target=self._spin, name='ros2nb-judge', daemon=True)
         self._thread.start()
-        self.watch_logs()
+        self.node.create_subscription(Log, '/rosout', self._on_log, ROSOUT_QOS)
 
     def _spin(self) -> None:
         """Run the node's callbacks until :meth:`close` (which wakes the wait at once)."""
@@ -67,51 +109,41 @@ class Observer:
     def _stopping(self) -> bool:
         return self._stop
 
-    def _note(self, store: list, item: Any) -> None:
+    def _on_log(self, msg: Log) -> None:
         with self.changed:
-            store.append(item)
+            self.logs.append(Line(self.now_ns, msg.name, msg.level, msg.msg))
+            self.log_counts[msg.name] += 1
             self.changed.notify_all()
 
-    def watch_logs(self) -> None:
-        """Collect every /rosout line (as ``ros2 topic echo /rosout`` would see it)."""
-        qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE,
-                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
-        self.node.create_subscription(Log, '/rosout',
-                                      lambda m: self._note(self.logs, (m.name, m.level, m.msg)),
-                                      qos)
+    def watch(self, topic: str, msg_type: Any,
+              keep: Callable[[Any], Any] = lambda msg: msg.data) -> list[Heard]:
+        """Hear every ``msg_type`` message on ``topic`` from now on; return the list they go to.
 
-    def listen_logs(self) -> tuple[list[tuple[str, str]], Callable[[], None]]:
-        """A /rosout subscription of its own from now on: its ``(node, text)`` lines, and a
-        function that ends it.  Transient local, so it also gets what live nodes logged
-        shortly before (rcl keeps /rosout lines 10 s), but nothing of nodes already gone.
+        Reliable, keeping every message; each is kept as ``keep(msg)`` with the judge's time
+        of arrival.  Watching a topic twice returns the same list (the first ``keep`` stays).
         """
-        lines: list[tuple[str, str]] = []
-        qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE,
-                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
-        subscription = self.node.create_subscription(
-            Log, '/rosout', lambda m: self._note(lines, (m.name, m.msg)), qos)
-        return lines, lambda: self.node.destroy_subscription(subscription)
+        if topic not in self.heard:
+            self.heard[topic] = store = []
 
-    def watch_readings(self, topic: str) -> None:
-        """Collect every Float32 on ``topic``, reliably (a long queue, nothing dropped)."""
-        if topic in self._watching:
-            return
-        self._watching.add(topic)
-        self.node.create_subscription(
-            Float32, topic, lambda m: self._note(self.readings, float(m.data)),
-            QoSProfile(depth=10000, reliability=ReliabilityPolicy.RELIABLE))
+            def note(msg: Any) -> None:
+                with self.changed:
+                    store.append(Heard(self.now_ns, keep(msg)))
+                    self.changed.notify_all()
 
-    def watch_messages(self, topic: str, msg_type: Any) -> list:
-        """Collect the ``data`` of every ``msg_type`` message on ``topic``; return the list.
+            self.node.create_subscription(msg_type, topic, note, EVERY_MESSAGE)
+        return self.heard[topic]
 
-        Reliable, with a long queue; watching a topic twice returns the same list.
-        """
-        if topic not in self.messages:
-            self.messages[topic] = store = []
-            self.node.create_subscription(
-                msg_type, topic, lambda m: self._note(store, m.data),
-                QoSProfile(depth=10000, reliability=ReliabilityPolicy.RELIABLE))
-        return self.messages[topic]
+    def quiet_node(self) -> Any:
+        """A node of the judge's that no thread spins: what its subscriptions receive waits in
+        their history until the judge takes it (nothing taken before it asks)."""
+        if self._quiet is None:
+            self._quiet = node_serving_nothing('_ros2nb_judge_taker', context=self.context)
+        return self._quiet
+
+    def counts(self) -> tuple[dict[str, int], dict[str, int]]:
+        """Messages heard so far per watched topic, and /rosout lines per logger."""
+        with self.changed:
+            return ({t: len(v) for t, v in self.heard.items()}, dict(self.log_counts))
 
     def wait_until(self, condition: Callable[[], bool], seconds: float) -> bool:
         """Wait until ``condition()`` holds (checked whenever something arrives)."""
@@ -127,7 +159,7 @@ class Observer:
     def lines_of(self, logger: str, start: int = 0) -> list[str]:
         """Log lines of one logger received so far, from position ``start`` on."""
         with self.changed:
-            return [text for name, _level, text in self.logs[start:] if name == logger]
+            return [line.text for line in self.logs[start:] if line.name == logger]
 
     def endpoints(self, name: str, namespace: str, expected: list[list[str]],
                   seconds: float = ARRIVAL_TIMEOUT_S) -> list[tuple[str, str, str]]:
@@ -244,5 +276,7 @@ class Observer:
         self.executor.wake()
         self._thread.join()
         self.executor.shutdown()
+        if self._quiet is not None:
+            self._quiet.destroy_node()
         self.node.destroy_node()
         rclpy.try_shutdown(context=self.context)

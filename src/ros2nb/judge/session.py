@@ -15,17 +15,20 @@ import stat
 import subprocess
 import sys
 import tempfile
+from importlib import resources
 from pathlib import Path
 from typing import Any, Callable, Iterator, Optional
 
 from rclpy.qos import QoSProfile, ReliabilityPolicy
-from std_msgs.msg import Float32
+from std_msgs.msg import Bool, Float32
 
 from .. import course
 from ..checks.base import AnswerRef, learner_error
 from ..checks.nodes import parts_verdict
 from ..errors import CheckFailed
 from ..processes import kill_process_group
+from ..terminal.workspace import WORKSPACE_ENV
+from .clock import JudgeClock
 from .observer import Observer
 from .subjects import (Output, SubjectHung, SubjectProcess, home_and_tmp, subject_env,
                        subject_prefix, subjects_folder)
@@ -37,6 +40,9 @@ SET_ENV_AND_EXEC = ('import json, os, sys; env = json.loads(sys.argv[1]); '
                     'os.execvpe(sys.argv[2], sys.argv[2:], env)')
 
 
+#: The course's reference node files (the judge's to read; a subject sees only the copies
+#: :meth:`Session.caught_up` hands it).
+reference_files = resources.files('ros2nb.reference')
 #: Most bytes :meth:`Session.taken_back` copies out of one folder (an hour's bag is < 1 MiB).
 MAX_TAKEN_BACK_BYTES = 64 << 20
 
@@ -53,6 +59,7 @@ class Session:
         # this descriptor, never through a path a subject may have changed since.
         self._scratch_fd = os.open(self.scratch, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW)
         self._observer: Optional[Observer] = None
+        self._clock: Optional[JudgeClock] = None
         self._subjects: dict[tuple, SubjectProcess] = {}
         self._probe: Any = None
         self.builds: dict[str, Any] = {}
@@ -61,7 +68,19 @@ class Session:
     def observer(self) -> Observer:
         if self._observer is None:
             self._observer = Observer()
+            # The course's topics are heard from the start, before any subject: what a
+            # subject announces it published there is waited for before each step of the
+            # clock (JudgeClock.drive), so every message is stamped with the step it came in.
+            self._observer.watch('/' + course.TOPIC, Float32, lambda m: float(m.data))
+            self._observer.watch('/' + course.FAN_TOPIC, Bool, lambda m: bool(m.data))
         return self._observer
+
+    @property
+    def clock(self) -> JudgeClock:
+        """The judge's clock: the only simulated time the learner's nodes run on."""
+        if self._clock is None:
+            self._clock = JudgeClock(self.observer)
+        return self._clock
 
     @property
     def probe_publisher(self) -> Any:
@@ -72,11 +91,17 @@ class Session:
                 QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE))
         return self._probe
 
-    def subject(self, key: tuple, load: Callable[[SubjectProcess], None]) -> SubjectProcess:
-        """A subject for ``key``, started and loaded once per session."""
+    def subject(self, key: tuple, load: Callable[[SubjectProcess], None],
+                workspace: Optional[Path] = None) -> SubjectProcess:
+        """A subject for ``key``, started and loaded once per session (in ``workspace``, by
+        default the learner's)."""
         subject = self._subjects.get(key)
         if subject is None or subject.proc.poll() is not None:
-            subject = SubjectProcess(self.workspace)
+            _ = self.clock  # published before any subject runs: it starts on the judge's time
+            where = workspace or self.workspace
+            heard = self.observer.counts()
+            subject = SubjectProcess(where, env=subject_env({WORKSPACE_ENV: str(where)}))
+            subject.heard_base = heard
             self._subjects[key] = subject
             try:
                 load(subject)
@@ -114,12 +139,34 @@ class Session:
 
         return self.subject(('file', relative), load)
 
-    def answer_subject(self, ref: AnswerRef) -> SubjectProcess:
-        """A subject with the course's context cells and the learner's answer cells run."""
+    def answer_subject(self, ref: AnswerRef, workspace: Optional[Path] = None) -> SubjectProcess:
+        """A subject with the course's context cells and the learner's answer cells run (in
+        ``workspace``, by default the learner's)."""
         def load(subject: SubjectProcess) -> None:
             subject.request('exec_cells', sources=list(ref.sources))
 
-        return self.subject(('cells', ref.sources), load)
+        return self.subject(('cells', ref.sources, str(workspace)), load, workspace)
+
+    def caught_up(self, steps: tuple[str, ...]) -> Path:
+        """The workspace a notebook's answers run in: the learner's, or, when a node file the
+        notebook relies on (``steps``, as :data:`ros2nb.course.STEPS` names them) is missing
+        because the notebook was handed in alone, a copy with the course's reference node in
+        its place: what ``catch_up`` promises a notebook run on its own.  The learner's own
+        files are kept; a link is never followed (the reference stands in for it).
+        """
+        files = {step: relative for step, relative in (('publisher', course.PUBLISHER_FILE),
+                                                     ('subscriber', course.SUBSCRIBER_FILE))
+                 if step in steps}
+        own = {relative: self.workspace / relative for relative in files.values()}
+        if all(path.is_file() and not path.is_symlink() for path in own.values()):
+            return self.workspace
+        given = {}
+        for relative, path in own.items():
+            if path.is_file() and not path.is_symlink():
+                given[relative] = path.read_bytes()
+            else:
+                given[relative] = reference_files.joinpath(Path(relative).name).read_bytes()
+        return self.hand_over('caught-up-', given)
 
     def start(self, argv: list[str], *, cwd: Path,
               env: Optional[dict[str, str]] = None) -> tuple[subprocess.Popen, Output]:

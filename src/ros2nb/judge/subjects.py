@@ -23,6 +23,7 @@ from .. import domains
 from ..checks.dispatch import IN_JUDGE_ENV
 from ..errors import CheckFailed
 from ..processes import Patience, kill_process_group, stop_process_group
+from ..runtime.clock import JUDGE_CLOCK_ENV
 
 #: JSON list put in front of every subject's command (the grader's sandbox).
 SUBJECT_PREFIX_ENV = 'ROS2NB_SUBJECT_PREFIX'
@@ -100,26 +101,106 @@ class Output:
         return '\n'.join(self.lines)
 
 
+def _well_formed_ack(line: bytes) -> Optional[dict]:
+    """An acknowledgement as :class:`~ros2nb.runtime.clock.JudgeTime` writes it, or None."""
+    try:
+        ack = json.loads(line)
+    except ValueError:
+        return None
+    if not (isinstance(ack, dict) and isinstance(ack.get('t'), int)
+            and (ack.get('wants') is None or isinstance(ack.get('wants'), int))):
+        return None
+    for key in ('published', 'logged'):
+        counts = ack.get(key)
+        if not (isinstance(counts, dict) and all(
+                isinstance(k, str) and isinstance(v, int) for k, v in counts.items())):
+            return None
+    failure = ack.get('failure')
+    if failure is not None and not (
+            isinstance(failure, dict)
+            and all(isinstance(failure.get(k), str) for k in ('callback', 'error', 'where', 'kind'))
+            and isinstance(failure.get('traceback'), list)
+            and all(isinstance(line, str) for line in failure['traceback'])):
+        return None
+    return ack
+
+
 class SubjectHung(CheckFailed):
     """The learner's code did not answer in time."""
 
 
 class SubjectProcess:
-    """A running ``ros2nb.subject``: one JSON command, one JSON reply."""
+    """A running ``ros2nb.subject``: one JSON command, one JSON reply; and, while its nodes
+    run on the judge's clock, one acknowledgement per step (:mod:`ros2nb.judge.clock`)."""
 
-    def __init__(self, workspace: Path) -> None:
+    def __init__(self, workspace: Path, env: Optional[dict[str, str]] = None) -> None:
         to_subject, self._commands = os.pipe()
         self._replies, from_subject = os.pipe()
+        self._acks, acks_from_subject = os.pipe()
+        os.set_blocking(self._acks, False)
         argv = [*subject_prefix(), sys.executable, '-m', 'ros2nb.subject',
                 str(to_subject), str(from_subject)]
-        self.proc = subprocess.Popen(argv, cwd=workspace, env=subject_env(), text=True,
+        environment = {**(env or subject_env()), JUDGE_CLOCK_ENV: str(acks_from_subject)}
+        self.proc = subprocess.Popen(argv, cwd=workspace, env=environment, text=True,
                                      stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                                      stderr=subprocess.STDOUT, start_new_session=True,
-                                     pass_fds=(to_subject, from_subject))
-        os.close(to_subject)
-        os.close(from_subject)
+                                     pass_fds=(to_subject, from_subject, acks_from_subject))
+        for fd in (to_subject, from_subject, acks_from_subject):
+            os.close(fd)
         self.output = Output(self.proc.stdout)
         self._buffer = b''
+        self._ack_buffer = b''
+        #: The newest well-formed acknowledgement of a step (None before the first).
+        self.last_ack: Optional[dict] = None
+        #: What the judge had heard when this process started: messages per watched topic,
+        #: /rosout lines per logger (set by the session that starts it).
+        self.heard_base: tuple[dict[str, int], dict[str, int]] = ({}, {})
+
+    def send(self, op: str, **arguments: Any) -> None:
+        """Send one command (its reply comes later: :meth:`receive`, :meth:`poll_reply`)."""
+        try:
+            os.write(self._commands, (json.dumps({'op': op, **arguments}) + '\n').encode())
+        except BrokenPipeError:
+            raise self._died() from None
+
+    def poll_reply(self, seconds: float) -> Optional[dict]:
+        """The reply, if it has come within ``seconds``; else None.
+
+        :raises CheckFailed: when the process ended (its last output line says why).
+        """
+        if b'\n' not in self._buffer:
+            ready, _, _ = select.select([self._replies, self._acks], [], [], seconds)
+            if self._replies in ready:
+                chunk = os.read(self._replies, 65536)
+                if not chunk:
+                    raise self._died()
+                self._buffer += chunk
+        if b'\n' not in self._buffer:
+            return None
+        line, self._buffer = self._buffer.split(b'\n', 1)
+        return json.loads(line)
+
+    def take_ack(self) -> Optional[dict]:
+        """The newest acknowledgement that came since the last call (None if none came).
+
+        Lines that are not well formed are skipped: the process runs learner code, which may
+        write anything there; what it says only tells the judge when to step and what to
+        wait for.
+        """
+        try:
+            while chunk := os.read(self._acks, 65536):
+                self._ack_buffer += chunk
+        except BlockingIOError:
+            pass
+        newest = None
+        *lines, self._ack_buffer = self._ack_buffer.split(b'\n')
+        for line in lines:
+            ack = _well_formed_ack(line)
+            if ack is not None:
+                newest = ack
+        if newest is not None:
+            self.last_ack = newest
+        return newest
 
     def request(self, op: str, *, timeout: float = REPLY_TIMEOUT_S, **arguments: Any) -> dict:
         """Send one command and return its reply.
@@ -130,22 +211,16 @@ class SubjectProcess:
         :raises SubjectHung: when no reply comes within ``timeout`` seconds, or the
             process died (its last output line is in the message).
         """
-        try:
-            os.write(self._commands, (json.dumps({'op': op, **arguments}) + '\n').encode())
-        except BrokenPipeError:
-            raise self._died() from None
+        self.send(op, **arguments)
         sent, patience = time.monotonic(), None
-        while b'\n' not in self._buffer:
-            ready, _, _ = select.select([self._replies], [], [], POLL_S)
-            if ready:
-                chunk = os.read(self._replies, 65536)
-                if not chunk:
-                    raise self._died()
-                self._buffer += chunk
-                continue
+        while True:
+            reply = self.poll_reply(POLL_S)
+            self.take_ack()
+            if reply is not None:
+                return reply
             # No reply within POLL_S: from now on the subject's CPU time counts.  (Most
             # replies come sooner, and reading /proc for each cost the judge more than the
-            # reply: an hour of a sensor asks 720 times.)
+            # reply.)
             if patience is None:
                 patience = Patience(self.proc.pid, timeout, started=sent)
             elif patience.exhausted():
@@ -153,8 +228,6 @@ class SubjectProcess:
                 raise SubjectHung(f'Your code did not finish within {timeout:g} s (an endless '
                                   'loop, or a call that waits for ever?): look for a loop that '
                                   'never ends in the part you wrote.')
-        line, self._buffer = self._buffer.split(b'\n', 1)
-        return json.loads(line)
 
     def _died(self) -> CheckFailed:
         code = self.proc.wait(5)
@@ -173,5 +246,6 @@ class SubjectProcess:
         except subprocess.TimeoutExpired:
             pass
         stop_process_group(self.proc)
-        with contextlib.suppress(OSError):
-            os.close(self._replies)
+        for fd in (self._replies, self._acks):
+            with contextlib.suppress(OSError):
+                os.close(fd)

@@ -23,6 +23,9 @@ class PlotFeeder(Node):
     def redraw(self):
         """Give the line every point so far and ask for a redraw; never waits for it."""
         self.redraws += 1
+        if self.times_s and self.temps_c:
+            self.get_logger().info(f'Plotted {self.temps_c[-1]:.2f} °C at '
+                                   f'{self.times_s[-1]:.3f} s, point {len(self.temps_c)}')
         if self.line is None:
             return
         start_s = self.times_s[0] if self.times_s else 0.0

@@ -26,7 +26,9 @@ class CountingMonitor(Node):
             Float32, TOPIC, self.count, QUEUE_DEPTH)
 
     def count(self, msg):
+        # add one to self.received, then log the new count
         self.received += 1
+        self.get_logger().info(f'received {self.received}')
 
 
 class Worker(Node):
@@ -40,10 +42,12 @@ class Worker(Node):
                                                  callback_group=heartbeat_group)
 
     def slow_work(self):
+        self.get_logger().info('slow work: start')
         time.sleep(SLOW_WORK_S)   # stands for a long computation
+        self.get_logger().info('slow work: done')
 
     def heartbeat(self):
-        pass                      # stands for a quick, regular job
+        self.get_logger().info('heartbeat')   # stands for a quick, regular job
 
 
 def responsive_worker():

@@ -94,6 +94,7 @@ class Runtime(LogLines, Spinning, NodeKeeping, SimulatedClock):
         self.node.create_subscription(Log, '/rosout', self._on_log, rosout_qos,
                                       event_callbacks=QUIET_SUBSCRIPTION)
         self.executor.add_node(self.node)
+        self.follow_judge_clock()  # in a judge's subject only: the judge's time from now on
         self.start_spinning()
 
     @property

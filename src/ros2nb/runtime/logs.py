@@ -29,12 +29,18 @@ class CallbackFailure:
     :ivar callback: qualified name of the callback, e.g. ``TemperatureMonitor.temperature_callback``.
     :ivar error: ``ExceptionType: message``, or ros2nb's one-line explanation of it.
     :ivar where: the learner's own line, ``FILE line N: source``; empty when none was found.
+    :ivar kind: the exception's type name, e.g. ``NameError``.
+    :ivar explained: True when ``error`` is ros2nb's explanation (else Python's own words).
+    :ivar traceback: the traceback through the learner's own frames (lines).
     """
 
     node: str
     callback: str
     error: str
     where: str
+    kind: str = ''
+    explained: bool = False
+    traceback: tuple[str, ...] = ()
 
     def __str__(self) -> str:
         text = (f'[ERROR] [{self.node.lstrip("/")}]: callback {self.callback} raised '
@@ -59,6 +65,8 @@ class LogLines:
         # (epoch, wall-clock ns): lines of that cell stamped before then are not shown
         self._muted: tuple[int, int] = (-1, 0)
         self._lock = threading.Lock()
+        #: Every callback that raised, in order (a judge's subject tells the judge the first).
+        self.failures: list[CallbackFailure] = []
 
     def own_logger(self, name: str) -> None:
         """Show the lines of logger ``name`` (a node handed over) and of its children."""
@@ -109,6 +117,7 @@ class LogLines:
 
     def _report_failure(self, failure: CallbackFailure) -> None:
         """Queue a callback that raised, to be shown with the lines of its cell."""
+        self.failures.append(failure)
         with self._lock:
             self._log_lines.append((self._epoch, CallbackFailure, 0, failure, time.time_ns()))
 

@@ -19,7 +19,7 @@ from rclpy.executors import (ConditionReachedException, ExternalShutdownExceptio
 from rclpy.node import Node
 
 from ..errors import Ros2nbError
-from ..explain.exceptions import explain_exception, learner_line
+from ..explain.exceptions import explain_exception, learner_line, learner_traceback
 from . import current
 from .logs import CallbackFailure
 from .stop_button import StopButton
@@ -113,7 +113,8 @@ class Spinning:
         self._report_failure(CallbackFailure(
             node=node.get_fully_qualified_name(), callback=label,
             error=explained or f'{type(error).__name__}: {error}',
-            where=learner_line(error)))
+            where=learner_line(error), kind=type(error).__name__, explained=bool(explained),
+            traceback=tuple(learner_traceback(error))))
         if self.on_failure is not None:
             self.on_failure(node.get_fully_qualified_name(), label, error)
         if node is not self.node:

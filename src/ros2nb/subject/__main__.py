@@ -1,25 +1,39 @@
 """``python -m ros2nb.subject IN_FD OUT_FD``: the process that runs the learner's code for a judge.
 
-Started by the judge (:mod:`ros2nb.judge.subjects`), sandboxed while grading.
+Started by the judge (:mod:`ros2nb.judge.subjects`), sandboxed while grading.  The first
+command loads the learner's code (:func:`ros2nb.subject.process.load`) before the command
+loop exists; the loop answers the rest.
 """
 
 from __future__ import annotations
 
+import json
 import os
 import sys
 
 from ..processes import end_this_process
-from .process import PROTOCOL_ERROR, serve
+from ..runtime.clock import JudgeTime
+from .process import LOADERS, PROTOCOL_ERROR, load, serve
 
 
 def main(argv: list[str]) -> int:
     """Entry point: ``python -m ros2nb.subject IN_FD OUT_FD``."""
+    JudgeTime.claim()  # the judge's pipe: this process's alone, never a child's
     if len(argv) != 2:
         print('Usage: python -m ros2nb.subject IN_FD OUT_FD (started by ros2nb.judge).',
               file=sys.stderr)
         return PROTOCOL_ERROR
     with os.fdopen(int(argv[0]), 'r') as commands, os.fdopen(int(argv[1]), 'w') as replies:
-        serve(commands, replies)
+        first = commands.readline()
+        if not first:
+            return 0
+        request = json.loads(first)
+        if request.get('op') not in LOADERS:
+            return PROTOCOL_ERROR
+        namespace, reply = load(request)
+        replies.write(json.dumps(reply) + '\n')
+        replies.flush()
+        serve(commands, replies, namespace)
     return 0
 
 

@@ -33,7 +33,8 @@ from pathlib import Path
 from typing import Any, Optional, Sequence
 
 import yaml
-from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.duration import Duration
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 if sys.version_info >= (3, 11):  # rosbags' apsw has no wheel for 3.10
     from rosbags import rosbag2, typesys
@@ -51,7 +52,13 @@ STORAGE_ID = 'mcap'
 #: rosbag2's metadata version written (Jazzy's rosbag2 writes and reads 9).
 METADATA_VERSION = 9
 #: What replay and recording keep: every message (a burst never overflows a queue).
+#: Wall-clock seconds a player waits for its subscriptions to match, or for their acks.
+MATCH_WAIT_S = 2.0
 KEEP_ALL = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE)
+#: /rosout is played as its nodes offer it (transient local, as ``ros2 bag play`` replays
+#: each topic with its recorded profile): whoever listens to /rosout hears the old lines.
+LATCHED = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE,
+                     durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
 
 def needs_python() -> None:
@@ -259,7 +266,8 @@ def bag_play(name: Any, *, rate: float = 1.0, topics: Optional[Sequence[str]] = 
     Before each message the kernel's simulated clock moves on by the gap recorded in the
     bag (``/clock`` is published, the nodes' timers fire); then the message is published
     (KEEP_ALL, reliable) and the kernel's nodes run until idle, so every one arrives.  At
-    most ``rate`` simulated seconds pass per wall-clock second.
+    most ``rate`` simulated seconds pass per wall-clock second.  (Run by a check's judge,
+    the clock is the judge's, and it sets the pace.)
 
     Introduced in ``10-record-and-replay.ipynb``.
 
@@ -284,6 +292,18 @@ def bag_play(name: Any, *, rate: float = 1.0, topics: Optional[Sequence[str]] = 
         return _play(rt, reader, path, rate, topics, show_logs)
 
 
+def _wait_matched(node: Any, publishers: Any) -> None:
+    """Wait (at most :data:`MATCH_WAIT_S` of the wall clock) until each new publisher has
+    matched every subscription the graph shows on its topic, so that the bag's first
+    messages reach the monitor started for them (a subscription whose QoS never matches
+    costs that wait once)."""
+    deadline = time.monotonic() + MATCH_WAIT_S
+    for publisher in publishers:
+        while time.monotonic() < deadline and \
+                publisher.get_subscription_count() < node.count_subscribers(publisher.topic_name):
+            time.sleep(0.005)
+
+
 def _play(rt: Any, reader: Any, path: Path, rate: float, topics: Optional[Sequence[str]],
           show_logs: bool) -> dict[str, int]:
     held = {c.topic: c for c in reader.connections}
@@ -293,8 +313,10 @@ def _play(rt: Any, reader: Any, path: Path, rate: float, topics: Optional[Sequen
             raise UsageError(f'{path.name} holds no {topic}; it holds {", ".join(held)}.')
     counts = dict.fromkeys(wanted, 0)
     with rt.exclusive():
-        publishers = {t: rt.node.create_publisher(message_type(held[t].msgtype), t, KEEP_ALL)
+        publishers = {t: rt.node.create_publisher(message_type(held[t].msgtype), t,
+                                                  LATCHED if t == '/rosout' else KEEP_ALL)
                       for t in wanted}
+    _wait_matched(rt.node, publishers.values())
     wall0, sim0, first = time.monotonic(), rt.sim_now_ns, None
     try:
         with rt.clock(True):
@@ -304,13 +326,15 @@ def _play(rt: Any, reader: Any, path: Path, rate: float, topics: Optional[Sequen
                 if gap_ns > 0:
                     rt.advance_sim_time(gap_ns / 1e9)
                 ahead = (stamp - first) / 1e9 / rate - (time.monotonic() - wall0)
-                if ahead > 0:
+                if ahead > 0 and rt.judge_time is None:  # a judge's clock keeps its own pace
                     time.sleep(ahead)
                 with rt.exclusive():
                     publishers[connection.topic].publish(data)
                     rt.drain()
                 counts[connection.topic] += 1
     finally:
+        for publisher in publishers.values():  # the last messages reach every subscription
+            publisher.wait_for_all_acked(Duration(seconds=MATCH_WAIT_S))
         with rt.exclusive():
             for publisher in publishers.values():
                 rt.node.destroy_publisher(publisher)

@@ -57,9 +57,11 @@ def judge_notebook(scratch: Scratch, notebook: str, submitted: nbformat.Notebook
         env['ROS2NB_SUBJECT_PREFIX'] = json.dumps(sandbox.inner_prefix(  # the course may be
             readable=[workspace, ROOT / 'src'], writable=[subjects],  # under /tmp too
             hidden=[ROOT / 'src' / 'ros2nb' / 'reference', own, given]))
+        # The judge may read the course's reference nodes (a notebook handed in alone runs
+        # on them where it relies on an earlier one's, as catch_up promises); its subjects
+        # see only the copies it hands them.
         box = sandbox.Sandbox(writable=[folder], env=env, cwd=given, nested=True,
-                              readable=[ROOT / 'src', workspace, given],
-                              hidden=[ROOT / 'src' / 'ros2nb' / 'reference'])
+                              readable=[ROOT / 'src', workspace, given])
         try:
             result = box.run(argv, limits, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                              text=True)

@@ -1,0 +1,157 @@
+"""The judge's clock: simulated time that only the judge decides and moves on.
+
+Part of the judge (:mod:`ros2nb.judge`).  The judge publishes ``/clock`` from its own node;
+the learner's nodes in a subject run on it (their runtime follows it, see
+:class:`ros2nb.runtime.clock.JudgeTime`), and everything the judge's node hears is stamped
+with it (:attr:`ros2nb.judge.observer.Observer.now_ns`).  How far each step goes, and how
+far the clock goes at all, is the judge's choice; a subject only says, after each step,
+that it has run what became due, how much it published and logged meanwhile (so that the
+judge waits for all of it to arrive before the next step, and stamps each message with the
+step that made it) and how far its spin would like to go.  A subject that lies about any of
+it only makes the judge wait longer or stamp its messages later.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any, Optional
+
+from rosgraph_msgs.msg import Clock
+
+from ..checks.base import ARRIVAL_TIMEOUT_S, learner_error
+from ..errors import CheckFailed
+from ..processes import Patience, kill_process_group
+from ..runtime.clock import JUDGE_CLOCK_QOS
+from .observer import Observer
+from .subjects import REPLY_TIMEOUT_S, SubjectHung, SubjectProcess
+
+#: Seconds between two looks at a subject that is neither answering nor acknowledging.
+POLL_S = 0.05
+
+
+class JudgeClock:
+    """The judge's ``/clock``: its time now and the steps that move it on.
+
+    :param observer: the judge's node (it publishes the clock and stamps what it hears).
+    """
+
+    def __init__(self, observer: Observer) -> None:
+        self._observer = observer
+        self._publisher = observer.node.create_publisher(Clock, '/clock', JUDGE_CLOCK_QOS)
+        self._publish()
+
+    @property
+    def now_ns(self) -> int:
+        """The judge's simulated time now (ns)."""
+        return self._observer.now_ns
+
+    @property
+    def now_s(self) -> float:
+        """The judge's simulated time now (s)."""
+        return self._observer.now_ns / 1e9
+
+    def _publish(self) -> None:
+        msg = Clock()
+        msg.clock.sec, msg.clock.nanosec = divmod(self._observer.now_ns, 1_000_000_000)
+        self._publisher.publish(msg)
+
+    def step_to(self, t_ns: int) -> None:
+        """Move the clock on to ``t_ns``: what the judge hears from now on is stamped so.
+
+        :raises ValueError: for a time before now (the judge's clock never goes back).
+        """
+        if t_ns < self._observer.now_ns:
+            raise ValueError('the judge\'s clock never goes back')
+        with self._observer.changed:
+            self._observer.now_ns = t_ns
+        self._publish()
+
+    def drive(self, subject: SubjectProcess, op: str, *, step_s: float, limit_s: float,
+              timeout: float = REPLY_TIMEOUT_S, what: str = 'your code',
+              **arguments: Any) -> dict:
+        """Send ``op`` to ``subject`` and move the clock on, a step of ``step_s`` at a time,
+        for as long as the subject's spin wants it (at most ``limit_s`` simulated seconds);
+        return the subject's reply once it comes.
+
+        Before each step the judge waits until every message the subject says it published
+        on a topic the judge watches, and every line it says it logged, has arrived.
+
+        :param what: who would be spinning too long, for the message (``record_hour(bag_path)``).
+        :raises CheckFailed: when the spin wants more than ``limit_s``, or a message the
+            subject announced never arrives.
+        :raises SubjectHung: when the subject neither answers nor finishes a step in time.
+        """
+        try:
+            return self._drive(subject, op, step_s, limit_s, timeout, what, arguments)
+        except BaseException:
+            # The subject is left in the middle of its command: it serves no other.
+            kill_process_group(subject.proc)
+            raise
+
+    def _drive(self, subject: SubjectProcess, op: str, step_s: float, limit_s: float,
+               timeout: float, what: str, arguments: dict) -> dict:
+        step_ns, limit_ns = round(step_s * 1e9), self.now_ns + round(limit_s * 1e9)
+        subject.send(op, **arguments)
+        # Patience reads /proc: it starts only once the subject has been quiet for POLL_S
+        # (an hour of steps would otherwise read it 7200 times).
+        patience: Optional[Patience] = None
+        quiet_since = time.monotonic()
+        while True:
+            reply = subject.poll_reply(POLL_S)
+            ack = subject.take_ack()
+            if ack is not None:
+                patience, quiet_since = None, time.monotonic()
+                self._settle(ack, subject.heard_base)
+            if reply is not None:
+                return reply
+            latest = subject.last_ack
+            wants = latest.get('wants') if latest else None
+            if latest is not None and latest['t'] >= self.now_ns and wants is not None \
+                    and wants > self.now_ns:
+                if self.now_ns + step_ns > limit_ns:
+                    kill_process_group(subject.proc)
+                    raise CheckFailed(f'{what} kept the nodes spinning past {limit_s:g} '
+                                      'simulated seconds of the grader\'s clock: spin only as '
+                                      'long as the task says.')
+                self.step_to(self.now_ns + step_ns)
+                patience, quiet_since = None, time.monotonic()
+            elif time.monotonic() - quiet_since < POLL_S:
+                continue
+            elif patience is None:
+                patience = Patience(subject.proc.pid, timeout, started=quiet_since)
+            elif patience.exhausted():
+                kill_process_group(subject.proc)
+                raise SubjectHung(f'Your code did not finish within {timeout:g} s (an endless '
+                                  'loop, or a call that waits for ever?): look for a loop that '
+                                  'never ends in the part you wrote.')
+
+    def _settle(self, ack: dict, base: tuple[dict[str, int], dict[str, int]]) -> None:
+        """Wait until what the subject announced in ``ack`` (all it published and logged
+        since it started) has arrived: what the judge heard since then (``base``: what it
+        had heard when the subject started), on the topics it watched then and on /rosout."""
+        topics0, logs0 = base
+        observer = self._observer
+        failure = ack.get('failure')
+        if failure:
+            explained = bool(failure.get('explained'))
+            message = failure['error'].split(': ', 1)[-1] if not explained else failure['error']
+            raise learner_error(failure['callback'], {
+                'type': failure['kind'], 'message': message, 'where': failure['where'],
+                'explanation': failure['error'] if explained else None,
+                'traceback': failure['traceback']})
+
+        def missing() -> list[str]:
+            topics, logs = observer.counts()
+            short = []
+            for topic, total in ack.get('published', {}).items():
+                if topic in topics0 and topics[topic] - topics0[topic] < total:
+                    short.append(topic)
+            for logger, total in ack.get('logged', {}).items():
+                if logs.get(logger, 0) - logs0.get(logger, 0) < total:
+                    short.append(f'/rosout ({logger})')
+            return short
+
+        if not observer.wait_until(lambda: not missing(), ARRIVAL_TIMEOUT_S):
+            raise CheckFailed(f'Messages on {", ".join(missing())} were published but never '
+                              f'reached the grader within {ARRIVAL_TIMEOUT_S:g} s (is the '
+                              'machine very busy?): run this check again.')

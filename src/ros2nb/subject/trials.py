@@ -1,0 +1,163 @@
+"""The subject's commands for notebooks 06 and 09: the learner's worker, rooms and QoS endpoints.
+
+Part of :mod:`ros2nb.subject` (a mixin of :class:`ros2nb.subject.process.Subject`).  Each
+command makes something of the learner's run (their executor spinning their Worker, nodes
+started with their arguments, an endpoint with their profile); the judge watches it over ROS
+itself.  A reply names the parts only so that the judge can say why what it saw went wrong.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from typing import Any, Optional
+
+from rclpy.duration import Duration
+from rclpy.executors import Executor
+from rclpy.node import Node
+from rclpy.qos import QoSProfile
+from std_msgs.msg import Float32, Int32
+
+from ..endpoints import node_endpoints
+from ..runtime.rates import callback_groups
+from .replies import describe_error, encode
+
+#: The node that makes an endpoint with the learner's QoS profile (notebook 09).
+QOS_NODE = 'qos_answer'
+#: Wall-clock seconds one spin of the learner's executor waits for work (notebook 06).
+SPIN_ROUND_S = 0.05
+
+
+class Trials:
+    """Commands of notebooks 06 and 09; the state lives in :class:`~.process.Subject`."""
+
+    namespace: dict[str, Any]
+    rooms: list[Node]
+    _spun: Optional[tuple[Node, Executor, threading.Thread, threading.Event, list]]
+    _qos: Optional[tuple[Node, Any, list[int]]]
+
+    def _runtime(self) -> Any:  # provided by Subject
+        raise NotImplementedError
+
+    # ------------------------------------------------------------ notebook 06
+    def worker(self, name: str) -> dict:
+        """Call the learner's ``name()`` for ``(node, executor)`` and spin them on the wall
+        clock in a thread until :meth:`worker_stop`; the judge listens to their lines."""
+        function = self.namespace.get(name)
+        if not callable(function):
+            return {'ok': False, 'undefined': True}
+        self._runtime()  # rclpy initialised, on this subject's domain
+        try:
+            made = function()
+        except BaseException as error:
+            return {'ok': False, 'error': describe_error(error)}
+        if not (isinstance(made, tuple) and len(made) == 2 and isinstance(made[0], Node)
+                and isinstance(made[1], Executor)):
+            return {'ok': False, 'returned': encode(made)}
+        node, executor = made
+        executor.add_node(node)
+        stop, failures = threading.Event(), []
+
+        def spin() -> None:
+            while not stop.is_set():
+                try:
+                    executor.spin_once(timeout_sec=SPIN_ROUND_S)
+                except BaseException as error:  # the learner's callback may raise anything
+                    failures.append({'callback': f'{type(node).__name__} callback',
+                                     **describe_error(error)})
+                    return
+
+        thread = threading.Thread(target=spin, name='ros2nb-subject-worker', daemon=True)
+        self._spun = (node, executor, thread, stop, failures)
+        thread.start()
+        return {'ok': True, 'name': node.get_name(), 'executor': type(executor).__name__,
+                'threads': getattr(executor, '_num_threads', None),
+                'groups': callback_groups(node)}
+
+    def worker_stop(self) -> dict:
+        """Stop spinning the learner's worker; the first failure of its callbacks, if any."""
+        if self._spun is None:
+            return {'ok': True, 'failure': None}
+        node, executor, thread, stop, failures = self._spun
+        self._spun = None
+        stop.set()
+        thread.join()
+        executor.shutdown(timeout_sec=5)
+        node.destroy_node()
+        return {'ok': True, 'failure': failures[0] if failures else None}
+
+    def room_nodes(self, arguments: list) -> dict:
+        """A stand-in sensor and monitor, each started with ``arguments`` (as ``--ros-args``)."""
+        self._runtime()
+        made: list[Node] = []
+        try:
+            for name, kind in (('temperature_sensor', 'publisher'),
+                               ('temperature_monitor', 'subscription')):
+                node = Node(name, cli_args=[str(a) for a in arguments],
+                            use_global_arguments=False, start_parameter_services=False)
+                if kind == 'publisher':
+                    node.create_publisher(Float32, 'temperature', 10)
+                else:
+                    node.create_subscription(Float32, 'temperature', lambda msg: None, 10)
+                made.append(node)
+        except BaseException as error:
+            for node in made:
+                node.destroy_node()
+            return {'ok': False, 'error': describe_error(error)}
+        self.rooms.extend(made)
+        return {'ok': True, 'nodes': [[n.get_name(), n.get_namespace(), node_endpoints(n)]
+                                      for n in made]}
+
+    # ------------------------------------------------------------ notebook 09
+    def qos_endpoint(self, name: str, topic: str, kind: str, numbers: tuple = ()) -> dict:
+        """Make a ``kind`` ('subscription' or 'publisher') of Int32 on ``topic`` with the
+        profile the learner's ``name()`` returns.  A subscription takes nothing until
+        :meth:`qos_take`; a publisher publishes ``numbers`` (the judge's) at once."""
+        function = self.namespace.get(name)
+        if not callable(function):
+            return {'ok': False, 'undefined': True}
+        self._runtime()
+        try:
+            profile = function()
+        except BaseException as error:
+            return {'ok': False, 'error': describe_error(error)}
+        if not isinstance(profile, QoSProfile):
+            return {'ok': False, 'returned': encode(profile)}
+        node = Node(QOS_NODE, start_parameter_services=False)
+        try:
+            if kind == 'subscription':
+                endpoint: Any = node.create_subscription(Int32, topic, lambda msg: None, profile)
+            else:
+                endpoint = node.create_publisher(Int32, topic, profile)
+                for number in numbers:
+                    endpoint.publish(Int32(data=int(number)))
+        except BaseException as error:
+            node.destroy_node()
+            return {'ok': False, 'error': describe_error(error)}
+        self._qos = (node, endpoint, [])
+        return {'ok': True, 'node': QOS_NODE}
+
+    def qos_take(self) -> dict:
+        """Take everything the learner's subscription kept, logging ``took N`` for each."""
+        if self._qos is None:
+            return {'ok': False, 'took': 0}
+        node, subscription, _ = self._qos
+        took = 0
+        with subscription.handle:
+            while (got := subscription.handle.take_message(subscription.msg_type,
+                                                            subscription.raw)) is not None:
+                node.get_logger().info(f'took {got[0].data}')
+                took += 1
+        return {'ok': True, 'took': took}
+
+    def qos_acked(self, seconds: float) -> dict:
+        """Wait (at most ``seconds``) until the judge's late joiner matched this publisher and
+        acknowledged the burst."""
+        if self._qos is None:
+            return {'ok': False}
+        _, publisher, _ = self._qos
+        deadline = time.monotonic() + seconds  # the judge's joiner matched on its side: wait
+        while publisher.get_subscription_count() < 1 and time.monotonic() < deadline:
+            time.sleep(0.01)  # for this side too, or nothing waits to be acknowledged yet
+        left = max(0.0, deadline - time.monotonic())
+        return {'ok': bool(publisher.wait_for_all_acked(Duration(seconds=left)))}

@@ -1,0 +1,220 @@
+"""Learners of our own, each one notebook, graded through the judge's grading path.
+
+Three corpora (``corpus_honest.py``, ``corpus_wrong.py``, ``corpus_attacks.py``) describe
+learners as the course's solution notebook with some answer cells written another way.
+:func:`grade_learner` grades one the way ``make grade`` does after the learner's notebook
+ran: the workspace holds what the notebook's ``%%part`` cells write on top of what
+``catch_up`` writes while grading (no reference node: the grader hides them), and the judge's
+own :func:`ros2nb.judge.grading.grade` runs every graded cell of the course's notebook, hidden
+tests included, on the submission.  Only the learner's kernel is left out: a notebook's
+answer cells reach the judge as its files and its answer cells, which is all the judge reads.
+
+``python tests/corpora.py [NAME ...]`` prints ``name<TAB>score<TAB>failed grade ids``, one
+line per learner; with the interpreter of an older checkout on ``PYTHONPATH``'s ``src`` it
+scores the same learners with that checkout's judge (the closing notes' "before" column).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import copy
+import io
+import json
+import os
+import re
+import shlex
+import sys
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Iterator, Optional, Union
+
+ROOT = Path(__file__).resolve().parent.parent
+SOLUTIONS = ROOT / 'solutions'
+NOTEBOOKS = {p.stem[:2]: p for p in SOLUTIONS.glob('*.ipynb')}
+#: A cell's new text, or (old, new) replacements in it.
+Change = Union[str, list[tuple[str, str]]]
+
+
+@dataclass
+class Learner:
+    """One learner's one notebook.
+
+    :ivar notebook: the notebook's number, e.g. ``'03'``.
+    :ivar cells: answer cell (its grade id without ``NN-`` and ``-answer``) -> new text
+        (its ``%%part`` line is kept) or a list of ``(old, new)`` replacements.
+    :ivar loses: grade ids (without ``NN-``) of the parts this learner must fail.
+    :ivar twin: for an attack, the learner it must score the same as.
+    """
+
+    name: str
+    notebook: str
+    cells: dict[str, Change]
+    loses: tuple[str, ...] = ()
+    twin: Optional[str] = None
+    why: str = ''
+    extra: dict = field(default_factory=dict)
+
+
+def _source(cell: dict) -> str:
+    text = cell['source']
+    return ''.join(text) if isinstance(text, list) else text
+
+
+def _grade_id(cell: dict) -> str:
+    return cell.get('metadata', {}).get('nbgrader', {}).get('grade_id', '')
+
+
+def submission(learner: Learner) -> dict:
+    """The learner's notebook: the solution with ``learner.cells`` written in.
+
+    :raises KeyError: naming an answer cell or a replacement that is not there.
+    """
+    number = learner.notebook
+    nb = json.loads(NOTEBOOKS[number].read_text())
+    by_key = {_grade_id(c)[3:-len('-answer')]: c for c in nb['cells']
+              if _grade_id(c).endswith('-answer')}
+    for key, change in learner.cells.items():
+        cell = by_key.get(key)
+        if cell is None:
+            raise KeyError(f'{learner.name}: no answer cell {key} in {number} '
+                           f'(there are {sorted(by_key)})')
+        text = _source(cell)
+        if isinstance(change, str):
+            first = text.splitlines()[0]
+            new = change.strip('\n') + '\n'
+            text = (first + '\n' + new) if first.startswith('%%part') and \
+                not new.startswith('%%') else new
+        else:
+            for old, replacement in change:
+                if old not in text:
+                    raise KeyError(f'{learner.name}: {old!r} is not in {key}')
+                text = text.replace(old, replacement)
+        cell['source'] = text
+        cell['outputs'] = []
+    return nb
+
+
+def points(number: str) -> dict[str, float]:
+    """grade id (without ``NN-``) -> points, of the course's notebook ``number``."""
+    nb = json.loads(NOTEBOOKS[number].read_text())
+    return {_grade_id(c)[3:]: c['metadata']['nbgrader']['points'] for c in nb['cells']
+            if c.get('metadata', {}).get('nbgrader', {}).get('grade')}
+
+
+def expected_score(learner: Learner) -> float:
+    """Full marks less the points of the parts the learner must lose."""
+    return sum(p for gid, p in points(learner.notebook).items() if gid not in learner.loses)
+
+
+def _write_parts(nb: dict) -> None:
+    """What the notebook's ``%%part`` cells write, in notebook order (as its kernel did)."""
+    from ros2nb import course
+    from ros2nb.terminal.files import write_part
+    names = {}
+    for cell in nb['cells']:
+        if cell['cell_type'] == 'code':
+            for name, constant in re.findall(r'^(\w+) = ros2nb\.course\.(\w+)', _source(cell),
+                                             re.M):
+                names[name] = getattr(course, constant)
+    for cell in nb['cells']:
+        text = _source(cell)
+        if cell['cell_type'] != 'code' or not text.startswith('%%part'):
+            continue
+        first, _, body = text.partition('\n')
+        words = [w for w in shlex.split(first)[1:] if w != '--overwrite']
+        with contextlib.redirect_stdout(io.StringIO()):
+            write_part(names[words[0].strip('{}')], int(words[1]), body, overwrite=True)
+
+
+@contextlib.contextmanager
+def _grading_env(root: Path) -> Iterator[Path]:
+    """This process as a judge on ``root/ws``, the course's reference nodes hidden from
+    ``catch_up`` (as in the grader's sandbox); everything put back afterwards."""
+    from ros2nb import course
+    from ros2nb.checks.dispatch import IN_JUDGE_ENV
+    from ros2nb.terminal import workspace as ws_module
+    saved = {k: os.environ.get(k) for k in ('ROS2NB_WORKSPACE', IN_JUDGE_ENV)}
+    os.environ['ROS2NB_WORKSPACE'] = str(root / 'ws')
+    os.environ[IN_JUDGE_ENV] = '1'
+    ws_module._current = None
+    reference = course.reference_source
+    course.reference_source = lambda name: None
+    try:
+        yield root / 'ws'
+    finally:
+        course.reference_source = reference
+        for key, value in saved.items():
+            if value is None:
+                os.environ.pop(key, None)
+            else:
+                os.environ[key] = value
+        ws_module._current = None
+
+
+def grade_learner(learner: Learner, root: Path) -> dict[str, dict]:
+    """Grade one learner's notebook in a fresh workspace under ``root``.
+
+    :return: ``{grade id without NN-: result}`` (``passed``, and ``message`` when failed).
+    """
+    from ros2nb import course
+    from ros2nb.checks.base import bind_judge
+    from ros2nb.judge.grading import grade
+    from ros2nb.judge.session import Session
+    from ros2nb.terminal.workspace import create_workspace
+    nb = submission(learner)
+    source = json.loads(NOTEBOOKS[learner.notebook].read_text())
+    number = int(learner.notebook)
+    with _grading_env(root) as ws, contextlib.redirect_stdout(io.StringIO()):
+        if number in course.STEPS:
+            course.catch_up(number)
+        else:
+            create_workspace()
+        _write_parts(nb)
+        session = Session(ws)
+        bind_judge(session)
+        try:
+            results = grade(source, copy.deepcopy(nb))
+        finally:
+            bind_judge(None)
+            session.close()
+    return {gid[3:]: result for gid, result in results.items()}
+
+
+def score(learner: Learner, results: dict[str, dict]) -> float:
+    """The points ``results`` earn in the learner's notebook."""
+    worth = points(learner.notebook)
+    return sum(worth[gid] for gid, result in results.items() if result['passed'])
+
+
+def every_learner() -> dict[str, Learner]:
+    """All three corpora, by name."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from corpus_attacks import ATTACKS
+    from corpus_honest import HONEST
+    from corpus_wrong import WRONG
+    found = {}
+    for learner in [*HONEST, *WRONG, *ATTACKS]:
+        assert learner.name not in found, learner.name
+        found[learner.name] = learner
+    return found
+
+
+def main(names: list[str]) -> int:
+    """Print each named learner's score (all of them without names)."""
+    learners = every_learner()
+    for name in names or learners:
+        learner = learners[name]
+        with tempfile.TemporaryDirectory(prefix='ros2nb-corpus-') as root:
+            try:
+                results = grade_learner(learner, Path(root))
+                failed = sorted(gid for gid, r in results.items() if not r['passed'])
+                shown = f'{score(learner, results):g}'
+            except Exception as error:  # an older judge may not grade it at all
+                failed, shown = [f'{type(error).__name__}: {error}'[:120]], 'error'
+        print(f'{name}\t{shown}\t{expected_score(learner):g}\t{",".join(failed)}', flush=True)
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,171 @@
+"""Honest learners: the parts written in other valid styles, every one worth full marks.
+
+Each is one notebook of :mod:`corpora`.  Styles ROS users write: the official tutorials'
+(``timer_period`` locals), ros2/examples idioms (executors,
+``spin_once`` loops), keyword arguments, lambdas, helpers, presets, a trailing slash.
+"""
+
+from corpora import Learner
+
+SENSOR_KEYWORDS = '''
+class TemperatureSensor(Node):
+    """Publishes one Float32 reading in °C every PUBLISH_PERIOD_S seconds."""
+
+    def __init__(self):
+        super().__init__(node_name='temperature_sensor')
+        self.publisher_ = self.create_publisher(msg_type=Float32, topic=TOPIC,
+                                                qos_profile=QUEUE_DEPTH)
+        timer_period = PUBLISH_PERIOD_S  # seconds
+        self.timer = self.create_timer(timer_period_sec=timer_period,
+                                       callback=lambda: self.publish_temperature())
+        self.temperature = START_TEMPERATURE_C
+        self.get_logger().info('Temperature Sensor Node Started')
+'''
+
+SENSOR_HELPERS = '''    def publish_temperature(self):
+        self.temperature = self._clamped(self.temperature + self._step())
+        self.publisher_.publish(Float32(data=float(self.temperature)))
+        self.get_logger().info('Publishing: %.2fC' % self.temperature)
+
+    @staticmethod
+    def _step():
+        return (2 * random.random() - 1) * MAX_STEP_C
+
+    @staticmethod
+    def _clamped(value):
+        return min(MAX_TEMPERATURE_C, max(MIN_TEMPERATURE_C, value))
+'''
+
+MAIN_SPIN_ONCE = '''
+def main(args=None):
+    rclpy.init(args=args)
+    node = TemperatureSensor()
+    try:
+        while rclpy.ok():
+            rclpy.spin_once(node, timeout_sec=0.1)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        _clean_up(node)
+
+
+def _clean_up(node):
+    node.destroy_node()
+    rclpy.try_shutdown()
+
+
+if __name__ == '__main__':
+    main()
+'''
+
+MAIN_EXECUTOR = '''
+def main(args=None):
+    from rclpy.executors import SingleThreadedExecutor
+    rclpy.init(args=args)
+    node = TemperatureSensor()
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
+    try:
+        executor.spin()
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        executor.shutdown()
+        node.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == '__main__':
+    main()
+'''
+
+MONITOR_LAMBDA = '''
+class TemperatureMonitor(Node):
+    """Logs every reading it receives with its status."""
+
+    def __init__(self):
+        super().__init__('temperature_monitor')
+        from rclpy.qos import QoSProfile
+        self.subscription = self.create_subscription(
+            msg_type=Float32, topic=TOPIC,
+            callback=lambda msg: self.temperature_callback(msg),
+            qos_profile=QoSProfile(depth=QUEUE_DEPTH))
+        self.get_logger().info('Temperature Monitor Node Started')
+'''
+
+MONITOR_HELPER = '''    def temperature_callback(self, msg):
+        reading = msg.data
+        self.get_logger().info('Temperature: %.2fC - Status: %s' % (reading, self._status(reading)))
+
+    @staticmethod
+    def _status(reading):
+        return 'High' if reading > HIGH_ABOVE_C else 'Low' if reading < LOW_BELOW_C else 'Normal'
+'''
+
+WORKER_TUPLE = '''
+def responsive_worker():
+    from rclpy.callback_groups import ReentrantCallbackGroup
+    shared = ReentrantCallbackGroup()
+    node, executor = Worker('responsive_worker', shared, shared), MultiThreadedExecutor(2)
+    return node, executor
+'''
+
+HONEST = [
+    Learner('03 keyword arguments, a lambda timer, helpers', '03',
+            {'sensor-constructor': SENSOR_KEYWORDS, 'sensor-callback': SENSOR_HELPERS}),
+    Learner('03 spin_once loop, cleanup in a helper called from finally', '03',
+            {'sensor-main': MAIN_SPIN_ONCE}),
+    Learner('03 an executor in main', '03', {'sensor-main': MAIN_EXECUTOR}),
+    Learner('04 a lambda subscription, a QoSProfile, a status helper', '04',
+            {'monitor-constructor': MONITOR_LAMBDA, 'monitor-callback': MONITOR_HELPER}),
+    Learner('04 an executor in main', '04', {'monitor-main': MAIN_EXECUTOR.replace(
+        'TemperatureSensor', 'TemperatureMonitor')}),
+    Learner('05 setup.cfg with a trailing slash and spaces', '05', {'setup-cfg': '''
+[develop]
+script_dir = $base/lib/sensor_simulator/
+[install]
+install_scripts = $base/lib/sensor_simulator/
+'''}),
+    Learner('06 a worker made in one line, one reentrant group', '06',
+            {'responsive-worker': WORKER_TUPLE}),
+    Learner('06 room arguments spelt out', '06', {'room-arguments': '''
+def room_arguments(room):
+    return ['--ros-args', '--remap', '__ns:=/' + room]
+'''}),
+    Learner('07 the reading kept through a helper', '07', {'plot-callback': '''
+    def temperature_callback(self, msg):
+        self._keep(self.get_clock().now(), msg.data)
+
+    def _keep(self, stamp, reading):
+        self.times_s += [stamp.nanoseconds * 1e-9]
+        self.temps_c += [reading]
+        self.redraw()
+'''}),
+    Learner('09 presets and copies', '09', {
+        'qos-newest-only': '''
+def newest_only_profile():
+    return QoSProfile(depth=1)
+''',
+        'qos-sensor-subscription': '''
+def sensor_subscription_profile():
+    return qos_profile_sensor_data
+''',
+        'qos-latched-thresholds': '''
+def latched_thresholds_profile():
+    import copy
+    profile = copy.copy(QoSProfile(depth=5))
+    profile.durability = DurabilityPolicy.TRANSIENT_LOCAL
+    return profile
+'''}),
+    Learner('10 the bag read with rosbags.rosbag2', '10', {'read-temperatures': '''
+def read_temperatures(bag_path):
+    from rosbags.rosbag2 import Reader
+    stamps, values = [], []
+    with Reader(bag_path) as reader:
+        for connection, stamp, raw in reader.messages():
+            if connection.topic == '/temperature':
+                stamps.append(stamp)
+                values.append(TYPESTORE.deserialize_cdr(raw, connection.msgtype).data)
+    return [(s - stamps[0]) / 1e9 for s in stamps], values
+'''}),
+]
