@@ -350,6 +350,9 @@ def _setup_cfg_cause(judge: Judge) -> Optional[str]:
 
 
 def _setup_cfg(judge: Judge) -> str:
+    if PLACEHOLDER in (TEXT.read(_package_source(judge) / 'setup.cfg') or ''):
+        raise CheckFailed('setup.cfg still holds the placeholder "raise NotImplementedError()": '
+                          'write the two settings in its place.')  # not written: no point
     try:  # the learner's setup.py may be at fault
         problem = _runs(judge, _built(judge))
     except CheckFailed as failure:
@@ -357,9 +360,6 @@ def _setup_cfg(judge: Judge) -> str:
     if problem is not None:  # with the course's setup.py, setup.cfg alone counts
         problem = _runs(judge, _built(judge, setup_py=course_setup_py()))
     if problem is not None:
-        if PLACEHOLDER in (TEXT.read(_package_source(judge) / 'setup.cfg') or ''):
-            raise CheckFailed('setup.cfg still holds the placeholder "raise '
-                              'NotImplementedError()": write the two settings in its place.')
         raise CheckFailed(_setup_cfg_cause(judge) or
                           f'{problem} setup.cfg puts the executables where ros2 run looks: '
                           f'$base/lib/{course.PACKAGE}.')
