@@ -20,7 +20,6 @@ import contextlib
 import copy
 import io
 import json
-import os
 import re
 import shlex
 import sys
@@ -30,6 +29,7 @@ from pathlib import Path
 from typing import Iterator, Optional, Union
 
 ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / 'tests'))  # judging.py, the corpora
 SOLUTIONS = ROOT / 'solutions'
 NOTEBOOKS = {p.stem[:2]: p for p in SOLUTIONS.glob('*.ipynb')}
 #: A cell's new text, or (old, new) replacements in it.
@@ -129,27 +129,17 @@ def _write_parts(nb: dict) -> None:
 
 @contextlib.contextmanager
 def _grading_env(root: Path) -> Iterator[Path]:
-    """This process as a judge on ``root/ws``, the course's reference nodes hidden from
-    ``catch_up`` (as in the grader's sandbox); everything put back afterwards."""
+    """This process as a judge on ``root/ws`` (:func:`judging.judging_env`), the course's
+    reference nodes hidden from ``catch_up`` (as in the grader's sandbox)."""
     from ros2nb import course
-    from ros2nb.checks.dispatch import IN_JUDGE_ENV
-    from ros2nb.terminal import workspace as ws_module
-    saved = {k: os.environ.get(k) for k in ('ROS2NB_WORKSPACE', IN_JUDGE_ENV)}
-    os.environ['ROS2NB_WORKSPACE'] = str(root / 'ws')
-    os.environ[IN_JUDGE_ENV] = '1'
-    ws_module._current = None
+    from judging import judging_env
     reference = course.reference_source
     course.reference_source = lambda name: None
     try:
-        yield root / 'ws'
+        with judging_env(root) as ws:
+            yield ws
     finally:
         course.reference_source = reference
-        for key, value in saved.items():
-            if value is None:
-                os.environ.pop(key, None)
-            else:
-                os.environ[key] = value
-        ws_module._current = None
 
 
 def grade_learner(learner: Learner, root: Path) -> dict[str, dict]:
@@ -189,7 +179,6 @@ def score(learner: Learner, results: dict[str, dict]) -> float:
 
 def every_learner() -> dict[str, Learner]:
     """All three corpora, by name."""
-    sys.path.insert(0, str(Path(__file__).resolve().parent))
     from corpus_attacks import ATTACKS
     from corpus_honest import HONEST
     from corpus_wrong import WRONG

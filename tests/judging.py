@@ -22,26 +22,35 @@ from ros2nb.terminal import workspace as ws_module
 
 
 @contextmanager
-def judge_session(root: Path, notebook: int) -> Iterator[Session]:
-    """A judge session (this process is the judge) on ``root/ws``, caught up to ``notebook``."""
+def judging_env(root: Path) -> Iterator[Path]:
+    """This process as a judge on the workspace ``root/ws``; everything put back afterwards."""
     saved = {k: os.environ.get(k) for k in ('ROS2NB_WORKSPACE', IN_JUDGE_ENV)}
     os.environ['ROS2NB_WORKSPACE'] = str(root / 'ws')
     os.environ[IN_JUDGE_ENV] = '1'
     ws_module._current = None
-    course.catch_up(notebook)
-    session = Session(root / 'ws')
-    bind_judge(session)
     try:
-        yield session
+        yield root / 'ws'
     finally:
-        bind_judge(None)
-        session.close()
         for key, value in saved.items():
             if value is None:
                 os.environ.pop(key, None)
             else:
                 os.environ[key] = value
         ws_module._current = None
+
+
+@contextmanager
+def judge_session(root: Path, notebook: int) -> Iterator[Session]:
+    """A judge session (this process is the judge) on ``root/ws``, caught up to ``notebook``."""
+    with judging_env(root) as ws:
+        course.catch_up(notebook)
+        session = Session(ws)
+        bind_judge(session)
+        try:
+            yield session
+        finally:
+            bind_judge(None)
+            session.close()
 
 
 #: A forging learner's module code that finds the subject's request loop from the learner's import and keeps

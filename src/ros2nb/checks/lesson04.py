@@ -12,13 +12,11 @@ import random
 import re
 from typing import Any
 
-from std_msgs.msg import Float32
-
 from .. import course
 from ..errors import CheckFailed
-from .base import ARRIVAL_TIMEOUT_S, Judge, judged, learner_error
+from .base import Judge, judged
 from .mains import run_main
-from .nodes import caught_up, new_node, reach, started_log_verdict
+from .nodes import feed, new_node, reach, started_log_verdict
 from .verdicts import endpoint_verdict, node_name_verdict
 
 #: Readings the monitor callback check sends: both boundaries and their neighbours (°C).
@@ -62,22 +60,13 @@ def _feed(judge: Judge, subject: Any, info: dict,
           readings: tuple[float, ...] | list[float]) -> list[list[str]]:
     """Publish readings to the learner's monitor from the judge's node; return the lines it
     logged for each (the subject's counts only say how many to wait for)."""
-    observer, publisher = judge.observer, judge.probe_publisher
     per_reading = []
-    before = subject.request('counts')
+    counts = subject.request('counts')
     for value in readings:
-        mark = len(observer.logs)
-        publisher.publish(Float32(data=value))
-        reply = subject.request('wait_received', count=before['received'] + 1,
-                                seconds=ARRIVAL_TIMEOUT_S)
-        if reply['failure']:
-            failure = reply['failure']
-            raise learner_error(failure['callback'], failure, context=f' for {value} °C')
-        if not reply['ok']:
-            raise CheckFailed(f'The reading {value} °C never reached the subscription\'s '
-                              'callback: keep the subscription in an attribute of the node.')
-        per_reading.append(caught_up(judge, info, mark, reply['logged'] - before['logged']))
-        before = reply
+        counts, lines = feed(judge, subject, info, value, counts,
+                             "the subscription's callback: keep the subscription in an "
+                             'attribute of the node.')
+        per_reading.append(lines)
     return per_reading
 
 

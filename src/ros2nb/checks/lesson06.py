@@ -12,32 +12,19 @@ from __future__ import annotations
 
 import re
 
-from std_msgs.msg import Bool, Float32
+from std_msgs.msg import Bool
 
 from .. import course
 from ..errors import CheckFailed
 from .base import ARRIVAL_TIMEOUT_S, Judge, judged, learner_error
 from .mains import run_main
-from .nodes import caught_up, new_node, reach
+from .nodes import caught_up, feed, new_node, reach
 from .verdicts import endpoint_verdict, node_name_verdict
 
 #: Readings the fan check sends (°C): both sides of the High threshold.
 FAN_READINGS_C = (22.0, 26.0, 26.01, 27.5, 25.99, 19.0)
 #: Readings the counting monitor check sends.
 COUNTED_READINGS = 5
-
-
-def _send(judge: Judge, subject, value: float, received: int, callback: str) -> dict:
-    """Publish one reading to the learner's node; return the subject's counts after it."""
-    judge.probe_publisher.publish(Float32(data=value))
-    reply = subject.request('wait_received', count=received + 1, seconds=ARRIVAL_TIMEOUT_S)
-    if reply['failure']:
-        raise learner_error(reply['failure']['callback'], reply['failure'],
-                            context=f' for {value} °C')
-    if not reply['ok']:
-        raise CheckFailed(f'The reading {value} °C never reached {callback}: is it the '
-                          'subscription\'s callback?')
-    return reply
 
 
 # ------------------------------------------------------------------ modularity
@@ -56,10 +43,11 @@ def _fan_controller(judge: Judge) -> str:
                           f'subscription on /{course.FAN_TOPIC}: is the machine very busy? '
                           'Run this check again.')
     reach(judge, subject, info['name'])
-    received = info['received']
+    counts = info
     for value in FAN_READINGS_C:
         before = len(commands)
-        received = _send(judge, subject, value, received, 'temperature_callback')['received']
+        counts, _lines = feed(judge, subject, info, value, counts,
+                              'temperature_callback: is it the subscription\'s callback?')
         judge.observer.wait_until(lambda: len(commands) > before, ARRIVAL_TIMEOUT_S)
         said = [heard.value for heard in commands[before:]]
         want = course.monitor_status(value) == 'High'
@@ -120,13 +108,11 @@ def _counting_monitor(judge: Judge) -> str:
     endpoint_verdict(name, found, 'subscription', '/' + course.TOPIC, course.MESSAGE_TYPE)
     caught_up(judge, info, mark, info['started_lines'])
     reach(judge, subject, name)
-    received, logged = info['received'], info['logged']
+    counts = info
     for index in range(1, COUNTED_READINGS + 1):
-        mark = len(observer.logs)
-        reply = _send(judge, subject, 20.0 + index, received, 'its callback')
-        lines = caught_up(judge, info, mark, reply['logged'] - logged)
-        received, logged = reply['received'], reply['logged']
-        counts = [int(n) for line in lines for n in re.findall(r'(?<![\d.])\d+(?![\d.])', line)]
+        counts, lines = feed(judge, subject, info, 20.0 + index, counts,
+                             "its callback: is it the subscription's callback?")
+        numbers = [int(n) for line in lines for n in re.findall(r'(?<![\d.])\d+(?![\d.])', line)]
         if not lines:
             raise CheckFailed(f'{name} logged nothing for reading {index}: log the count in '
                               'count(), after adding one, e.g. '
@@ -134,7 +120,7 @@ def _counting_monitor(judge: Judge) -> str:
         if len(lines) > 1:
             raise CheckFailed(f'{name} logged {len(lines)} lines for reading {index}; log one, '
                               'with the count.')
-        if index not in counts:
+        if index not in numbers:
             raise CheckFailed(f'After {index} reading{"s" if index > 1 else ""} {name} logged '
                               f'"{lines[0]}": add one to self.received for every message, and '
                               'log the new count.')

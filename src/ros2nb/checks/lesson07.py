@@ -14,12 +14,10 @@ import math
 import re
 from typing import Optional
 
-from std_msgs.msg import Float32
-
 from .. import course
 from ..errors import CheckFailed
-from .base import ARRIVAL_TIMEOUT_S, Judge, judged, learner_error
-from .nodes import caught_up, new_node, reach
+from .base import Judge, judged
+from .nodes import caught_up, feed, new_node, reach
 from .source import ClassSource
 from .verdicts import endpoint_verdict, node_name_verdict
 
@@ -50,22 +48,12 @@ def _plot_callback(judge: Judge) -> str:
     endpoint_verdict(info['name'], found, 'subscription', '/' + course.TOPIC, course.MESSAGE_TYPE)
     caught_up(judge, info, mark, info['started_lines'])
     reach(judge, subject, info['name'])
-    publisher = judge.probe_publisher
-    received, logged = info['received'], info['logged']
+    counts = info
     for number, value in enumerate(PLOT_READINGS_C, start=1):
         judge.clock.drive(subject, 'run', seconds=READING_GAP_S, step_s=READING_GAP_S,
                           limit_s=READING_GAP_S, what=course.PLOT_CLASS)
         sent_s = judge.clock.now_s
-        mark = len(observer.logs)
-        publisher.publish(Float32(data=value))
-        reply = subject.request('wait_received', count=received + 1, seconds=ARRIVAL_TIMEOUT_S)
-        if reply['failure']:
-            raise learner_error(reply['failure']['callback'], reply['failure'],
-                                context=f' for {value} °C')
-        if not reply['ok']:
-            raise CheckFailed(f'The reading {value} °C never reached temperature_callback.')
-        lines = caught_up(judge, info, mark, reply['logged'] - logged)
-        received, logged = reply['received'], reply['logged']
+        counts, lines = feed(judge, subject, info, value, counts, 'temperature_callback.')
         _point_verdict(judge, value, sent_s, number, _plotted(lines))
     return (f'each of {len(PLOT_READINGS_C)} readings was plotted once, at the time it arrived '
             'on the node\'s clock (the grader\'s simulated time), with its value.')

@@ -18,13 +18,12 @@ from typing import Any, Callable, Optional
 from rcl_interfaces.msg import ParameterType
 from rclpy.parameter import Parameter, parameter_value_to_python
 from rclpy.parameter_client import AsyncParameterClient
-from std_msgs.msg import Float32
 
 from .. import course
 from ..errors import CheckFailed
 from ..runtime.services import call_until_answered
 from .base import ARRIVAL_TIMEOUT_S, Judge, judged, learner_error
-from .nodes import caught_up, new_node, reach
+from .nodes import caught_up, feed, new_node, reach
 
 #: The on-set callback the learner writes (part 4); the constructor registers it.
 CALLBACK = 'on_set_thresholds'
@@ -60,7 +59,7 @@ class _Monitor:
         self.full = self.info['namespace'].rstrip('/') + '/' + self.name
         caught_up(judge, self.info, mark, self.info['started_lines'])
         reach(judge, self.subject, self.name)
-        self.received, self.logged = self.info['received'], self.info['logged']
+        self.counts = self.info
         self.subject.request('serve')
         self.client = AsyncParameterClient(self.observer.node, self.full)
         if not self.client.wait_for_services(ARRIVAL_TIMEOUT_S):
@@ -104,18 +103,8 @@ class _Monitor:
     def status(self, reading: float) -> Optional[str]:
         """The status the monitor logs for ``reading``, published by the judge (None: no
         status in what it logged)."""
-        mark = len(self.observer.logs)
-        self.judge.probe_publisher.publish(Float32(data=reading))
-        reply = self.subject.request('wait_received', count=self.received + 1,
-                                     seconds=ARRIVAL_TIMEOUT_S)
-        if reply['failure']:
-            raise learner_error(reply['failure']['callback'], reply['failure'],
-                                context=f' for {reading} °C')
-        if not reply['ok']:
-            raise CheckFailed(f'The reading {reading} °C never reached {self.name}: keep its '
-                              'subscription (given in part 3).')
-        lines = caught_up(self.judge, self.info, mark, reply['logged'] - self.logged)
-        self.received, self.logged = reply['received'], reply['logged']
+        self.counts, lines = feed(self.judge, self.subject, self.info, reading, self.counts,
+                                  f'{self.name}: keep its subscription (given in part 3).')
         found = [word for line in lines for word in STATUS.findall(line)]
         return found[-1] if found else None
 

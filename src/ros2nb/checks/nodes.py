@@ -1,6 +1,6 @@
 """A node from the learner's file, created in a subject and watched by the judge.
 
-Part of :mod:`ros2nb.checks`: what the checks of notebooks 03, 04 and 06 share.
+Part of :mod:`ros2nb.checks`: what the checks of notebooks 03, 04, 06, 07 and 08 share.
 """
 
 from __future__ import annotations
@@ -11,6 +11,8 @@ from typing import Any, Optional
 from .. import course
 from ..errors import CheckFailed
 from ..terminal.files import missing_parts
+from std_msgs.msg import Float32
+
 from .base import ARRIVAL_TIMEOUT_S, Judge, learner_error
 
 
@@ -80,3 +82,28 @@ def reach(judge: Judge, subject, node: str) -> None:
                            seconds=ARRIVAL_TIMEOUT_S, timeout=ARRIVAL_TIMEOUT_S + 10)['ok']:
         raise CheckFailed(f"The grader's publisher on /{course.TOPIC} never reached {node}: "
                           'check its subscription\'s topic name and type.')
+
+
+def feed(judge: Judge, subject: Any, info: dict, value: float, counts: dict,
+         never: str) -> tuple[dict, list[str]]:
+    """Publish one reading from the judge's node to the learner's node ``info`` in
+    ``subject``, and wait until its subscription took it.
+
+    :param counts: the subject's counts before (``received``, ``logged``): how many lines to
+        wait for, never what passes.
+    :param never: where the reading should have gone, for the line when it never arrives.
+    :return: the subject's counts after it, and the lines the node logged meanwhile (as the
+        judge heard them on /rosout).
+    :raises LearnerCodeError: when the node's callback raised for it.
+    :raises CheckFailed: when it never reached the callback.
+    """
+    mark = len(judge.observer.logs)
+    judge.probe_publisher.publish(Float32(data=value))
+    reply = subject.request('wait_received', count=counts['received'] + 1,
+                            seconds=ARRIVAL_TIMEOUT_S)
+    if reply['failure']:
+        raise learner_error(reply['failure']['callback'], reply['failure'],
+                            context=f' for {value} °C')
+    if not reply['ok']:
+        raise CheckFailed(f'The reading {value} °C never reached {never}')
+    return reply, caught_up(judge, info, mark, reply['logged'] - counts['logged'])

@@ -23,7 +23,7 @@ from ..errors import CheckFailed
 from ..processes import Patience, kill_process_group
 from ..runtime.clock import JUDGE_CLOCK_QOS
 from .observer import Observer
-from .subjects import REPLY_TIMEOUT_S, SubjectHung, SubjectProcess
+from .subjects import REPLY_TIMEOUT_S, SubjectProcess
 
 #: Seconds between two looks at a subject that is neither answering nor acknowledging.
 POLL_S = 0.05
@@ -120,10 +120,7 @@ class JudgeClock:
             elif patience is None:
                 patience = Patience(subject.proc.pid, timeout, started=quiet_since)
             elif patience.exhausted():
-                kill_process_group(subject.proc)
-                raise SubjectHung(f'Your code did not finish within {timeout:g} s (an endless '
-                                  'loop, or a call that waits for ever?): look for a loop that '
-                                  'never ends in the part you wrote.')
+                raise subject.given_up(timeout)
 
     def _settle(self, ack: dict, base: tuple[dict[str, int], dict[str, int]]) -> None:
         """Wait until what the subject announced in ``ack`` (all it published and logged

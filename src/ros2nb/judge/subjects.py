@@ -224,10 +224,14 @@ class SubjectProcess:
             if patience is None:
                 patience = Patience(self.proc.pid, timeout, started=sent)
             elif patience.exhausted():
-                kill_process_group(self.proc)
-                raise SubjectHung(f'Your code did not finish within {timeout:g} s (an endless '
-                                  'loop, or a call that waits for ever?): look for a loop that '
-                                  'never ends in the part you wrote.')
+                raise self.given_up(timeout)
+
+    def given_up(self, timeout: float) -> SubjectHung:
+        """End this subject, which used up ``timeout`` seconds; the error to raise for it."""
+        kill_process_group(self.proc)
+        return SubjectHung(f'Your code did not finish within {timeout:g} s (an endless loop, or '
+                           'a call that waits for ever?): look for a loop that never ends in the '
+                           'part you wrote.')
 
     def _died(self) -> CheckFailed:
         code = self.proc.wait(5)
