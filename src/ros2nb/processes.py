@@ -74,6 +74,8 @@ BUSY_SHARE = 0.05
 BUSY_WINDOW_S = 5.0
 #: However busy it is, a process tree gets at most this many times its limit on the wall clock.
 WALL_LIMIT_FACTOR = 10.0
+#: Seconds between two looks at a process that is asked to exit.
+POLL_EXIT_S = 0.1
 _TICKS_PER_S = os.sysconf('SC_CLK_TCK')
 
 
@@ -157,6 +159,23 @@ class Patience:
             return False
         since, cpu_then = self._samples[0]
         return cpu - cpu_then < BUSY_SHARE * (now - since)
+
+
+def wait_patiently(proc: subprocess.Popen, limit_s: float) -> Optional[int]:
+    """Wait for ``proc`` to exit, with :class:`Patience` (``limit_s`` of its tree's work, or
+    of its waiting): on a busy machine a slow exit is not a hang.
+
+    Introduced in ``03-write-the-publisher.ipynb`` (a main() stopped with Ctrl+C).
+
+    :return: its exit code, or None when it had its limit and still runs.
+    """
+    patience = Patience(proc.pid, limit_s)
+    while True:
+        try:
+            return proc.wait(POLL_EXIT_S)
+        except subprocess.TimeoutExpired:
+            if patience.exhausted():
+                return None
 
 
 def _name(pid: int) -> str:

@@ -17,7 +17,6 @@ import json
 import os
 import random
 import shutil
-import subprocess
 import sys
 from hashlib import sha256
 from importlib.metadata import EntryPoint
@@ -28,8 +27,9 @@ from std_msgs.msg import Float32
 
 from .. import course
 from ..errors import CheckFailed, Ros2nbError
-from ..processes import interrupt, kill_process_group
+from ..processes import interrupt, kill_process_group, wait_patiently
 from ..terminal.colcon import build_cause, venv_tool
+from ..terminal.files import saved_parts
 from ..terminal.pkg_templates import SETUP_CFG, render_setup_py
 from ..terminal.run import find_executable
 from .base import ARRIVAL_TIMEOUT_S, Judge, judged
@@ -228,13 +228,10 @@ def _stop(procs: list[Any]) -> list[Optional[int]]:
     """Ctrl+C for each process; their exit codes (None: one had to be killed)."""
     for proc in procs:
         interrupt(proc)
-    codes: list[Optional[int]] = []
-    for proc in procs:
-        try:
-            codes.append(proc.wait(EXIT_AFTER_CTRL_C_S))
-        except subprocess.TimeoutExpired:
+    codes = [wait_patiently(proc, EXIT_AFTER_CTRL_C_S) for proc in procs]
+    for proc, code in zip(procs, codes):
+        if code is None:
             kill_process_group(proc)
-            codes.append(None)
     return codes
 
 
@@ -350,9 +347,10 @@ def _setup_cfg_cause(judge: Judge) -> Optional[str]:
 
 
 def _setup_cfg(judge: Judge) -> str:
-    if PLACEHOLDER in (TEXT.read(_package_source(judge) / 'setup.cfg') or ''):
-        raise CheckFailed('setup.cfg still holds the placeholder "raise NotImplementedError()": '
-                          'write the two settings in its place.')  # not written: no point
+    if PLACEHOLDER in (TEXT.read(_package_source(judge) / 'setup.cfg') or '') or \
+            saved_parts(judge.workspace, course.SETUP_CFG_FILE) == set():  # its cell: unwritten
+        raise CheckFailed('The setup.cfg cell still holds the placeholder "raise '
+                          'NotImplementedError()": write the two settings in its place and run it.')
     try:  # the learner's setup.py may be at fault
         problem = _runs(judge, _built(judge))
     except CheckFailed as failure:

@@ -13,13 +13,12 @@ from __future__ import annotations
 import ast
 import re
 import signal
-import subprocess
 import sys
 from pathlib import Path
 from typing import Any, Optional
 
 from ..errors import CheckFailed
-from ..processes import interrupt, kill_process_group
+from ..processes import interrupt, kill_process_group, wait_patiently
 from .base import ARRIVAL_TIMEOUT_S, Judge
 from .source import TEXT
 
@@ -93,11 +92,10 @@ def _watch_stop(observer: Any, path: Path, node_name: str, part: int, proc: Any,
                           'bring rclpy up, create the node and spin it until Ctrl+C.')
     interrupt(proc, sig)
     pressed = STOPPING_SIGNALS[sig]
-    try:
-        code = proc.wait(EXIT_AFTER_CTRL_C_S)
-    except subprocess.TimeoutExpired:
+    code = wait_patiently(proc, EXIT_AFTER_CTRL_C_S)
+    if code is None:
         raise CheckFailed(f'{path.name} did not stop within {EXIT_AFTER_CTRL_C_S:g} s of '
-                          f'{pressed}: let {STOP_EXCEPTIONS[sig]} end the spin.') from None
+                          f'{pressed}: let {STOP_EXCEPTIONS[sig]} end the spin.')
     text = output.text()
     stuck = _last_frame(text, path)
     if not spinning and stuck is not None and stuck[1] != 'main':

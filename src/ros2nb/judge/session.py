@@ -27,6 +27,7 @@ from ..checks.base import AnswerRef, learner_error
 from ..checks.nodes import parts_verdict
 from ..errors import CheckFailed
 from ..processes import kill_process_group
+from ..runtime.clock import JUDGE_TOPICS_ENV
 from ..terminal.workspace import WORKSPACE_ENV
 from .clock import JudgeClock
 from .observer import Observer
@@ -100,7 +101,8 @@ class Session:
             _ = self.clock  # published before any subject runs: it starts on the judge's time
             where = workspace or self.workspace
             heard = self.observer.counts()
-            subject = SubjectProcess(where, env=subject_env({WORKSPACE_ENV: str(where)}))
+            subject = SubjectProcess(where, env=subject_env({
+                WORKSPACE_ENV: str(where), JUDGE_TOPICS_ENV: json.dumps(sorted(heard[0]))}))
             subject.heard_base = heard
             self._subjects[key] = subject
             try:

@@ -20,6 +20,7 @@ import contextlib
 import dataclasses
 import json
 import os
+import time
 from collections import Counter
 from typing import Any, Callable, Iterable, Iterator, Optional
 
@@ -41,6 +42,11 @@ JUDGE_CLOCK_ENV = 'ROS2NB_JUDGE_CLOCK_FD'
 #: that starts later (transient local), so a new runtime starts at the judge's time.
 JUDGE_CLOCK_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                              durability=DurabilityPolicy.TRANSIENT_LOCAL)
+#: The topics the judge hears (a JSON list in the environment of its subjects): a message
+#: published there must reach it, so a subject's spin starts once they are matched.
+JUDGE_TOPICS_ENV = 'ROS2NB_JUDGE_TOPICS'
+#: Wall-clock seconds a subject's spin waits at most for its publishers to reach the judge.
+JUDGE_MATCH_WAIT_S = 30.0
 #: Seconds one wait for the judge's next step lasts before it is waited for again.
 JUDGE_STEP_WAIT_S = 0.5
 
@@ -60,6 +66,8 @@ class JudgeTime:
     _logged: Counter = Counter()
     _counting = False
     _claimed: Optional[int] = None
+    #: The topics the judge hears (:data:`JUDGE_TOPICS_ENV`).
+    topics: frozenset = frozenset()
 
     def __init__(self, fd: int) -> None:
         self._fd = fd
@@ -75,6 +83,11 @@ class JudgeTime:
         value = os.environ.pop(JUDGE_CLOCK_ENV, '')
         if value.isdigit():
             cls._claimed = int(value)
+        try:
+            topics = json.loads(os.environ.pop(JUDGE_TOPICS_ENV, '[]'))
+        except ValueError:
+            topics = []
+        cls.topics = cls.topics or frozenset(t for t in topics if isinstance(t, str))
 
     @classmethod
     def for_this_process(cls) -> Optional['JudgeTime']:
@@ -291,6 +304,18 @@ class SimulatedClock:
                 raise
         return (self.sim_now_ns - start) / 1e9
 
+    def _reach_judge(self, topics: frozenset) -> None:
+        """Wait (at most :data:`JUDGE_MATCH_WAIT_S` of the wall clock) until each publisher
+        here on a topic the judge hears has matched a subscription: a message published
+        before the judge's subscription was discovered would never reach it (a volatile
+        topic keeps nothing for late joiners), however idle or busy the machine."""
+        publishers = [p for node in (self.node, *self._nodes.values()) for p in node.publishers
+                      if p.topic_name in topics]
+        deadline = time.monotonic() + JUDGE_MATCH_WAIT_S
+        while any(p.get_subscription_count() < 1 for p in publishers) and \
+                time.monotonic() < deadline:
+            time.sleep(0.01)
+
     def _follow_judge(self, end: int, until: Optional[Callable[[], bool]],
                       on_step: Optional[Callable[[], None]]) -> None:
         """:meth:`advance_sim_time` in a judge's subject: wait for each step of the judge's
@@ -303,6 +328,7 @@ class SimulatedClock:
         judge = self.judge_time
         assert judge is not None
         with self.exclusive():
+            self._reach_judge(judge.topics)
             self.drain()
             judge.ack(self.sim_now_ns, end, self.failures, self.is_ours)
             while self.sim_now_ns < end and not (until and until()):

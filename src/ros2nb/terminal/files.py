@@ -138,19 +138,28 @@ def _parts_of(path: Path) -> Iterator[dict[int, str]]:
     record_file.write_text(json.dumps(record, indent=1, sort_keys=True) + '\n')
 
 
-def missing_parts(workspace: Path, relative: str) -> list[int]:
-    """The part numbers below the highest saved part of ``relative`` that were never saved.
+def saved_parts(workspace: Path, relative: str) -> Optional[set[int]]:
+    """The part numbers of ``relative`` that ``%%part`` cells saved: an empty set when its
+    cells ran but saved nothing (each still held the placeholder), None when none of its
+    cells ran (or the record cannot be read).
 
-    Read from the workspace's ``.ros2nb-parts.json`` (what ``%%part`` cells saved).
-    Introduced in ``03-write-the-publisher.ipynb`` (checks name a part run out of order).
+    Read from the workspace's ``.ros2nb-parts.json``.  Introduced in
+    ``03-write-the-publisher.ipynb``.
     """
     record_file = workspace / PARTS_RECORD
     try:
         record = json.loads(record_file.read_text()) if record_file.is_file() else {}
-        saved = {int(n) for n in record.get(relative, {})}
+        return {int(n) for n in record[relative]} if relative in record else None
     except (OSError, ValueError, TypeError, AttributeError):  # not a record %%part wrote
-        return []
-    return _gaps(saved)
+        return None
+
+
+def missing_parts(workspace: Path, relative: str) -> list[int]:
+    """The part numbers below the highest saved part of ``relative`` that were never saved.
+
+    Introduced in ``03-write-the-publisher.ipynb`` (checks name a part run out of order).
+    """
+    return _gaps(saved_parts(workspace, relative) or set())
 
 
 def _gaps(saved: set[int]) -> list[int]:
