@@ -204,7 +204,7 @@ def _effect_verdict(node: _Monitor) -> None:
 
 
 def _monitor_parameters(judge: Judge) -> str:
-    node = _Monitor(judge, ('thresholds_on_set',))
+    node = _Monitor(judge, ('thresholds_on_set', 'thresholds_callback'))  # part 4's, given
     _declared_verdict(node)
     _descriptor_verdict(node)
     _effect_verdict(node)

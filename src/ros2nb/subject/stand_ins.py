@@ -116,6 +116,15 @@ def thresholds_on_set(self: Node, parameters: list) -> SetParametersResult:
     return SetParametersResult(successful=True)
 
 
+def thresholds_callback(self: Node, msg: Float32) -> None:
+    """Notebook 08's monitor callback (given in part 4): the status by both thresholds as
+    they are now."""
+    high = self.get_parameter(course.HIGH_PARAMETER).value
+    low = self.get_parameter(course.LOW_PARAMETER).value
+    status = 'High' if msg.data > high else 'Low' if msg.data < low else 'Normal'
+    self.get_logger().info(f'Temperature: {msg.data:.2f}C - Status: {status}')
+
+
 #: Stand-ins by name: the method of the learner's class each one replaces, and the function.
 STAND_INS: dict[str, tuple[str, Callable[..., Any]]] = {
     'sensor_init': ('__init__', sensor_init),
@@ -126,6 +135,7 @@ STAND_INS: dict[str, tuple[str, Callable[..., Any]]] = {
     'fan_callback': ('temperature_callback', fan_callback),
     'thresholds_init': ('__init__', thresholds_init),
     'thresholds_on_set': ('on_set_thresholds', thresholds_on_set),
+    'thresholds_callback': ('temperature_callback', thresholds_callback),
 }
 #: Whole nodes for a ``main()`` graded alone: the class main() creates, by class name.
 STAND_IN_NODES = {
