@@ -18,12 +18,17 @@ from pathlib import Path
 from typing import Any, Optional
 
 from ..errors import CheckFailed
-from ..processes import interrupt, kill_process_group, wait_patiently
-from .base import ARRIVAL_TIMEOUT_S, Judge
+from ..processes import Patience, interrupt, kill_process_group, wait_patiently
+from .base import Judge
 from .source import TEXT
 
 #: Seconds a node process gets to exit after Ctrl+C (which comes once its node spins).
 EXIT_AFTER_CTRL_C_S = 20.0
+#: Seconds a program gets to put its node in the graph: of its own work while it works (a
+#: busy machine makes it slow, not wrong), of the wall clock while it waits for nothing.
+START_PATIENCE_S = 30.0
+#: Seconds between two looks at how much the program has worked.
+LOOK_AGAIN_S = 0.5
 #: How a running node is stopped, in turn: Ctrl+C in its terminal, and a shutdown from
 #: outside (SIGTERM, as ``ros2 launch`` after its grace period, systemd or docker stop send).
 #: On Jazzy the first ends the spin with KeyboardInterrupt, the second with
@@ -80,16 +85,15 @@ def _watch_stop(observer: Any, path: Path, node_name: str, part: int, proc: Any,
     # Ctrl+C once the node spins (it answers a parameter call), as a learner presses it
     # once the node runs: earlier, a busy machine would decide what the learner is told.
     # The graph is read once for the verdict: the read that ended the wait, not a second one.
-    started = observer.wait_until(
-        lambda: proc.poll() is not None or observer.has_node(node_name), ARRIVAL_TIMEOUT_S,
-    ) and proc.poll() is None
+    started = _wait_for_node(observer, proc, node_name) and proc.poll() is None
     spinning = started and observer.spins(node_name)
     if proc.poll() is not None:
         raise _ended_early(path, part, output.text(), proc.returncode)
     if not started:  # the judge's own graph: no node of that name appeared while it ran
         raise CheckFailed(f'{path.name} never started its node {node_name} (none appeared in the '
-                          f'grader\'s ROS graph within {ARRIVAL_TIMEOUT_S:g} s): main() should '
-                          'bring rclpy up, create the node and spin it until Ctrl+C.')
+                          f'grader\'s ROS graph while the program had {START_PATIENCE_S:g} s to '
+                          'start it): main() should bring rclpy up, create the node and spin it '
+                          'until Ctrl+C.')
     interrupt(proc, sig)
     pressed = STOPPING_SIGNALS[sig]
     code = wait_patiently(proc, EXIT_AFTER_CTRL_C_S)
@@ -115,6 +119,18 @@ def _watch_stop(observer: Any, path: Path, node_name: str, part: int, proc: Any,
         what = f'{pressed} had already shut rclpy down' if already else last
         raise CheckFailed(f'{path.name} exited with code {code} after {pressed} ({what}): '
                           f'{_ctrl_c_advice(path, already)}.')
+
+
+def _wait_for_node(observer: Any, proc: Any, node_name: str) -> bool:
+    """Wait until the node is in the judge's graph or the program ended: True then, False
+    once the program had :data:`START_PATIENCE_S` (:class:`~ros2nb.processes.Patience`:
+    seconds of its own work while it works, of the wall clock while it waits)."""
+    patience = Patience(proc.pid, START_PATIENCE_S)
+    while not observer.wait_until(
+            lambda: proc.poll() is not None or observer.has_node(node_name), LOOK_AGAIN_S):
+        if patience.exhausted():
+            return False
+    return True
 
 
 def _ended_early(path: Path, part: int, text: str, code: int) -> CheckFailed:
