@@ -84,6 +84,16 @@ def reach(judge: Judge, subject, node: str) -> None:
                           'check its subscription\'s topic name and type.')
 
 
+def announced(counts: dict, topic: str) -> Optional[int]:
+    """How many messages a subject's counts say it published on ``topic``, or None when
+    they say nothing usable: how long to wait for them, never what passes."""
+    published = counts.get('published')
+    if not isinstance(published, dict):
+        return None
+    value = published.get(topic, 0)
+    return value if isinstance(value, int) and not isinstance(value, bool) else None
+
+
 def feed(judge: Judge, subject: Any, info: dict, value: float, counts: dict,
          never: str) -> tuple[dict, list[str]]:
     """Publish one reading from the judge's node to the learner's node ``info`` in

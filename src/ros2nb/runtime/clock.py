@@ -90,6 +90,12 @@ class JudgeTime:
         cls.topics = cls.topics or frozenset(t for t in topics if isinstance(t, str))
 
     @classmethod
+    def published(cls) -> Optional[dict[str, int]]:
+        """Messages this process has published so far, per topic; None when nothing is
+        counted here (no judge's time was made in this process)."""
+        return dict(cls._counts) if cls._counting else None
+
+    @classmethod
     def for_this_process(cls) -> Optional['JudgeTime']:
         """The judge's time when this process is a judge's subject, else None."""
         cls.claim()

@@ -29,6 +29,7 @@ from .. import domains
 from ..endpoints import node_endpoints
 from ..errors import Ros2nbError
 from ..runtime import Runtime, enable_field_checks
+from ..runtime.clock import JudgeTime
 from .replies import decode_argument, describe_error, encode
 from .stand_ins import with_stand_ins
 from .trials import Trials
@@ -168,7 +169,8 @@ class Subject(Trials):
     def _counts(self) -> dict:
         rt = self._runtime()
         logged = rt.log_counts.get(self.node.get_logger().name, 0) if self.node else 0
-        return {'received': self.received, 'logged': logged, 'failure': self.failure}
+        return {'received': self.received, 'logged': logged, 'failure': self.failure,
+                'published': JudgeTime.published()}
 
     def counts(self) -> dict:
         return {'ok': True, **self._counts()}
