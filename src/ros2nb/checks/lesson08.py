@@ -246,10 +246,12 @@ def _refusal_hint(name: str) -> str:
 
 def _declared(judge: Judge) -> _Monitor:
     """The learner's monitor with its own constructor, or the course's when theirs does not
-    declare both thresholds (a mistake in part 3 costs part 3 only)."""
+    declare and describe both thresholds as part 3 asks (a mistake in part 3 costs part 3
+    only: parameter services that answer from a table of their own describe no range)."""
     try:
         node = _Monitor(judge, ())
         _declared_verdict(node)
+        _descriptor_verdict(node)
         return node
     except CheckFailed:
         return _Monitor(judge, ('thresholds_init',))
