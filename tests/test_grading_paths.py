@@ -171,8 +171,8 @@ def test_a_subject_writes_nowhere_its_judge_reads(scratch, monkeypatch):
     submitted = nbformat.read(SOLUTION[NB02], as_version=4)
     next(c for c in submitted.cells if 'def package_dependencies' in c.source).source = \
         PLANTING_READER
-    results, problem = judge_notebook(scratch, NB02, submitted, Settings(120, 600, True),
-                                      scratch.snapshot(NB02))
+    results, problem, _flags = judge_notebook(scratch, NB02, submitted, Settings(120, 600, True),
+                                             scratch.snapshot(NB02))
     assert problem is None and results and all(r.get('passed') for r in results.values()), \
         results
     folder = scratch.top / f'judge-{NB02}'
@@ -227,8 +227,8 @@ def test_a_learners_build_scripts_never_run_in_the_judge(scratch, monkeypatch):
         '    data_files=[\n', f"    data_files=[\n        ('share/{course.PACKAGE}/hook', "
                              "['planted.sh']),\n", 1))
     submitted = nbformat.read(SOLUTION[NB05], as_version=4)
-    results, problem = judge_notebook(scratch, NB05, submitted, Settings(120, 600, True),
-                                      scratch.snapshot(NB05))
+    results, problem, _flags = judge_notebook(scratch, NB05, submitted, Settings(120, 600, True),
+                                             scratch.snapshot(NB05))
     assert problem is None and results and all(r.get('passed') for r in results.values()), \
         results
     folder = scratch.top / f'judge-{NB05}'

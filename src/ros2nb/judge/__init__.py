@@ -13,7 +13,8 @@ and cannot see, signal or trace the judge.
 
 Modules: ``observer`` (its own ROS node), ``subjects`` (the processes that run the
 learner's code), ``session`` (what the checks get as their judge), ``grading`` (a whole
-notebook's graded cells), ``__main__`` (the command line).  It imports the checks it
+notebook's graded cells), ``flags`` (code that reaches in, for the instructor),
+``__main__`` (the command line).  It imports the checks it
 runs; the checks never import it (the kernel starts it by name).
 
 Command line (``python -m ros2nb.judge``):
@@ -21,7 +22,8 @@ Command line (``python -m ros2nb.judge``):
 - ``check NAME KWARGS_JSON``: run ``ros2nb.checks.NAME(**kwargs)``; print one JSON line.
 - ``grade SOURCE.ipynb SUBMISSION.ipynb``: run every graded cell of the course's source
   notebook (hidden tests included) against the learner's submission and workspace; print
-  one JSON object, ``{grade_id: result}``.
+  one JSON object, ``{"results": {grade_id: result}, "flags": [...]}`` (the flags, for the
+  instructor only, from :mod:`ros2nb.judge.flags`).
 
 Both take the learner's workspace from ``ROS2NB_WORKSPACE``.
 """

@@ -17,6 +17,7 @@ from ..checks.base import bind_judge
 from ..checks.dispatch import IN_JUDGE_ENV, captured
 from ..processes import end_this_process
 from ..terminal.workspace import default_workspace
+from .flags import notebook_flags
 from .grading import grade
 from .session import Session
 
@@ -36,7 +37,8 @@ def main(argv: list[str]) -> int:
             result: Any = captured(lambda: function(**json.loads(argv[2])))
         else:
             source, submission = (json.loads(Path(p).read_text()) for p in argv[1:])
-            result = grade(source, submission)
+            result = {'results': grade(source, submission),
+                      'flags': notebook_flags(submission, session.workspace)}
     finally:
         bind_judge(None)
         session.close()

@@ -14,7 +14,7 @@ import shutil
 import subprocess
 import sys
 from pathlib import Path
-from typing import Optional
+from typing import NamedTuple, Optional
 
 import nbformat
 
@@ -26,9 +26,26 @@ from .scratch import Scratch, sandbox_env
 from .settings import JUDGE_TIMEOUT_S, Settings
 
 
+#: Flags of one notebook kept for the instructor's notes (each cut to 300 characters).
+MAX_FLAGS = 20
+
+
+class Verdict(NamedTuple):
+    """What the judge decided about one notebook.
+
+    :ivar results: ``{grade_id: result}`` (empty when nothing could be checked).
+    :ivar problem: why nothing could be checked, or None.
+    :ivar flags: code that reaches into the course, for the instructor (:mod:`ros2nb.judge.flags`).
+    """
+
+    results: dict
+    problem: Optional[str]
+    flags: tuple[str, ...] = ()
+
+
 def judge_notebook(scratch: Scratch, notebook: str, submitted: nbformat.NotebookNode,
-                   settings: Settings, workspace: Path) -> tuple[dict, Optional[str]]:
-    """Run the judge on what the learner wrote; return ``{grade_id: result}`` or a problem.
+                   settings: Settings, workspace: Path) -> Verdict:
+    """Run the judge on what the learner wrote; return its :class:`Verdict`.
 
     :param submitted: the learner's notebook as the grader read it (nbformat 4, whatever
         version was handed in; attachments too large to keep already dropped).
@@ -66,7 +83,7 @@ def judge_notebook(scratch: Scratch, notebook: str, submitted: nbformat.Notebook
             result = box.run(argv, limits, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                              text=True)
         except OSError as error:  # e.g. the notebook made its workspace unreadable
-            return {}, f'the grader could not check it: {error}'
+            return Verdict({}, f'the grader could not check it: {error}')
         out, err, code, timed_out = result.stdout, result.stderr, result.returncode, \
             result.timed_out
     else:
@@ -77,12 +94,22 @@ def judge_notebook(scratch: Scratch, notebook: str, submitted: nbformat.Notebook
         except subprocess.TimeoutExpired:
             out, err, code, timed_out = '', '', -9, True
     if timed_out:
-        return {}, f'checking it took longer than {JUDGE_TIMEOUT_S} s'
+        return Verdict({}, f'checking it took longer than {JUDGE_TIMEOUT_S} s')
+    return _read_verdict(out, err, code)
+
+
+def _read_verdict(out: str, err: Optional[str], code: int) -> Verdict:
+    """The judge's verdict from the last line it printed (``{"results", "flags"}``)."""
     try:
-        return json.loads(out.strip().splitlines()[-1]), None
-    except (IndexError, ValueError):
+        printed = json.loads(out.strip().splitlines()[-1])
+        results, flags = printed['results'], printed['flags']
+        if not (isinstance(results, dict) and isinstance(flags, list)):
+            raise ValueError('not the judge\'s answer')
+    except (IndexError, ValueError, TypeError, KeyError):
         last = (err or '').strip().splitlines()[-1:] or ['no message']
-        return {}, f'the grader could not check it (judge exit code {code}: {last[0][:200]})'
+        return Verdict({}, f'the grader could not check it (judge exit code {code}: '
+                           f'{last[0][:200]})')
+    return Verdict(results, None, tuple(str(flag)[:300] for flag in flags[:MAX_FLAGS]))
 
 
 class Judges:

@@ -19,6 +19,10 @@ from .scratch import HOME_BYTES, OUT_OF_SPACE, Scratch
 from .settings import Settings
 from .submissions import Learner, readable
 
+#: How a note introduces the judge's flags (code that reaches into the course or its
+#: process, ros2nb.judge.flags): the grade does not depend on them.
+FLAGGED = 'code to look at (no points changed; it reaches past what the lessons use):'
+
 
 def grade_learner(course: Path, scratch_root: Path, learner: Learner, notebooks: list[str],
                   settings: Settings, judges: Judges) -> None:
@@ -93,9 +97,11 @@ def _file(target: Path, learner: Learner, notebook: str, release: nbformat.Noteb
           executed: nbformat.NotebookNode, verdict: concurrent.futures.Future) -> None:
     """Put the judged notebook where nbgrader scores it (or a note why it could not be)."""
     try:
-        results, problem = verdict.result()
+        results, problem, flags = verdict.result()
         if problem:
             learner.note(notebook, problem)
+        if flags:  # the instructor's to look at; the points are the judge's verdict alone
+            learner.note(notebook, f'{FLAGGED} ' + ' | '.join(flags))
         scored = notebooks_of.for_scoring(release, executed, results, problem)
     except Exception as error:  # noqa: BLE001 - one learner's problem, said in a note
         scored = notebooks_of.note_notebook(release, _not_gradable(learner, notebook, error))

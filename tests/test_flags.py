@@ -1,0 +1,93 @@
+"""The judge's flags for the instructor: code that reaches into the course or its process.
+
+Every attack of ``corpus_attacks.py`` that reaches in (stack frames, the garbage collector's
+objects, rclpy's classes patched, a ``setup.py`` that writes the executables itself) is
+flagged; no honest learner, no wrong learner and no solution is.  Some of these attacks
+look the same as honest code on the wire (``same_on_the_wire``): the flag is how the
+instructor learns of them.  The flag reaches ``notes.json`` through the host's note of the
+notebook, and changes no point.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import json
+
+import nbformat
+import pytest
+
+from corpora import NOTEBOOKS, Learner, every_learner, flags_of
+from ros2nb.judge.flags import reaching_in
+from ros2nb_instructor.grading import learners as learners_module
+from ros2nb_instructor.grading.judging import Verdict
+from ros2nb_instructor.grading.submissions import Learner as ClassLearner
+
+LEARNERS = every_learner()
+SOLUTIONS = [Learner(f'solution {number}', number, {}) for number in sorted(NOTEBOOKS)
+             if number >= '03']
+
+
+@pytest.mark.parametrize('learner', [*LEARNERS.values(), *SOLUTIONS],
+                         ids=[*LEARNERS, *(s.name for s in SOLUTIONS)])
+def test_flagged_exactly_when_the_code_reaches_in(learner: Learner, tmp_path):
+    flags = flags_of(learner, tmp_path)
+    assert bool(flags) == learner.flagged, flags
+    assert all(' line ' in flag and '\n' not in flag for flag in flags), flags
+
+
+@pytest.mark.parametrize('code, found', [
+    ('import sys\nframe = sys._getframe(1)', "sys._getframe (reads the caller's stack frames)"),
+    ('import inspect as i\ni.stack()', 'inspect.stack'),
+    ('from gc import get_objects\nget_objects()', 'gc.get_objects'),
+    ('def f(tb):\n    return tb.tb_frame.f_locals', '.f_locals'),
+    ("open('/proc/1/cmdline')", '/proc'),
+    ('from rclpy.publisher import Publisher\nPublisher.publish = print', 'Publisher.publish'),
+    ('import rclpy\nsetattr(rclpy, "spin", print)', 'an attribute of rclpy'),
+    ('from ros2nb.runtime import clock', "ros2nb.runtime.clock (ros2nb's internals)"),
+    ('import ros2nb\nros2nb.current_runtime()', 'ros2nb.current_runtime'),
+    ('import ctypes', 'ctypes'),
+])
+def test_each_kind_is_named(code, found):
+    flags = reaching_in(code, 'cell')
+    assert any(found in flag for flag in flags), flags
+
+
+@pytest.mark.parametrize('code', [
+    'import ros2nb\nros2nb.add(node)\nros2nb.course.TOPIC',
+    'self.timer = self.create_timer(1.0, lambda: self.tick())',
+    "self.get_logger().info('/processing')",
+    'import random\nrandom.seed(7)',
+    'node.declare_parameter("x", 1.0)',
+    'this is not python',
+])
+def test_honest_code_is_not_flagged(code):
+    assert reaching_in(code, 'cell') == []
+
+
+def test_setup_py_writes_are_flagged_only_in_setup_py():
+    code = "with open('notes.txt', 'w') as f:\n    f.write('x')"
+    assert reaching_in(code, 'setup.py', setup_py=True)
+    assert reaching_in(code, 'helper.py') == []
+
+
+def test_a_flag_reaches_the_instructors_note_and_no_point(tmp_path):
+    """The host writes the judge's flags into the notebook's note; the results it scores
+    are the judge's, untouched."""
+    number = '02'
+    release = nbformat.read(NOTEBOOKS[number], as_version=4)
+    graded = {c.metadata['nbgrader']['grade_id']: {'passed': True, 'lines': ['Check passed: x']}
+              for c in release.cells if c.metadata.get('nbgrader', {}).get('grade')}
+    verdict: concurrent.futures.Future = concurrent.futures.Future()
+    verdict.set_result(Verdict(graded, None, ('answer cell 02-x line 3: uses sys._getframe',)))
+    learner = ClassLearner('ada', 'ada')
+    learners_module._file(tmp_path, learner, NOTEBOOKS[number].stem, release,
+                          copy_of(release), verdict)
+    note = learner.notes[NOTEBOOKS[number].stem]
+    assert note.startswith(learners_module.FLAGGED) and 'sys._getframe' in note
+    scored = json.loads((tmp_path / f'{NOTEBOOKS[number].stem}.ipynb').read_text())
+    shown = [''.join(o.get('text', '')) for c in scored['cells'] for o in c.get('outputs', [])]
+    assert sum('Check passed: x' in text for text in shown) == len(graded)
+
+
+def copy_of(nb: nbformat.NotebookNode) -> nbformat.NotebookNode:
+    return nbformat.reads(nbformat.writes(nb), as_version=4)
