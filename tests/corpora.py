@@ -44,7 +44,8 @@ class Learner:
     :ivar cells: answer cell (its grade id without ``NN-`` and ``-answer``) -> new text
         (its ``%%part`` line is kept) or a list of ``(old, new)`` replacements.
     :ivar loses: grade ids (without ``NN-``) of the parts this learner must fail.
-    :ivar twin: for an attack, the learner it must score the same as.
+    :ivar twin: for an attack, the learner it must score the same as (unless
+        ``same_on_the_wire``: then the score it deserves).
     """
 
     name: str
@@ -52,6 +53,11 @@ class Learner:
     cells: dict[str, Change]
     loses: tuple[str, ...] = ()
     twin: Optional[str] = None
+    #: code that reaches into the course or its process: the judge flags it for the instructor
+    flagged: bool = False
+    #: an attack the wire cannot tell from honest code (its score may exceed its twin's;
+    #: only the flag tells the instructor)
+    same_on_the_wire: bool = False
     why: str = ''
     extra: dict = field(default_factory=dict)
 
@@ -142,18 +148,13 @@ def _grading_env(root: Path) -> Iterator[Path]:
         course.reference_source = reference
 
 
-def grade_learner(learner: Learner, root: Path) -> dict[str, dict]:
-    """Grade one learner's notebook in a fresh workspace under ``root``.
-
-    :return: ``{grade id without NN-: result}`` (``passed``, and ``message`` when failed).
-    """
+@contextlib.contextmanager
+def learner_workspace(learner: Learner, root: Path) -> Iterator[tuple[Path, dict]]:
+    """The learner's workspace under ``root`` as their notebook left it, and the notebook:
+    what ``catch_up`` writes while grading, then what its ``%%part`` cells write."""
     from ros2nb import course
-    from ros2nb.checks.base import bind_judge
-    from ros2nb.judge.grading import grade
-    from ros2nb.judge.session import Session
     from ros2nb.terminal.workspace import create_workspace
     nb = submission(learner)
-    source = json.loads(NOTEBOOKS[learner.notebook].read_text())
     number = int(learner.notebook)
     with _grading_env(root) as ws, contextlib.redirect_stdout(io.StringIO()):
         if number in course.STEPS:
@@ -161,6 +162,20 @@ def grade_learner(learner: Learner, root: Path) -> dict[str, dict]:
         else:
             create_workspace()
         _write_parts(nb)
+        yield ws, nb
+
+
+def grade_learner(learner: Learner, root: Path) -> dict[str, dict]:
+    """Grade one learner's notebook in a fresh workspace under ``root``.
+
+    :return: ``{grade id without NN-: result}`` (``passed``, and ``message`` when failed).
+    """
+    from ros2nb.checks.base import bind_judge
+    from ros2nb.judge.grading import grade
+    from ros2nb.judge.session import Session
+    source = json.loads(NOTEBOOKS[learner.notebook].read_text())
+    with learner_workspace(learner, root) as (ws, nb), \
+            contextlib.redirect_stdout(io.StringIO()):
         session = Session(ws)
         bind_judge(session)
         try:
@@ -169,6 +184,13 @@ def grade_learner(learner: Learner, root: Path) -> dict[str, dict]:
             bind_judge(None)
             session.close()
     return {gid[3:]: result for gid, result in results.items()}
+
+
+def flags_of(learner: Learner, root: Path) -> list[str]:
+    """What the judge flags for the instructor in the learner's notebook and files."""
+    from ros2nb.judge.flags import notebook_flags
+    with learner_workspace(learner, root) as (ws, nb):
+        return notebook_flags(nb, ws)
 
 
 def score(learner: Learner, results: dict[str, dict]) -> float:

@@ -8,6 +8,60 @@ subject reports about the learner's objects.
 
 from corpora import Learner
 
+#: 03: no timer; every step of the course's runtime (found among the garbage collector's
+#: objects) publishes the walk.  On the wire, one reading per simulated second, as a timer's.
+STEP_PUBLISHES = [(
+    '        self.timer = self.create_timer(PUBLISH_PERIOD_S, self.publish_temperature)\n', '''\
+        import gc
+        self._second = None
+        for runtime in [o for o in gc.get_objects() if hasattr(type(o), '_publish_clock')]:
+            def stepped(real=runtime._publish_clock):
+                real()
+                second = self.get_clock().now().nanoseconds // 10**9
+                if self._second is not None and second > self._second:
+                    self.publish_temperature()
+                self._second = second
+            runtime._publish_clock = stepped
+''')]
+#: 04: the callback does nothing; every subscription the process makes is wrapped (rclpy's
+#: own Node.create_subscription replaced) with one that logs the statuses.
+WRAPPED_SUBSCRIPTIONS = '''
+    def temperature_callback(self, msg):
+        return
+
+
+def _logging(make=Node.create_subscription):
+    def create_subscription(node, msg_type, topic, callback, *args, **kwargs):
+        def logged(msg):
+            status = 'High' if msg.data > 26.0 else 'Low' if msg.data < 20.0 else 'Normal'
+            node.get_logger().info(f'Temperature: {msg.data:.2f}C - Status: {status}')
+            callback(msg)
+        return make(node, msg_type, topic, logged, *args, **kwargs)
+    return create_subscription
+
+
+Node.create_subscription = _logging()
+'''
+#: 05: no console_scripts; setup.py writes the executables where ros2 run looks for them.
+SETUP_WRITES_SCRIPTS = [(
+    "            'temperature_publisher = sensor_simulator.temperature_publisher:main',\n"
+    "            'temperature_subscriber = sensor_simulator.temperature_subscriber:main',\n",
+    ''), ('from setuptools import find_packages, setup\n', '''\
+import os
+import sys
+from setuptools import find_packages, setup
+
+for _argument in sys.argv:
+    if _argument.startswith('--prefix='):
+        _bin = os.path.join(_argument.split('=', 1)[1], 'lib', 'sensor_simulator')
+        os.makedirs(_bin, exist_ok=True)
+        for _name in ('temperature_publisher', 'temperature_subscriber'):
+            with open(os.path.join(_bin, _name), 'w') as _script:
+                _script.write(f'#!{sys.executable}\\nfrom sensor_simulator.{_name} import main\\n'
+                              'main()\\n')
+            os.chmod(os.path.join(_bin, _name), 0o755)
+''')]
+
 #: Module code that finds the subject's request loop from the learner's import, as the
 #: attacks of 123efa2's sample class did, and answers every question with a right answer's
 #: numbers.  The subject now loads the learner's code before the loop exists.
@@ -37,13 +91,91 @@ def {name}():
 ''' for name in ('newest_only_profile', 'sensor_subscription_profile',
                  'latched_thresholds_profile')}
 
+#: 08: nothing declared; the node's parameter services are its own, answered from a table
+#: (every set accepted), while the statuses keep the fixed thresholds.
+PARAMETERS_TWIN = '''
+from rclpy.parameter import Parameter
+
+
+class TemperatureMonitor(Node):
+    """Logs every reading with its status."""
+
+    def __init__(self):
+        super().__init__('temperature_monitor')
+        self.get_parameter = lambda name: Parameter(name, value={'high_above_c': HIGH_ABOVE_C,
+                                                                 'low_below_c': LOW_BELOW_C}[name])
+        self.subscription = self.create_subscription(
+            Float32, TOPIC, self.temperature_callback, QUEUE_DEPTH)
+        self.get_logger().info('Temperature Monitor Node Started')
+'''
+PARAMETERS_TABLE = '''
+from rclpy.parameter import Parameter
+
+
+class TemperatureMonitor(Node):
+    """Logs every reading with its status; answers parameter calls from a table."""
+
+    def __init__(self):
+        super().__init__('temperature_monitor', start_parameter_services=False)
+        from rcl_interfaces.msg import ParameterDescriptor, ParameterType, ParameterValue
+        from rcl_interfaces.srv import (DescribeParameters, GetParameters, GetParameterTypes,
+                                        ListParameters, SetParameters, SetParametersAtomically)
+        table = {'high_above_c': HIGH_ABOVE_C, 'low_below_c': LOW_BELOW_C}
+        double = ParameterType.PARAMETER_DOUBLE
+
+        def get(request, response):
+            response.values = [ParameterValue(type=double, double_value=table.get(n, 0.0))
+                               for n in request.names]
+            return response
+
+        def set_(request, response):
+            for parameter in request.parameters:
+                table[parameter.name] = parameter.value.double_value
+            response.results = [SetParametersResult(successful=True)
+                                for _ in request.parameters]
+            return response
+
+        def set_all(request, response):
+            for parameter in request.parameters:
+                table[parameter.name] = parameter.value.double_value
+            response.result = SetParametersResult(successful=True)
+            return response
+
+        def types(request, response):
+            response.types = [double for _ in request.names]
+            return response
+
+        def list_(request, response):
+            response.result.names = list(table)
+            return response
+
+        def describe(request, response):
+            response.descriptors = [ParameterDescriptor(name=n, type=double)
+                                    for n in request.names]
+            return response
+
+        for name, kind, answer in (('get_parameters', GetParameters, get),
+                                   ('set_parameters', SetParameters, set_),
+                                   ('list_parameters', ListParameters, list_),
+                                   ('describe_parameters', DescribeParameters, describe),
+                                   ('get_parameter_types', GetParameterTypes, types),
+                                   ('set_parameters_atomically', SetParametersAtomically,
+                                    set_all)):
+            self.create_service(kind, f'~/{name}', answer)
+        self.get_parameter = lambda name: Parameter(name, value={'high_above_c': HIGH_ABOVE_C,
+                                                                 'low_below_c': LOW_BELOW_C}[name])
+        self.subscription = self.create_subscription(
+            Float32, TOPIC, self.temperature_callback, QUEUE_DEPTH)
+        self.get_logger().info('Temperature Monitor Node Started')
+'''
+
 ATTACKS = [
     Learner('07 twin: a callback that does nothing', '07', {'plot-callback': PLOT_DEAD},
             loses=('plot-callback',)),
     Learner('07 attack: the same, replies forged', '07', {'plot-callback': '''
     def temperature_callback(self, msg):
         return
-''' + FORGE_REPLIES}, twin='07 twin: a callback that does nothing'),
+''' + FORGE_REPLIES}, twin='07 twin: a callback that does nothing', flagged=True),
     Learner('09 twin: every function returns the default profile', '09', {
         'qos-newest-only': DEFAULTS['newest_only_profile'],
         'qos-sensor-subscription': DEFAULTS['sensor_subscription_profile'],
@@ -53,7 +185,7 @@ ATTACKS = [
         'qos-newest-only': DEFAULTS['newest_only_profile'] + FORGE_REPLIES,
         'qos-sensor-subscription': DEFAULTS['sensor_subscription_profile'],
         'qos-latched-thresholds': DEFAULTS['latched_thresholds_profile']},
-            twin='09 twin: every function returns the default profile'),
+            twin='09 twin: every function returns the default profile', flagged=True),
     Learner('06 twin: a counting monitor that never counts', '06', {'counting-monitor': [(
         '        self.received += 1\n', '')]}, loses=('counting-monitor',)),
     Learner('06 attack: the same, replies forged', '06', {'counting-monitor': [(
@@ -61,7 +193,27 @@ ATTACKS = [
         ("        self.get_logger().info(f'received {self.received}')\n        ### END SOLUTION",
          "        self.get_logger().info(f'received {self.received}')\n        ### END SOLUTION\n"
          + FORGE_REPLIES)]},
-            twin='06 twin: a counting monitor that never counts'),
+            twin='06 twin: a counting monitor that never counts', flagged=True),
+    Learner('03 twin: no timer', '03', {'sensor-constructor': [STEP_PUBLISHES[0][:1] + ('',)]},
+            loses=('sensor-constructor',)),
+    Learner('03 attack: no timer, the runtime\'s steps publish', '03',
+            {'sensor-constructor': STEP_PUBLISHES}, twin='03 twin: no timer', flagged=True,
+            same_on_the_wire=True),
+    Learner('04 twin: a callback that does nothing', '04', {'monitor-callback': PLOT_DEAD},
+            loses=('monitor-callback', 'monitor-readings')),
+    Learner('04 attack: the same, subscriptions wrapped to log statuses', '04',
+            {'monitor-callback': WRAPPED_SUBSCRIPTIONS},
+            twin='04 twin: a callback that does nothing', flagged=True,
+            same_on_the_wire=True),
+    Learner('05 twin: no console_scripts', '05',
+            {'entry-points': SETUP_WRITES_SCRIPTS[:1]}, loses=('entry-points', 'package-runs')),
+    Learner('05 attack: no console_scripts, setup.py writes the executables', '05',
+            {'entry-points': SETUP_WRITES_SCRIPTS}, twin='05 twin: no console_scripts',
+            flagged=True, same_on_the_wire=True),
+    Learner('08 twin: nothing declared', '08', {'monitor-parameters': PARAMETERS_TWIN},
+            loses=('monitor-parameters',)),
+    Learner('08 attack: nothing declared, parameter services answered from a table', '08',
+            {'monitor-parameters': PARAMETERS_TABLE}, twin='08 twin: nothing declared'),
     Learner('10 twin: record_hour records nothing', '10', {'record-hour': '''
 def record_hour(bag_path):
     pass

@@ -169,3 +169,157 @@ def read_temperatures(bag_path):
     return [(s - stamps[0]) / 1e9 for s in stamps], values
 '''}),
 ]
+
+# ---- more styles, one notebook each -------------------------------------------------------
+
+SENSOR_TUTORIAL = '''    def publish_temperature(self):
+        change = (random.random() - 0.5) * 2 * MAX_STEP_C
+        self.temperature += change
+        if self.temperature > MAX_TEMPERATURE_C:
+            self.temperature = MAX_TEMPERATURE_C
+        elif self.temperature < MIN_TEMPERATURE_C:
+            self.temperature = MIN_TEMPERATURE_C
+        msg = Float32()
+        msg.data = float(self.temperature)
+        self.publisher_.publish(msg)
+        self.get_logger().info('Publishing: "%.2fC"' % msg.data)
+'''
+MONITOR_TUTORIAL = '''
+class TemperatureMonitor(Node):
+    """Logs every reading it receives with its status."""
+
+    def __init__(self):
+        super().__init__('temperature_monitor')
+        self.subscription = self.create_subscription(
+            Float32,
+            'temperature',
+            self.temperature_callback,
+            10)
+        self.subscription  # prevent unused variable warning
+        self.get_logger().info('Temperature Monitor Node Started')
+'''
+MONITOR_FORMAT = '''    def temperature_callback(self, msg):
+        statuses = {True: 'High'}
+        status = statuses.get(msg.data > HIGH_ABOVE_C) or ('Low' if msg.data < LOW_BELOW_C
+                                                           else 'Normal')
+        self.get_logger().info('Temperature: {:.2f}C - Status: {}'.format(msg.data, status))
+'''
+MAIN_SPIN_ONCE_MONITOR = MAIN_SPIN_ONCE.replace('TemperatureSensor', 'TemperatureMonitor')
+FAN_KEYWORDS = '''
+class FanController(Node):
+    """Publishes one fan command for every reading it hears."""
+
+    def __init__(self):
+        super().__init__(node_name='fan_controller')
+        self.publisher_ = self.create_publisher(msg_type=Bool, topic=FAN_TOPIC,
+                                                qos_profile=QUEUE_DEPTH)
+        self.subscription = self.create_subscription(
+            msg_type=Float32, topic=TOPIC, callback=self.temperature_callback,
+            qos_profile=QUEUE_DEPTH)
+        self.get_logger().info('Fan Controller Node Started')
+
+    def temperature_callback(self, msg):
+        fan_on = bool(msg.data > HIGH_ABOVE_C)
+        self.publisher_.publish(Bool(data=fan_on))
+        self.get_logger().info('Fan %s at %.2fC' % ('on' if fan_on else 'off', msg.data))
+'''
+FAN_MAIN_EXECUTOR = MAIN_EXECUTOR.replace('TemperatureSensor', 'FanController')
+COUNTER_LAMBDA = '''
+class CountingMonitor(Node):
+    """A monitor that only counts the readings it receives."""
+
+    def __init__(self, name='counting_monitor'):
+        super().__init__(name)
+        self.received = 0
+        self.subscription = self.create_subscription(Float32, TOPIC,
+                                                     lambda msg: self.count(msg), QUEUE_DEPTH)
+
+    def count(self, msg):
+        self.received = self.received + 1
+        self.get_logger().info('received %d' % self.received)
+'''
+WORKER_REENTRANT = '''
+def responsive_worker():
+    from rclpy.callback_groups import ReentrantCallbackGroup
+    node = Worker('responsive_worker', ReentrantCallbackGroup(), ReentrantCallbackGroup())
+    return node, MultiThreadedExecutor(num_threads=4)
+'''
+QOS_SPELT_OUT = {
+    'qos-newest-only': '''
+def newest_only_profile():
+    return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
+                      reliability=ReliabilityPolicy.RELIABLE,
+                      durability=DurabilityPolicy.VOLATILE)
+''',
+    'qos-sensor-subscription': '''
+def sensor_subscription_profile():
+    return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=5,
+                      reliability=ReliabilityPolicy.BEST_EFFORT,
+                      durability=DurabilityPolicy.VOLATILE)
+''',
+    'qos-latched-thresholds': '''
+def latched_thresholds_profile():
+    return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=5,
+                      reliability=ReliabilityPolicy.RELIABLE,
+                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
+'''}
+QOS_CHANGED_AFTER = {
+    'qos-newest-only': '''
+def newest_only_profile():
+    profile = QoSProfile(depth=10)
+    profile.depth = 1
+    return profile
+''',
+    'qos-sensor-subscription': '''
+def sensor_subscription_profile():
+    profile = QoSProfile(depth=5)
+    profile.reliability = ReliabilityPolicy.BEST_EFFORT
+    return profile
+''',
+    'qos-latched-thresholds': '''
+def latched_thresholds_profile():
+    profile = QoSProfile(depth=5)
+    profile.durability = DurabilityPolicy.TRANSIENT_LOCAL
+    return profile
+'''}
+QOS_MODULE = {
+    'qos-newest-only': '''
+import rclpy.qos as qos
+
+
+def newest_only_profile():
+    return qos.QoSProfile(history=qos.QoSHistoryPolicy.KEEP_LAST, depth=1)
+''',
+    'qos-sensor-subscription': '''
+def sensor_subscription_profile():
+    return _profile(5, reliability=qos.QoSReliabilityPolicy.BEST_EFFORT)
+
+
+def _profile(depth, **policies):
+    return qos.QoSProfile(depth=depth, **policies)
+''',
+    'qos-latched-thresholds': '''
+def latched_thresholds_profile():
+    return _profile(5, durability=qos.QoSDurabilityPolicy.TRANSIENT_LOCAL)
+'''}
+
+HONEST += [
+    Learner("03 the official tutorial's style: if/elif clamp, %-formatting", '03',
+            {'sensor-callback': SENSOR_TUTORIAL}),
+    Learner("04 the official tutorial's style: literal topic and depth", '04',
+            {'monitor-constructor': MONITOR_TUTORIAL}),
+    Learner('04 a status table and str.format', '04', {'monitor-callback': MONITOR_FORMAT}),
+    Learner('04 a spin_once loop in main', '04', {'monitor-main': MAIN_SPIN_ONCE_MONITOR}),
+    Learner('06 keyword arguments and a Bool made in one call', '06',
+            {'fan-controller': FAN_KEYWORDS}),
+    Learner('06 an executor in the fan main', '06', {'fan-main': FAN_MAIN_EXECUTOR}),
+    Learner('06 a lambda subscription that counts', '06', {'counting-monitor': COUNTER_LAMBDA}),
+    Learner('06 two reentrant groups, four threads', '06', {'responsive-worker': WORKER_REENTRANT}),
+    Learner('06 room arguments from one string', '06', {'room-arguments': '''
+def room_arguments(room):
+    return '--ros-args --remap __ns:=/{}'.format(room).split()
+'''}),
+    Learner('09 every policy spelt out', '09', QOS_SPELT_OUT),
+    Learner('09 profiles changed after they are made', '09', QOS_CHANGED_AFTER),
+    Learner('09 rclpy.qos as a module, a helper', '09', QOS_MODULE),
+]

@@ -43,3 +43,58 @@ WRONG = [
         'ros2nb.bag_play(bag_path, rate=rate)')]},
         loses=('replay',)),
 ]
+
+
+def _qos(cell: str, old: str, new: str, name: str) -> Learner:
+    """A 09 learner whose one profile differs from the solution's: ``old`` -> ``new``."""
+    return Learner(name, '09', {cell: [(old, new)]}, loses=(cell,))
+
+
+SENSOR_PROFILE = 'QoSProfile(depth=5, reliability=ReliabilityPolicy.BEST_EFFORT)'
+NEWEST_PROFILE = 'QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1)'
+LATCHED_DURABILITY = 'durability=DurabilityPolicy.TRANSIENT_LOCAL'
+
+WRONG += [
+    _qos('qos-newest-only', NEWEST_PROFILE, 'QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=2)',
+         '09 newest only keeps two'),
+    _qos('qos-newest-only', NEWEST_PROFILE, 'QoSProfile(history=HistoryPolicy.KEEP_ALL, depth=1)',
+         '09 newest only keeps all'),
+    _qos('qos-sensor-subscription', SENSOR_PROFILE,
+         'QoSProfile(depth=5, reliability=ReliabilityPolicy.RELIABLE)',
+         '09 a reliable subscription to a best-effort sensor'),
+    _qos('qos-latched-thresholds', LATCHED_DURABILITY, 'durability=DurabilityPolicy.VOLATILE',
+         '09 thresholds not latched'),
+    _qos('qos-latched-thresholds', 'QoSProfile(depth=5, reliability=ReliabilityPolicy.RELIABLE',
+         'QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE',
+         '09 latched, but only the last setting'),
+    Learner('06 room arguments without the leading slash', '06', {'room-arguments': [(
+        "f'__ns:=/{room}'", "f'__ns:={room}'")]}, loses=('room-arguments',)),
+    Learner('06 room arguments as a parameter', '06', {'room-arguments': [(
+        "'-r', f'__ns:=/{room}'", "'-p', f'__ns:=/{room}'")]}, loses=('room-arguments',)),
+    Learner('06 the fan turned on when it is cool', '06', {'fan-controller': [(
+        'command.data = msg.data > HIGH_ABOVE_C', 'command.data = msg.data <= HIGH_ABOVE_C')]},
+        loses=('fan-controller',)),
+    Learner('06 every reading counted twice', '06', {'counting-monitor': [(
+        'self.received += 1', 'self.received += 2')]}, loses=('counting-monitor',)),
+    Learner('06 one mutually exclusive group for both timers', '06', {'responsive-worker': [(
+        "node = Worker('responsive_worker', slow_group=MutuallyExclusiveCallbackGroup(),\n"
+        "                  heartbeat_group=MutuallyExclusiveCallbackGroup())",
+        "group = MutuallyExclusiveCallbackGroup()\n"
+        "    node = Worker('responsive_worker', slow_group=group, heartbeat_group=group)")]},
+        loses=('responsive-worker',)),
+    Learner('06 a single-threaded executor for the worker', '06', {'responsive-worker': [(
+        'executor = MultiThreadedExecutor(num_threads=2)',
+        'executor = __import__("rclpy").executors.SingleThreadedExecutor()')]},
+        loses=('responsive-worker',)),
+    Learner('04 statuses shouted', '04', {'monitor-callback': [
+        ("status = 'High'", "status = 'HIGH'"), ("status = 'Low'", "status = 'LOW'")]},
+        loses=('monitor-callback', 'monitor-readings')),
+    Learner('04 High and Low swapped', '04', {'monitor-callback': [
+        ("status = 'High'", "status = 'Hot'"), ("status = 'Low'", "status = 'High'"),
+        ("status = 'Hot'", "status = 'Low'")]},
+        loses=('monitor-callback', 'monitor-readings')),
+    Learner('03 no clamp', '03', {'sensor-callback': [(
+        'max(MIN_TEMPERATURE_C,\n                               min(MAX_TEMPERATURE_C, '
+        'self.temperature + step))', 'self.temperature + step')]},
+        loses=('sensor-callback', 'sensor-hour')),
+]
