@@ -323,3 +323,237 @@ def room_arguments(room):
     Learner('09 profiles changed after they are made', '09', QOS_CHANGED_AFTER),
     Learner('09 rclpy.qos as a module, a helper', '09', QOS_MODULE),
 ]
+
+
+# ---- presets, declare_parameters, more helpers ----------------------------------------------
+# (ros2/examples' ``with rclpy.init(args=args):`` is not here: Jazzy's rclpy.init returns None.)
+
+THRESHOLDS_PLURAL = '''
+def _threshold(description):
+    return ParameterDescriptor(description=description + ' (°C)', floating_point_range=[
+        FloatingPointRange(from_value=MIN_THRESHOLD_C, to_value=MAX_THRESHOLD_C, step=0.0)])
+
+
+class TemperatureMonitor(Node):
+    """Logs every reading with its status; the thresholds are parameters."""
+
+    def __init__(self):
+        super().__init__('temperature_monitor')
+        self.declare_parameters(namespace='', parameters=[
+            ('high_above_c', HIGH_ABOVE_C, _threshold('Readings strictly above this are High')),
+            ('low_below_c', LOW_BELOW_C, _threshold('Readings strictly below this are Low')),
+        ])
+        self.add_on_set_parameters_callback(self.on_set_thresholds)
+        self.subscription = self.create_subscription(
+            Float32, TOPIC, self.temperature_callback, QUEUE_DEPTH)
+        self.get_logger().info(
+            'Temperature Monitor Node Started: '
+            f"Low below {self.get_parameter('low_below_c').value:.2f}C, "
+            f"High above {self.get_parameter('high_above_c').value:.2f}C")
+'''
+ON_SET_LOOP = '''    def on_set_thresholds(self, parameters):
+        high_c = self.get_parameter('high_above_c').value
+        low_c = self.get_parameter('low_below_c').value
+        for parameter in parameters:
+            if parameter.name == 'high_above_c':
+                high_c = parameter.value
+            elif parameter.name == 'low_below_c':
+                low_c = parameter.value
+        result = SetParametersResult()
+        result.successful = low_c < high_c
+        if not result.successful:
+            result.reason = 'low_below_c must stay below high_above_c'
+        return result
+
+    def temperature_callback(self, msg):
+        high_c = self.get_parameter('high_above_c').value
+        low_c = self.get_parameter('low_below_c').value
+        temperature_c = msg.data
+        if temperature_c > high_c:
+            status = 'High'
+        elif temperature_c < low_c:
+            status = 'Low'
+        else:
+            status = 'Normal'
+        self.get_logger().info(f'Temperature: {temperature_c:.2f}C - Status: {status}')
+'''
+QOS_PRESETS = {
+    'qos-newest-only': '''
+from rclpy.qos import QoSPresetProfiles
+
+
+def newest_only_profile():
+    return QoSProfile(history=1, depth=1)  # 1: KEEP_LAST, as rclpy numbers it
+''',
+    'qos-sensor-subscription': '''
+def sensor_subscription_profile():
+    return QoSPresetProfiles.SENSOR_DATA.value
+''',
+    'qos-latched-thresholds': '''
+def latched_thresholds_profile():
+    services = QoSPresetProfiles.SERVICES_DEFAULT.value  # reliable, volatile, depth 10
+    return QoSProfile(history=services.history, depth=5, reliability=services.reliability,
+                      durability=DurabilityPolicy.TRANSIENT_LOCAL)
+'''}
+
+HONEST += [
+    Learner('07 the time from seconds_nanoseconds()', '07', {'plot-callback': '''
+    def temperature_callback(self, msg):
+        seconds, nanoseconds = self.get_clock().now().seconds_nanoseconds()
+        self.times_s.extend([seconds + nanoseconds / 1e9])
+        self.temps_c.extend([msg.data])
+        self.redraw()
+'''}),
+    Learner('08 declare_parameters and a descriptor helper', '08',
+            {'monitor-parameters': THRESHOLDS_PLURAL}),
+    Learner('08 the on-set callback walks the parameters', '08',
+            {'threshold-callback': ON_SET_LOOP}),
+    Learner('09 preset profiles and a number for KEEP_LAST', '09', QOS_PRESETS),
+]
+
+
+# ---- one more of each, in other words ---------------------------------------------------
+
+MONITOR_STATUS_METHOD = '''    def temperature_callback(self, msg):
+        self.get_logger().info('Temperature: ' + format(msg.data, '.2f') + 'C - Status: '
+                               + self.status(msg.data))
+
+    def status(self, reading):
+        if reading > HIGH_ABOVE_C:
+            return 'High'
+        if reading < LOW_BELOW_C:
+            return 'Low'
+        return 'Normal'
+'''
+MONITOR_HISTORY = '''
+class TemperatureMonitor(Node):
+    """Logs every reading it receives with its status."""
+
+    def __init__(self):
+        super().__init__('temperature_monitor')
+        from rclpy.qos import HistoryPolicy, QoSProfile
+        keep_last = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=QUEUE_DEPTH)
+        self.subscription = self.create_subscription(Float32, TOPIC, self.temperature_callback,
+                                                     keep_last)
+        self.get_logger().info('Temperature Monitor Node Started')
+'''
+ON_SET_DICT = '''    def on_set_thresholds(self, parameters):
+        current = {name: self.get_parameter(name).value for name in ('high_above_c', 'low_below_c')}
+        current.update({parameter.name: parameter.value for parameter in parameters})
+        ok = current['low_below_c'] < current['high_above_c']
+        return SetParametersResult(successful=ok,
+                                   reason='' if ok else 'low_below_c must stay below high_above_c')
+
+    def temperature_callback(self, msg):
+        high_c = self.get_parameter('high_above_c').value
+        low_c = self.get_parameter('low_below_c').value
+        status = 'High' if msg.data > high_c else 'Low' if msg.data < low_c else 'Normal'
+        self.get_logger().info(f'Temperature: {msg.data:.2f}C - Status: {status}')
+'''
+
+HONEST += [
+    Learner('03 the clamp as the middle of three', '03', {'sensor-callback': [(
+        '        self.temperature = max(MIN_TEMPERATURE_C,\n'
+        '                               min(MAX_TEMPERATURE_C, self.temperature + step))',
+        '        self.temperature = sorted([MIN_TEMPERATURE_C, self.temperature + step,\n'
+        '                                   MAX_TEMPERATURE_C])[1]')]}),
+    Learner('04 a status method with early returns, the line joined with +', '04',
+            {'monitor-callback': MONITOR_STATUS_METHOD}),
+    Learner('04 a KEEP_LAST profile for the subscription', '04',
+            {'monitor-constructor': MONITOR_HISTORY}),
+    Learner('05 entry points without spaces', '05', {'entry-points': [
+        ("'temperature_publisher = sensor_simulator.temperature_publisher:main'",
+         "'temperature_publisher=sensor_simulator.temperature_publisher:main'"),
+        ("'temperature_subscriber = sensor_simulator.temperature_subscriber:main'",
+         "'temperature_subscriber=sensor_simulator.temperature_subscriber:main'")]}),
+    Learner('06 a fan command from a conditional expression', '06', {'fan-controller': [(
+        '        command = Bool()\n        command.data = msg.data > HIGH_ABOVE_C\n',
+        '        command = Bool(data=True if msg.data > HIGH_ABOVE_C else False)\n')]}),
+    Learner('06 a slash added only when the room has none', '06', {'room-arguments': '''
+def room_arguments(room):
+    namespace = room if room.startswith('/') else '/' + room
+    return ['--ros-args', '--remap', f'__ns:={namespace}']
+'''}),
+    Learner('06 the count logged with %d', '06', {'counting-monitor': [(
+        "self.get_logger().info(f'received {self.received}')",
+        "self.get_logger().info('received %d' % self.received)")]}),
+    Learner('07 the time as a float of the clock, the reading as float()', '07',
+            {'plot-callback': '''
+    def temperature_callback(self, msg):
+        now = self.get_clock().now()
+        self.times_s.append(now.nanoseconds * 1e-9)
+        self.temps_c.append(float(msg.data))
+        self.redraw()
+'''}),
+    Learner('08 the on-set callback with a dict of current values', '08',
+            {'threshold-callback': ON_SET_DICT}),
+    Learner("09 policies as rclpy's numbers", '09', {
+        'qos-newest-only': '''
+def newest_only_profile():
+    return QoSProfile(depth=1)  # KEEP_LAST is the default
+''',
+        'qos-sensor-subscription': '''
+def sensor_subscription_profile():
+    return QoSProfile(depth=5, reliability=2)  # 2: BEST_EFFORT
+''',
+        'qos-latched-thresholds': '''
+def latched_thresholds_profile():
+    return QoSProfile(depth=5, durability=1)  # 1: TRANSIENT_LOCAL
+'''}),
+    Learner('09 one factory for the three profiles', '09', {
+        'qos-newest-only': '''
+def _profile(depth, reliable=True, latched=False):
+    return QoSProfile(
+        depth=depth,
+        reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT,
+        durability=DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE)
+
+
+def newest_only_profile():
+    return _profile(1)
+''',
+        'qos-sensor-subscription': '''
+def sensor_subscription_profile():
+    return _profile(5, reliable=False)
+''',
+        'qos-latched-thresholds': '''
+def latched_thresholds_profile():
+    return _profile(5, latched=True)
+'''}),
+]
+
+HONEST += [
+    Learner('04 the status from a match statement', '04', {'monitor-callback': '''
+    def temperature_callback(self, msg):
+        match msg.data:
+            case reading if reading > HIGH_ABOVE_C:
+                status = 'High'
+            case reading if reading < LOW_BELOW_C:
+                status = 'Low'
+            case _:
+                status = 'Normal'
+        self.get_logger().info(f'Temperature: {msg.data:.2f}C - Status: {status}')
+'''}),
+    Learner('09 settings kept in dictionaries', '09', {
+        'qos-newest-only': '''
+NEWEST = {'history': HistoryPolicy.KEEP_LAST, 'depth': 1}
+
+
+def newest_only_profile():
+    return QoSProfile(**NEWEST)
+''',
+        'qos-sensor-subscription': '''
+SENSOR = {'depth': 5, 'reliability': ReliabilityPolicy.BEST_EFFORT}
+
+
+def sensor_subscription_profile():
+    return QoSProfile(**SENSOR)
+''',
+        'qos-latched-thresholds': '''
+LATCHED = {'depth': 5, 'durability': DurabilityPolicy.TRANSIENT_LOCAL}
+
+
+def latched_thresholds_profile():
+    return QoSProfile(**LATCHED)
+'''}),
+]

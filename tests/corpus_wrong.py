@@ -98,3 +98,31 @@ WRONG += [
         'self.temperature + step))', 'self.temperature + step')]},
         loses=('sensor-callback', 'sensor-hour')),
 ]
+
+WRONG += [
+    Learner('08 the on-set callback accepts every change', '08', {'threshold-callback': [(
+        "        if low_c >= high_c:\n", "        if False:\n")]}, loses=('threshold-callback',)),
+    Learner('08 refusals without a reason', '08', {'threshold-callback': [(
+        "                reason=f'low_below_c ({low_c}) must stay below high_above_c ({high_c})')",
+        "                reason='')")]}, loses=('threshold-callback',)),
+    Learner('08 thresholds without a range', '08', {'monitor-parameters': [(
+        ",\n            floating_point_range=in_clamp_range)", ')')]},
+        loses=('monitor-parameters',)),
+    Learner('08 thresholds declared as whole numbers', '08', {'monitor-parameters': [(
+        "self.declare_parameter('high_above_c', HIGH_ABOVE_C,",
+        "self.declare_parameter('high_above_c', int(HIGH_ABOVE_C),")]},
+        loses=('monitor-parameters',)),
+    Learner('07 times in milliseconds', '07', {'plot-callback': [(
+        'self.get_clock().now().nanoseconds / 1e9', 'self.get_clock().now().nanoseconds / 1e6')]},
+        loses=('plot-callback',)),
+    Learner('04 main catches only KeyboardInterrupt', '04', {'monitor-main': [(
+        'except (KeyboardInterrupt, ExternalShutdownException):', 'except KeyboardInterrupt:')]},
+        loses=('monitor-main',)),
+    Learner('04 readings logged with one decimal', '04', {'monitor-callback': [(
+        "{temperature_c:.2f}C", "{temperature_c:.1f}C")]},
+        loses=('monitor-callback', 'monitor-readings')),
+    Learner('06 the fan publishes twice per reading', '06', {'fan-controller': [(
+        '        self.publisher_.publish(command)\n',
+        '        self.publisher_.publish(command)\n        self.publisher_.publish(command)\n')]},
+        loses=('fan-controller',)),
+]

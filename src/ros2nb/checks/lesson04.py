@@ -147,7 +147,7 @@ def _statuses_verdict(readings: tuple[float, ...] | list[float], lines: list[lis
 
 def _monitor_callback(judge: Judge) -> str:
     lines = _own_or_course_constructor(judge, list(BOUNDARY_READINGS_C))
-    _statuses_verdict(BOUNDARY_READINGS_C, lines, with_value=False)
+    _statuses_verdict(BOUNDARY_READINGS_C, lines, with_value=True)
     return (f'one line with the right status for each of {len(BOUNDARY_READINGS_C)} readings, '
             f'including {course.LOW_BELOW_C} and {course.HIGH_ABOVE_C} °C (both Normal).')
 
@@ -157,7 +157,7 @@ def check_monitor_callback() -> None:
 
     The judge publishes readings around both thresholds (19.99, 20.0, 26.0, 26.01 °C and
     more) to your monitor over ROS and reads its log lines from ``/rosout``: exactly one
-    line per message, naming High, Low or Normal correctly.
+    line per message, with the reading (two decimals), naming High, Low or Normal correctly.
 
     Introduced in ``04-write-the-subscriber.ipynb``.
 

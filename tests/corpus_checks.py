@@ -1,0 +1,56 @@
+"""What the corpora's tests assert, one function per corpus (the test files are split by
+notebooks so that pytest-xdist, which keeps a file on one worker, spreads the grading).
+
+- An honest learner (``corpus_honest.py``) gets full marks, and gets them with the judge's
+  reader of their text replaced by one that knows nothing: no point depends on reading the
+  learner's code (:data:`ros2nb.checks.source.TEXT`).
+- A wrong learner (``corpus_wrong.py``) loses exactly the part it gets wrong, each with a
+  one-line message.
+- An attack (``corpus_attacks.py``) scores what its honest twin scores.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ros2nb.checks import source
+from corpora import Learner, expected_score, grade_learner, score
+
+
+class KnowsNothing(source.TextReader):
+    """A reader of the learner's text that never finds anything."""
+
+    def read(self, path):
+        return None
+
+
+def failed(results: dict) -> dict[str, str]:
+    """grade id -> message, of the parts that failed."""
+    return {gid: r.get('message', '') for gid, r in results.items() if not r['passed']}
+
+
+def within(corpus: list[Learner], first: str, last: str) -> list[Learner]:
+    """The learners of notebooks ``first`` to ``last`` (e.g. ``'03'``, ``'05'``)."""
+    return [learner for learner in corpus if first <= learner.notebook <= last]
+
+
+def full_marks_without_the_text_reader(learner: Learner, root: Path, monkeypatch) -> None:
+    monkeypatch.setattr(source.TEXT, 'read', KnowsNothing().read)
+    results = grade_learner(learner, root)
+    assert failed(results) == {}, learner.name
+
+
+def loses_exactly_its_part(learner: Learner, root: Path) -> None:
+    results = grade_learner(learner, root)
+    lost = failed(results)
+    assert set(lost) == set(learner.loses), lost
+    assert all(message and '\n' not in message for message in lost.values()), lost
+    assert score(learner, results) == expected_score(learner)
+
+
+def scores_what_its_twin_scores(attack: Learner, twin: Learner, root: Path) -> None:
+    attacked = grade_learner(attack, root / 'attack')
+    honest = grade_learner(twin, root / 'twin')
+    assert set(failed(honest)) == set(twin.loses)
+    assert set(failed(attacked)) == set(failed(honest)), failed(attacked)
+    assert score(attack, attacked) == score(twin, honest)
