@@ -102,6 +102,8 @@ class JudgeClock:
             if ack is not None:
                 patience, quiet_since = None, time.monotonic()
                 self._settle(ack, subject.heard_base)
+                if ack.get('wants') is None:  # its spin ended, and all it told of arrived:
+                    self._publish()  # the same time again lets it go on (destroy its nodes)
             if reply is not None:
                 return reply
             latest = subject.last_ack

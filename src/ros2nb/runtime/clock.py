@@ -73,6 +73,9 @@ class JudgeTime:
         self._fd = fd
         #: The newest step of the judge's clock received (ns).
         self.latest_ns: Optional[int] = None
+        #: ``/clock`` messages received: the judge publishes the same time again once it
+        #: has heard everything a finished spin told it of (:meth:`Runtime._follow_judge`).
+        self.heard = 0
         self._count_publishing()
 
     @classmethod
@@ -128,6 +131,7 @@ class JudgeTime:
     def on_clock(self, msg: Clock) -> None:
         """Take one step of the judge's clock (the ``/clock`` subscription's callback)."""
         now = msg.clock.sec * 1_000_000_000 + msg.clock.nanosec
+        self.heard += 1
         if self.latest_ns is None or now > self.latest_ns:
             self.latest_ns = now
 
@@ -347,4 +351,11 @@ class SimulatedClock:
                 if on_step is not None:
                     on_step()
                 judge.ack(self.sim_now_ns, end, self.failures, self.is_ours)
+            released = judge.heard
             judge.ack(self.sim_now_ns, None, self.failures, self.is_ours)
+            # Go on (the caller may destroy the nodes next, and with them their lines not yet
+            # delivered) once the judge says it heard all of it, at most JUDGE_MATCH_WAIT_S.
+            deadline = time.monotonic() + JUDGE_MATCH_WAIT_S
+            while judge.heard == released and time.monotonic() < deadline:
+                self.stop_button.point()
+                self._run_one(JUDGE_STEP_WAIT_S)
