@@ -13,13 +13,21 @@ from ..errors import CheckFailed
 from .base import AnswerRef, current_judge, learner_error
 
 
+def defined_verdict(reply: dict, name: str) -> None:
+    """Raise when a subject's reply says the answer cells define no ``name``.
+
+    :raises CheckFailed: telling the learner to define it in their answer cell.
+    """
+    if reply.get('undefined'):
+        raise CheckFailed(f'{name} is not defined in your answer cell: define it there '
+                          '(and run the cell) without renaming it.')
+
+
 def answer_results(ref: AnswerRef, inputs: list[list[Any]]) -> list[dict]:
     """Call the learner's function ``ref`` (from their answer cell) in a subject."""
     subject = current_judge().answer_subject(ref)
     reply = subject.request('call', name=ref.name, inputs=inputs)
-    if reply.get('undefined'):
-        raise CheckFailed(f'{ref.name} is not defined in your answer cell: define it there '
-                          '(and run the cell) without renaming it.')
+    defined_verdict(reply, ref.name)
     return reply['outputs']
 
 

@@ -21,7 +21,7 @@ from std_msgs.msg import Int32
 
 from .. import qos
 from ..errors import CheckFailed
-from .answers import type_name_of
+from .answers import defined_verdict, type_name_of
 from .base import ARRIVAL_TIMEOUT_S, AnswerRef, call_learner, current_judge, learner_error, passed
 
 #: The burst of part 1 and what a display of the newest reading must be left with.
@@ -68,9 +68,7 @@ class _Endpoint:
         self.subject = judge.answer_subject(ref)
         reply = self.subject.request('qos_endpoint', name=ref.name, topic=self.topic, kind=kind,
                                      numbers=list(numbers))
-        if reply.get('undefined'):
-            raise CheckFailed(f'{ref.name} is not defined in your answer cell: define it there '
-                              '(and run the cell) without renaming it.')
+        defined_verdict(reply, ref.name)
         if 'error' in reply:
             raise learner_error(f'{ref.name}()', reply['error'])
         if 'returned' in reply:

@@ -28,7 +28,7 @@ from .. import course
 from ..errors import CheckFailed
 from ..runtime import current_runtime
 from ..terminal import bag
-from .answers import decoded
+from .answers import decoded, defined_verdict
 from .bags import (CHECK_LOGGER, ROSOUT, TEMPERATURE, check_bag, check_readings_c, fresh_path,
                    bag_messages, read_back)
 from .base import AnswerRef, call_learner, current_judge, learner_error, passed
@@ -115,9 +115,7 @@ def _call(function: Any, label: str, *args: Any, spin_s: float = 0.0) -> Any:
         encoded = [{'path': str(a)} if isinstance(a, Path) else a for a in args]
         reply = judge.clock.drive(subject, 'call', name=function.name, inputs=[encoded],
                                   step_s=STEP_S, limit_s=spin_s + SPARE_S, what=label)
-        if reply.get('undefined'):
-            raise CheckFailed(f'{function.name} is not defined in your answer cell: define it '
-                              'there (and run the cell) without renaming it.')
+        defined_verdict(reply, function.name)
         output = reply['outputs'][0]
         if 'error' in output:
             raise learner_error(label, output['error'])

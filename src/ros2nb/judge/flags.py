@@ -124,9 +124,9 @@ def _why(node: ast.AST, modules: dict[str, str], setup_py: bool) -> Optional[str
     if isinstance(node, ast.Call):
         name = _dotted(node.func) or (node.func.attr if isinstance(node.func, ast.Attribute)
                                       else '')
-        if name == 'setattr' and node.args and _dotted(node.args[0]) is not None and \
-                _dotted(node.args[0]).split('.')[0] in PATCHED_OWNERS | set(modules):
-            return f'replaces an attribute of {_dotted(node.args[0])} (patches code that is not its own)'
+        owner = _dotted(node.args[0]) if name == 'setattr' and node.args else None
+        if owner is not None and owner.split('.')[0] in PATCHED_OWNERS | set(modules):
+            return f'replaces an attribute of {owner} (patches code that is not its own)'
         if setup_py and (name.rsplit('.', 1)[-1] in WRITING_CALLS or (
                 name == 'open' and any(isinstance(a, ast.Constant) and isinstance(a.value, str)
                                        and set(a.value) & set('wax') for a in node.args[1:2]))):
