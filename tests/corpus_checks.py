@@ -52,5 +52,9 @@ def scores_what_its_twin_scores(attack: Learner, twin: Learner, root: Path) -> N
     attacked = grade_learner(attack, root / 'attack')
     honest = grade_learner(twin, root / 'twin')
     assert set(failed(honest)) == set(twin.loses)
-    assert set(failed(attacked)) == set(failed(honest)), failed(attacked)
-    assert score(attack, attacked) == score(twin, honest)
+    # The protection is that an attack gains nothing: it loses every part its twin loses.
+    # It may lose more: a flood logged outside the runtime (not spun on the judge's clock,
+    # so never acknowledged) can still be arriving when a later part of the same notebook
+    # listens, and then that part hears it too.
+    assert set(failed(attacked)) >= set(failed(honest)), failed(attacked)
+    assert score(attack, attacked) <= score(twin, honest)
