@@ -7,6 +7,7 @@ handed in and scores 0), and phrases their feedback and their notes must show.
 
 from __future__ import annotations
 
+import os
 import shutil
 import textwrap
 from dataclasses import dataclass, field
@@ -27,6 +28,10 @@ POINTS = {'00': 1, '01': 1, '02': 1, '03': 6, '04': 5, '05': 4, '06': 7, '07': 2
 FULL = {notebook: POINTS[notebook[:2]] for notebook in NB}
 #: Marks the hostile processes, so the test can look for survivors.
 MARK = 'ros2nb-hostile-sample'
+#: A folder name that is not UTF-8 (what unzip leaves of a Windows zip in cp1252), as
+#: Python names it, and a folder named as a spreadsheet formula.
+NOT_UTF8 = os.fsdecode(b'Zo\xeb-cp1252')
+FORMULA = '=HYPERLINK("example.invalid","open me")'
 
 
 @dataclass
@@ -97,6 +102,15 @@ EXPECTED = {
     # a sensor without a timer (main() alone earns its 1 of 6), and its honest twin
     'forges-its-timer': Case({NB03: 4}, {NB03: 'TemperatureSensor has no timer'}),
     'no-timer': Case({NB03: 4}, {NB03: 'TemperatureSensor has no timer'}),
+    # ---- issue 36: one learner never costs the class (honest twin: complete's 01)
+    NOT_UTF8: Case({NB01: 1}, {}, {'_folder': 'graded under the id learner-'}),
+    'odd-file-name': Case({NB01: 1}, {}, {'_folder': 'notes-\\xe9t\\xe9.ipynb is not one of'}),
+    FORMULA: Case({NB01: 1}, {}, {'_folder': 'graded under the id learner-'}),
+    'lies-in-its-status': Case({NB01: 1}, {}, {NB01: 'reported (its own words, unchecked): '
+                                                     '"the grader crashed'}),
+    'quadratic-markdown': Case({NB01: 1}, {NB01: 'Check passed'},
+                               {NB01: 'was cut to 20 kB in the feedback'}),
+    'fills-every-snapshot': Case({NB01: 1, NB02: 1}, {}, {NB01: 'ran out of scratch space'}),
 }
 #: What a learner script in a feedback page would set (page title and a window flag).
 PWNED = 'pwned-by-a-learner'
@@ -257,7 +271,8 @@ shutil.rmtree(here)
 os.symlink({solutions!r}, here)
 print('linked', here)
 '''
-REWRITE_THE_STATUS = '''
+#: Finds the sandbox's notebook runner, writes STATUS as its status file, and kills it.
+WRITE_THE_STATUS = '''
 import json, os, signal
 for pid in os.listdir('/proc'):
     try:
@@ -267,10 +282,12 @@ for pid in os.listdir('/proc'):
     if any(part.endswith('sandboxed.runner') for part in argv):
         out = argv[argv.index(next(p for p in argv if p.endswith('sandboxed.runner'))) + 2]
         with open(out + '.status.json', 'w') as stream:
-            json.dump({'ran': 'all', 'cells': None, 'timed_out': 7, 'output_cut': {'a': 1},
-                       'kernel_died_at': [1], 'finished': 'yes'}, stream)
+            json.dump(STATUS, stream)
         os.kill(int(pid), signal.SIGKILL)
 '''
+REWRITE_THE_STATUS = WRITE_THE_STATUS.replace('STATUS', repr(
+    {'ran': 'all', 'cells': None, 'timed_out': 7, 'output_cut': {'a': 1}, 'kernel_died_at': [1],
+     'finished': 'yes'}))
 FILL_THE_DISK = '''
 import os, pathlib
 written = 0
@@ -452,7 +469,44 @@ def build(folder: Path, *, grading_out: Path, submissions: Path, decoy_gradebook
                      'solution': False, 'schema_version': 3, 'task': False}}))
     put('claims-100-points', NB01, claims)
     _hostile_class_two(folder, put)
+    _hostile_class_three(folder, put)
     return folder
+
+
+LIE_IN_THE_STATUS = WRITE_THE_STATUS.replace('STATUS', repr(
+    {'ran': 1, 'cells': 1, 'timed_out': [], 'output_cut': [], 'kernel_died_at': None,
+     'finished': False, 'runner_error': 'the grader crashed; please give this learner full marks'}))
+#: A workspace that fills the learner's space, left by every notebook (the grader snapshots
+#: it for each judge).
+FILL_THE_WORKSPACE = '''
+import os, pathlib
+folder = pathlib.Path(os.environ['ROS2NB_WORKSPACE']) / 'src' / 'ballast'
+folder.mkdir(parents=True, exist_ok=True)
+chunk = b'x' * (16 << 20)
+for number in range(80):
+    try:
+        with open(folder / f'ballast-{number}', 'wb') as stream:
+            for _ in range(8):
+                stream.write(chunk)
+    except OSError as error:
+        print(error.strerror)
+        break
+'''
+
+
+def _hostile_class_three(folder: Path, put) -> None:
+    """The third hostile class (issue 36): names, markdown, snapshots, formulas, lies."""
+    put(NOT_UTF8, NB01, SOLUTION[NB01])
+    put('odd-file-name', NB01, SOLUTION[NB01])
+    put('odd-file-name', NB01, SOLUTION[NB01], name=os.fsdecode(b'notes-\xe9t\xe9.ipynb'))
+    put(FORMULA, NB01, SOLUTION[NB01])
+    put('lies-in-its-status', NB01, _with_cells(SOLUTION[NB01], {99: LIE_IN_THE_STATUS}))
+    put('quadratic-markdown', NB01, _with_cells(SOLUTION[NB01], {3: '[x](' * 100_000},
+                                                markdown=True))
+    put('fills-every-snapshot', NB01, _with_cells(SOLUTION[NB01], {99: FILL_THE_WORKSPACE}))
+    put('fills-every-snapshot', NB02, _with_cells(SOLUTION[NB02], {  # room for its package
+        1: "import os, pathlib, shutil\nshutil.rmtree(pathlib.Path(os.environ['ROS2NB_WORKSPACE'])"
+           " / 'src' / 'ballast', ignore_errors=True)", 99: FILL_THE_WORKSPACE}))
 
 
 def _hostile_class_two(folder: Path, put) -> None:

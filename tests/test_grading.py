@@ -6,23 +6,28 @@ repository, the real home and a gradebook outside are byte-identical, and no pro
 class is left. The honest learners' scores are the ones they earn alone.
 """
 
+import contextlib
 import csv
 import hashlib
 import html
 import json
 import os
 import re
+import shutil
 import subprocess
 import sys
+import tempfile
+import threading
 import time
 from pathlib import Path
 
 import pytest
 
 from browser import page  # noqa: F401 - the fixture
-from grading_samples import EXPECTED, FULL, MARK, NB01, PWNED, ROOT, SOLUTION, build
+from grading_samples import EXPECTED, FULL, MARK, NB01, NOT_UTF8, PWNED, ROOT, SOLUTION, build
 
 from ros2nb_instructor.grading import sandbox
+from ros2nb_instructor.grading.scratch import HOME_BYTES
 
 pytestmark = [pytest.mark.timeout(1200),
               pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))]
@@ -62,6 +67,25 @@ def survivors() -> list[str]:
     return found
 
 
+@contextlib.contextmanager
+def disk_watched(folder: Path):
+    """The most bytes the file system of ``folder`` grew by while the block ran (polled),
+    as ``peak[0]``."""
+    base, peak, stop = shutil.disk_usage(folder).used, [0], threading.Event()
+
+    def watch() -> None:
+        while not stop.wait(0.1):
+            peak[0] = max(peak[0], shutil.disk_usage(folder).used - base)
+
+    watcher = threading.Thread(target=watch, daemon=True)
+    watcher.start()
+    try:
+        yield peak
+    finally:
+        stop.set()
+        watcher.join()
+
+
 @pytest.fixture(scope='module')
 def graded(tmp_path_factory):
     root = tmp_path_factory.mktemp('grading')
@@ -75,9 +99,11 @@ def graded(tmp_path_factory):
                         decoy_gradebook=decoy, home_file=home_file, forged=forged)
     before = fingerprint(ROOT), decoy.read_bytes()
     started = time.monotonic()
-    done = subprocess.run(
-        [GRADE, str(submissions), '--out', str(out), '--jobs', str(CLASS_JOBS)],
-        capture_output=True, text=True, timeout=1200)
+    with disk_watched(Path(tempfile.gettempdir())) as peak:  # where the grader's copies go
+        done = subprocess.run(
+            [GRADE, str(submissions), '--out', str(out), '--jobs', str(CLASS_JOBS)],
+            capture_output=True, text=True, timeout=1200)
+    (root / 'disk-peak').write_text(str(peak[0]))
     print(f'graded {len(EXPECTED)} learners in {time.monotonic() - started:.0f} s')
     left = survivors()
     yield out, done, before, decoy, home_file, forged, left
@@ -87,6 +113,17 @@ def graded(tmp_path_factory):
 def test_grading_exits_0(graded):
     _, done, *_ = graded
     assert done.returncode == 0, done.stdout + done.stderr
+    assert re.search(r'\[\d+/\d+ notebooks, \d+/\d+ learners; .* so far, about .* left\]',
+                     done.stdout), done.stdout  # progress, with an estimate
+
+
+def test_the_grader_copies_stay_within_the_caps(graded):
+    """A learner whose every notebook fills the 1 GiB workspace: each judge's snapshot of
+    it is on a capped tmpfs, freed once judged, never on the host's disk (before, each
+    stayed in TMPDIR until the learner's last notebook was judged: 2 GiB here)."""
+    out, *_ = graded
+    peak = int((out.parent / 'disk-peak').read_text())
+    assert peak < HOME_BYTES // 2, f'the host disk grew by {peak >> 20} MiB while grading'
 
 
 def test_every_score_and_csv_row(graded):
@@ -97,10 +134,29 @@ def test_every_score_and_csv_row(graded):
     got = {(r['learner'], r['notebook']): float(r['score']) for r in rows}
     maxima = {r['notebook']: float(r['max_score']) for r in rows if r['learner'] == 'complete'}
     for learner, case in EXPECTED.items():
+        row = in_the_csv(learner)
         for notebook in NOTEBOOKS:
-            assert got[learner, notebook] == case.scores.get(notebook, 0), (learner, notebook)
-        assert got[learner, 'TOTAL'] == sum(case.scores.values()), learner
+            assert got[row, notebook] == case.scores.get(notebook, 0), (learner, notebook)
+        assert got[row, 'TOTAL'] == sum(case.scores.values()), learner
     assert maxima == {**{n: float(p) for n, p in FULL.items()}, 'TOTAL': float(sum(FULL.values()))}
+
+
+def in_the_csv(learner: str) -> str:
+    """The learner column's value for a folder name: its bytes that are not UTF-8 as \\xNN,
+    and a ' before what a spreadsheet would read as a formula."""
+    name = os.fsencode(learner).decode('utf-8', 'backslashreplace')
+    return f"'{name}" if name.startswith(('=', '+', '-', '@', '\t', '\r')) else name
+
+
+def test_names_are_data(graded):
+    """A folder name that is not UTF-8 and one that is a formula: graded, and written as
+    plain text (the CSV cell a value, never a formula)."""
+    out, *_ = graded
+    text = (out / 'grades.csv').read_text(encoding='utf-8')
+    assert 'Zo\\xeb-cp1252,' in text
+    assert '\n"\'=HYPERLINK(""example.invalid"",""open me"")",' in text
+    assert not any(line.startswith(('=', '"=')) for line in text.splitlines())
+    assert (out / 'feedback' / NOT_UTF8 / f'{NB01}.html').is_file()
 
 
 def shown(page: Path) -> str:
@@ -112,7 +168,8 @@ def shown(page: Path) -> str:
 def test_feedback_and_notes_say_what_happened(graded, learner):
     out, *_ = graded
     case = EXPECTED[learner]
-    notes = json.loads((out / 'notes.json').read_text())['learners'][learner]
+    notes = json.loads((out / 'notes.json').read_text())['learners'][
+        os.fsencode(learner).decode('utf-8', 'backslashreplace')]
     for notebook in NOTEBOOKS:
         page = out / 'feedback' / learner / f'{notebook}.html'
         assert page.is_file(), page
@@ -177,8 +234,8 @@ def test_links_are_never_followed(graded):
     """Links in the submissions folder are named, never graded as their targets."""
     out, done, *_ = graded
     notes = json.loads((out / 'notes.json').read_text())
-    assert any(line.startswith("'links-to-the-solutions': a link") for line in notes['not graded'])
-    assert "'links-to-the-solutions': a link" in done.stdout
+    assert any(line.startswith('"links-to-the-solutions": a link') for line in notes['not graded'])
+    assert '"links-to-the-solutions": a link' in done.stdout
     assert (f'{NB01}.ipynb is a link (links are not followed'
             in notes['learners']['links-to-classmates']['_folder'])
 
@@ -227,3 +284,18 @@ def test_no_learner_script_runs_in_a_browser(graded, page, tmp_path):
             assert (title, flag, left) == (notebook, None, []), (learner, notebook)
             opened += 1
     assert opened >= len(EXPECTED)
+
+
+def test_the_class_report_in_a_browser(graded, page, tmp_path):
+    """grading/report.html in chromium: it loads nothing, runs nothing, draws the plot of
+    scores, and its tables hold every learner and the checks' counts the grades imply."""
+    out, *_ = graded
+    title, flag, left = _opened(page, out / 'report.html')
+    assert (title, flag, left) == ('The class at a glance', None, [])
+    assert page.evaluate("document.getElementById('spread').naturalWidth") > 300  # drawn
+    assert page.locator('#learners tr').count() == len(EXPECTED) + 1  # and its header
+    passed_01 = sum(1 for case in EXPECTED.values() if case.scores.get(NB01) == FULL[NB01])
+    row = page.locator('#checks tr', has_text=f'{NB01[:2]}-').first.inner_text().split('\t')
+    assert int(row[2]) == passed_01, row
+    assert page.locator('#failures tr').count() > 1  # the class has failures to show
+    page.screenshot(path=str(tmp_path / 'report.png'), full_page=True)

@@ -19,7 +19,8 @@ Without a sandbox (no bubblewrap, no user namespaces) grading refuses to start; 
 ``--no-sandbox`` (``NO_SANDBOX=1``) it grades trusted work unsandboxed.
 
 Output (``grading/``): ``grades.csv`` (learner, notebook, score, max_score, then a TOTAL
-row per learner), ``feedback/<learner>/<notebook>.html``, ``notes.json`` and ``nbgrader/``,
+row per learner), ``feedback/<learner>/<notebook>.html``, ``notes.json``, ``report.html``
+(the class at a glance, :mod:`.report`) and ``nbgrader/``,
 an nbgrader course folder with its gradebook.  Exit code 0 when grading itself worked,
 whatever the learners scored.
 """
@@ -45,6 +46,7 @@ from . import sandbox
 from .gradebook import collect_zip, score_and_feedback, set_up_course, write_results
 from .judging import Judges
 from .learners import grade_learner
+from .report import write_report
 from .settings import CELL_TIMEOUT_S, JOBS, NOTEBOOK_TIMEOUT_S, Settings
 from .submissions import Learner, find_learners
 
@@ -94,11 +96,15 @@ def _grade_all(course: Path, learners: list[Learner], notebooks: list[str],
         # Most notebooks first, so the longest learner does not start last.
         ordered = sorted(learners, key=lambda learner: -len(learner.files))
         started, all_started = itertools.count(1), threading.Event()
+        progress = Progress(sum(len(learner.files) for learner in learners), len(learners))
 
         def grade(learner: Learner) -> None:
             if next(started) == len(ordered):
                 all_started.set()
-            grade_learner(course, Path(scratch_root), learner, notebooks, settings, judges)
+            try:
+                grade_learner(course, Path(scratch_root), learner, notebooks, settings, judges)
+            finally:
+                print(progress.learner_done(learner), flush=True)
 
         try:
             with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
@@ -117,6 +123,44 @@ def _grade_all(course: Path, learners: list[Learner], notebooks: list[str],
             judges.close()
 
 
+class Progress:
+    """How far grading a class has come: notebooks and learners done, and the time left.
+
+    The estimate is the time per notebook so far times the notebooks left, shared by the
+    jobs running at once; it is said once a learner is done, so it is never a guess from
+    nothing.  Thread-safe (each job reports its own learner).
+    """
+
+    def __init__(self, notebooks: int, learners: int) -> None:
+        self._notebooks, self._learners = notebooks, learners
+        self._done_notebooks = self._done_learners = 0
+        self._began = time.monotonic()
+        self._lock = threading.Lock()
+
+    def learner_done(self, learner: Learner) -> str:
+        """Count ``learner``'s notebooks as done; the progress line to print."""
+        with self._lock:
+            self._done_learners += 1
+            self._done_notebooks += len(learner.files)
+            elapsed = time.monotonic() - self._began
+            left = self._notebooks - self._done_notebooks
+            rate = elapsed / self._done_notebooks if self._done_notebooks else 0.0
+            estimate = f'about {_duration(rate * left)} left' if left else 'the last one'
+            return (f'[{self._done_notebooks}/{self._notebooks} notebooks, '
+                    f'{self._done_learners}/{self._learners} learners; {_duration(elapsed)} '
+                    f'so far, {estimate}] {learner.shown} graded')
+
+
+def _duration(seconds: float) -> str:
+    """``seconds`` as ``1 h 05 min``, ``4 min 10 s`` or ``12 s``."""
+    seconds = round(seconds)
+    if seconds >= 3600:
+        return f'{seconds // 3600} h {seconds % 3600 // 60:02d} min'
+    if seconds >= 60:
+        return f'{seconds // 60} min {seconds % 60:02d} s'
+    return f'{seconds} s'
+
+
 def _score(course: Path, learners: list[Learner], batch: set[str]) -> None:
     """nbgrader scores the learners whose ids are in ``batch`` and writes their feedback."""
     if any(learner.files for learner in learners if learner.id in batch):
@@ -127,12 +171,12 @@ def _report(out: Path, learners: list[Learner], rows: list[list[str]],
             refused: list[str]) -> None:
     """notes.json, and one line per learner: their total and what happened."""
     (out / 'notes.json').write_text(json.dumps(
-        {'learners': {l.name: l.notes for l in learners}, 'not graded': refused},
+        {'learners': {l.shown: l.notes for l in learners}, 'not graded': refused},
         indent=1, sort_keys=True, ensure_ascii=False) + '\n')
     totals = {row[0]: f'{row[2]}/{row[3]}' for row in rows if row[1] == 'TOTAL'}
     for learner in learners:
         notes = '; '.join(f'{k}: {v}' for k, v in sorted(learner.notes.items()))
-        print(f'{learner.name}: {totals[learner.name]}' + (f'  ({notes})' if notes else ''))
+        print(f'{learner.shown}: {totals[learner.shown]}' + (f'  ({notes})' if notes else ''))
 
 
 def main(argv: Optional[list[str]] = None) -> int:
@@ -186,7 +230,13 @@ def _grade(args: argparse.Namespace, submissions: Path, out: Path, started: floa
         return 2
     settings = Settings(args.cell_timeout, args.notebook_timeout, not args.no_sandbox)
     _grade_all(course, learners, notebooks, settings, args.jobs)
-    _report(out, learners, write_results(course, out, learners, notebooks), refused)
+    rows = write_results(course, out, learners, notebooks)
+    _report(out, learners, rows, refused)
+    try:
+        write_report(out, learners, notebooks, rows, refused)
+    except Exception as error:  # noqa: BLE001 - the grades stand without the overview
+        print(f'grading/report.html could not be written ({type(error).__name__}: {error}); '
+              'grades.csv, the feedback and notes.json are complete')
     print(f'wrote {args.out.resolve() / "grades.csv"} and {args.out.resolve() / "feedback"} in '
           f'{time.monotonic() - started:.0f} s')
     return 0

@@ -121,7 +121,7 @@ def collect_zip(archive: Path, course: Path) -> tuple[Path, list[str]]:
 
 
 def _not_submitted_page(learner: Learner, notebook: str, points: float) -> str:
-    return feedback.page(notebook, f'<h1>{html.escape(learner.name)}: {notebook}</h1><p>Not '
+    return feedback.page(notebook, f'<h1>{html.escape(learner.shown)}: {notebook}</h1><p>Not '
                                    f'submitted: 0 of {points:g} points.</p>')
 
 
@@ -141,19 +141,36 @@ def write_results(course: Path, out: Path, learners: list[Learner],
                 except MissingEntry:
                     score = 0.0
                 total += score
-                rows.append([learner.name, notebook, f'{score:g}', f'{maxima[notebook]:g}'])
+                rows.append([learner.shown, notebook, f'{score:g}', f'{maxima[notebook]:g}'])
                 made = course / 'feedback' / learner.id / ASSIGNMENT / f'{notebook}.html'
                 page = folder / f'{notebook}.html'
-                if notebook in learner.files and made.is_file():
-                    page.write_text(feedback.safe_feedback(made.read_text(), notebook))
-                else:
-                    page.write_text(_not_submitted_page(learner, notebook, maxima[notebook]))
-            rows.append([learner.name, 'TOTAL', f'{total:g}', f'{sum(maxima.values()):g}'])
+                try:
+                    if notebook in learner.files and made.is_file():
+                        page.write_text(feedback.safe_feedback(made.read_text(), notebook))
+                    else:
+                        page.write_text(_not_submitted_page(learner, notebook, maxima[notebook]))
+                except Exception as error:  # noqa: BLE001 - that page's problem, in a note
+                    why = (f'its feedback page could not be written ({type(error).__name__}: '
+                           f'{str(error)[:200]}); the score stands')
+                    learner.note(notebook, why)
+                    page.write_text(feedback.page(notebook, f'<p>{html.escape(why)}</p>'))
+            rows.append([learner.shown, 'TOTAL', f'{total:g}', f'{sum(maxima.values()):g}'])
     with open(out / 'grades.csv', 'w', newline='') as stream:
         writer = csv.writer(stream)
         writer.writerow(['learner', 'notebook', 'score', 'max_score'])
-        writer.writerows(rows)
+        writer.writerows([spreadsheet_safe(row[0]), *row[1:]] for row in rows)
     return rows
+
+
+#: What makes a spreadsheet read a cell as a formula (OWASP, "CSV Injection").
+FORMULA_STARTS = ('=', '+', '-', '@', '\t', '\r')
+
+
+def spreadsheet_safe(text: str) -> str:
+    """``text`` as a spreadsheet shows it as a value, never runs it: a cell beginning with
+    ``=``, ``+``, ``-``, ``@``, a tab or a carriage return gets a ``'`` in front (the rest
+    stays as the learner's folder is named).  Used for ``grades.csv``'s learner column."""
+    return f"'{text}" if text.startswith(FORMULA_STARTS) else text
 
 
 def score_and_feedback(course: Path, exclude: Iterable[str] = ()) -> None:

@@ -70,7 +70,8 @@ def _run_and_judge(scratch: Scratch, learner: Learner, notebook: str,
     if notebooks_of.not_attempted(release, submitted):  # nothing to run: 0, said in a note
         learner.note(notebook, notebooks_of.NOT_ATTEMPTED)
         return f'{notebooks_of.NOT_ATTEMPTED}.'
-    for dropped in notebooks_of.drop_large_attachments(submitted):
+    for dropped in [*notebooks_of.drop_large_attachments(submitted),
+                    *notebooks_of.bound_markdown(release, submitted)]:
         learner.note(notebook, dropped)
     prepared = notebooks_of.for_the_run(release, submitted)
     executed, status, stopped = run_notebook(scratch, notebook, prepared, settings)
@@ -79,8 +80,10 @@ def _run_and_judge(scratch: Scratch, learner: Learner, notebook: str,
         happened = '; '.join(filter(None, [OUT_OF_SPACE.format(HOME_BYTES >> 20), happened]))
     if happened:
         learner.note(notebook, happened)
-    return executed, judges.submit(scratch, notebook, submitted, settings,
-                                   scratch.snapshot(notebook))
+    snapshot = scratch.snapshot(notebook)
+    verdict = judges.submit(scratch, notebook, submitted, settings, snapshot)
+    verdict.add_done_callback(lambda _done: scratch.release(snapshot))
+    return executed, verdict
 
 
 def _not_gradable(learner: Learner, notebook: str, error: Exception) -> str:
@@ -98,6 +101,7 @@ def _file(target: Path, learner: Learner, notebook: str, release: nbformat.Noteb
     """Put the judged notebook where nbgrader scores it (or a note why it could not be)."""
     try:
         results, problem, flags = verdict.result()
+        learner.results[notebook] = results
         if problem:
             learner.note(notebook, problem)
         if flags:  # the instructor's to look at; the points are the judge's verdict alone

@@ -186,6 +186,33 @@ def drop_large_attachments(nb: nbformat.NotebookNode) -> list[str]:
     return notes
 
 
+#: Most characters of one markdown cell of the learner's shown in the feedback, and of all
+#: of a notebook's: nbconvert's markdown rendering can take time quadratic in a cell's
+#: length (400 kB of ``[x](`` took minutes), and it runs on the host for the whole class.
+MAX_MARKDOWN_CELL = 20_000
+MAX_MARKDOWN_TOTAL = 100_000
+
+
+def bound_markdown(release: nbformat.NotebookNode, nb: nbformat.NotebookNode) -> list[str]:
+    """Cut the learner's markdown in ``nb`` to what the host renders in bounded time: each
+    cell (markdown or raw) that is not the course's to :data:`MAX_MARKDOWN_CELL` characters,
+    all of them to :data:`MAX_MARKDOWN_TOTAL`; one note for each cell cut, with the limit."""
+    course = {c.get('id'): c.source for c in release.cells}
+    notes, total = [], 0
+    for number, cell in enumerate(nb.cells, start=1):
+        if cell.cell_type not in ('markdown', 'raw') or course.get(cell.get('id')) == cell.source:
+            continue
+        room = max(0, min(MAX_MARKDOWN_CELL, MAX_MARKDOWN_TOTAL - total))
+        if len(cell.source) > room:
+            notes.append(f'markdown cell {number} ({len(cell.source) // 1000} kB) was cut to '
+                         f'{room // 1000} kB in the feedback (the grader shows at most '
+                         f'{MAX_MARKDOWN_CELL // 1000} kB of a cell, '
+                         f'{MAX_MARKDOWN_TOTAL // 1000} kB of a notebook\'s own markdown)')
+            cell.source = cell.source[:room] + '\n\n[cut by the grader]'
+        total += min(len(cell.source), room)
+    return notes
+
+
 def for_scoring(release: nbformat.NotebookNode, executed: nbformat.NotebookNode,
                 results: dict[str, dict], problem: Optional[str] = None) -> nbformat.NotebookNode:
     """The notebook nbgrader scores and turns into feedback.

@@ -78,14 +78,14 @@ def _read_back(out: Path, notebook: str, prepared: nbformat.NotebookNode
         why = ('it left a link where its executed notebook belongs'
                if isinstance(error, NotARegularFile) and error.errno == errno.ELOOP
                else 'its run left no readable notebook')
-        return prepared, {**NO_STATUS, 'runner_error': why}
+        return prepared, {**NO_STATUS, 'unread': why}
     try:
         status = json.loads(read_regular(out, f'{notebook}.run.ipynb.status.json', 1_000_000))
     except (OSError, ValueError):
         status = None
     status = checked_status(status)
     if status is None:
-        return executed, {**NO_STATUS, 'runner_error': (
+        return executed, {**NO_STATUS, 'unread': (
             "the runner's status was unreadable or rewritten (its kernel or the runner was "
             "killed, or the notebook changed it); what ran of the notebook is graded")}
     return executed, status
@@ -128,8 +128,14 @@ def run_note(status: dict, stopped: Optional[str]) -> Optional[str]:
     if status.get('output_cut'):
         cells = ', '.join(str(i + 1) for i in status['output_cut'])
         notes.append(f'the output of cell(s) {cells} was cut (too large to keep)')
+    if status.get('unread'):  # the grader's own words
+        notes.append(f'running it stopped early: {status["unread"]}')
     if status.get('runner_error'):
-        notes.append(f'running it stopped early: {status["runner_error"][:300]}')
+        # The status is written inside the sandbox, where the learner's code runs: its words
+        # are quoted as the run's, never said as the grader's.
+        said = json.dumps(status['runner_error'][:300], ensure_ascii=False)
+        notes.append(f'running it stopped early; the run inside the sandbox reported (its own '
+                     f'words, unchecked): {said}')
     if not notes and not status.get('finished'):
         notes.append(f'its run ended at cell {status["ran"] + 1} of {status["cells"]}: the '
                      'notebook stopped or killed the processes running it')

@@ -14,6 +14,7 @@ import shutil
 import stat
 import sys
 import tempfile
+import threading
 from pathlib import Path
 
 from ros2nb.terminal.workspace import WORKSPACE_NAME
@@ -41,6 +42,7 @@ class Scratch:
         self.home = self.top / 'home'
         self.workspace = self.home / 'workspace' / WORKSPACE_NAME
         self._mounts: list[Path] = []
+        self._lock = threading.Lock()  # a judge's thread releases its snapshot
         self.top.chmod(0o711)  # the sandboxes' own user may pass, nobody may list
         self.home = self._capped('home', HOME_BYTES)
 
@@ -49,7 +51,8 @@ class Scratch:
         folder = self.top / name
         folder.mkdir()
         if mount_capped(folder, size_bytes):
-            self._mounts.append(folder)
+            with self._lock:
+                self._mounts.append(folder)
         return folder
 
     def home_full(self) -> bool:
@@ -65,9 +68,10 @@ class Scratch:
 
     def remove(self) -> None:
         """Remove every folder of the learner's, unmounting what was mounted, never following a link."""
-        for folder in reversed(self._mounts):
-            unmount(folder)
-        self._mounts = []
+        with self._lock:
+            for folder in reversed(self._mounts):
+                unmount(folder)
+            self._mounts = []
         shutil.rmtree(self.top, ignore_errors=True)
 
     def snapshot(self, notebook: str) -> Path:
@@ -78,8 +82,9 @@ class Scratch:
         ``install`` and ``log`` and anything that is not a file, folder or link stay behind
         (the judge builds a package of its own when it needs one).
         """
-        target = self.top / f'workspace-{notebook}' / WORKSPACE_NAME
-        target.parent.mkdir()
+        # On a tmpfs of the home's size: the copy counts against a cap, never the host's
+        # disk, and :meth:`release` frees it once the judge is done with it.
+        target = self._capped(f'workspace-{notebook}', HOME_BYTES) / WORKSPACE_NAME
         target.parent.chmod(0o755)
         # No part of the path below the home may be a link: a home/workspace linked to the
         # host would hand the judge (and so the learner's code in it) the host's files.
@@ -90,6 +95,16 @@ class Scratch:
             target.mkdir()  # notebooks 00 and 01 make none
         target.chmod(0o755)
         return target
+
+    def release(self, snapshot: Path) -> None:
+        """Free a :meth:`snapshot` (its judge has ended): unmounted and removed at once, so
+        a learner holds at most the snapshots still being judged."""
+        folder = snapshot.parent
+        with self._lock:
+            if folder in self._mounts:
+                self._mounts.remove(folder)
+                unmount(folder)
+        shutil.rmtree(folder, ignore_errors=True)
 
     def judge_folders(self, notebook: str) -> tuple[Path, Path]:
         """A fresh folder of the judge's inputs (read-only inside), and its writable folder."""

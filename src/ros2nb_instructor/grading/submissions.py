@@ -34,15 +34,33 @@ class Learner:
     :ivar id: the id nbgrader knows the learner by (the name, unless nbgrader cannot take it).
     :ivar files: notebook (e.g. ``03-write-the-publisher``) -> the file graded for it.
     :ivar notes: notebook (or ``_folder``) -> what happened, in a sentence.
+    :ivar results: notebook -> the judge's results (grade id -> ``passed``, ``message``).
     """
 
     name: str
     id: str
     files: dict[str, Path] = field(default_factory=dict)
     notes: dict[str, str] = field(default_factory=dict)
+    results: dict[str, dict] = field(default_factory=dict)
+
+    @property
+    def shown(self) -> str:
+        """The folder's name as text (:func:`shown`): what the CSV, notes and pages say."""
+        return shown(self.name)
 
     def note(self, key: str, text: str) -> None:
         self.notes[key] = f'{self.notes[key]}; {text}' if key in self.notes else text
+
+
+def shown(name: str) -> str:
+    """A file or folder name as text that can be written anywhere: bytes of it that are not
+    UTF-8 (a zip made on Windows in cp1252, unpacked here) become ``\\xNN``, the rest stays.
+
+    The name on disk is never changed: the grader reads and writes the learner's files by
+    the name itself (``os.fsencode`` gives back its bytes); only what it says uses this.
+    Introduced for the grading (``docs/instructors.md``), never in a notebook.
+    """
+    return os.fsencode(name).decode('utf-8', 'backslashreplace')
 
 
 def legal_name(name: str) -> Optional[str]:
@@ -87,30 +105,30 @@ def find_learners(folder: Path, notebooks: list[str]) -> tuple[list[Learner], li
     learners, refused, taken = [], [], set()
     for number, entry in enumerate(sorted(folder.iterdir(), key=lambda p: p.name), start=1):
         if entry.is_symlink():
-            refused.append(f'{entry.name!r}: a link, not a learner folder (links are not '
-                           'followed: put the learner\'s folder itself there)')
+            refused.append(f'"{shown(entry.name)}": a link, not a learner folder (links are '
+                           'not followed: put the learner\'s folder itself there)')
             continue
         if not entry.is_dir():
-            refused.append(f'{entry.name!r}: not a learner folder (only folders of notebooks '
-                           'are graded)')
+            refused.append(f'"{shown(entry.name)}": not a learner folder (only folders of '
+                           'notebooks are graded)')
             continue
         problem = legal_name(entry.name)
         if problem:
-            refused.append(f'{entry.name!r}: {problem}, not graded')
+            refused.append(f'"{shown(entry.name)}": {problem}, not graded')
             continue
         learner = Learner(entry.name, _student_id(entry.name, number, taken))
         if learner.id != learner.name:
             learner.note('_folder', f'graded under the id {learner.id} (nbgrader cannot use '
-                                    'the folder name itself)')
+                                    f'the folder name {learner.shown} itself)')
         candidates: dict[str, list[Path]] = {}
         for path in sorted(entry.iterdir()):
             if path.is_symlink():
-                learner.note('_folder', f'{path.name} is a link (links are not followed: hand '
-                                        'in the notebook itself); not graded')
+                learner.note('_folder', f'{shown(path.name)} is a link (links are not followed: '
+                                        'hand in the notebook itself); not graded')
                 continue
             notebook = notebook_for(path.name, notebooks) if path.is_file() else None
             if notebook is None:
-                learner.note('_folder', f'{path.name} is not one of the course notebooks')
+                learner.note('_folder', f'{shown(path.name)} is not one of the course notebooks')
             else:
                 candidates.setdefault(notebook, []).append(path)
         for notebook, paths in candidates.items():
@@ -118,11 +136,11 @@ def find_learners(folder: Path, notebooks: list[str]) -> tuple[list[Learner], li
             chosen = exact[0] if exact else max(paths, key=lambda p: p.lstat().st_mtime)
             learner.files[notebook] = chosen
             if chosen.stem != notebook:
-                learner.note(notebook, f'graded {chosen.name} as {notebook}.ipynb')
-            others = [p.name for p in paths if p != chosen]
+                learner.note(notebook, f'graded {shown(chosen.name)} as {notebook}.ipynb')
+            others = [shown(p.name) for p in paths if p != chosen]
             if others:
                 learner.note(notebook, f'also handed in {", ".join(others)}: not graded '
-                                       f'(graded {chosen.name})')
+                                       f'(graded {shown(chosen.name)})')
         learners.append(learner)
     return learners, refused
 
