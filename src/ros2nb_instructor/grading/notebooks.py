@@ -191,6 +191,12 @@ def drop_large_attachments(nb: nbformat.NotebookNode) -> list[str]:
 #: length (400 kB of ``[x](`` took minutes), and it runs on the host for the whole class.
 MAX_MARKDOWN_CELL = 20_000
 MAX_MARKDOWN_TOTAL = 100_000
+#: Most characters of a code cell of the learner's shown in the feedback (what is graded
+#: is the judge's reading of the notebook handed in, never this copy).
+MAX_CODE_SHOWN = 50_000
+#: Most bytes of outputs (as JSON, images included) shown in a notebook's feedback; the
+#: cells after that show a line saying so.
+MAX_OUTPUTS_SHOWN = 10_000_000
 
 
 def bound_markdown(release: nbformat.NotebookNode, nb: nbformat.NotebookNode) -> list[str]:
@@ -245,16 +251,26 @@ def for_scoring(release: nbformat.NotebookNode, executed: nbformat.NotebookNode,
             cell.outputs = result_outputs(results.get(grade_id), problem)
             cell.execution_count = 1
         previous = cell
+    shown = 0  # bytes of outputs kept so far
     for index, cell in enumerate(nb.cells):
         if cell.cell_type == 'raw':  # shown as text, never as the HTML it may claim to be
             cell = nb.cells[index] = nbformat.v4.new_markdown_cell(cell.source)
+        original = course_cells.get(cell.get('id'))
+        theirs = original is None or original.source != cell.source
         if cell.cell_type == 'markdown':
-            original = course_cells.get(cell.get('id'))
-            if original is None or original.source != cell.source:
+            if theirs:
                 cell.source = _escape_markdown(cell.source)
             _safe_attachments(cell)
         elif cell.cell_type == 'code' and not nbgrader(cell).get('grade'):
+            if theirs and len(cell.source) > MAX_CODE_SHOWN:
+                cell.source = (f'{cell.source[:MAX_CODE_SHOWN]}\n# [the grader shows the first '
+                               f'{MAX_CODE_SHOWN // 1000} kB of a cell]')
             cell.outputs = _safe_outputs(cell.get('outputs', []))
+            shown += len(json.dumps(cell.outputs))
+            if shown > MAX_OUTPUTS_SHOWN:
+                cell.outputs = [nbformat.v4.new_output('stream', name='stdout', text=(
+                    f'[outputs not shown: the feedback shows {MAX_OUTPUTS_SHOWN // 1_000_000} '
+                    'MB of a notebook\'s outputs]'))]
     return nb
 
 
