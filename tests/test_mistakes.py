@@ -179,8 +179,39 @@ def test_publishing_a_bare_value(ros):
             "        self.create_timer(1.0, lambda: self.pub.publish(22.5))\n\n"
             's = ros2nb.add(Sensor())')
     stderr = ros.run('_ = ros2nb.spin(2)')['stderr']
-    assert 'publish() takes a message object, not a bare value' in stderr
+    assert 'publish() takes a Float32 message, not a bare value (float)' in stderr
     assert stderr.count('[ERROR] [s]') == 1  # reported once; the node is stopped
+
+
+@pytest.mark.parametrize('published, fragments', [
+    ('True', ('takes a Bool message, not a bare value (bool)', 'msg = Bool()')),
+    # what the old advice (msg = Float32()) led to: told apart, never the same line again
+    ('Float32(data=1.0)', ('created for Bool messages and was handed a Float32',
+                           'create a Bool (msg = Bool())')),
+])
+def test_the_fan_publishing_what_its_bool_publisher_refuses(ros, published, fragments):
+    """The advice names the publisher's own type (06's fan publishes Bool)."""
+    ros.run('from std_msgs.msg import Bool\n'
+            "fan = Node('fan_one')\nfan_pub = fan.create_publisher(Bool, 'fan_on', 10)")
+    ros.one_line(f'fan_pub.publish({published})', *fragments)
+
+
+def test_executor_spin_in_a_cell(ros):
+    """06's executor spun in a cell: one line at once, not a hang until Stop."""
+    ros.run('from rclpy.executors import MultiThreadedExecutor\n'
+            "ex = MultiThreadedExecutor(num_threads=2)\nex.add_node(Node('worker_one'))")
+    ros.one_line('ex.spin()', 'executor.spin() never returns in a notebook cell',
+                 'ros2nb.add(node)', 'ros2nb.timer_runs(node, executor, seconds)')
+
+
+def test_spin_until_future_complete_without_a_timeout(ros):
+    ros.run('import rclpy.task\nfuture = rclpy.task.Future()\n'
+            "waiter = Node('waiter_one')")
+    ros.one_line('rclpy.spin_until_future_complete(waiter, future)',
+                 'without timeout_sec blocks the cell', 'timeout_sec=5.0')
+    done = ros.run('rclpy.spin_until_future_complete(waiter, future, timeout_sec=0.1)\n'
+                   'print(future.done())')
+    assert done['error'] is None and done['stdout'].strip() == 'False', done  # a limit: runs
 
 
 def test_a_part_before_its_file_name_was_set(kernel):
@@ -392,3 +423,31 @@ def test_a_part_run_out_of_order_says_which_part_is_missing(kernel, tmp_path):
     out = kernel.run('%%part scripts/order.py 3\nc = 3\n')['stdout']
     assert out.strip().endswith('part 3 saved (parts 3; 1 lines; parts 1, 2 not saved yet: run '
                                 'their cells too)'), out
+
+
+@pytest.mark.parametrize('profile, fragments', [
+    ("QoSProfile(depth=1, reliability='best_effort')",
+     ("reliability takes a QoSReliabilityPolicy, not str 'best_effort'",
+      'reliability=QoSReliabilityPolicy.BEST_EFFORT')),
+    ("QoSProfile(depth='1')", ("depth takes a whole number, not str '1'", 'no quotes')),
+])
+def test_a_qos_setting_of_the_wrong_type_in_09(ros, profile, fragments):
+    """rclpy's bare assert (an empty AssertionError 40 lines down rclpy) becomes one line
+    at the learner's own line."""
+    ros.run(f'from rclpy.qos import QoSProfile\ndef newest_only_profile():\n    return {profile}')
+    line = ros.one_line('ros2nb.checks.check_newest_only(newest_only_profile)', *fragments)
+    assert 'cell line 3' in line, line
+
+
+def test_an_error_inside_the_learners_bag_reader_in_10(ros):
+    """An error in the learner's own function comes out through their frames only, never
+    through the check, rosbags or rclpy."""
+    ros.run('def read_temperatures(bag_path):\n'
+            '    readings = {}\n'
+            "    return readings['temperature']\n")
+    result = ros.run('ros2nb.checks.check_readings(read_temperatures)')
+    shown = result['error']['traceback']
+    assert "read_temperatures() raised: KeyError: 'temperature'" in shown[-1], shown
+    assert 'in read_temperatures' in shown[1], shown  # their own line, as Python shows it
+    assert not any('ros2nb/checks' in line or 'site-packages' in line for line in shown), shown
+    assert len(shown) <= 6, shown

@@ -14,7 +14,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, ContextManager, Optional, Protocol
 
-from ..errors import CheckFailed, LearnerCodeError
+from ..errors import CheckFailed, LearnerCodeError, Ros2nbError
+from ..explain.exceptions import describe_error
 from .dispatch import in_judge, run_in_judge
 
 #: Seconds the judge waits for what a subject published to arrive over ROS, and for ROS
@@ -85,13 +86,22 @@ def judged(name: str, body: Callable[..., str], **arguments: Any) -> None:
 
 
 def call_learner(function: Callable[..., Any], *args: Any) -> Any:
-    """Call the learner's function in the kernel; NotImplementedError becomes one line."""
+    """Call the learner's function in the kernel: NotImplementedError becomes one line, and
+    any other error the learner's code raised a failure through their own frames only (or
+    the one line of a known mistake), never a traceback through the check, rclpy or rosbags.
+
+    :raises CheckFailed: (or :class:`LearnerCodeError`) for an error in the learner's code.
+    """
     try:
         return function(*args)
     except NotImplementedError:
         raise CheckFailed(f'{function.__name__}() still raises NotImplementedError: replace '
                           '"raise NotImplementedError()" with your code and run its cell '
                           'again.') from None
+    except (CheckFailed, Ros2nbError):  # ros2nb's own line, raised in their code's call
+        raise
+    except Exception as error:  # their frames only, or the one line of a known mistake
+        raise learner_error(f'{function.__name__}()', describe_error(error)) from None
 
 
 @dataclass(frozen=True)

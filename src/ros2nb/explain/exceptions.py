@@ -84,6 +84,23 @@ def learner_traceback(exc: BaseException) -> list[str]:
     return lines
 
 
+def describe_error(error: BaseException) -> dict:
+    """The learner-facing facts of an exception: ``type``, ``message`` (at most 500
+    characters), ``explanation`` (the one line of a known mistake, or None), ``traceback``
+    (their own frames, :func:`learner_traceback`) and ``where`` (:func:`learner_line`).
+
+    What a check makes of an error in the learner's code, in a subject or in the kernel
+    (``ros2nb.checks.base.learner_error``); introduced in ``03-write-the-publisher.ipynb``.
+    """
+    try:
+        explanation = explain_exception(error)
+    except Exception:  # explaining must never hide the original error
+        explanation = None
+    return {'type': type(error).__name__, 'message': str(error)[:500],
+            'explanation': explanation, 'traceback': learner_traceback(error),
+            'where': learner_line(error)}
+
+
 def _called_code(exc: BaseException) -> Any:
     """The code of the learner's function that rclpy called with the wrong arguments, or None."""
     match = _SIGNATURE.match(str(exc)) if isinstance(exc, TypeError) else None
@@ -118,10 +135,39 @@ _NUMBERS = {'float': 'a decimal number such as 22.0', 'int': 'a whole number suc
             'str': "text such as 'hello'", 'bool': 'True or False'}
 
 
+#: The policy class of each QoSProfile setting that takes one.
+_QOS_POLICIES = {'history': 'QoSHistoryPolicy', 'reliability': 'QoSReliabilityPolicy',
+                 'durability': 'QoSDurabilityPolicy', 'liveliness': 'QoSLivelinessPolicy'}
+_QOS_DURATIONS = ('lifespan', 'deadline', 'liveliness_lease_duration')
+
+
+def _qos_setting(exc: AssertionError) -> Optional[str]:
+    """A QoSProfile setting given a value of the wrong type (a policy as a string, say):
+    rclpy's bare ``assert`` says nothing, so the line names the setting and what it takes."""
+    frames = list(_frames(exc))
+    last = frames[-1] if frames else None
+    if last is None or not last.f_code.co_filename.endswith(os.path.join('rclpy', 'qos.py')):
+        return None
+    setting, value = last.f_code.co_name, last.f_locals.get('value')
+    got = f'not {type(value).__name__} {value!r}'
+    if setting in _QOS_POLICIES:
+        policy = _QOS_POLICIES[setting]
+        member = str(value).upper() if isinstance(value, str) and str(value).isidentifier() \
+            else 'NAME'
+        return (f"QoSProfile's {setting} takes a {policy}, {got}: from rclpy.qos import "
+                f'{policy}, then {setting}={policy}.{member}.')
+    if setting == 'depth':
+        return f"QoSProfile's depth takes a whole number, {got}: write depth=10, no quotes."
+    if setting in _QOS_DURATIONS:
+        return (f"QoSProfile's {setting} takes a Duration, {got}: from rclpy.duration import "
+                f'Duration, then {setting}=Duration(seconds=...).')
+    return None
+
+
 def _field_type(exc: AssertionError) -> Optional[str]:
     match = _FIELD_TYPE.search(str(exc))
     if not match:
-        return None
+        return _qos_setting(exc)
     field, wanted = match.groups()
     frame = list(_frames(exc))[-1]
     message = frame.f_locals.get('self')
@@ -234,8 +280,7 @@ def explain_exception(exc: BaseException, *, ros_started: bool = False) -> Optio
     if type(exc).__name__ == 'RCLError' and 'context is invalid' in text:
         return SHUT_DOWN_MESSAGE
     if isinstance(exc, TypeError) and text.startswith('Expected <class'):
-        return ('publish() takes a message object, not a bare value: create the message '
-                '(msg = Float32()), set msg.data, then publish(msg).')
+        return _wrong_message_published(text)
     if isinstance(exc, TypeError) and text.startswith('Expected QoSProfile or int'):
         return ('the arguments are in the wrong order: create_subscription takes the message '
                 'type, the topic, the callback and the queue depth (create_publisher: the type, '
@@ -243,6 +288,21 @@ def explain_exception(exc: BaseException, *, ros_started: bool = False) -> Optio
     if isinstance(exc, TypeError):
         return _message_not_a_value(exc)
     return None
+
+
+def _wrong_message_published(text: str) -> str:
+    """publish() given something other than its publisher's message type: the advice names
+    that type (a ``Bool`` publisher gets ``Bool`` advice), and a message of another type is
+    told apart from a bare value."""
+    found = re.match(r"Expected <class '([\w.]+)'>, got <class '([\w.]+)'>", text)
+    wanted, got = (found.group(1).rsplit('.', 1)[-1], found.group(2)) if found else ('Float32', '')
+    if '.msg.' in got:  # another message type
+        return (f'this publisher was created for {wanted} messages and was handed a '
+                f'{got.rsplit(".", 1)[-1]}: create a {wanted} (msg = {wanted}()), set its '
+                'fields, then publish(msg); or create the publisher with the type you publish.')
+    bare = f' ({got})' if got else ''
+    return (f'publish() takes a {wanted} message, not a bare value{bare}: create the message '
+            f'(msg = {wanted}()), set msg.data, then publish(msg).')
 
 
 def _placeholder(exc: BaseException) -> Optional[str]:

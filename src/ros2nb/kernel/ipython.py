@@ -4,7 +4,8 @@ Introduced in ``00-setup-and-the-pubsub-idea.ipynb``.  :func:`ros2nb.start` inst
 a notebook; ``%load_ext ros2nb`` does too (notebook 05 runs no ROS in the kernel).
 Runs in the learner's kernel.
 
-- ``rclpy.spin(node)`` in a cell says what to use instead of blocking the kernel.
+- ``rclpy.spin(node)``, ``executor.spin()`` and ``spin_until_future_complete`` without a
+  timeout, in a cell, say what to use instead of blocking the kernel.
 - ``%%part FILE N [--overwrite]`` saves the cell as part N of FILE (:func:`ros2nb.write_part`).
 - Known beginner mistakes raised through rclpy or a message class show as one line
   naming the learner's own line (:mod:`ros2nb.explain`); other errors keep their normal
@@ -25,6 +26,7 @@ import threading
 from typing import Any, Optional
 
 import rclpy
+from rclpy.executors import Executor
 
 from ..errors import Ros2nbError, UsageError
 from ..explain.exceptions import explain_exception, learner_line
@@ -33,6 +35,11 @@ from ..terminal.files import write_part
 
 _INSTALLED = '_ros2nb_installed'
 _original_spin = rclpy.spin
+_original_executor_spin = Executor.spin
+_original_until_complete = Executor.spin_until_future_complete
+#: What to do instead of blocking a cell, for every spin that would.
+_INSTEAD = ('hand the node over with ros2nb.add(node) and let it run with '
+            'ros2nb.spin(seconds)')
 
 
 def _spin_in_a_cell(node: Any, executor: Any = None) -> None:
@@ -44,6 +51,29 @@ def _spin_in_a_cell(node: Any, executor: Any = None) -> None:
                           f'kernel until you press Stop): {first}hand the node over with '
                           'ros2nb.add(node) and let it run with ros2nb.spin(seconds).')
     return _original_spin(node, executor)
+
+
+def _executor_spin_in_a_cell(executor: Executor) -> None:
+    """``Executor.spin`` in a kernel: from a cell it explains instead of blocking the kernel
+    (the executor of notebook 06 included; its threads spin as before)."""
+    if threading.current_thread() is threading.main_thread():
+        raise Ros2nbError('executor.spin() never returns in a notebook cell (it would block the '
+                          f'kernel until you press Stop): {_INSTEAD}; to watch an executor at '
+                          'work for a while, ros2nb.timer_runs(node, executor, seconds).')
+    return _original_executor_spin(executor)
+
+
+def _until_complete_in_a_cell(executor: Executor, future: Any,
+                              timeout_sec: Optional[float] = None) -> None:
+    """``spin_until_future_complete`` with no timeout, in a cell: explains instead of
+    blocking the kernel until a future that may never complete does."""
+    if threading.current_thread() is threading.main_thread() and (
+            timeout_sec is None or timeout_sec < 0):
+        raise Ros2nbError('spin_until_future_complete(...) without timeout_sec blocks the cell '
+                          'until the future is done, which may be never: give it a limit, '
+                          'timeout_sec=5.0, then check future.done(); or '
+                          f'{_INSTEAD}.')
+    return _original_until_complete(executor, future, timeout_sec)
 
 
 def part(line: str, cell: str) -> None:
@@ -110,5 +140,7 @@ def install(ip: Any = None) -> bool:
     ip.events.register('post_run_cell', _after_cell)
     ip.set_custom_exc((Exception,), _explain)
     rclpy.spin = _spin_in_a_cell
+    Executor.spin = _executor_spin_in_a_cell
+    Executor.spin_until_future_complete = _until_complete_in_a_cell
     setattr(ip, _INSTALLED, True)
     return True

@@ -28,9 +28,10 @@ from rclpy.node import Node
 from .. import domains
 from ..endpoints import node_endpoints
 from ..errors import Ros2nbError
+from ..explain.exceptions import describe_error
 from ..runtime import Runtime, enable_field_checks
 from ..runtime.clock import JudgeTime
-from .replies import decode_argument, describe_error, encode
+from .replies import decode_argument, encode
 from .stand_ins import with_stand_ins
 from .trials import Trials
 

@@ -10,8 +10,6 @@ import math
 from pathlib import Path
 from typing import Any
 
-from ..explain.exceptions import explain_exception, learner_line, learner_traceback
-
 
 def encode(value: Any) -> Any:
     """Return a JSON-safe description of a value the learner's code returned."""
@@ -32,13 +30,3 @@ def decode_argument(value: Any) -> Any:
         return Path(value['path'])
     return value
 
-
-def describe_error(error: BaseException) -> dict:
-    """The learner-facing facts of an exception: type, message, explanation, their traceback."""
-    lines = learner_traceback(error)
-    try:
-        explanation = explain_exception(error)
-    except Exception:
-        explanation = None
-    return {'type': type(error).__name__, 'message': str(error)[:500],
-            'explanation': explanation, 'traceback': lines, 'where': learner_line(error)}

@@ -19,8 +19,9 @@ from rclpy.qos import QoSProfile
 from std_msgs.msg import Float32, Int32
 
 from ..endpoints import node_endpoints
+from ..explain.exceptions import describe_error
 from ..runtime.rates import callback_groups
-from .replies import describe_error, encode
+from .replies import encode
 
 #: The node that makes an endpoint with the learner's QoS profile (notebook 09).
 QOS_NODE = 'qos_answer'
