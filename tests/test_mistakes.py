@@ -451,3 +451,47 @@ def test_an_error_inside_the_learners_bag_reader_in_10(ros):
     assert 'in read_temperatures' in shown[1], shown  # their own line, as Python shows it
     assert not any('ros2nb/checks' in line or 'site-packages' in line for line in shown), shown
     assert len(shown) <= 6, shown
+
+
+PARAMETER_NODE = '''
+from rcl_interfaces.msg import SetParametersResult
+
+class Thresholds(Node):
+    def __init__(self, **kwargs):
+        super().__init__('thresholds_one', **kwargs)
+        {body}
+
+    def on_parameters_set(self, parameters):
+        return SetParametersResult(successful=True)
+'''
+
+
+@pytest.mark.parametrize('body, made, fragments', [
+    ("self.high = self.get_parameter('high_above_c').value\n"
+     "        self.declare_parameter('high_above_c', 26.0)", 'Thresholds()',
+     ("the parameter 'high_above_c' was read (or set) before it was declared",
+      "self.declare_parameter('high_above_c', default) first")),
+    ("self.add_on_set_parameters_callback(self.on_parameters_set(None))", 'Thresholds()',
+     ('add_on_set_parameters_callback takes the callback itself', 'without ()')),
+    ("self.declare_parameter('high_above_c', 26.0)",
+     "Thresholds(cli_args=['--ros-args', '-p', 'high_above_c:=25'])",
+     ("the parameter 'high_above_c' holds a double", "'25' is an integer",
+      '-p high_above_c:=25.0')),
+])
+def test_the_classic_parameter_mistakes_of_08(ros, body, made, fragments):
+    ros.run(PARAMETER_NODE.format(body=body))
+    ros.one_line(made, *fragments)
+
+
+@pytest.mark.parametrize('arguments, fragments', [
+    ("['--ros-args', '-r', '__ns:=kitchen']", ("the remap rule '-r __ns:=kitchen'",
+                                              'a namespace starts with a slash: __ns:=/kitchen')),
+    ("['--ros-args', '-p', '__ns:=/kitchen']", ('__ns is not a parameter but a remap',
+                                               '-r __ns:=/kitchen')),
+    ("['--ros-args', '-r', 'temperature=kitchen_temperature']", ('written FROM:=TO, with :=',)),
+])
+def test_rcl_refusing_a_rule_is_one_line_with_the_rule_written_right(ros, arguments, fragments):
+    """06's room arguments as beginners write them: rcl's 'Expected lexeme type 19, got 18 at
+    index 6' becomes what is wrong and how the rule is written."""
+    line = ros.one_line(f"Node('fan_in_a_room', cli_args={arguments})", *fragments)
+    assert 'lexeme' not in line, line

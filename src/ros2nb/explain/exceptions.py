@@ -270,6 +270,9 @@ def explain_exception(exc: BaseException, *, ros_started: bool = False) -> Optio
         return ('rclpy.init() was called, but ros2nb.start() already brought ROS 2 up in this '
                 'kernel: remove that call; to run a node here hand it to ros2nb.add(node) '
                 '(main() is for `ros2 run`, notebook 05).')
+    parameter = _parameter_mistake(exc, text) or _ros_arguments_mistake(exc, text)
+    if parameter:
+        return parameter
     if type(exc).__name__ == 'InvalidQoSProfileException':
         return ('a QoSProfile needs its history depth: QoSProfile(depth=10), or pass just the '
                 'depth, 10.')
@@ -288,6 +291,58 @@ def explain_exception(exc: BaseException, *, ros_started: bool = False) -> Optio
     if isinstance(exc, TypeError):
         return _message_not_a_value(exc)
     return None
+
+
+_WRONG_PARAMETER_TYPE = re.compile(r"Trying to set parameter '(\w+)' to '([^']*)' of type "
+                                   r"'(\w+)', expecting type '(\w+)'")
+
+
+def _parameter_mistake(exc: BaseException, text: str) -> Optional[str]:
+    """The classic parameter mistakes of notebook 08, each with its fix."""
+    kind = type(exc).__name__
+    if kind == 'ParameterNotDeclaredException':
+        name = text.rsplit(': ', 1)[-1]
+        return (f"the parameter '{name}' was read (or set) before it was declared: call "
+                f"self.declare_parameter('{name}', default) first, in __init__, then "
+                'get_parameter.')
+    found = _WRONG_PARAMETER_TYPE.search(text) if kind == 'InvalidParameterTypeException' \
+        else None
+    if found:
+        name, value, given, wanted = found.groups()
+        fix = (f'{value}.0, e.g. -p {name}:={value}.0' if (given, wanted) == ('INTEGER', 'DOUBLE')
+               else f'a {wanted.lower()} value')
+        return (f"the parameter '{name}' holds a {wanted.lower()} (its default decides), and "
+                f"'{value}' is {'an' if given[0] in 'AEIOU' else 'a'} {given.lower()}: give it "
+                f'{fix}.')
+    if isinstance(exc, TypeError) and text.startswith("('Callback must be callable"):
+        return ('add_on_set_parameters_callback takes the callback itself, and was given what '
+                'calling it returned: pass self.on_parameters_set, without ().')
+    return None
+
+
+_ROS_RULE = re.compile(r"Couldn't parse (remap|parameter override) rule: '(-[rp]) ([^']*)'")
+
+
+def _ros_arguments_mistake(exc: BaseException, text: str) -> Optional[str]:
+    """rcl's refusal of a ``-r`` or ``-p`` rule (``Expected lexeme type 19...``), as the
+    rule, what is wrong with it, and how it is written (notebooks 06 and 08)."""
+    found = _ROS_RULE.search(text) if type(exc).__name__ == 'RCLInvalidROSArgsError' else None
+    if found is None:
+        return None
+    kind, flag, rule = found.groups()
+    name, _, value = rule.partition(':=') if ':=' in rule else rule.partition('=')
+    if kind == 'remap' and ':=' not in rule:
+        why = 'a remap is written FROM:=TO, with :='
+    elif kind == 'remap' and name == '__ns' and not value.startswith('/'):
+        why = f'a namespace starts with a slash: __ns:=/{value}'
+    elif kind == 'remap':
+        why = 'a remap is FROM:=TO, each a valid name (letters, digits, _ and /)'
+    elif name.startswith('__'):
+        why = (f'{name} is not a parameter but a remap: -r {rule}'
+               + ('' if value.startswith('/') or name != '__ns' else f' (with a slash: /{value})'))
+    else:
+        why = 'a parameter is written -p NAME:=VALUE, the name in letters, digits and _'
+    return f"ROS could not read the {kind} rule '{flag} {rule}': {why}."
 
 
 def _wrong_message_published(text: str) -> str:
