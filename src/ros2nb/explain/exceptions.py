@@ -23,6 +23,7 @@ from typing import Any, Optional
 from rclpy.exceptions import NameValidationException, NotInitializedException
 
 from ..errors import SHUT_DOWN_MESSAGE
+from .settings import parameter_mistake, qos_setting, ros_arguments_mistake
 
 #: The ros2nb package: its files are not the learner's.
 _HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -135,39 +136,10 @@ _NUMBERS = {'float': 'a decimal number such as 22.0', 'int': 'a whole number suc
             'str': "text such as 'hello'", 'bool': 'True or False'}
 
 
-#: The policy class of each QoSProfile setting that takes one.
-_QOS_POLICIES = {'history': 'QoSHistoryPolicy', 'reliability': 'QoSReliabilityPolicy',
-                 'durability': 'QoSDurabilityPolicy', 'liveliness': 'QoSLivelinessPolicy'}
-_QOS_DURATIONS = ('lifespan', 'deadline', 'liveliness_lease_duration')
-
-
-def _qos_setting(exc: AssertionError) -> Optional[str]:
-    """A QoSProfile setting given a value of the wrong type (a policy as a string, say):
-    rclpy's bare ``assert`` says nothing, so the line names the setting and what it takes."""
-    frames = list(_frames(exc))
-    last = frames[-1] if frames else None
-    if last is None or not last.f_code.co_filename.endswith(os.path.join('rclpy', 'qos.py')):
-        return None
-    setting, value = last.f_code.co_name, last.f_locals.get('value')
-    got = f'not {type(value).__name__} {value!r}'
-    if setting in _QOS_POLICIES:
-        policy = _QOS_POLICIES[setting]
-        member = str(value).upper() if isinstance(value, str) and str(value).isidentifier() \
-            else 'NAME'
-        return (f"QoSProfile's {setting} takes a {policy}, {got}: from rclpy.qos import "
-                f'{policy}, then {setting}={policy}.{member}.')
-    if setting == 'depth':
-        return f"QoSProfile's depth takes a whole number, {got}: write depth=10, no quotes."
-    if setting in _QOS_DURATIONS:
-        return (f"QoSProfile's {setting} takes a Duration, {got}: from rclpy.duration import "
-                f'Duration, then {setting}=Duration(seconds=...).')
-    return None
-
-
 def _field_type(exc: AssertionError) -> Optional[str]:
     match = _FIELD_TYPE.search(str(exc))
     if not match:
-        return _qos_setting(exc)
+        return qos_setting(exc, list(_frames(exc)))
     field, wanted = match.groups()
     frame = list(_frames(exc))[-1]
     message = frame.f_locals.get('self')
@@ -270,7 +242,7 @@ def explain_exception(exc: BaseException, *, ros_started: bool = False) -> Optio
         return ('rclpy.init() was called, but ros2nb.start() already brought ROS 2 up in this '
                 'kernel: remove that call; to run a node here hand it to ros2nb.add(node) '
                 '(main() is for `ros2 run`, notebook 05).')
-    parameter = _parameter_mistake(exc, text) or _ros_arguments_mistake(exc, text)
+    parameter = parameter_mistake(exc, text) or ros_arguments_mistake(exc, text)
     if parameter:
         return parameter
     if type(exc).__name__ == 'InvalidQoSProfileException':
@@ -291,58 +263,6 @@ def explain_exception(exc: BaseException, *, ros_started: bool = False) -> Optio
     if isinstance(exc, TypeError):
         return _message_not_a_value(exc)
     return None
-
-
-_WRONG_PARAMETER_TYPE = re.compile(r"Trying to set parameter '(\w+)' to '([^']*)' of type "
-                                   r"'(\w+)', expecting type '(\w+)'")
-
-
-def _parameter_mistake(exc: BaseException, text: str) -> Optional[str]:
-    """The classic parameter mistakes of notebook 08, each with its fix."""
-    kind = type(exc).__name__
-    if kind == 'ParameterNotDeclaredException':
-        name = text.rsplit(': ', 1)[-1]
-        return (f"the parameter '{name}' was read (or set) before it was declared: call "
-                f"self.declare_parameter('{name}', default) first, in __init__, then "
-                'get_parameter.')
-    found = _WRONG_PARAMETER_TYPE.search(text) if kind == 'InvalidParameterTypeException' \
-        else None
-    if found:
-        name, value, given, wanted = found.groups()
-        fix = (f'{value}.0, e.g. -p {name}:={value}.0' if (given, wanted) == ('INTEGER', 'DOUBLE')
-               else f'a {wanted.lower()} value')
-        return (f"the parameter '{name}' holds a {wanted.lower()} (its default decides), and "
-                f"'{value}' is {'an' if given[0] in 'AEIOU' else 'a'} {given.lower()}: give it "
-                f'{fix}.')
-    if isinstance(exc, TypeError) and text.startswith("('Callback must be callable"):
-        return ('add_on_set_parameters_callback takes the callback itself, and was given what '
-                'calling it returned: pass self.on_parameters_set, without ().')
-    return None
-
-
-_ROS_RULE = re.compile(r"Couldn't parse (remap|parameter override) rule: '(-[rp]) ([^']*)'")
-
-
-def _ros_arguments_mistake(exc: BaseException, text: str) -> Optional[str]:
-    """rcl's refusal of a ``-r`` or ``-p`` rule (``Expected lexeme type 19...``), as the
-    rule, what is wrong with it, and how it is written (notebooks 06 and 08)."""
-    found = _ROS_RULE.search(text) if type(exc).__name__ == 'RCLInvalidROSArgsError' else None
-    if found is None:
-        return None
-    kind, flag, rule = found.groups()
-    name, _, value = rule.partition(':=') if ':=' in rule else rule.partition('=')
-    if kind == 'remap' and ':=' not in rule:
-        why = 'a remap is written FROM:=TO, with :='
-    elif kind == 'remap' and name == '__ns' and not value.startswith('/'):
-        why = f'a namespace starts with a slash: __ns:=/{value}'
-    elif kind == 'remap':
-        why = 'a remap is FROM:=TO, each a valid name (letters, digits, _ and /)'
-    elif name.startswith('__'):
-        why = (f'{name} is not a parameter but a remap: -r {rule}'
-               + ('' if value.startswith('/') or name != '__ns' else f' (with a slash: /{value})'))
-    else:
-        why = 'a parameter is written -p NAME:=VALUE, the name in letters, digits and _'
-    return f"ROS could not read the {kind} rule '{flag} {rule}': {why}."
 
 
 def _wrong_message_published(text: str) -> str:

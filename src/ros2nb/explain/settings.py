@@ -1,0 +1,104 @@
+"""One line for the ROS settings beginners get wrong: QoS settings, parameters, ``-r``/``-p`` rules.
+
+Part of :mod:`ros2nb.explain` (:func:`~ros2nb.explain.exceptions.explain_exception` asks
+here first); runs wherever learner code does: the kernel and the judge's subjects.  rclpy
+and rcl answer these with a bare ``assert``, a tuple printed as text or lexeme numbers; each
+function here returns the line that says what is wrong and what to write, or None.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from typing import Any, Optional
+
+
+#: The policy class of each QoSProfile setting that takes one.
+_QOS_POLICIES = {'history': 'QoSHistoryPolicy', 'reliability': 'QoSReliabilityPolicy',
+                 'durability': 'QoSDurabilityPolicy', 'liveliness': 'QoSLivelinessPolicy'}
+_QOS_DURATIONS = ('lifespan', 'deadline', 'liveliness_lease_duration')
+
+
+def qos_setting(exc: AssertionError, frames: list[Any]) -> Optional[str]:
+    """A QoSProfile setting given a value of the wrong type (a policy as a string, say):
+    rclpy's bare ``assert`` says nothing, so the line names the setting and what it takes.
+
+    :param frames: the exception's frames, outermost first (rclpy's setter last).
+    Introduced in ``09-qos.ipynb``.
+    """
+    last = frames[-1] if frames else None
+    if last is None or not last.f_code.co_filename.endswith(os.path.join('rclpy', 'qos.py')):
+        return None
+    setting, value = last.f_code.co_name, last.f_locals.get('value')
+    got = f'not {type(value).__name__} {value!r}'
+    if setting in _QOS_POLICIES:
+        policy = _QOS_POLICIES[setting]
+        member = str(value).upper() if isinstance(value, str) and str(value).isidentifier() \
+            else 'NAME'
+        return (f"QoSProfile's {setting} takes a {policy}, {got}: from rclpy.qos import "
+                f'{policy}, then {setting}={policy}.{member}.')
+    if setting == 'depth':
+        return f"QoSProfile's depth takes a whole number, {got}: write depth=10, no quotes."
+    if setting in _QOS_DURATIONS:
+        return (f"QoSProfile's {setting} takes a Duration, {got}: from rclpy.duration import "
+                f'Duration, then {setting}=Duration(seconds=...).')
+    return None
+
+
+_WRONG_PARAMETER_TYPE = re.compile(r"Trying to set parameter '(\w+)' to '([^']*)' of type "
+                                   r"'(\w+)', expecting type '(\w+)'")
+
+
+def parameter_mistake(exc: BaseException, text: str) -> Optional[str]:
+    """The classic parameter mistakes, each with its fix: read before declared, the wrong type
+    given with ``-p``, the on-set callback called instead of passed.  None for any other error.
+
+    Introduced in ``08-parameters.ipynb``.
+    """
+    kind = type(exc).__name__
+    if kind == 'ParameterNotDeclaredException':
+        name = text.rsplit(': ', 1)[-1]
+        return (f"the parameter '{name}' was read (or set) before it was declared: call "
+                f"self.declare_parameter('{name}', default) first, in __init__, then "
+                'get_parameter.')
+    found = _WRONG_PARAMETER_TYPE.search(text) if kind == 'InvalidParameterTypeException' \
+        else None
+    if found:
+        name, value, given, wanted = found.groups()
+        fix = (f'{value}.0, e.g. -p {name}:={value}.0' if (given, wanted) == ('INTEGER', 'DOUBLE')
+               else f'a {wanted.lower()} value')
+        return (f"the parameter '{name}' holds a {wanted.lower()} (its default decides), and "
+                f"'{value}' is {'an' if given[0] in 'AEIOU' else 'a'} {given.lower()}: give it "
+                f'{fix}.')
+    if isinstance(exc, TypeError) and text.startswith("('Callback must be callable"):
+        return ('add_on_set_parameters_callback takes the callback itself, and was given what '
+                'calling it returned: pass self.on_parameters_set, without ().')
+    return None
+
+
+_ROS_RULE = re.compile(r"Couldn't parse (remap|parameter override) rule: '(-[rp]) ([^']*)'")
+
+
+def ros_arguments_mistake(exc: BaseException, text: str) -> Optional[str]:
+    """rcl's refusal of a ``-r`` or ``-p`` rule (``Expected lexeme type 19...``), as the
+    rule, what is wrong with it, and how it is written; None for any other error.
+
+    Introduced in ``06-five-promises.ipynb`` (a room's namespace) and ``08-parameters.ipynb``.
+    """
+    found = _ROS_RULE.search(text) if type(exc).__name__ == 'RCLInvalidROSArgsError' else None
+    if found is None:
+        return None
+    kind, flag, rule = found.groups()
+    name, _, value = rule.partition(':=') if ':=' in rule else rule.partition('=')
+    if kind == 'remap' and ':=' not in rule:
+        why = 'a remap is written FROM:=TO, with :='
+    elif kind == 'remap' and name == '__ns' and not value.startswith('/'):
+        why = f'a namespace starts with a slash: __ns:=/{value}'
+    elif kind == 'remap':
+        why = 'a remap is FROM:=TO, each a valid name (letters, digits, _ and /)'
+    elif name.startswith('__'):
+        why = (f'{name} is not a parameter but a remap: -r {rule}'
+               + ('' if value.startswith('/') or name != '__ns' else f' (with a slash: /{value})'))
+    else:
+        why = 'a parameter is written -p NAME:=VALUE, the name in letters, digits and _'
+    return f"ROS could not read the {kind} rule '{flag} {rule}': {why}."
