@@ -495,3 +495,14 @@ def test_rcl_refusing_a_rule_is_one_line_with_the_rule_written_right(ros, argume
     index 6' becomes what is wrong and how the rule is written."""
     line = ros.one_line(f"Node('fan_in_a_room', cli_args={arguments})", *fragments)
     assert 'lexeme' not in line, line
+
+
+def test_nodes_left_running_are_named_not_blamed_on_the_replay(ros):
+    """10: the live sensor of an earlier cell still up when the replay is checked: the line
+    names the nodes left running and what to do, never the learner's (here empty) replay."""
+    ros.run("leftover = ros2nb.add(Node('temperature_sensor'))\n"
+            'def replay(bag_path, rate):\n    pass')
+    line = ros.one_line('ros2nb.checks.check_replay(replay)',
+                        'still running in this kernel (/temperature_sensor)',
+                        'Run ros2nb.stop(), then this check again')
+    assert 'replay(' in line and 'add the monitor' not in line, line

@@ -121,8 +121,22 @@ def _call(function: Any, label: str, *args: Any, spin_s: float = 0.0) -> Any:
             raise learner_error(label, output['error'])
         judge.drop_all()  # its nodes leave the graph: what they said is heard by now
         return _plain(output['result'])
+    if spin_s:  # the function runs nodes: none of an earlier cell's may run beside them
+        _no_nodes_left(label)
     with contextlib.redirect_stdout(io.StringIO()):  # the verdict is the check's line alone
         return call_learner(function, *args)
+
+
+def _no_nodes_left(label: str) -> None:
+    """In the kernel: nodes an earlier cell left running would publish and log beside what
+    the learner's function makes; say so, before it runs, instead of blaming the function."""
+    rt = current_runtime()
+    left = sorted(rt.nodes) if rt is not None else []
+    if left:
+        raise CheckFailed(f'{len(left)} node(s) from earlier cells are still running in this '
+                          f'kernel ({", ".join(left)}): what they publish and log would mix '
+                          f'with what {label} makes. Run ros2nb.stop(), then this check again '
+                          '(and end your function with ros2nb.stop(), so it leaves none).')
 
 
 def _plain(result: dict) -> Any:
