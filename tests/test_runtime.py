@@ -237,7 +237,15 @@ def test_a_simulated_step_waits_only_for_work_of_the_nodes(ros, capsys):
     assert len(lines) == 11 and all(line.startswith('[INFO] [temperature_sensor]: Publishing: ')
                                     for line in lines[:10]), lines
     assert readings[-1] == pytest.approx(sensor.value) and len(readings) == 10
-    assert (spun, recorded) == (2 * 10 + 1, 2 * 10 + 1)  # + the idle round before the first step
+    # Two rounds a step, and the idle round before the first: 21. A reading or line that
+    # DDS delivers late, on a busy machine, may cost a round more now and then (the count
+    # depends on delivery), never a round more every step, which would be 31.
+    assert 2 * 10 + 1 <= spun <= 2 * 10 + 1 + LATE_ROUNDS, spun
+    assert 2 * 10 + 1 <= recorded <= 2 * 10 + 1 + LATE_ROUNDS, recorded
+
+
+#: Wait rounds a busy machine may add to ten simulated steps (late deliveries), at most.
+LATE_ROUNDS = 4
 
 
 def test_a_callback_of_ros2nbs_own_node_that_raises_is_reported_and_the_spin_goes_on(
