@@ -29,6 +29,9 @@ $(STAMP): environment/requirements.txt environment/installer.txt pyproject.toml
 	@$(PYTHON) -c 'import sys, platform; v = sys.version_info; \
 	  ok = (3, 10) <= v[:2] <= (3, 13) and platform.system() == "Linux" and platform.machine() == "x86_64"; \
 	  sys.exit(0 if ok else "The pip route needs Linux x86_64 and Python 3.10-3.13 (found %s %s, Python %d.%d); see README for RoboStack." % (platform.system(), platform.machine(), v[0], v[1]))'
+	@$(PYTHON) -c 'import ensurepip, venv' 2>/dev/null || { echo "Python's venv is not installed: sudo apt install python3-venv (Debian, Ubuntu), then make again."; exit 1; }
+	@if [ -e $(VENV) ] && ! $(PY) -m pip --version >/dev/null 2>&1; then \
+	  echo "$(VENV) was left half-made by an earlier try: making it again."; rm -rf $(VENV); fi
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet -r environment/installer.txt
 	@# --compile-bytecode: uv compiles site-packages once, on every CPU; where
