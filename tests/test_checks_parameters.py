@@ -65,9 +65,19 @@ DECLARATION_MISTAKES = [
     ('placeholder', 'in_clamp_range = [', 'raise NotImplementedError()\n        in_clamp_range = [',
      r'TemperatureMonitor\(\) still raises NotImplementedError: write your code where it says'),
     ('one not declared', DECLARE, '',
-     r'TemperatureMonitor\(\) reads the parameter low_below_c, which it never declares: declare it'),
+     r'TemperatureMonitor\(\) reads the parameter low_below_c before it declares it, or never '
+     r'declares it: declare it'),
     ('name typo', "declare_parameter('high_above_c'", "declare_parameter('high_above'",
-     r'TemperatureMonitor\(\) reads the parameter high_above_c, which it never declares'),
+     r'TemperatureMonitor\(\) reads the parameter high_above_c before it declares it, or never'),
+    ('read before declared', "        self.declare_parameter('high_above_c', HIGH_ABOVE_C,",
+     "        self.get_parameter('high_above_c')\n"
+     "        self.declare_parameter('high_above_c', HIGH_ABOVE_C,",
+     r'TemperatureMonitor\(\) reads the parameter high_above_c before it declares it'),
+    # told at once (it waited 60 s and blamed a busy machine)
+    ('no parameter services', "super().__init__('temperature_monitor')",
+     "super().__init__('temperature_monitor', start_parameter_services=False)",
+     r'TemperatureMonitor has no parameter services \(was it made with '
+     r'start_parameter_services=False\?\)'),
     ('integer default', "'high_above_c', HIGH_ABOVE_C,", "'high_above_c', 26,",
      r'high_above_c is an integer parameter \(26\): give it the float default 26.0'),
     ('wrong default', "'low_below_c', LOW_BELOW_C,", "'low_below_c', 18.0,",

@@ -47,12 +47,14 @@ class _Monitor:
             self.subject, self.info = new_node(judge, course.SUBSCRIBER_FILE,
                                                course.MONITOR_CLASS, stand_ins=stand_ins)
         except CheckFailed as error:
-            undeclared = re.search(r"undeclared parameter\(s\)\W*(\w+)", str(error))
+            undeclared = re.search(r"undeclared parameter\(s\)\W*(\w+)|the parameter '(\w+)' "
+                                   r"was read \(or set\) before it was declared", str(error))
             if undeclared is None:
                 raise
             raise CheckFailed(f'{course.MONITOR_CLASS}() reads the parameter '
-                              f'{undeclared.group(1)}, which it never declares: declare it in '
-                              '__init__ with self.declare_parameter() (names must match '
+                              f'{undeclared.group(1) or undeclared.group(2)} before it declares '
+                              'it, or never declares it: declare it in __init__ with '
+                              'self.declare_parameter() before reading it (names must match '
                               'exactly).') from None
         self.judge, self.observer = judge, judge.observer
         self.name = self.info['name']
@@ -62,6 +64,10 @@ class _Monitor:
         self.counts = self.info
         self.subject.request('serve')
         self.client = AsyncParameterClient(self.observer.node, self.full)
+        if self.info.get('parameter_services') is False:  # the subject says: no use waiting
+            raise CheckFailed(f'{course.MONITOR_CLASS} has no parameter services (was it made '
+                              'with start_parameter_services=False?): ros2 param cannot reach '
+                              'it; leave that argument out of super().__init__().')
         if not self.client.wait_for_services(ARRIVAL_TIMEOUT_S):
             raise CheckFailed(f'The grader could not reach the parameter services of {self.full} '
                               f'within {ARRIVAL_TIMEOUT_S:g} s (is the machine very busy?): run '

@@ -165,7 +165,10 @@ class Subject(Trials):
         logger = node.get_logger().name
         return {'ok': True, 'name': node.get_name(), 'namespace': node.get_namespace(),
                 'started_lines': rt.log_counts[logger] - logged_before.get(logger, 0),
-                'endpoints': node_endpoints(node), **self._counts()}
+                'endpoints': node_endpoints(node), **self._counts(),
+                # names a failure, never earns a point (``ros2 param`` reaches it or not)
+                'parameter_services': any(service.srv_name.endswith('/set_parameters')
+                                          for service in node.services)}
 
     def _counts(self) -> dict:
         rt = self._runtime()
