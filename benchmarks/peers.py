@@ -18,6 +18,8 @@ peers and repeats them.
 - ``idle-kernel``: a kernel's runtime between cells (the sensor and the monitor added, on
   simulated time, nothing to do): CPU seconds it uses per second of wall clock.
 - ``idle-bare``: the same nodes in a bare rclpy program blocked in ``executor.spin()``.
+- ``interrupt-kernel``: from interrupting a kernel (Stop) to the end of its cell, which spins
+  a ticking node on the wall clock.
 """
 
 from __future__ import annotations
@@ -92,6 +94,42 @@ def sim_hour_kernel() -> tuple[float, float]:
         run(f'_, values = ros2nb.record({course.TOPIC!r}, {SIMULATED_S})\n'
             f'assert len(values) == {SIMULATED_S}, len(values)')
         return time.perf_counter() - started[0], tree_cpu_seconds(pid) - started[1]
+    finally:
+        client.stop_channels()
+        manager.shutdown_kernel(now=True)
+
+
+def interrupt_kernel() -> float:
+    """From the kernel's interrupt (the Stop button) to the end of a cell spinning a ticking
+    node on the wall clock for longer than anyone waits: what a learner waits after Stop."""
+    from jupyter_client.manager import start_new_kernel
+    manager, client = start_new_kernel(kernel_name='python3')
+    try:
+        client.execute_interactive('import ros2nb\n_ = ros2nb.start()', timeout=120,
+                                   output_hook=lambda _msg: None)
+        msg_id = client.execute("from rclpy.node import Node\n"
+                                "ticker = Node('ticker')\n"
+                                "ticker.create_timer(1.0, lambda: None)\n"
+                                "ros2nb.add(ticker)\nprint('spinning', flush=True)\n"
+                                "_ = ros2nb.spin(10 ** 7)\n")
+        while True:  # the spin has begun once its cell printed
+            msg = client.get_iopub_msg(timeout=120)
+            if msg['parent_header'].get('msg_id') == msg_id and msg['msg_type'] == 'stream':
+                break
+        time.sleep(1.0)  # well inside the spin
+        began, said = time.perf_counter(), ''
+        manager.interrupt_kernel()
+        while True:
+            msg = client.get_iopub_msg(timeout=120)
+            if msg['parent_header'].get('msg_id') != msg_id:
+                continue
+            if msg['msg_type'] in ('stream', 'error'):
+                said += msg['content'].get('text', '') + msg['content'].get('evalue', '')
+            if msg['msg_type'] == 'status' and msg['content']['execution_state'] == 'idle':
+                took = time.perf_counter() - began
+                if 'Interrupted after' not in said:
+                    raise RuntimeError(f'the spin ended otherwise: {said!r}')
+                return took
     finally:
         client.stop_channels()
         manager.shutdown_kernel(now=True)
@@ -235,7 +273,8 @@ MEASURES = {'sim-hour-ros2nb': sim_hour_ros2nb, 'sim-hour-bare': sim_hour_bare,
             'sim-hour-kernel': sim_hour_kernel,
             'first-message-kernel': first_message_kernel,
             'first-message-processes': first_message_processes,
-            'idle-kernel': idle_kernel, 'idle-bare': idle_bare}
+            'idle-kernel': idle_kernel, 'idle-bare': idle_bare,
+            'interrupt-kernel': interrupt_kernel}
 
 if __name__ == '__main__':
     if len(sys.argv) != 2 or sys.argv[1] not in MEASURES:

@@ -506,3 +506,20 @@ def test_nodes_left_running_are_named_not_blamed_on_the_replay(ros):
                         'still running in this kernel (/temperature_sensor)',
                         'Run ros2nb.stop(), then this check again')
     assert 'replay(' in line and 'add the monitor' not in line, line
+
+
+@pytest.mark.parametrize('cell, fragments', [
+    ('import random\nstep = random.randint(-0.5, 0.5)',
+     ('random.randint draws whole numbers only', 'random.uniform(-0.5, 0.5)')),
+    ("t = 22.5\nNode('logs_like_print').get_logger().info('T:', t)",
+     ('get_logger().info() takes one string, not a list of values as print does',)),
+    ("class Ticking(Node):\n    def __init__(self):\n        super().__init__('ticking')\n"
+     '        self.create_timer(1.0, publish_temperature)\n\n'
+     '    def publish_temperature(self):\n        pass\n\nTicking()',
+     ('publish_temperature is a method of Ticking: inside the class, name it '
+      'self.publish_temperature.', 'cell line 4')),
+])
+def test_python_used_the_way_another_tool_is_in_03(ros, cell, fragments):
+    """01-05, new kinds: randint for a decimal step, a logger called like print, a method
+    named without self."""
+    ros.one_line(cell, *fragments)

@@ -242,6 +242,9 @@ def explain_exception(exc: BaseException, *, ros_started: bool = False) -> Optio
         return ('rclpy.init() was called, but ros2nb.start() already brought ROS 2 up in this '
                 'kernel: remove that call; to run a node here hand it to ros2nb.add(node) '
                 '(main() is for `ros2 run`, notebook 05).')
+    python = _python_mistake(exc, text)
+    if python:
+        return python
     parameter = parameter_mistake(exc, text) or ros_arguments_mistake(exc, text)
     if parameter:
         return parameter
@@ -262,6 +265,32 @@ def explain_exception(exc: BaseException, *, ros_started: bool = False) -> Optio
                 'the topic and the depth); something else came where the depth belongs.')
     if isinstance(exc, TypeError):
         return _message_not_a_value(exc)
+    return None
+
+
+_LOGGER_ARGUMENTS = re.compile(r'^RcutilsLogger\.(\w+)\(\) takes 2 positional arguments')
+_UNDEFINED = re.compile(r"^name '(\w+)' is not defined")
+
+
+def _python_mistake(exc: BaseException, text: str) -> Optional[str]:
+    """Python used the way another tool is: randint for a decimal step, a logger given
+    print's list of values, a method named without ``self.`` (notebooks 03 and 04)."""
+    if isinstance(exc, ValueError) and text.startswith('non-integer arg') \
+            and _raised_in(exc, 'randrange'):
+        return ('random.randint draws whole numbers only: for a step between -0.5 and 0.5 °C '
+                'use random.uniform(-0.5, 0.5).')
+    logger = _LOGGER_ARGUMENTS.match(text) if isinstance(exc, TypeError) else None
+    if logger:
+        return (f'get_logger().{logger.group(1)}() takes one string, not a list of values as '
+                f"print does: put the values into it, get_logger().{logger.group(1)}"
+                "(f'Temperature: {value:.2f}').")
+    undefined = _UNDEFINED.match(text) if isinstance(exc, NameError) else None
+    frame = _learner_frame(exc) if undefined else None
+    owner = frame.f_locals.get('self') if frame is not None else None
+    if undefined and owner is not None and callable(getattr(owner, undefined.group(1), None)):
+        name = undefined.group(1)
+        return (f'{name} is a method of {type(owner).__name__}: inside the class, name it '
+                f'self.{name}.')
     return None
 
 
