@@ -111,7 +111,40 @@ EXPECTED = {
     'quadratic-markdown': Case({NB01: 1}, {NB01: 'Check passed'},
                                {NB01: 'was cut to 20 kB in the feedback'}),
     'fills-every-snapshot': Case({NB01: 1, NB02: 1}, {}, {NB01: 'ran out of scratch space'}),
+    # a fault planted in each host-side stage (PLANTED), one learner each: one learner's note
+    'plant-read': Case({NB01: 0}, {}, {NB01: 'a fault planted in read'}),
+    'x-run': Case({NB01: 0}, {}, {NB01: 'a fault planted in run'}),
+    'x-judge': Case({NB01: 0}, {}, {NB01: 'a fault planted in judge'}),
+    'x-file': Case({NB01: 0}, {}, {NB01: 'a fault planted in file'}),
+    'x-feedback': Case({NB01: 1}, {}, {NB01: 'a fault planted in feedback'}),  # score stands
 }
+#: Host-side stages a fault is planted in: reading the file, running it, judging it, filing
+#: it for nbgrader, writing its feedback page.
+STAGES = ('read', 'run', 'judge', 'file', 'feedback')
+#: ros2nb-grade's main with a fault planted in each host-side stage, for the learner whose
+#: file path (read) or notebook (the others) holds ``plant-STAGE``; everyone else is graded
+#: exactly as ros2nb-grade grades them.  python -c GRADE_WITH_FAULTS SUBMISSIONS --out ...
+GRADE_WITH_FAULTS = '''
+import functools, json, sys
+from ros2nb_instructor.grading import cli, feedback, judging, learners, notebooks
+
+def plant(module, name, stage, text_of):
+    real = getattr(module, name)
+    @functools.wraps(real)
+    def faulty(*args, **kwargs):
+        if f'plant-{stage}' in text_of(*args):
+            raise RuntimeError(f'a fault planted in {stage}')
+        return real(*args, **kwargs)
+    setattr(module, name, faulty)
+
+plant(learners, 'readable', 'read', lambda path: str(path))
+plant(learners, 'run_notebook', 'run', lambda scratch, nb, prepared, settings: json.dumps(prepared))
+plant(judging, 'judge_notebook', 'judge', lambda s, n, submitted, *rest: json.dumps(submitted))
+plant(notebooks, 'for_scoring', 'file', lambda release, executed, *rest: json.dumps(executed))
+plant(feedback, 'safe_feedback', 'feedback', lambda made, title: made)
+sys.exit(cli.main(sys.argv[1:]))
+'''
+
 #: What a learner script in a feedback page would set (page title and a window flag).
 PWNED = 'pwned-by-a-learner'
 
@@ -495,7 +528,8 @@ for number in range(80):
 
 
 def _hostile_class_three(folder: Path, put) -> None:
-    """The third hostile class (issue 36): names, markdown, snapshots, formulas, lies."""
+    """The third hostile class (issue 36): names, markdown, snapshots, formulas, lies, and a
+    fault planted in each host-side stage (graded with GRADE_WITH_FAULTS)."""
     put(NOT_UTF8, NB01, SOLUTION[NB01])
     put('odd-file-name', NB01, SOLUTION[NB01])
     put('odd-file-name', NB01, SOLUTION[NB01], name=os.fsdecode(b'notes-\xe9t\xe9.ipynb'))
@@ -504,6 +538,11 @@ def _hostile_class_three(folder: Path, put) -> None:
     put('quadratic-markdown', NB01, _with_cells(SOLUTION[NB01], {3: '[x](' * 100_000},
                                                 markdown=True))
     put('fills-every-snapshot', NB01, _with_cells(SOLUTION[NB01], {99: FILL_THE_WORKSPACE}))
+    for stage in STAGES[1:]:  # the file's path names the learner of 'read'
+        planted = nbformat.read(SOLUTION[NB01], as_version=4)
+        planted.cells.insert(1, nbformat.v4.new_markdown_cell(f'plant-{stage}'))
+        put(f'x-{stage}', NB01, planted)
+    put('plant-read', NB01, SOLUTION[NB01])
     put('fills-every-snapshot', NB02, _with_cells(SOLUTION[NB02], {  # room for its package
         1: "import os, pathlib, shutil\nshutil.rmtree(pathlib.Path(os.environ['ROS2NB_WORKSPACE'])"
            " / 'src' / 'ballast', ignore_errors=True)", 99: FILL_THE_WORKSPACE}))

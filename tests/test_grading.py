@@ -24,17 +24,18 @@ from pathlib import Path
 import pytest
 
 from browser import page  # noqa: F401 - the fixture
-from grading_samples import EXPECTED, FULL, MARK, NB01, NOT_UTF8, PWNED, ROOT, SOLUTION, build
+from grading_samples import (EXPECTED, FULL, GRADE_WITH_FAULTS, MARK, NB01, NOT_UTF8, PWNED, ROOT,
+                             SOLUTION, STAGES, build)
 
 from ros2nb_instructor.grading import sandbox
 from ros2nb_instructor.grading.scratch import HOME_BYTES
 
 pytestmark = [pytest.mark.timeout(1200),
               pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))]
-#: The instructor's grading command, as the course's venv installs it. The class is graded
-#: with its default limits per cell and per notebook: an honest notebook must never meet them,
-#: however busy the machine (a 30 s limit cut a complete learner's simulated hour under load).
-GRADE = str(Path(sys.executable).with_name('ros2nb-grade'))
+#: The class is graded by ros2nb-grade's own main (GRADE_WITH_FAULTS: five learners meet a
+#: planted fault) with its default limits per cell and per notebook: an honest notebook must
+#: never meet them, however busy the machine (a 30 s limit cut a complete learner's simulated
+#: hour under load).
 NOTEBOOKS = sorted(SOLUTION)
 #: Learners graded at once. Two learners of the class hang a cell until the 120 s limit: with
 #: the default (the CPUs + 1) they hold two of three jobs for two minutes while the rest of
@@ -100,9 +101,9 @@ def graded(tmp_path_factory):
     before = fingerprint(ROOT), decoy.read_bytes()
     started = time.monotonic()
     with disk_watched(Path(tempfile.gettempdir())) as peak:  # where the grader's copies go
-        done = subprocess.run(
-            [GRADE, str(submissions), '--out', str(out), '--jobs', str(CLASS_JOBS)],
-            capture_output=True, text=True, timeout=1200)
+        done = subprocess.run(  # ros2nb-grade, with a fault planted for five learners
+            [sys.executable, '-c', GRADE_WITH_FAULTS, str(submissions), '--out', str(out),
+             '--jobs', str(CLASS_JOBS)], capture_output=True, text=True, timeout=1200)
     (root / 'disk-peak').write_text(str(peak[0]))
     print(f'graded {len(EXPECTED)} learners in {time.monotonic() - started:.0f} s')
     left = survivors()
@@ -146,6 +147,20 @@ def in_the_csv(learner: str) -> str:
     and a ' before what a spreadsheet would read as a formula."""
     name = os.fsencode(learner).decode('utf-8', 'backslashreplace')
     return f"'{name}" if name.startswith(('=', '+', '-', '@', '\t', '\r')) else name
+
+
+def test_a_fault_in_any_host_stage_is_one_learners_note(graded):
+    """A fault planted in each host-side stage (reading the file, running it, judging it,
+    filing it for nbgrader, its feedback page), one learner each, beside the class: grading
+    ends with exit 0 and every other score stands (test_every_score_and_csv_row); each of
+    them gets a note naming the fault (test_feedback_and_notes_say_what_happened), and a
+    page that could not be made keeps its score."""
+    out, done, *_ = graded
+    assert done.returncode == 0, done.stdout + done.stderr
+    notes = json.loads((out / 'notes.json').read_text())['learners']
+    for learner in ('plant-read', *(f'x-{stage}' for stage in STAGES[1:])):
+        assert 'a fault planted in' in notes[learner][NB01], (learner, notes[learner])
+    assert 'could not be written' in notes['x-feedback'][NB01]
 
 
 def test_names_are_data(graded):

@@ -5,7 +5,6 @@ by side under pytest-xdist (``--dist loadfile`` keeps a file on one worker).
 """
 
 import csv
-import json
 import os
 import subprocess
 import sys
@@ -111,58 +110,3 @@ def test_without_a_sandbox_grading_refuses_unless_told(tmp_path):
                            "install bubblewrap); grading runs learners' code, so it stops. For "
                            "work you trust, run again with NO_SANDBOX=1 (--no-sandbox).\n")
 
-
-#: Plants a fault in one host-side stage for the learner whose notebook (or file path) names
-#: it, then grades the class as ros2nb-grade does.
-PLANTED = '''
-import functools, json, sys
-from ros2nb_instructor.grading import cli, feedback, judging, learners, notebooks
-
-def plant(module, name, stage, text_of):
-    real = getattr(module, name)
-    @functools.wraps(real)
-    def faulty(*args, **kwargs):
-        if f'plant-{stage}' in text_of(*args):
-            raise RuntimeError(f'a fault planted in {stage}')
-        return real(*args, **kwargs)
-    setattr(module, name, faulty)
-
-plant(learners, 'readable', 'read', lambda path: str(path))
-plant(learners, 'run_notebook', 'run', lambda scratch, nb, prepared, settings: json.dumps(prepared))
-plant(judging, 'judge_notebook', 'judge', lambda s, n, submitted, *rest: json.dumps(submitted))
-plant(notebooks, 'for_scoring', 'file', lambda release, executed, *rest: json.dumps(executed))
-plant(feedback, 'safe_feedback', 'feedback', lambda made, title: made)
-sys.exit(cli.main(sys.argv[1:]))
-'''
-STAGES = ('read', 'run', 'judge', 'file', 'feedback')
-
-
-def test_a_fault_in_any_host_stage_is_one_learners_note(tmp_path):
-    """A fault planted in each host-side stage in turn (reading the file, running it,
-    judging it, filing it for nbgrader, its feedback page), each for one learner beside
-    honest classmates: grading ends with exit 0, every honest learner keeps their score,
-    and each faulty learner gets a note naming what failed (a page that could not be made
-    keeps its score)."""
-    import nbformat
-    submissions = tmp_path / 'class'
-    for name in ('honest-a', 'honest-b', *(f'plant-{s}' if s == 'read' else f'x-{s}'
-                                           for s in STAGES)):
-        (submissions / name).mkdir(parents=True)
-        nb = nbformat.read(SOLUTION[NB01], as_version=4)
-        if name.startswith('x-'):
-            nb.cells.insert(1, nbformat.v4.new_markdown_cell(f'plant-{name[2:]}'))
-        nbformat.write(nb, submissions / name / f'{NB01}.ipynb')
-    done = subprocess.run([sys.executable, '-c', PLANTED, str(submissions), '--out',
-                           str(tmp_path / 'grading'), '--cell-timeout=60', '--jobs=3'],
-                          capture_output=True, text=True, timeout=900)
-    assert done.returncode == 0, done.stdout + done.stderr
-    totals = {r['learner']: r['score'] for r in csv.DictReader(open(tmp_path / 'grading' /
-                                                                    'grades.csv'))
-              if r['notebook'] == 'TOTAL'}
-    assert totals == {'honest-a': '1', 'honest-b': '1', 'plant-read': '0', 'x-run': '0',
-                      'x-judge': '0', 'x-file': '0', 'x-feedback': '1'}, done.stdout
-    notes = json.loads((tmp_path / 'grading' / 'notes.json').read_text())['learners']
-    for learner in ('plant-read', 'x-run', 'x-judge', 'x-file', 'x-feedback'):
-        assert 'a fault planted in' in notes[learner].get(NB01, ''), (learner, notes[learner])
-    assert not notes['honest-a'] and not notes['honest-b'], notes
-    assert (tmp_path / 'grading' / 'report.html').is_file()

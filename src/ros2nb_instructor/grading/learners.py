@@ -101,12 +101,12 @@ def _file(target: Path, learner: Learner, notebook: str, release: nbformat.Noteb
     """Put the judged notebook where nbgrader scores it (or a note why it could not be)."""
     try:
         results, problem, flags = verdict.result()
-        learner.results[notebook] = results
         if problem:
             learner.note(notebook, problem)
         if flags:  # the instructor's to look at; the points are the judge's verdict alone
             learner.note(notebook, f'{FLAGGED} ' + ' | '.join(flags))
         scored = notebooks_of.for_scoring(release, executed, results, problem)
+        learner.results[notebook] = results  # what nbgrader scores: the report counts it
     except Exception as error:  # noqa: BLE001 - one learner's problem, said in a note
         scored = notebooks_of.note_notebook(release, _not_gradable(learner, notebook, error))
     nbformat.write(scored, target / f'{notebook}.ipynb')
