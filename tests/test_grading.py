@@ -142,10 +142,15 @@ def test_every_score_and_csv_row(graded):
     assert maxima == {**{n: float(p) for n, p in FULL.items()}, 'TOTAL': float(sum(FULL.values()))}
 
 
+def as_text(learner: str) -> str:
+    """A folder name as the notes and pages say it: its bytes that are not UTF-8 as \\xNN."""
+    return os.fsencode(learner).decode('utf-8', 'backslashreplace')
+
+
 def in_the_csv(learner: str) -> str:
-    """The learner column's value for a folder name: its bytes that are not UTF-8 as \\xNN,
-    and a ' before what a spreadsheet would read as a formula."""
-    name = os.fsencode(learner).decode('utf-8', 'backslashreplace')
+    """The learner column's value for a folder name: :func:`as_text`, and a ' before what a
+    spreadsheet would read as a formula."""
+    name = as_text(learner)
     return f"'{name}" if name.startswith(('=', '+', '-', '@', '\t', '\r')) else name
 
 
@@ -183,8 +188,7 @@ def shown(page: Path) -> str:
 def test_feedback_and_notes_say_what_happened(graded, learner):
     out, *_ = graded
     case = EXPECTED[learner]
-    notes = json.loads((out / 'notes.json').read_text())['learners'][
-        os.fsencode(learner).decode('utf-8', 'backslashreplace')]
+    notes = json.loads((out / 'notes.json').read_text())['learners'][as_text(learner)]
     for notebook in NOTEBOOKS:
         page = out / 'feedback' / learner / f'{notebook}.html'
         assert page.is_file(), page

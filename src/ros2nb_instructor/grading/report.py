@@ -76,13 +76,13 @@ def _e(text: object) -> str:
     return html.escape(str(text))
 
 
-def _notebook_table(notebooks: list[str], scores: dict[str, dict[str, float]],
+def _notebook_table(notebooks: list[str], handed: dict[str, list[float]],
                     maxima: dict[str, float], learners: list[Learner]) -> str:
     lines = ['<table id="notebooks"><caption>Notebooks</caption><tr><th>notebook</th>'
              '<th>handed in</th><th>median score</th><th>mean</th><th>full marks</th>'
              '<th>points</th></tr>']
     for notebook in notebooks:
-        got = [scores[notebook][l.shown] for l in learners if notebook in l.files]
+        got = handed[notebook]
         full = sum(1 for s in got if s == maxima[notebook])
         median = f'{statistics.median(got):g}' if got else '–'
         mean = f'{statistics.mean(got):.2f}' if got else '–'
@@ -177,7 +177,7 @@ def write_report(out: Path, learners: list[Learner], notebooks: list[str],
         f'<h1>The class at a glance: {len(learners)} learners</h1>',
         '<h2>Scores</h2>',
         f'<img id="spread" src="{plot}" alt="the spread of scores per notebook">',
-        _notebook_table(notebooks, scores, maxima, learners),
+        _notebook_table(notebooks, handed, maxima, learners),
         '<h2>Checks</h2>', _checks_table(notebooks, learners),
         '<h2>Failures</h2>', _failures_table(learners),
         '<h2>Learners</h2>', _learners_table(notebooks, scores, learners, totals),
