@@ -255,6 +255,9 @@ def test_package_checks(session, capsys):
         setup_cfg.write_text(generated_cfg.replace('=$base/lib/sensor_simulator',
                                                    '=$base/lib/sensor_simulator/'))
         checks.check_setup_cfg()  # a trailing slash: the same folder, ros2 run finds them
+        setup_cfg.write_text(generated_cfg.replace('script_dir', 'script-dir'))  # older template
+        fails(checks.check_setup_cfg, r'^setup.cfg spells script-dir with a dash: .*setuptools 78 '
+                                      r'and later refuse it .*: write script_dir\.$')
         setup_cfg.unlink()
         fails(checks.check_setup_cfg, r'setup.cfg is missing')
         setup_cfg.write_text(generated_cfg)

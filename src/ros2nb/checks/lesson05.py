@@ -16,6 +16,7 @@ import configparser
 import json
 import os
 import random
+import re
 import shutil
 import sys
 from hashlib import sha256
@@ -34,46 +35,16 @@ from ..terminal.pkg_templates import SETUP_CFG, render_setup_py
 from ..terminal.run import find_executable
 from .base import ARRIVAL_TIMEOUT_S, Judge, judged
 from .mains import EXIT_AFTER_CTRL_C_S, last_line
+from .package_stand_ins import EXECUTABLES
 from .source import TEXT
 
 # ------------------------------------------------------------------ the package
-#: The grader's own stand-in nodes, so notebook 05 is graded on its own: they take the
-#: place of temperature_publisher.py and temperature_subscriber.py in the judge's build.
-#: The sensor publishes the number given as its parameter ``reading`` five times a second;
-#: the monitor logs every reading it hears.
-STAND_IN = '''\
-"""Grader's stand-in {name}: a node that only {does}."""
-import rclpy
-from rclpy.executors import ExternalShutdownException
-from rclpy.node import Node
-from std_msgs.msg import Float32
-
-
-def main(args=None):
-    rclpy.init(args=args)
-    node = Node('{name}')
-    {setup}
-    try:
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
-'''
-STAND_IN_PUBLISHER = STAND_IN.format(
-    name=course.SENSOR_NODE, does='publishes the reading it is given, five times a second',
-    setup="reading = node.declare_parameter('reading', 0.0).value\n"
-          "    publisher = node.create_publisher(Float32, 'temperature', 10)\n"
-          "    node.create_timer(0.2, lambda: publisher.publish(Float32(data=reading)))")
-STAND_IN_SUBSCRIBER = STAND_IN.format(
-    name=course.MONITOR_NODE, does='logs every reading it hears',
-    setup="node.create_subscription(Float32, 'temperature',\n"
-          "                             lambda m: node.get_logger().info(f'heard {m.data:.3f}'), 10)")
 PLACEHOLDER = 'raise NotImplementedError'
-#: The two executables, the module of each, and the grader's stand-in for it.
-EXECUTABLES = ((course.PUBLISHER_EXECUTABLE, STAND_IN_PUBLISHER),
-               (course.SUBSCRIBER_EXECUTABLE, STAND_IN_SUBSCRIBER))
+#: setuptools' warning for a setup.cfg key spelt with a dash (``script-dir``), in a build's
+#: output; setuptools 78 and later refuse such keys.
+DASHED_KEY = re.compile(r"Usage of dash-separated '([\w-]+)' will not be supported")
+#: The dash-spelt keys each successful build warned about, by its workspace.
+_DASHED: dict[Path, list[str]] = {}
 
 
 def course_setup_py() -> str:
@@ -181,6 +152,7 @@ def _built(judge: Judge, *, setup_py: Optional[str] = None,
         raise CheckFailed(f'colcon build of your package failed: '
                           f'{syntax or build_cause(output.splitlines())}')
     judge.builds[digest] = ws
+    _DASHED[ws] = DASHED_KEY.findall(output)
     return ws
 
 
@@ -356,11 +328,18 @@ def _setup_cfg(judge: Judge) -> str:
     except CheckFailed as failure:
         problem = str(failure)
     if problem is not None:  # with the course's setup.py, setup.cfg alone counts
-        problem = _runs(judge, _built(judge, setup_py=course_setup_py()))
+        built = _built(judge, setup_py=course_setup_py())
+        problem = _runs(judge, built)
+    else:
+        built = _built(judge)
     if problem is not None:
         raise CheckFailed(_setup_cfg_cause(judge) or
                           f'{problem} setup.cfg puts the executables where ros2 run looks: '
                           f'$base/lib/{course.PACKAGE}.')
+    for key in _DASHED.get(built, []):
+        raise CheckFailed(f'setup.cfg spells {key} with a dash: this setuptools still reads it, '
+                          'with a warning in the build, but setuptools 78 and later refuse it '
+                          f'(then ros2 run finds nothing): write {key.replace("-", "_")}.')
     return f'setup.cfg installs the executables into lib/{course.PACKAGE}, where ros2 run finds them.'
 
 

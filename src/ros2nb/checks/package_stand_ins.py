@@ -1,0 +1,46 @@
+"""The grader's stand-in nodes for notebook 05's build: the package is graded on its own.
+
+Part of :mod:`ros2nb.checks` (:mod:`ros2nb.checks.lesson05` builds them into a copy of the
+learner's package in place of ``temperature_publisher.py`` and ``temperature_subscriber.py``).
+"""
+
+from __future__ import annotations
+
+from .. import course
+
+#: The grader's own stand-in nodes, so notebook 05 is graded on its own: they take the
+#: place of temperature_publisher.py and temperature_subscriber.py in the judge's build.
+#: The sensor publishes the number given as its parameter ``reading`` five times a second;
+#: the monitor logs every reading it hears.
+STAND_IN = '''\
+"""Grader's stand-in {name}: a node that only {does}."""
+import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from std_msgs.msg import Float32
+
+
+def main(args=None):
+    rclpy.init(args=args)
+    node = Node('{name}')
+    {setup}
+    try:
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+'''
+STAND_IN_PUBLISHER = STAND_IN.format(
+    name=course.SENSOR_NODE, does='publishes the reading it is given, five times a second',
+    setup="reading = node.declare_parameter('reading', 0.0).value\n"
+          "    publisher = node.create_publisher(Float32, 'temperature', 10)\n"
+          "    node.create_timer(0.2, lambda: publisher.publish(Float32(data=reading)))")
+STAND_IN_SUBSCRIBER = STAND_IN.format(
+    name=course.MONITOR_NODE, does='logs every reading it hears',
+    setup="node.create_subscription(Float32, 'temperature',\n"
+          "                             lambda m: node.get_logger().info(f'heard {m.data:.3f}'), 10)")
+#: The two executables, the module of each, and the grader's stand-in for it.
+EXECUTABLES = ((course.PUBLISHER_EXECUTABLE, STAND_IN_PUBLISHER),
+               (course.SUBSCRIBER_EXECUTABLE, STAND_IN_SUBSCRIBER))
