@@ -83,6 +83,10 @@ MISTAKES = [
     ('newest_only_profile', 'depth 10', 'depth=1)', 'depth=10)',
      r'After a burst of 30 your subscription got 10 messages \[20, 21, \.\.\., 29\]: its '
      r'history keeps that many; a display of the newest reading keeps depth=1\.'),
+    # passes by the vendor's default depth (1 in Fast DDS), with rclpy's warning under it
+    ('newest_only_profile', 'depth 0', 'depth=1)', 'depth=0)',
+     r"raised: depth=0 with KEEP_LAST does not mean 'keep none'.*e\.g\. depth=1 for the newest "
+     r'only\. \(.*line \d+'),
     ('newest_only_profile', 'keep all', 'history=HistoryPolicy.KEEP_LAST',
      'history=HistoryPolicy.KEEP_ALL',
      r'got all 30: KEEP_ALL \(or a depth of 30 or more\) keeps every message; use KEEP_LAST '

@@ -20,6 +20,7 @@ from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityP
 from std_msgs.msg import Int32
 
 from .. import qos
+from ..explain.settings import zero_depth_refused
 from ..errors import CheckFailed
 from .answers import defined_verdict, type_name_of
 from .base import ARRIVAL_TIMEOUT_S, AnswerRef, call_learner, current_judge, learner_error, passed
@@ -41,7 +42,8 @@ def learner_profile(make_profile: Any) -> QoSProfile:
 
     :raises CheckFailed: when it raises, or returns anything but a QoSProfile.
     """
-    profile = call_learner(make_profile)
+    with zero_depth_refused():
+        profile = call_learner(make_profile)
     if not isinstance(profile, QoSProfile):
         raise CheckFailed(f'{make_profile.__name__}() returned {type_name_of(profile)} '
                           f'{profile!r}; return a QoSProfile(...).')

@@ -8,9 +8,11 @@ function here returns the line that says what is wrong and what to write, or Non
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
-from typing import Any, Optional
+import warnings
+from typing import Any, Iterator, Optional
 
 
 #: The policy class of each QoSProfile setting that takes one.
@@ -43,6 +45,32 @@ def qos_setting(exc: AssertionError, frames: list[Any]) -> Optional[str]:
         return (f"QoSProfile's {setting} takes a Duration, {got}: from rclpy.duration import "
                 f'Duration, then {setting}=Duration(seconds=...).')
     return None
+
+
+#: The start of rclpy's warning for ``depth=0`` with KEEP_LAST (it then uses the system default).
+_ZERO_DEPTH = "A zero depth with KEEP_LAST doesn't make sense"
+
+
+@contextlib.contextmanager
+def zero_depth_refused() -> Iterator[None]:
+    """Inside, rclpy's warning for ``depth=0`` with KEEP_LAST is raised as an error at the
+    learner's line (:func:`zero_depth` explains it) instead of printed under a passing check.
+
+    Used wherever a check calls the learner's profile function, in the kernel and in a
+    subject; introduced in ``09-qos.ipynb``.
+    """
+    with warnings.catch_warnings():
+        warnings.filterwarnings('error', message=re.escape(_ZERO_DEPTH), category=UserWarning)
+        yield
+
+
+def zero_depth(exc: BaseException, text: str) -> Optional[str]:
+    """The line for a KEEP_LAST depth of 0 refused by :func:`zero_depth_refused`, or None."""
+    if not (isinstance(exc, UserWarning) and text.startswith(_ZERO_DEPTH)):
+        return None
+    return ("depth=0 with KEEP_LAST does not mean 'keep none': rclpy leaves the depth to the DDS "
+            "vendor's default, so the profile no longer says what it keeps: write the number of "
+            'messages to keep, e.g. depth=1 for the newest only.')
 
 
 _WRONG_PARAMETER_TYPE = re.compile(r"Trying to set parameter '(\w+)' to '([^']*)' of type "

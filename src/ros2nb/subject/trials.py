@@ -20,6 +20,7 @@ from std_msgs.msg import Float32, Int32
 
 from ..endpoints import node_endpoints
 from ..explain.exceptions import describe_error
+from ..explain.settings import zero_depth_refused
 from ..runtime.rates import callback_groups
 from .replies import encode
 
@@ -119,7 +120,8 @@ class Trials:
             return {'ok': False, 'undefined': True}
         self._runtime()
         try:
-            profile = function()
+            with zero_depth_refused():
+                profile = function()
         except BaseException as error:
             return {'ok': False, 'error': describe_error(error)}
         if not isinstance(profile, QoSProfile):
