@@ -82,6 +82,10 @@ MISTAKES = [
      checks.check_fan_controller, r'published nothing on /fan_command: publish one Bool'),
     ('fan: topic typo', FAN, "FAN_TOPIC = 'fan_command'", "FAN_TOPIC = 'fan_comand'",
      checks.check_fan_controller, r'no publisher on /fan_command \(it has: /fan_comand'),
+    ('fan: a callback that sleeps', FAN, '        self.publisher_.publish(command)\n',
+     "        __import__('time').sleep(1.0)\n        self.publisher_.publish(command)\n",
+     checks.check_fan_controller, r'took 0\.5 s or more to answer each of 6 readings: '
+                                  r'temperature_callback waits \(a time\.sleep\?\)'),
     ('fan: node name', FAN, "super().__init__('fan_controller')", "super().__init__('fan')",
      checks.check_fan_controller, r'The node is called fan; name it fan_controller'),
     ('counting: name ignored', PROMISES, 'super().__init__(name)',
@@ -117,6 +121,15 @@ MISTAKES = [
      r"room_arguments\('kitchen'\) still raises NotImplementedError"),
     ('plot: wall-clock time', PLOT, 'self.get_clock().now().nanoseconds / 1e9', "__import__('time').time()",
      checks.check_plot_callback, r"was plotted at [\d.e+]+ s: use the node's clock in seconds"),
+    ('plot: plt.pause in the callback', PLOT, '        self.redraw()\n',
+     '        self.redraw()\n        import matplotlib.pyplot as plt\n        plt.pause(0.5)\n',
+     checks.check_plot_callback, r'temperature_callback raised for 21\.5 °C: plt\.pause\(\) in '
+                                 r'a callback waits its interval on every message.*\(live_plot\.py '
+                                 r'line \d+: plt\.pause\(0\.5\)\)$'),
+    ('plot: plt.show in the callback', PLOT, '        self.redraw()\n',
+     '        self.redraw()\n        import matplotlib.pyplot as plt\n        plt.show()\n',
+     checks.check_plot_callback, r'plt\.show\(\) in a callback draws the whole figure again on '
+                                 r'every message'),
     ('plot: no redraw', PLOT, '        self.redraw()\n', '',
      checks.check_plot_callback, r'nothing was plotted: append the time and the reading, then '
                                  r'call self.redraw\(\) once per message'),

@@ -430,6 +430,8 @@ def test_a_part_run_out_of_order_says_which_part_is_missing(kernel, tmp_path):
      ("reliability takes a QoSReliabilityPolicy, not str 'best_effort'",
       'reliability=QoSReliabilityPolicy.BEST_EFFORT')),
     ("QoSProfile(depth='1')", ("depth takes a whole number, not str '1'", 'no quotes')),
+    # rclpy's own warning under "Check passed" before: Fast DDS's default depth happens to be 1
+    ('QoSProfile(depth=0)', ("depth=0 with KEEP_LAST does not mean 'keep none'", 'depth=1')),
 ])
 def test_a_qos_setting_of_the_wrong_type_in_09(ros, profile, fragments):
     """rclpy's bare assert (an empty AssertionError 40 lines down rclpy) becomes one line
@@ -437,6 +439,28 @@ def test_a_qos_setting_of_the_wrong_type_in_09(ros, profile, fragments):
     ros.run(f'from rclpy.qos import QoSProfile\ndef newest_only_profile():\n    return {profile}')
     line = ros.one_line('ros2nb.checks.check_newest_only(newest_only_profile)', *fragments)
     assert 'cell line 3' in line, line
+
+
+def test_plt_pause_in_a_plot_callback_is_one_line_not_a_minute_of_copies(ros):
+    """07: plt.pause in the callback held every message up for its interval (the live cell
+    took 78 s instead of 1.3 s) and drew a copy each time; now the node stops at the first
+    message with one line at the learner's line."""
+    ros.run('import matplotlib.pyplot as plt\n'
+            'class Pausing(Node):\n'
+            '    def __init__(self):\n'
+            "        super().__init__('pausing_plot')\n"
+            "        self.create_subscription(Float32, 'temperature', self.on_reading, 10)\n"
+            '    def on_reading(self, msg):\n'
+            '        plt.pause(0.5)\n'
+            "feeder = Node('feeding_sensor')\n"
+            "out = feeder.create_publisher(Float32, 'temperature', 10)\n"
+            'feeder.create_timer(1.0, lambda: out.publish(Float32(data=21.0)))\n'
+            'ros2nb.add(Pausing()); ros2nb.add(feeder)')
+    stderr = ros.run('_ = ros2nb.spin(5)')['stderr']
+    assert 'plt.pause() in a callback waits its interval on every message' in stderr, stderr
+    assert 'cell line 7: plt.pause(0.5)' in stderr and stderr.count('[ERROR]') == 1, stderr
+    shown = ros.run('plt.show()')  # outside a callback, pyplot's own
+    assert shown['error'] is None, shown
 
 
 def test_an_error_inside_the_learners_bag_reader_in_10(ros):

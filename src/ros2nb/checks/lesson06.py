@@ -11,6 +11,7 @@ executor it was given) only says how long to wait, or why a failure happened.
 from __future__ import annotations
 
 import re
+import time
 
 from std_msgs.msg import Bool
 
@@ -23,6 +24,9 @@ from .verdicts import endpoint_verdict, node_name_verdict
 
 #: Readings the fan check sends (°C): both sides of the High threshold.
 FAN_READINGS_C = (22.0, 26.0, 26.01, 27.5, 25.99, 19.0)
+#: A fan controller slower than this (s, the judge's own watch) for every one of its readings
+#: waits in its callback: honest ones answer in milliseconds, even on a busy machine.
+SLOW_CALLBACK_S = 0.5
 #: Readings the counting monitor check sends.
 COUNTED_READINGS = 5
 
@@ -45,8 +49,10 @@ def _fan_controller(judge: Judge) -> str:
     reach(judge, subject, info['name'])
     counts = info
     fan_topic = '/' + course.FAN_TOPIC
+    answered_s = []  # per reading: from the judge's publishing it to its command arriving
     for value in FAN_READINGS_C:
         before, sent_before = len(commands), announced(counts, fan_topic)
+        started = time.monotonic()
         counts, _lines = feed(judge, subject, info, value, counts,
                               'temperature_callback: is it the subscription\'s callback?')
         # Wait for as many commands as the subject says its callback published (none: no
@@ -54,6 +60,7 @@ def _fan_controller(judge: Judge) -> str:
         after = announced(counts, fan_topic)
         sent = 1 if after is None or sent_before is None else after - sent_before
         judge.observer.wait_until(lambda: len(commands) - before >= sent, ARRIVAL_TIMEOUT_S)
+        answered_s.append(time.monotonic() - started)
         said = [heard.value for heard in commands[before:]]
         want = course.monitor_status(value) == 'High'
         if not said:
@@ -66,9 +73,20 @@ def _fan_controller(judge: Judge) -> str:
             raise CheckFailed(f'For {value} °C the fan controller published {bool(said[0])}; it '
                               f'should be {want}: the fan is on only when the reading is High, '
                               f'strictly above HIGH_ABOVE_C = {course.HIGH_ABOVE_C} °C.')
+    _slow_callback_verdict(min(answered_s))
     return (f'{info["name"]} hears /{course.TOPIC} and publishes one command on '
             f'/{course.FAN_TOPIC} per reading, True only when High ({len(FAN_READINGS_C)} '
             'readings).')
+
+
+def _slow_callback_verdict(fastest_s: float) -> None:
+    """A callback that waits (``time.sleep``, a loop, a blocking call) holds up every other
+    callback of its node: notebook 06 says to answer each reading at once."""
+    if fastest_s >= SLOW_CALLBACK_S:
+        raise CheckFailed(f'The fan controller took {SLOW_CALLBACK_S:g} s or more to answer each '
+                          f'of {len(FAN_READINGS_C)} readings: temperature_callback waits (a '
+                          'time.sleep?), and meanwhile every other callback of its node waits '
+                          'too (section 4): publish the command at once, without waiting.')
 
 
 def check_fan_controller() -> None:

@@ -23,6 +23,7 @@ from rclpy.node import Node
 from .. import domains
 from ..errors import Ros2nbError, UsageError
 from ..explain.guards import guard_endpoint_types
+from ..explain.plots import guard_pyplot
 from ..runtime import NodeOrName, Runtime, current_runtime, enable_field_checks, kernel_runtime
 from ..runtime.current import participant_prefix, set_kernel_runtime
 from . import ipython
@@ -82,6 +83,7 @@ def start(*, domain_id: Optional[int] = None, sim_time: Optional[bool] = None) -
     set_kernel_runtime(rt)
     atexit.register(shutdown)
     guard_endpoint_types(participant_prefix)
+    guard_pyplot()  # plt.pause / plt.show in a callback: one line, not a minute of copies
     ipython.install()  # inside IPython: cell hooks, one-line errors, %%part, rclpy.spin explained
     print(f'ROS 2 is up in this kernel: {_describe(rt)}.')
     return rt

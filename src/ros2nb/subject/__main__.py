@@ -11,6 +11,7 @@ import json
 import os
 import sys
 
+from ..explain.plots import guard_pyplot
 from ..processes import end_this_process
 from ..runtime.clock import JudgeTime
 from .process import LOADERS, PROTOCOL_ERROR, load, serve
@@ -19,6 +20,7 @@ from .process import LOADERS, PROTOCOL_ERROR, load, serve
 def main(argv: list[str]) -> int:
     """Entry point: ``python -m ros2nb.subject IN_FD OUT_FD``."""
     JudgeTime.claim()  # the judge's pipe: this process's alone, never a child's
+    guard_pyplot()  # plt.pause / plt.show in a callback: the learner's one line
     if len(argv) != 2:
         print('Usage: python -m ros2nb.subject IN_FD OUT_FD (started by ros2nb.judge).',
               file=sys.stderr)
