@@ -38,6 +38,9 @@ MISTAKES = [
     ('record_hour', 'another folder', 'bag_record(bag_path,',
      "bag_record(Path(tempfile.mkdtemp()) / 'elsewhere',",
      r'^record_hour\(bag_path\) wrote no bag at the path it was given: pass bag_path'),
+    ('record_hour', 'no seed', '    random.seed(SEED)\n', '',
+     r'^record_hour\(bag_path\) recorded an hour starting [\d., ]+ °C, but the sensor seeded '
+     r'with random\.seed\(SEED\) starts [\d., ]+ °C: call random\.seed\(SEED\) in record_hour'),
     ('record_hour', 'no monitor', '    ros2nb.add(sub.TemperatureMonitor())\n', '',
      r'^temperature_monitor logged no status while record_hour\(bag_path\) ran: add your monitor'),
     ('replay', 'no monitor', '    ros2nb.add(sub.TemperatureMonitor())\n', '',

@@ -42,6 +42,16 @@ CHECK_RATE = 100.0
 STEP_S = 1.0
 #: Simulated seconds a function may keep its nodes running beyond what the task needs.
 SPARE_S = 30.0
+#: The notebook's sensor, seeded as the task says, for a few seconds: what the hour's first
+#: readings must be (the context cell's names: random, SEED, pub, ros2nb).
+SEEDED_S = 5
+SEEDED = f'''
+def _ros2nb_seeded_sensor():
+    random.seed(SEED)
+    ros2nb.add(pub.TemperatureSensor())
+    ros2nb.spin({SEEDED_S}, show_logs=False)
+    ros2nb.stop()
+'''
 
 
 # ------------------------------------------------------------------ what the check hears
@@ -175,7 +185,35 @@ def _recording(record_hour: Any) -> str:
         if not path.is_dir():
             _bag_verdict(path, label)  # the line for "no bag at all"
         with read_back(path) as copy:
-            return _recording_verdict(copy, label, seen)
+            verdict = _recording_verdict(copy, label, seen)
+    _seed_verdict(record_hour, label, [value for _t, value in seen.readings])
+    return verdict
+
+
+def _seed_verdict(record_hour: Any, label: str, hour: list[float]) -> None:
+    """The hour must be the one ``random.seed(SEED)`` gives (the same on every run): its
+    first readings are what the notebook's sensor publishes right after that seed, as the
+    check hears it.  Without the notebook's names (SEED, pub) there is nothing to compare."""
+    if isinstance(record_hour, AnswerRef):
+        probe: Any = AnswerRef('_ros2nb_seeded_sensor', (*record_hour.sources, SEEDED))
+    else:
+        names = dict(record_hour.__globals__)
+        if not all(name in names for name in ('random', 'SEED', 'pub', 'ros2nb')):
+            return
+        exec(SEEDED, names)  # noqa: S102 - the course's own lines, in a copy of the names
+        probe = names['_ros2nb_seeded_sensor']
+    try:
+        with _witnessing() as seen:
+            _call(probe, 'the seeded sensor', spin_s=SEEDED_S)
+    except CheckFailed:
+        return  # the notebook's names are not what the course gave: no comparison
+    seeded = [value for _t, value in seen.readings]
+    if seeded and [round(v, 3) for v in hour[:len(seeded)]] != [round(v, 3) for v in seeded]:
+        got, want = (', '.join(f'{v:.2f}' for v in values[:3]) for values in (hour, seeded))
+        raise CheckFailed(f'{label} recorded an hour starting {got} °C, but the sensor seeded '
+                          f'with random.seed(SEED) starts {want} °C: call random.seed(SEED) in '
+                          'record_hour before the hour runs, so that it is the same hour on '
+                          'every run.')
 
 
 def _recording_verdict(path: Path, label: str, seen: Witness) -> str:
