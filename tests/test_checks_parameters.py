@@ -78,6 +78,17 @@ DECLARATION_MISTAKES = [
      "super().__init__('temperature_monitor', start_parameter_services=False)",
      r'TemperatureMonitor has no parameter services \(was it made with '
      r'start_parameter_services=False\?\)'),
+    # issue 37: rclpy's "PARAMETER_NOT_SET", a None formatted as a number, a part-4 line
+    ('no default', "'high_above_c', HIGH_ABOVE_C, ParameterDescriptor(",
+     "'high_above_c', None, ParameterDescriptor(",
+     r'TemperatureMonitor\(\) raised: declare_parameter got no default \(None\): .*pass its '
+     r'default value as the second argument'),
+    ('no default, no descriptor', DECLARE, "        self.declare_parameter('low_below_c')\n",
+     r"TemperatureMonitor\(\) raised: the parameter 'low_below_c' holds None: it was declared "
+     r'without a default'),
+    ('registration forgotten', '        self.add_on_set_parameters_callback(self.on_set_thresholds)\n',
+     '', r'was accepted: register the on-set callback in __init__ with '
+         r'self\.add_on_set_parameters_callback'),
     ('integer default', "'high_above_c', HIGH_ABOVE_C,", "'high_above_c', 26,",
      r'high_above_c is an integer parameter \(26\): give it the float default 26.0'),
     ('wrong default', "'low_below_c', LOW_BELOW_C,", "'low_below_c', 18.0,",
@@ -104,6 +115,11 @@ CALLBACK_MISTAKES = [
      "new.get('low_below_c', LOW_BELOW_C)",
      r'Setting high_above_c to 20.5 while low_below_c is 21.0 was accepted: your callback gets '
      r'only the parameters being set'),
+    ('indexed by a name not set',
+     "high_c = new.get('high_above_c', self.get_parameter('high_above_c').value)",
+     "high_c = new['high_above_c']",
+     r"on_set_thresholds raised KeyError: 'high_above_c' for ros2 param set low_below_c 25\.5: it "
+     r'gets only the parameters being set'),
     ('equal allowed', 'low_c >= high_c', 'low_c > high_c',
      r'Setting low_below_c to 25.0 while high_above_c is 25.0 was accepted'),
     ('no reason', REFUSE[1], "reason='')",
@@ -119,6 +135,16 @@ MISTAKES = ([(checks.check_monitor_parameters, *m) for m in DECLARATION_MISTAKES
             + [(checks.check_threshold_callback, *m) for m in CALLBACK_MISTAKES])
 
 
+def test_a_forgotten_registration_costs_its_own_part_only(session, capsys):
+    """Part 3 registers the callback; part 4's callback, right, is graded with the course's
+    registration (before: part 4 blamed the correct callback for accepting everything)."""
+    write_monitor(session, REFERENCE.replace(
+        '        self.add_on_set_parameters_callback(self.on_set_thresholds)\n', '', 1))
+    capsys.readouterr()
+    checks.check_threshold_callback()
+    assert 'Check passed: on_set_thresholds accepts valid thresholds' in capsys.readouterr().out
+
+
 @pytest.mark.parametrize('check, label, old, new, pattern', MISTAKES,
                          ids=[f'{m[0].__name__}: {m[1]}' for m in MISTAKES])
 def test_a_mistake_gets_one_line(session, check, label, old, new, pattern):
@@ -130,5 +156,6 @@ def test_a_mistake_gets_one_line(session, check, label, old, new, pattern):
         else str(caught.value)
     assert re.search(pattern, message), message
     assert '\n' not in message
-    assert "declare_parameter('" not in message and 'SetParametersResult(successful=False' \
-        not in message
+    said = re.sub(r' \([\w.]+ line \d+: .*\)\.?$', '', message)  # the learner's own line aside
+    assert "declare_parameter('" not in said and 'SetParametersResult(successful=False' \
+        not in said

@@ -56,7 +56,7 @@ class _Monitor:
                               'it, or never declares it: declare it in __init__ with '
                               'self.declare_parameter() before reading it (names must match '
                               'exactly).') from None
-        self.judge, self.observer = judge, judge.observer
+        self.judge, self.observer, self.stand_ins = judge, judge.observer, stand_ins
         self.name = self.info['name']
         self.full = self.info['namespace'].rstrip('/') + '/' + self.name
         caught_up(judge, self.info, mark, self.info['started_lines'])
@@ -121,6 +121,13 @@ def _callback_failure(failure: dict, what: str) -> None:
         returned = failure['message'].split("'")[1]
         raise CheckFailed(f'{CALLBACK} returned a {returned}, not a SetParametersResult: return '
                           'SetParametersResult(successful=..., reason=...).')
+    missing = re.fullmatch(r"'(\w+)'", failure.get('message', ''))
+    if failure.get('type') == 'KeyError' and missing and missing.group(1) in \
+            course.THRESHOLD_DEFAULTS_C:
+        where = f' ({failure["where"]})' if failure.get('where') else ''
+        raise CheckFailed(f'{CALLBACK} raised KeyError: {missing.group(0)} for {what}: it gets '
+                          f'only the parameters being set, so read the other with new.get(name, '
+                          f'self.get_parameter(name).value){where}.')
     raise learner_error(f'{course.MONITOR_CLASS}.{CALLBACK}', failure, context=f' for {what}')
 
 
@@ -263,8 +270,36 @@ def _declared(judge: Judge) -> _Monitor:
         return _Monitor(judge, ('thresholds_init',))
 
 
+class _AcceptedInvalid(CheckFailed):
+    """A change that leaves ``low_below_c`` at or above ``high_above_c`` was accepted."""
+
+
 def _threshold_callback(judge: Judge) -> str:
     node = _declared(judge)
+    try:
+        return _threshold_steps(node)
+    except _AcceptedInvalid:
+        if node.stand_ins or not _never_registered(judge):
+            raise
+    # The constructor never registers the callback (part 3's mistake, costing part 3 only):
+    # the course's constructor registers the learner's callback.
+    return _threshold_steps(_Monitor(judge, ('thresholds_init',)))
+
+
+def _never_registered(judge: Judge) -> bool:
+    """True when the learner's constructor registers no on-set callback: with the course's
+    callback in the learner's class, an inverted pair is still accepted."""
+    try:
+        probe = _Monitor(judge, ('thresholds_on_set',))
+        result = probe.set(course.LOW_PARAMETER,
+                           course.THRESHOLD_DEFAULTS_C[course.HIGH_PARAMETER] + 1)
+    except CheckFailed:
+        return False
+    return bool(getattr(result, 'successful', False))
+
+
+def _threshold_steps(node: _Monitor) -> str:
+    """Part 4 on ``node``: each change of :data:`STEPS`, its answer and the statuses after."""
     current = dict(course.THRESHOLD_DEFAULTS_C)
     for name, value, valid, reading in STEPS:
         other = course.LOW_PARAMETER if name == course.HIGH_PARAMETER else course.HIGH_PARAMETER
@@ -281,8 +316,8 @@ def _threshold_callback(judge: Judge) -> str:
                               f'refused ({result.reason or "no reason"}): that pair is valid, '
                               'return SetParametersResult(successful=True) for it.')
         if not valid and result.successful:
-            raise CheckFailed(f'Setting {name} to {value} while {other} is {current[other]} was '
-                              f'accepted: {_refusal_hint(name)}')
+            raise _AcceptedInvalid(f'Setting {name} to {value} while {other} is '
+                                   f'{current[other]} was accepted: {_refusal_hint(name)}')
         if not valid and not result.reason.strip():
             raise CheckFailed(f'Setting {name} to {value} was refused without a reason: give the '
                               'SetParametersResult a reason that says why (ros2 param set shows '

@@ -24,7 +24,7 @@ from rclpy.exceptions import NameValidationException, NotInitializedException
 
 from ..errors import SHUT_DOWN_MESSAGE
 from .plots import plot_in_callback
-from .settings import parameter_mistake, qos_setting, ros_arguments_mistake, zero_depth
+from .settings import qos_setting, settings_mistake
 
 #: The ros2nb package: its files are not the learner's.
 _HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -246,8 +246,7 @@ def explain_exception(exc: BaseException, *, ros_started: bool = False) -> Optio
     python = _python_mistake(exc, text)
     if python:
         return python
-    parameter = parameter_mistake(exc, text) or ros_arguments_mistake(exc, text) \
-        or zero_depth(exc, text) or plot_in_callback(exc, text)
+    parameter = settings_mistake(exc, text, list(_frames(exc))) or plot_in_callback(exc, text)
     if parameter:
         return parameter
     if type(exc).__name__ == 'InvalidQoSProfileException':

@@ -73,6 +73,45 @@ def zero_depth(exc: BaseException, text: str) -> Optional[str]:
             'messages to keep, e.g. depth=1 for the newest only.')
 
 
+#: rclpy's refusal of ``declare_parameter(name, None, descriptor)``.
+_NO_DEFAULT = ('Cannot declare a statically typed parameter with default value of type '
+               'PARAMETER_NOT_SET')
+
+
+def settings_mistake(exc: BaseException, text: str, frames: list[Any]) -> Optional[str]:
+    """The line for any mistake of this module's kinds (parameters, ``-r``/``-p`` rules, a
+    depth of 0), or None.
+
+    :param frames: the exception's frames, outermost first.
+    """
+    return (parameter_mistake(exc, text) or ros_arguments_mistake(exc, text)
+            or zero_depth(exc, text) or unset_parameter(exc, frames))
+
+
+def unset_parameter(exc: BaseException, frames: list[Any]) -> Optional[str]:
+    """A parameter declared without a default holds None (rclpy's PARAMETER_NOT_SET): the
+    TypeError of using it as a number, explained.  Introduced in ``08-parameters.ipynb``.
+
+    :param frames: the exception's frames, outermost first.
+    """
+    if isinstance(exc, ValueError) and str(exc).startswith(_NO_DEFAULT):
+        return ('declare_parameter got no default (None): rclpy cannot give a parameter with '
+                'a descriptor a type without one (PARAMETER_NOT_SET): pass its default value '
+                'as the second argument, before the descriptor.')
+    if not isinstance(exc, TypeError) or 'NoneType' not in str(exc):
+        return None
+    for frame in reversed(frames):
+        parameters = getattr(frame.f_locals.get('self'), '_parameters', None)
+        if isinstance(parameters, dict):
+            unset = sorted(name for name, parameter in parameters.items()
+                           if getattr(getattr(parameter, 'type_', None), 'name', '') == 'NOT_SET')
+            if unset:
+                return (f"the parameter '{unset[0]}' holds None: it was declared without a "
+                        'default, so rclpy gives it the type PARAMETER_NOT_SET; pass its '
+                        'default value to declare_parameter as the second argument.')
+    return None
+
+
 _WRONG_PARAMETER_TYPE = re.compile(r"Trying to set parameter '(\w+)' to '([^']*)' of type "
                                    r"'(\w+)', expecting type '(\w+)'")
 

@@ -156,6 +156,31 @@ class JudgeTime:
             os.write(self._fd, line.encode())
 
 
+#: A node's lists of parameter callbacks (rclpy's own, the time source's among them).
+_PARAMETER_CALLBACKS = ('_pre_set_parameters_callbacks', '_on_set_parameters_callbacks',
+                        '_post_set_parameters_callbacks')
+
+
+@contextlib.contextmanager
+def _rclpy_callbacks_only(node: Node) -> Iterator[None]:
+    """Inside, the node's parameter callbacks are rclpy's own: ros2nb's switch of
+    ``use_sim_time`` reaches the learner's as ``-p use_sim_time:=true`` at start-up does in
+    ROS, i.e. never (a callback that reads only the thresholds, or refuses what it does not
+    know, would otherwise fail or keep the node off the clock)."""
+    saved = {}
+    for name in _PARAMETER_CALLBACKS:
+        callbacks = getattr(node, name, None)
+        if isinstance(callbacks, list):
+            saved[name] = list(callbacks)
+            callbacks[:] = [c for c in callbacks if getattr(getattr(c, '__func__', c),
+                                                            '__module__', '').startswith('rclpy.')]
+    try:
+        yield
+    finally:
+        for name, callbacks in saved.items():
+            getattr(node, name)[:] = callbacks
+
+
 def _deaf_to_clock(node: Node) -> None:
     """In a judge's subject, a node's time moves only when the runtime takes the judge's step
     (:meth:`SimulatedClock._publish_clock`), never on its own: its time source's ``/clock``
@@ -245,7 +270,8 @@ class SimulatedClock:
             name = node.get_fully_qualified_name()
             if (name in self._on_sim) == sim:
                 continue
-            node.set_parameters([Parameter('use_sim_time', Parameter.Type.BOOL, sim)])
+            with _rclpy_callbacks_only(node):
+                node.set_parameters([Parameter('use_sim_time', Parameter.Type.BOOL, sim)])
             if sim and self.judge_time is not None:
                 _deaf_to_clock(node)
             (self._on_sim.add if sim else self._on_sim.discard)(name)
