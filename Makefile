@@ -21,7 +21,7 @@ export PIP_DISABLE_PIP_VERSION_CHECK := 1
 # numpy (rclpy's message types), and none of them does linear algebra: 0.05-0.1 CPU-s each.
 export OPENBLAS_NUM_THREADS := 1
 
-.PHONY: lab lab-instructor test setup bytecode sandbox-tool browser-tool graph-tool solutions learner-notebooks bench grade clean
+.PHONY: image image-tool lab lab-instructor test setup bytecode sandbox-tool browser-tool graph-tool solutions learner-notebooks bench grade clean
 
 setup: $(STAMP)
 
@@ -51,8 +51,10 @@ bytecode: $(STAMP)
 # never overwrites a notebook there, it puts the new version beside it), nbgrader's instructor
 # tools, the news pop-up and the Extension Manager off (environment/jupyter-learner/).
 # Localhost only, token authentication on (src/ros2nb_instructor/lab.py).
+LAB_ARGS ?=
+
 lab: $(STAMP) bytecode graph-tool
-	$(VENV)/bin/ros2nb-lab
+	$(VENV)/bin/ros2nb-lab $(LAB_ARGS)
 
 # The instructor's lab: the course folder itself, nbgrader's Formgrader and Create Assignment on.
 lab-instructor: $(STAMP) bytecode graph-tool
@@ -77,12 +79,20 @@ graph-tool:
 	  || { apt-get update -q >/dev/null 2>&1 && apt-get install -y -q graphviz >/dev/null 2>&1; } || true
 	@command -v dot >/dev/null || echo "graphviz is not installed (sudo apt-get install graphviz): notebook 06 lists the graph as text instead of drawing it."
 
+# The image test (tests/test_image.py) builds the course's image with Debian's podman and runc
+# on a base debootstrap makes: installed here when make runs as root, else the test skips.
+image-tool:
+	@command -v podman >/dev/null && command -v runc >/dev/null && command -v debootstrap >/dev/null \
+	  || [ "$$(id -u)" != 0 ] || apt-get install -y -q podman runc debootstrap >/dev/null 2>&1 \
+	  || { apt-get update -q >/dev/null 2>&1 && apt-get install -y -q podman runc debootstrap >/dev/null 2>&1; } || true
+	@command -v podman >/dev/null || echo "podman is not installed (sudo apt-get install podman runc debootstrap): the image test skips."
+
 # Three steps, always all three (tests/run_steps.sh): tests/ with pytest-xdist, and nbval
 # over solutions/ and notebooks/ alongside it; one failure never hides the others, the
 # results come together at the end, and make fails if any step failed.
 TEST_WORKERS ?= 4
 
-test: $(STAMP) bytecode sandbox-tool browser-tool graph-tool
+test: $(STAMP) bytecode sandbox-tool browser-tool graph-tool image-tool
 	@tests/run_steps.sh $(PY) $(TEST_WORKERS)
 
 # Re-run solutions/ in place so their stored outputs are fresh (then make learner-notebooks).
@@ -105,6 +115,20 @@ grade: $(STAMP) bytecode sandbox-tool
 
 clean:
 	rm -rf $(VENV) .cache .jupyter
+
+# The course as an image (environment/Containerfile), with podman or else docker:
+# `make image` (IMAGE=ros2-course, BASE=a Debian 12 or Ubuntu 24.04 image, PULL=never for a
+# base that is only local).
+IMAGE   ?= ros2-course
+BASE    ?= docker.io/library/debian:bookworm
+PULL    ?= missing
+# This machine's certificate authorities, handed to the build as a secret (behind a proxy
+# that re-signs HTTPS, pip needs them); an empty file when there are none.
+HOST_CA ?= $(firstword $(wildcard /etc/ssl/certs/ca-certificates.crt) /dev/null)
+image:
+	@engine=$$(command -v podman || command -v docker) || { echo "Neither podman nor docker is installed: sudo apt install podman (Debian, Ubuntu), then make image again."; exit 1; }; \
+	  $$engine build --network host --pull=$(PULL) --build-arg BASE=$(BASE) \
+	    --secret id=host-ca,src=$(HOST_CA) -f environment/Containerfile -t $(IMAGE) .
 
 # ---- Classroom server: JupyterHub on this machine (docs/classroom-server.md) --------------
 # `make hub` (as root): JupyterHub on 127.0.0.1:8000 for the local users of the Unix group

@@ -116,7 +116,10 @@ def main(argv: Optional[list[str]] = None) -> NoReturn:
               'notebook open in one tab only.', file=sys.stderr)
         learner_environment(os.environ)
         default_url = '/lab'
-    os.execv(jupyter, [str(jupyter), 'lab', '--ServerApp.ip=127.0.0.1',
+    # Localhost unless told otherwise (the course's image listens on every interface of its
+    # container: `make lab LAB_ARGS=--ServerApp.ip=0.0.0.0`); traitlets refuses two values.
+    given_ip = any(a.startswith(('--ServerApp.ip', '--ip')) for a in args)
+    os.execv(jupyter, [str(jupyter), 'lab', *([] if given_ip else ['--ServerApp.ip=127.0.0.1']),
                        f'--ServerApp.root_dir={root}', f'--LabApp.default_url={default_url}',
                        *(['--allow-root'] if os.geteuid() == 0 else []), *args])
 
