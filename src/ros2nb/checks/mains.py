@@ -25,8 +25,10 @@ from .source import TEXT
 #: Seconds a node process gets to exit after Ctrl+C (which comes once its node spins).
 EXIT_AFTER_CTRL_C_S = 20.0
 #: Seconds a program gets to put its node in the graph: of its own work while it works (a
-#: busy machine makes it slow, not wrong), of the wall clock while it waits for nothing.
-START_PATIENCE_S = 30.0
+#: busy machine makes it slow, not wrong), of the wall clock while it waits for nothing (an
+#: honest main() puts its node there within a second or two of work; at 30 s a main() that
+#: never starts ROS kept the learner waiting a minute, its own run and the stand-in's).
+START_PATIENCE_S = 10.0
 #: Seconds between two looks at how much the program has worked.
 LOOK_AGAIN_S = 0.5
 #: How a running node is stopped, in turn: Ctrl+C in its terminal, and a shutdown from
