@@ -17,6 +17,9 @@ export MPLCONFIGDIR        := $(HERE)/.cache/matplotlib
 export ROS_HOME            := $(HERE)/.cache/ros
 export ROS_LOG_DIR         := $(HERE)/.cache/ros/log
 export PIP_DISABLE_PIP_VERSION_CHECK := 1
+# uv trusts the machine's certificate store, as pip does: behind a proxy that re-signs HTTPS
+# (an institution's, whose CA the machine trusts), uv's own roots refuse PyPI.
+export UV_SYSTEM_CERTS := 1
 # numpy's OpenBLAS starts a thread per CPU that spins at import; every process with ROS imports
 # numpy (rclpy's message types), and none of them does linear algebra: 0.05-0.1 CPU-s each.
 export OPENBLAS_NUM_THREADS := 1
