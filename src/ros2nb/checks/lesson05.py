@@ -336,10 +336,11 @@ def _setup_cfg(judge: Judge) -> str:
         raise CheckFailed(_setup_cfg_cause(judge) or
                           f'{problem} setup.cfg puts the executables where ros2 run looks: '
                           f'$base/lib/{course.PACKAGE}.')
-    for key in _DASHED.get(built, []):
-        raise CheckFailed(f'setup.cfg spells {key} with a dash: this setuptools still reads it, '
-                          'with a warning in the build, but setuptools 78 and later refuse it '
-                          f'(then ros2 run finds nothing): write {key.replace("-", "_")}.')
+    dashed = _DASHED.get(built)
+    if dashed:
+        raise CheckFailed(f'setup.cfg spells {dashed[0]} with a dash: this setuptools still reads '
+                          'it, with a warning in the build, but setuptools 78 and later refuse it '
+                          f'(then ros2 run finds nothing): write {dashed[0].replace("-", "_")}.')
     return f'setup.cfg installs the executables into lib/{course.PACKAGE}, where ros2 run finds them.'
 
 

@@ -37,7 +37,7 @@ def _in_callback() -> bool:
     """True when an rclpy executor is running the code that called (a callback's)."""
     frame: Any = sys._getframe(2)
     while frame is not None:
-        if frame.f_code.co_filename.endswith(('rclpy/executors.py', 'ros2nb/runtime/spinning.py')):
+        if frame.f_code.co_filename.endswith('rclpy/executors.py'):
             return True
         frame = frame.f_back
     return False

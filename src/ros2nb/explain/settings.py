@@ -85,20 +85,20 @@ def settings_mistake(exc: BaseException, text: str, frames: list[Any]) -> Option
     :param frames: the exception's frames, outermost first.
     """
     return (parameter_mistake(exc, text) or ros_arguments_mistake(exc, text)
-            or zero_depth(exc, text) or unset_parameter(exc, frames))
+            or zero_depth(exc, text) or unset_parameter(exc, text, frames))
 
 
-def unset_parameter(exc: BaseException, frames: list[Any]) -> Optional[str]:
+def unset_parameter(exc: BaseException, text: str, frames: list[Any]) -> Optional[str]:
     """A parameter declared without a default holds None (rclpy's PARAMETER_NOT_SET): the
     TypeError of using it as a number, explained.  Introduced in ``08-parameters.ipynb``.
 
     :param frames: the exception's frames, outermost first.
     """
-    if isinstance(exc, ValueError) and str(exc).startswith(_NO_DEFAULT):
+    if isinstance(exc, ValueError) and text.startswith(_NO_DEFAULT):
         return ('declare_parameter got no default (None): rclpy cannot give a parameter with '
                 'a descriptor a type without one (PARAMETER_NOT_SET): pass its default value '
                 'as the second argument, before the descriptor.')
-    if not isinstance(exc, TypeError) or 'NoneType' not in str(exc):
+    if not isinstance(exc, TypeError) or 'NoneType' not in text:
         return None
     for frame in reversed(frames):
         parameters = getattr(frame.f_locals.get('self'), '_parameters', None)
