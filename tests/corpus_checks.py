@@ -37,7 +37,7 @@ def within(corpus: list[Learner], first: str, last: str) -> list[Learner]:
 def full_marks_without_the_text_reader(learner: Learner, root: Path, monkeypatch) -> None:
     monkeypatch.setattr(source.TEXT, 'read', KnowsNothing().read)
     results = grade_learner(learner, root)
-    assert failed(results) == {}, learner.name
+    assert failed(results) == {}, (learner.name, failed(results))
 
 
 def loses_exactly_its_part(learner: Learner, root: Path) -> None:

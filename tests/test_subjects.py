@@ -16,6 +16,7 @@ import pytest
 
 from ros2nb.judge import observer
 from ros2nb.judge.subjects import SubjectHung, SubjectProcess
+from ros2nb.processes import BUSY_SHARE, Patience, tree_cpu_seconds
 from waiting import PATIENCE_S, wait_until
 
 #: Seconds the subject is given in these tests.
@@ -75,6 +76,41 @@ def test_a_call_that_waits_for_ever_is_cut_after_the_limit_on_the_wall_clock(sub
     with pytest.raises(SubjectHung, match=r'^Your code did not finish within 2 s'):
         call(subject, 'waits_for_ever')
     assert time.monotonic() - began >= LIMIT_S
+
+
+STARVED = """
+import os, sys
+os.sched_setaffinity(0, {int(sys.argv[1])})
+os.sched_setscheduler(0, os.SCHED_IDLE, os.sched_param(0))
+print('starved', flush=True)
+while True:
+    pass
+"""
+
+
+def test_a_program_the_scheduler_starves_is_working_not_waiting():
+    """A program that stands ready on the run queue while others hold the CPU is not waiting
+    for ever. Beside two CPU burners and a test run, a learner's main() was measured at 0.07 s
+    of CPU and 8.7 s queued in its first 10 s, and was told it never started its node.
+    Here a program of the lowest scheduling class shares one CPU with a burner."""
+    cpu = min(os.sched_getaffinity(0))
+    burner = subprocess.Popen([sys.executable, '-c', 'import os\nos.sched_setaffinity(0, {%d})\n'
+                               'while True: pass' % cpu])
+    starved = subprocess.Popen([sys.executable, '-c', STARVED, str(cpu)], text=True,
+                               stdout=subprocess.PIPE)
+    try:
+        assert starved.stdout.readline() == 'starved\n'
+        patience, cpu_before = Patience(starved.pid, LIMIT_S / 4), tree_cpu_seconds(starved.pid)
+        began = time.monotonic()
+        while time.monotonic() - began < LIMIT_S:
+            assert not patience.exhausted(), 'a program starved of CPU was taken for one that waits'
+            time.sleep(0.1)
+        # the failure prevented: counted by its CPU time alone, it sat waiting
+        assert tree_cpu_seconds(starved.pid) - cpu_before < BUSY_SHARE * LIMIT_S
+    finally:
+        for process in (burner, starved):
+            process.kill()
+            process.wait()
 
 
 @pytest.mark.timeout(2 * PATIENCE_S)

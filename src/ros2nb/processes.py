@@ -13,6 +13,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 from collections import deque
 from typing import NoReturn, Optional, Sequence
@@ -81,6 +82,9 @@ def kill_process_group(proc: subprocess.Popen) -> Optional[int]:
 BUSY_SHARE = 0.05
 #: Seconds over which that share is measured.
 BUSY_WINDOW_S = 5.0
+#: A process tree one of whose threads stood ready to run in this share of the looks at it
+#: is working (the kernel brings its time on the run queue up to date only when it runs).
+READY_SHARE = 0.5
 #: However busy it is, a process tree gets at most this many times its limit on the wall clock.
 WALL_LIMIT_FACTOR = 10.0
 #: Seconds between two looks at a process that is asked to exit.
@@ -116,6 +120,16 @@ def child_pids(pid: int) -> list[int]:
     return _children().get(pid, [])
 
 
+def _tree(pid: int, children: dict[int, list[int]]) -> list[int]:
+    """``pid`` and every process under it."""
+    found, pending = [pid], [pid]
+    while pending:
+        below = children.get(pending.pop(), [])
+        found += below
+        pending += below
+    return found
+
+
 def tree_cpu_seconds(pid: int) -> float:
     """CPU seconds (user + system) used so far by ``pid`` and every process under it.
 
@@ -123,12 +137,30 @@ def tree_cpu_seconds(pid: int) -> float:
     A process that is gone counts 0.
     """
     children, cpu = _processes()
-    total, pending = 0.0, [pid]
-    while pending:
-        current = pending.pop()
-        total += cpu.get(current, 0.0)
-        pending.extend(children.get(current, []))
-    return total
+    return sum(cpu.get(each, 0.0) for each in _tree(pid, children))
+
+
+def queued_seconds(pids: Sequence[int], skip: Optional[int] = None) -> tuple[float, bool]:
+    """How much the threads of ``pids`` (but thread ``skip``) stood ready to run, waiting on
+    the run queue for a CPU: the seconds the kernel counted (the second field of
+    ``/proc/PID/task/TID/schedstat``, brought up to date only when a thread gets a CPU), and
+    whether one of them stands ready now (state R).  Gone processes and threads, and a
+    kernel without schedstats, count nothing."""
+    total, ready = 0.0, False
+    for pid in pids:
+        try:
+            tasks = [task for task in os.listdir(f'/proc/{pid}/task') if task != str(skip)]
+        except OSError:
+            continue
+        for task in tasks:
+            try:
+                with open(f'/proc/{pid}/task/{task}/stat') as stat:
+                    ready = ready or stat.read().rsplit(')', 1)[1].split()[0] == 'R'
+                with open(f'/proc/{pid}/task/{task}/schedstat') as schedstat:
+                    total += int(schedstat.read().split()[1]) / 1e9
+            except (OSError, IndexError, ValueError):
+                continue
+    return total, ready
 
 
 class Patience:
@@ -137,9 +169,14 @@ class Patience:
     A limit on the wall clock alone cuts honest work short on a busy machine, where a
     process gets a fraction of a CPU.  So the limit counts work: the tree has had long
     enough once it used ``limit_s`` CPU seconds (an endless loop), or once ``limit_s``
-    seconds passed on the wall clock while it sat waiting (less than :data:`BUSY_SHARE`
-    of a CPU over the last :data:`BUSY_WINDOW_S` seconds: a call that waits for ever).
-    A tree that keeps working slowly is cut after ``WALL_LIMIT_FACTOR * limit_s`` seconds.
+    seconds passed on the wall clock while it sat waiting: less than :data:`BUSY_SHARE` of a
+    CPU over the last :data:`BUSY_WINDOW_S` seconds, counting the time its threads (and the
+    watching process's other threads, which read the answer) stood ready on the run queue for
+    a CPU (:func:`queued_seconds`), or one of them stood ready in :data:`READY_SHARE` of the
+    looks.  A program the scheduler starves is working, not
+    waiting: beside two CPU burners and a test run a starting program was measured at
+    0.07 s of CPU and 8.7 s queued in its first 10 s.  A tree that keeps working slowly is
+    cut after ``WALL_LIMIT_FACTOR * limit_s`` seconds.
 
     :param pid: the process at the top of the tree (a sandbox's own process is fine).
     :param limit_s: seconds of CPU time, or of waiting, the tree is given.
@@ -151,14 +188,24 @@ class Patience:
     def __init__(self, pid: int, limit_s: float, started: Optional[float] = None) -> None:
         self.pid, self.limit_s = pid, limit_s
         self.started = time.monotonic() if started is None else started
-        self.cpu_at_start = tree_cpu_seconds(pid)
-        # (when, CPU seconds then): the busy share is measured between real samples
-        self._samples: deque[tuple[float, float]] = deque([(time.monotonic(), self.cpu_at_start)])
+        self.cpu_at_start, queued, ready = self._work()
+        # (when, CPU and queued seconds then, a thread ready then): the busy share is
+        # measured between real samples
+        self._samples: deque[tuple[float, float, bool]] = deque(
+            [(time.monotonic(), self.cpu_at_start + queued, ready)])
+
+    def _work(self) -> tuple[float, float, bool]:
+        """The tree's CPU seconds; the seconds its threads and the watcher's other threads
+        stood queued, and whether one stands ready now."""
+        children, cpu = _processes()
+        tree = _tree(self.pid, children)
+        queued, ready = queued_seconds([*tree, os.getpid()], skip=threading.get_native_id())
+        return sum(cpu.get(each, 0.0) for each in tree), queued, ready
 
     def exhausted(self) -> bool:
         """True once the tree has had its limit (call it every fraction of a second)."""
-        now, cpu = time.monotonic(), tree_cpu_seconds(self.pid)
-        self._samples.append((now, cpu))
+        (cpu, queued, ready), now = self._work(), time.monotonic()
+        self._samples.append((now, cpu + queued, ready))
         while len(self._samples) > 2 and now - self._samples[1][0] >= BUSY_WINDOW_S:
             self._samples.popleft()
         waited = now - self.started
@@ -166,8 +213,10 @@ class Patience:
             return True
         if waited < self.limit_s:
             return False
-        since, cpu_then = self._samples[0]
-        return cpu - cpu_then < BUSY_SHARE * (now - since)
+        (since, busy_then, _), recent = self._samples[0], list(self._samples)[1:]
+        if sum(sample[2] for sample in recent) >= READY_SHARE * len(recent):
+            return False  # starved, not waiting: the kernel counts its queueing late
+        return cpu + queued - busy_then < BUSY_SHARE * (now - since)
 
 
 def wait_patiently(proc: subprocess.Popen, limit_s: float) -> Optional[int]:
