@@ -163,6 +163,21 @@ def queued_seconds(pids: Sequence[int], skip: Optional[int] = None) -> tuple[flo
     return total, ready
 
 
+def tree_work(pid: int, watcher: bool = True) -> tuple[float, float, bool]:
+    """What a process tree has done, as the kernel counts it: the CPU seconds of ``pid`` and
+    every process under it; the seconds their threads (with ``watcher``, also the calling
+    process's other threads, which watch it) stood ready on the run queue for a CPU
+    (:func:`queued_seconds`); and whether one of them stands ready now.
+
+    Introduced in ``03-write-the-publisher.ipynb`` (how long the judge waits for a subject).
+    """
+    children, cpu = _processes()
+    tree = _tree(pid, children)
+    queued, ready = queued_seconds([*tree, *([os.getpid()] if watcher else [])],
+                                   skip=threading.get_native_id())
+    return sum(cpu.get(each, 0.0) for each in tree), queued, ready
+
+
 class Patience:
     """Whether a process tree asked to do something has had long enough to do it.
 
@@ -195,12 +210,7 @@ class Patience:
             [(time.monotonic(), self.cpu_at_start + queued, ready)])
 
     def _work(self) -> tuple[float, float, bool]:
-        """The tree's CPU seconds; the seconds its threads and the watcher's other threads
-        stood queued, and whether one stands ready now."""
-        children, cpu = _processes()
-        tree = _tree(self.pid, children)
-        queued, ready = queued_seconds([*tree, os.getpid()], skip=threading.get_native_id())
-        return sum(cpu.get(each, 0.0) for each in tree), queued, ready
+        return tree_work(self.pid)
 
     def exhausted(self) -> bool:
         """True once the tree has had its limit (call it every fraction of a second)."""
