@@ -168,6 +168,8 @@ STARVE = """
 
 #: CPU-bound programs beside the starved subject on its CPU.
 BURNERS = 4
+#: Seconds under which no answer of the starved subject came (measured: 0.45 s and more).
+STARVED_BAR_S = 0.1
 
 
 def test_an_honest_fan_starved_of_cpu_is_not_called_slow(session, capsys, monkeypatch):
@@ -183,6 +185,9 @@ def test_an_honest_fan_starved_of_cpu_is_not_called_slow(session, capsys, monkey
         real(fastest_s, queued_s)
 
     monkeypatch.setattr(lesson06, '_slow_callback_verdict', recorded)
+    # A bar the starved answers surely pass (how late they come depends on the scheduler):
+    # the verdict, not the bar, is what is tested.
+    monkeypatch.setattr(lesson06, 'SLOW_CALLBACK_S', STARVED_BAR_S)
     cpu = min(os.sched_getaffinity(0))
     # burners in sessions of their own: each is a scheduling group of full weight
     burners = [subprocess.Popen([sys.executable, '-c', f'import os\nos.sched_setaffinity(0, '
@@ -198,7 +203,7 @@ def test_an_honest_fan_starved_of_cpu_is_not_called_slow(session, capsys, monkey
             burner.wait()
     (fastest_s, queued_s), = verdicts
     # the failure prevented: by the judge's watch alone, the honest callback was slow
-    assert fastest_s >= lesson06.SLOW_CALLBACK_S, verdicts
+    assert fastest_s >= STARVED_BAR_S, verdicts
 
 
 #: A program with a node named like the learner's that owns no endpoint of the learner's:
