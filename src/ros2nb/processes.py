@@ -188,10 +188,10 @@ class Patience:
     CPU over the last :data:`BUSY_WINDOW_S` seconds, counting the time its threads (and the
     watching process's other threads, which read the answer) stood ready on the run queue for
     a CPU (:func:`queued_seconds`), or one of them stood ready in :data:`READY_SHARE` of the
-    looks.  A program the scheduler starves is working, not
-    waiting: beside two CPU burners and a test run a starting program was measured at
-    0.07 s of CPU and 8.7 s queued in its first 10 s.  A tree that keeps working slowly is
-    cut after ``WALL_LIMIT_FACTOR * limit_s`` seconds.
+    looks.  A program the scheduler starves is working, not waiting: beside two CPU burners
+    and a test run, a starting program was measured at 0.07 s of CPU and 8.7 s queued in its
+    first 10 s.  A tree that keeps working slowly is cut after ``WALL_LIMIT_FACTOR * limit_s``
+    seconds.
 
     :param pid: the process at the top of the tree (a sandbox's own process is fine).
     :param limit_s: seconds of CPU time, or of waiting, the tree is given.
@@ -203,18 +203,15 @@ class Patience:
     def __init__(self, pid: int, limit_s: float, started: Optional[float] = None) -> None:
         self.pid, self.limit_s = pid, limit_s
         self.started = time.monotonic() if started is None else started
-        self.cpu_at_start, queued, ready = self._work()
+        self.cpu_at_start, queued, ready = tree_work(pid)
         # (when, CPU and queued seconds then, a thread ready then): the busy share is
         # measured between real samples
         self._samples: deque[tuple[float, float, bool]] = deque(
             [(time.monotonic(), self.cpu_at_start + queued, ready)])
 
-    def _work(self) -> tuple[float, float, bool]:
-        return tree_work(self.pid)
-
     def exhausted(self) -> bool:
         """True once the tree has had its limit (call it every fraction of a second)."""
-        (cpu, queued, ready), now = self._work(), time.monotonic()
+        (cpu, queued, ready), now = tree_work(self.pid), time.monotonic()
         self._samples.append((now, cpu + queued, ready))
         while len(self._samples) > 2 and now - self._samples[1][0] >= BUSY_WINDOW_S:
             self._samples.popleft()
