@@ -21,13 +21,13 @@ import os
 import subprocess
 import sys
 import tempfile
-import threading
 import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / 'tests'))
 from grading_samples import EXPECTED, build  # noqa: E402
+from sampling import Sampling  # noqa: E402
 
 GRADE = str(Path(sys.executable).with_name('ros2nb-grade'))
 TICKS_PER_S = os.sysconf('SC_CLK_TCK')
@@ -53,29 +53,18 @@ def busy_cpu_s() -> float:
     return (sum(fields) - fields[3] - fields[4]) / TICKS_PER_S
 
 
-class Sampler:
+class Sampler(Sampling):
     """Every process that starts after it: its kind and its CPU seconds, read every 50 ms."""
 
     def __init__(self) -> None:
+        super().__init__(SAMPLE_S)
         self.before = set(os.listdir('/proc'))
         self.seen: dict[tuple[str, str], tuple[str, float]] = {}
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._run, daemon=True)
 
-    def __enter__(self) -> 'Sampler':
-        self._thread.start()
-        return self
-
-    def __exit__(self, *_exc: object) -> None:
-        self._stop.set()
-        self._thread.join()
-
-    def _run(self) -> None:
-        while not self._stop.is_set():
-            for pid in os.listdir('/proc'):
-                if pid.isdigit() and pid not in self.before:
-                    self._read(pid)
-            time.sleep(SAMPLE_S)
+    def sample(self) -> None:
+        for pid in os.listdir('/proc'):
+            if pid.isdigit() and pid not in self.before:
+                self._read(pid)
 
     def _read(self, pid: str) -> None:
         try:

@@ -22,31 +22,13 @@ from __future__ import annotations
 import argparse
 import os
 import tempfile
-import threading
 import time
 from pathlib import Path
 
 from jupyter_client.manager import start_new_kernel
 
-TICKS = os.sysconf('SC_CLK_TCK')
-
-
-def tree(pid: int) -> list[int]:
-    """``pid`` and every process below it."""
-    children: dict[int, list[int]] = {}
-    for entry in os.listdir('/proc'):
-        if entry.isdigit():
-            try:
-                parent = int(Path(f'/proc/{entry}/stat').read_text().rsplit(')', 1)[1].split()[1])
-            except (OSError, IndexError):
-                continue
-            children.setdefault(parent, []).append(int(entry))
-    found, todo = [], [pid]
-    while todo:
-        current = todo.pop()
-        found.append(current)
-        todo.extend(children.get(current, []))
-    return found
+from ros2nb.processes import tree_cpu_seconds, tree_pids
+from sampling import Sampling
 
 
 def pss_mib(pids: list[int]) -> float:
@@ -61,35 +43,15 @@ def pss_mib(pids: list[int]) -> float:
     return total / 1024
 
 
-def cpu_s(pids: list[int]) -> float:
-    total = 0
-    for pid in pids:
-        try:
-            fields = Path(f'/proc/{pid}/stat').read_text().rsplit(')', 1)[1].split()
-            total += int(fields[11]) + int(fields[12]) + int(fields[13]) + int(fields[14])
-        except (OSError, IndexError):
-            continue
-    return total / TICKS
-
-
-class Peak:
+class Peak(Sampling):
     """The largest PSS of a process tree while the block runs (read every 0.2 s)."""
 
     def __init__(self, pid: int) -> None:
-        self.pid, self.mib, self._stop = pid, 0.0, threading.Event()
-        self._thread = threading.Thread(target=self._run, daemon=True)
+        super().__init__(0.2)
+        self.pid, self.mib = pid, 0.0
 
-    def _run(self) -> None:
-        while not self._stop.wait(0.2):
-            self.mib = max(self.mib, pss_mib(tree(self.pid)))
-
-    def __enter__(self) -> 'Peak':
-        self._thread.start()
-        return self
-
-    def __exit__(self, *_exc: object) -> None:
-        self._stop.set()
-        self._thread.join()
+    def sample(self) -> None:
+        self.mib = max(self.mib, pss_mib(tree_pids(self.pid)))
 
 
 def run(client, code: str) -> None:
@@ -114,19 +76,20 @@ def main() -> None:
                     'sub = ros2nb.import_file(ros2nb.course.SUBSCRIBER_FILE)\n'
                     'ros2nb.add(pub.TemperatureSensor()); ros2nb.add(sub.TemperatureMonitor())')
         time.sleep(5)
-        before, started = cpu_s(tree(pid)), time.monotonic()
+        before, started = tree_cpu_seconds(pid), time.monotonic()
         time.sleep(args.idle_s)
-        idle_pct = 100 * (cpu_s(tree(pid)) - before) / (time.monotonic() - started)
-        print(f'idle kernel (two nodes, between cells): {pss_mib(tree(pid)):.0f} MiB PSS, '
+        idle_pct = 100 * (tree_cpu_seconds(pid) - before) / (time.monotonic() - started)
+        print(f'idle kernel (two nodes, between cells): {pss_mib(tree_pids(pid)):.0f} MiB PSS, '
               f'{idle_pct:.1f} % of one CPU')
         for label, code in (('busy kernel: one simulated hour of both nodes',
                              '_ = ros2nb.spin(3600, show_logs=False)'),
                             ("a check from the kernel (notebook 03's check_sensor_callback)",
                              'ros2nb.stop()\nros2nb.checks.check_sensor_callback()')):
-            before, started = cpu_s(tree(pid)), time.monotonic()
+            before, started = tree_cpu_seconds(pid), time.monotonic()
             with Peak(pid) as peak:
                 run(client, code)
-            print(f'{label}: peak {peak.mib:.0f} MiB PSS, {cpu_s(tree(pid)) - before:.1f} CPU-s '
+            used = tree_cpu_seconds(pid) - before
+            print(f'{label}: peak {peak.mib:.0f} MiB PSS, {used:.1f} CPU-s '
                   f'(children that ended are counted once reaped), '
                   f'{time.monotonic() - started:.1f} s wall')
     finally:

@@ -130,6 +130,11 @@ def _tree(pid: int, children: dict[int, list[int]]) -> list[int]:
     return found
 
 
+def tree_pids(pid: int) -> list[int]:
+    """``pid`` and every process under it now (read from /proc)."""
+    return _tree(pid, _children())
+
+
 def tree_cpu_seconds(pid: int) -> float:
     """CPU seconds (user + system) used so far by ``pid`` and every process under it.
 
