@@ -87,6 +87,16 @@ MISTAKES = [
      "        __import__('time').sleep(1.0)\n        self.publisher_.publish(command)\n",
      checks.check_fan_controller, r'took 0\.5 s or more to answer each of 6 readings: '
                                   r'temperature_callback waits \(a time\.sleep\?\)'),
+    # Busy programs of its own keep one another waiting for a CPU: the subject's CPU shows it.
+    ('fan: a callback that sleeps beside busy programs of its own', FAN,
+     '        self.publisher_.publish(command)\n',
+     "        if not hasattr(self, 'busy'):\n"
+     "            import subprocess, sys\n"
+     "            self.busy = [subprocess.Popen([sys.executable, '-c', 'while True: pass'])\n"
+     "                         for _ in range(4)]\n"
+     "        __import__('time').sleep(1.0)\n        self.publisher_.publish(command)\n",
+     checks.check_fan_controller, r'took 0\.5 s or more to answer each of 6 readings: '
+                                  r'temperature_callback waits \(a time\.sleep\?\)'),
     ('fan: node name', FAN, "super().__init__('fan_controller')", "super().__init__('fan')",
      checks.check_fan_controller, r'The node is called fan; name it fan_controller'),
     ('counting: name ignored', PROMISES, 'super().__init__(name)',
@@ -180,9 +190,9 @@ def test_an_honest_fan_starved_of_cpu_is_not_called_slow(session, capsys, monkey
     from ros2nb.checks import lesson06
     verdicts, real = [], lesson06._slow_callback_verdict
 
-    def recorded(fastest_s, queued_s):
-        verdicts.append((fastest_s, queued_s))
-        real(fastest_s, queued_s)
+    def recorded(fastest_s, queued_s, cpu_s):
+        verdicts.append((fastest_s, queued_s, cpu_s))
+        real(fastest_s, queued_s, cpu_s)
 
     monkeypatch.setattr(lesson06, '_slow_callback_verdict', recorded)
     # A bar the starved answers surely pass (how late they come depends on the scheduler):
@@ -201,7 +211,7 @@ def test_an_honest_fan_starved_of_cpu_is_not_called_slow(session, capsys, monkey
         for burner in burners:
             burner.kill()
             burner.wait()
-    (fastest_s, queued_s), = verdicts
+    (fastest_s, _queued_s, _cpu_s), = verdicts
     # the failure prevented: by the judge's watch alone, the honest callback was slow
     assert fastest_s >= STARVED_BAR_S, verdicts
 

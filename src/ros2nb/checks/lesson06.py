@@ -52,11 +52,12 @@ def _fan_controller(judge: Judge) -> str:
     counts = info
     fan_topic = '/' + course.FAN_TOPIC
     # per reading: (from the judge's publishing it to its command arriving, the seconds the
-    # subject's threads stood queued for a CPU meanwhile)
-    answered: list[tuple[float, float]] = []
+    # subject's threads stood queued for a CPU meanwhile, and the CPU seconds they used)
+    answered: list[tuple[float, float, float]] = []
     for value in FAN_READINGS_C:
         before, sent_before = len(commands), announced(counts, fan_topic)
-        started, queued_before = time.monotonic(), tree_work(subject.proc.pid, watcher=False)[1]
+        cpu_before, queued_before, _ = tree_work(subject.proc.pid, watcher=False)
+        started = time.monotonic()
         counts, _lines = feed(judge, subject, info, value, counts,
                               'temperature_callback: is it the subscription\'s callback?')
         # Wait for as many commands as the subject says its callback published (none: no
@@ -64,8 +65,9 @@ def _fan_controller(judge: Judge) -> str:
         after = announced(counts, fan_topic)
         sent = 1 if after is None or sent_before is None else after - sent_before
         judge.observer.wait_until(lambda: len(commands) - before >= sent, ARRIVAL_TIMEOUT_S)
-        answered.append((time.monotonic() - started,
-                         tree_work(subject.proc.pid, watcher=False)[1] - queued_before))
+        cpu_after, queued_after, _ = tree_work(subject.proc.pid, watcher=False)
+        answered.append((time.monotonic() - started, queued_after - queued_before,
+                         cpu_after - cpu_before))
         said = [heard.value for heard in commands[before:]]
         want = course.monitor_status(value) == 'High'
         if not said:
@@ -84,11 +86,14 @@ def _fan_controller(judge: Judge) -> str:
             'readings).')
 
 
-def _slow_callback_verdict(fastest_s: float, queued_s: float) -> None:
+def _slow_callback_verdict(fastest_s: float, queued_s: float, cpu_s: float) -> None:
     """A callback that waits (``time.sleep``, a loop, a blocking call) holds up every other
     callback of its node: notebook 06 says to answer each reading at once.  An answer that
-    spent half its time or more waiting for a CPU (``queued_s``) is the machine's doing."""
-    if fastest_s >= SLOW_CALLBACK_S and queued_s < fastest_s / 2:
+    spent half its time or more waiting for a CPU (``queued_s``) while the subject used little
+    (``cpu_s``) is the machine's doing; threads of the subject's own that keep the CPU busy
+    (and one another waiting) are not."""
+    starved = queued_s >= fastest_s / 2 and cpu_s < fastest_s / 2
+    if fastest_s >= SLOW_CALLBACK_S and not starved:
         raise CheckFailed(f'The fan controller took {SLOW_CALLBACK_S:g} s or more to answer each '
                           f'of {len(FAN_READINGS_C)} readings: temperature_callback waits (a '
                           'time.sleep?), and meanwhile every other callback of its node waits '
