@@ -168,18 +168,17 @@ def queued_seconds(pids: Sequence[int], skip: Optional[int] = None) -> tuple[flo
     return total, ready
 
 
-def tree_work(pid: int, watcher: bool = True) -> tuple[float, float, bool]:
+def tree_work(pid: int) -> tuple[float, float, bool]:
     """What a process tree has done, as the kernel counts it: the CPU seconds of ``pid`` and
-    every process under it; the seconds their threads (with ``watcher``, also the calling
-    process's other threads, which watch it) stood ready on the run queue for a CPU
+    every process under it; the seconds their threads, and the calling process's other
+    threads (which watch it), stood ready on the run queue for a CPU
     (:func:`queued_seconds`); and whether one of them stands ready now.
 
     Introduced in ``03-write-the-publisher.ipynb`` (how long the judge waits for a subject).
     """
     children, cpu = _processes()
     tree = _tree(pid, children)
-    queued, ready = queued_seconds([*tree, *([os.getpid()] if watcher else [])],
-                                   skip=threading.get_native_id())
+    queued, ready = queued_seconds([*tree, os.getpid()], skip=threading.get_native_id())
     return sum(cpu.get(each, 0.0) for each in tree), queued, ready
 
 
