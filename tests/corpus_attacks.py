@@ -68,7 +68,7 @@ for _argument in sys.argv:
 FORGE_REPLIES = '''
 import sys as _sys
 _frame = _sys._getframe()
-while _frame is not None and 'handlers' not in _frame.f_locals:
+while _frame is not None and not {'handlers', 'subject'} <= _frame.f_locals.keys():
     _frame = _frame.f_back
 if _frame is not None:
     _handlers = _frame.f_locals['handlers']

@@ -54,11 +54,12 @@ def judge_session(root: Path, notebook: int) -> Iterator[Session]:
 
 
 #: A forging learner's module code that finds the subject's request loop from the learner's import and keeps
-#: its handlers and its Subject (nothing happens when the file runs as a program).
+#: its handlers and its Subject (nothing happens when the file runs as a program).  The loop is
+#: the frame with both names: a forked subject's stack also holds the fork server's frames.
 FIND_SUBJECT = '''
 import sys as _sys
 _frame = _sys._getframe()
-while _frame is not None and 'handlers' not in _frame.f_locals:
+while _frame is not None and not {'handlers', 'subject'} <= _frame.f_locals.keys():
     _frame = _frame.f_back
 _HANDLERS = _frame.f_locals['handlers'] if _frame else {}
 _SUBJECT = _frame.f_locals['subject'] if _frame else None

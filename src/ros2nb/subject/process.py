@@ -54,7 +54,8 @@ def load(request: dict) -> tuple[dict, dict]:
     """Run the first command, which loads the learner's code; return (namespace, reply).
 
     Called before the command loop exists: code of the learner's that looks up the stack
-    while it is imported finds this function's frame, the process's ``main()`` and no more.
+    while it is imported finds this function's frame, the process's ``main()`` and what
+    started the process (``runpy``, or the fork server's, :mod:`.forked`), never the loop.
     """
     op = request.get('op')
     namespace: dict[str, Any] = {'__name__': '__main__'}

@@ -1,0 +1,88 @@
+"""A subject forked from the fork server is the process a started one is.
+
+After the first, a judge forks its unsandboxed subjects from a server that has imported ROS
+(``ros2nb.subject.forked``): 0.06 CPU-s each instead of 0.23.  What the learner's code can
+see of its process must not change with it: environment, working folder, ``sys.path``, its own
+session, standard streams, and rclpy's field checks, which generated message modules read
+from the environment once, when the server imported them (the judge's own environment, here
+without ``ROS_PYTHON_CHECK_FIELDS``).
+"""
+
+import json
+import os
+import signal
+import subprocess
+
+import pytest
+
+from ros2nb.judge.subjects import SUBJECT_PREFIX_ENV, SubjectProcess, subject_env
+from ros2nb.processes import kill_process_group
+
+pytestmark = pytest.mark.timeout(120)
+
+VIEW = '''
+import json, os, sys, tempfile
+from std_msgs.msg import Float32
+
+def fds():
+    found = []
+    for name in os.listdir('/proc/self/fd'):
+        try:
+            found.append(os.readlink('/proc/self/fd/' + name).split(':')[0])
+        except OSError:  # the listing's own
+            pass
+    return sorted(found)
+
+try:
+    Float32(data='hot')
+    checks_fields = False
+except AssertionError:
+    checks_fields = True
+print('VIEW', json.dumps({
+    'leads its session': os.getsid(0) == os.getpgid(0) == os.getpid(),
+    'cwd': os.getcwd(), 'sys.path': sys.path, 'argv': len(sys.argv),
+    'tempdir': tempfile.gettempdir(), 'home': os.path.expanduser('~'),
+    'environment': {k: v for k, v in os.environ.items() if k != 'ROS2NB_JUDGE_CLOCK'},
+    'checks fields': checks_fields, 'stdin': sys.stdin.read(),
+    'stdout written at once': sys.stdout.write_through, 'open files': fds(),
+    'parent is the judge': os.getppid() == JUDGE}))
+'''
+
+
+def view(tmp_path, judge_pid: int) -> tuple[dict, SubjectProcess]:
+    """What a new subject's code sees of its process."""
+    (tmp_path / 'tmp').mkdir(exist_ok=True)
+    extra = {'TMPDIR': str(tmp_path / 'tmp'), 'HOME': str(tmp_path / 'home'),
+             'PYTHONPATH': str(tmp_path / 'lib')}
+    subject = SubjectProcess(tmp_path, env=subject_env(extra))
+    subject.send('exec_cells', sources=[f'JUDGE = {judge_pid}\n' + VIEW])
+    reply = None
+    while reply is None:
+        reply = subject.poll_reply(1.0)
+    assert reply == {'ok': True, 'cell_errors': []}, reply
+    subject.close()
+    line, = (line for line in subject.output.text().splitlines() if line.startswith('VIEW '))
+    return json.loads(line[len('VIEW '):]), subject
+
+
+def test_a_forked_subject_sees_what_a_started_one_sees(tmp_path, monkeypatch):
+    monkeypatch.delenv('ROS_PYTHON_CHECK_FIELDS', raising=False)  # the subjects' env sets it
+    view(tmp_path, os.getpid())  # this process's first subject, if no test started one yet
+    forked, _ = view(tmp_path, os.getpid())
+    monkeypatch.setenv(SUBJECT_PREFIX_ENV, json.dumps(['env']))  # a prefix: started afresh
+    started, _ = view(tmp_path, os.getpid())
+    assert not forked.pop('parent is the judge') and started.pop('parent is the judge')
+    assert forked == started
+    assert forked['checks fields'] and forked['leads its session']
+    assert forked['sys.path'][:2] == [str(tmp_path), str(tmp_path / 'lib')]
+
+
+def test_a_forked_subject_is_stopped_and_reaped_as_a_started_one(tmp_path):
+    SubjectProcess(tmp_path).close()  # this process's first subject is started afresh
+    subject = SubjectProcess(tmp_path)
+    assert subject.proc.poll() is None
+    with pytest.raises(subprocess.TimeoutExpired):
+        subject.proc.wait(0.1)
+    assert kill_process_group(subject.proc) == -signal.SIGTERM
+    assert subject.proc.poll() == -signal.SIGTERM
+    subject.close()
