@@ -13,7 +13,6 @@ import os
 import signal
 import subprocess
 import sys
-import threading
 import time
 from collections import deque
 from typing import NoReturn, Optional, Sequence
@@ -145,16 +144,16 @@ def tree_cpu_seconds(pid: int) -> float:
     return sum(cpu.get(each, 0.0) for each in _tree(pid, children))
 
 
-def queued_seconds(pids: Sequence[int], skip: Optional[int] = None) -> tuple[float, bool]:
-    """How much the threads of ``pids`` (but thread ``skip``) stood ready to run, waiting on
-    the run queue for a CPU: the seconds the kernel counted (the second field of
-    ``/proc/PID/task/TID/schedstat``, brought up to date only when a thread gets a CPU), and
-    whether one of them stands ready now (state R).  Gone processes and threads, and a
-    kernel without schedstats, count nothing."""
+def queued_seconds(pids: Sequence[int]) -> tuple[float, bool]:
+    """How much the threads of ``pids`` stood ready to run, waiting on the run queue for a
+    CPU: the seconds the kernel counted (the second field of ``/proc/PID/task/TID/schedstat``,
+    brought up to date only when a thread gets a CPU), and whether one of them stands ready
+    now (state R).  Gone processes and threads, and a kernel without schedstats, count
+    nothing."""
     total, ready = 0.0, False
     for pid in pids:
         try:
-            tasks = [task for task in os.listdir(f'/proc/{pid}/task') if task != str(skip)]
+            tasks = os.listdir(f'/proc/{pid}/task')
         except OSError:
             continue
         for task in tasks:
@@ -170,15 +169,19 @@ def queued_seconds(pids: Sequence[int], skip: Optional[int] = None) -> tuple[flo
 
 def tree_work(pid: int) -> tuple[float, float, bool]:
     """What a process tree has done, as the kernel counts it: the CPU seconds of ``pid`` and
-    every process under it; the seconds their threads, and the calling process's other
-    threads (which watch it), stood ready on the run queue for a CPU
-    (:func:`queued_seconds`); and whether one of them stands ready now.
+    every process under it; the seconds their threads stood ready on the run queue for a
+    CPU (:func:`queued_seconds`); and whether one of them stands ready now.
+
+    The watching process's own threads do not count: a judge at work (the corpora grade in
+    the test process, its executor and Fast DDS threads beside the watch) stood ready in
+    every look on a busy machine, and a ``main()`` that never starts ROS was given ten
+    times its limit (124 s instead of 20 beside two CPU burners).
 
     Introduced in ``03-write-the-publisher.ipynb`` (how long the judge waits for a subject).
     """
     children, cpu = _processes()
     tree = _tree(pid, children)
-    queued, ready = queued_seconds([*tree, os.getpid()], skip=threading.get_native_id())
+    queued, ready = queued_seconds(tree)
     return sum(cpu.get(each, 0.0) for each in tree), queued, ready
 
 
@@ -189,10 +192,9 @@ class Patience:
     process gets a fraction of a CPU.  So the limit counts work: the tree has had long
     enough once it used ``limit_s`` CPU seconds (an endless loop), or once ``limit_s``
     seconds passed on the wall clock while it sat waiting: less than :data:`BUSY_SHARE` of a
-    CPU over the last :data:`BUSY_WINDOW_S` seconds, counting the time its threads (and the
-    watching process's other threads, which read the answer) stood ready on the run queue for
-    a CPU (:func:`queued_seconds`), or one of them stood ready in :data:`READY_SHARE` of the
-    looks.  A program the scheduler starves is working, not waiting: beside two CPU burners
+    CPU over the last :data:`BUSY_WINDOW_S` seconds, counting the time its threads stood
+    ready on the run queue for a CPU (:func:`queued_seconds`), or one of them stood ready in
+    :data:`READY_SHARE` of the looks.  A program the scheduler starves is working, not waiting: beside two CPU burners
     and a test run, a starting program was measured at 0.07 s of CPU and 8.7 s queued in its
     first 10 s.  A tree that keeps working slowly is cut after ``WALL_LIMIT_FACTOR * limit_s``
     seconds.
