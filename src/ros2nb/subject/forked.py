@@ -30,8 +30,12 @@ import time
 from multiprocessing.connection import Connection
 from typing import IO, Optional
 
-#: What the fork server imports before it forks the first subject.
-PRELOAD = ['ros2nb.subject.__main__', 'rclpy.node', 'rcl_interfaces.srv', 'numpy', 'rosidl_generator_py.import_type_support_impl', 'std_msgs.msg']
+#: What the fork server imports before it forks the first subject: the subject's own
+#: modules and what rclpy imports when the first node starts (the parameter services' types,
+#: numpy for their arrays, rosidl's type support with its parser).  numpy starts no thread
+#: with ``OPENBLAS_NUM_THREADS=1``, which every way of running the course sets.
+PRELOAD = ['ros2nb.subject.__main__', 'rclpy.node', 'rcl_interfaces.srv', 'numpy',
+           'rosidl_generator_py.import_type_support_impl', 'std_msgs.msg']
 #: The variable generated message modules read once, when imported (rosidl_generator_py):
 #: a forked subject sets what they read from its own environment.
 CHECK_FIELDS_ENV = 'ROS_PYTHON_CHECK_FIELDS'
@@ -55,6 +59,7 @@ class ForkedProcess:
 
     @property
     def returncode(self) -> Optional[int]:
+        """The exit code once it ended (negative: the signal that ended it), else None."""
         return self._process.exitcode
 
     def poll(self) -> Optional[int]:
@@ -177,6 +182,7 @@ def _site_path() -> list[str]:
     ``PYTHONPATH`` (the standard library, site-packages and their ``.pth`` files): the fork
     server's own is the judge's, with whatever the judge added to it."""
     env = {k: v for k, v in os.environ.items() if k != 'PYTHONPATH'}
-    done = subprocess.run([sys.executable, '-c', 'import json, sys; print(json.dumps(sys.path[1:]))'],
-                          env=env, capture_output=True, text=True, check=True)
+    program = 'import json, sys\nprint(json.dumps(sys.path[1:]))'
+    done = subprocess.run([sys.executable, '-c', program], env=env, capture_output=True,
+                          text=True, check=True)
     return json.loads(done.stdout)
