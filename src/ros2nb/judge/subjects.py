@@ -145,9 +145,9 @@ class SubjectProcess:
         self._replies, from_subject = os.pipe()
         self._acks, acks_from_subject = os.pipe()
         os.set_blocking(self._acks, False)
-        prefix, environment = subject_prefix(), env or subject_env()
+        prefix, environment, first = subject_prefix(), env or subject_env(), next(_STARTED) == 0
         try:
-            if prefix or next(_STARTED) == 0:  # a sandbox of its own, or the first: afresh
+            if prefix or first:  # a sandbox of its own, or this process's first: afresh
                 argv = [*prefix, sys.executable, '-m', 'ros2nb.subject', str(to_subject),
                         str(from_subject)]
                 self.proc: Any = subprocess.Popen(
