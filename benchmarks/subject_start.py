@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import subprocess
 import sys
 import tempfile
 import time
@@ -39,10 +40,9 @@ def run(count: int, folder: Path) -> tuple[float, float]:
     return (busy_cpu_s() - busy) / count, (time.monotonic() - began) / count
 
 
-def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
-    parser.add_argument('--subjects', type=int, default=20)
-    count = parser.parse_args().subjects
+def measure(count: int) -> None:
+    """Print the table (run with ``python -c``: a judge run from a script file never forks
+    its subjects, :func:`ros2nb.subject.forked.forkable`)."""
     with tempfile.TemporaryDirectory() as folder:
         os.environ[SUBJECT_PREFIX_ENV] = json.dumps(['env'])
         afresh = run(count, Path(folder))
@@ -52,7 +52,15 @@ def main() -> int:
     print('|---|---|---|')
     for name, (cpu, wall) in (('started afresh', afresh), ('forked', forked)):
         print(f'| {name} | {cpu:.3f} | {wall:.3f} |')
-    return 0
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--subjects', type=int, default=20)
+    count = parser.parse_args().subjects
+    here = str(Path(__file__).resolve().parent)
+    return subprocess.call([sys.executable, '-c', f'import sys\nsys.path.insert(0, {here!r})\n'
+                            f'import subject_start\nsubject_start.measure({count})'])
 
 
 if __name__ == '__main__':

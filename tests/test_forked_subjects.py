@@ -12,6 +12,7 @@ import json
 import os
 import signal
 import subprocess
+import sys
 
 import pytest
 
@@ -86,3 +87,32 @@ def test_a_forked_subject_is_stopped_and_reaped_as_a_started_one(tmp_path):
     assert kill_process_group(subject.proc) == -signal.SIGTERM
     assert subject.proc.poll() == -signal.SIGTERM
     subject.close()
+
+
+SCRIPT_JUDGE = '''
+import sys
+from pathlib import Path
+print('the judge script ran')
+if __name__ == '__main__':
+    from ros2nb.judge.subjects import SubjectProcess
+    for _ in range(2):  # the process's first subject is started afresh in any case
+        subject = SubjectProcess(Path(sys.argv[1]))
+        subject.request('exec_cells', sources=['import os\\nprint("parent", os.getppid())'])
+        subject.close()
+        print('subject said:', subject.output.text().replace('\\n', ' | '))
+'''
+
+
+def test_a_judge_run_from_a_script_file_never_runs_it_in_its_subjects(tmp_path):
+    """multiprocessing runs the parent's main module again in each forked child: a judge
+    whose main module is a script file (a benchmark, tests/corpora.py) starts its subjects
+    afresh, so that none of its code runs in them."""
+    script = tmp_path / 'judge_script.py'
+    script.write_text(SCRIPT_JUDGE)
+    judge = subprocess.Popen([sys.executable, str(script), str(tmp_path)], text=True,
+                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    out, _ = judge.communicate(timeout=60)
+    said = [line for line in out.splitlines() if line.startswith('subject said:')]
+    assert len(said) == 2 and judge.returncode == 0, out
+    assert all('the judge script ran' not in line for line in said), out
+    assert all(f'parent {judge.pid}' in line for line in said), out  # both started afresh

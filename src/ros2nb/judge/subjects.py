@@ -25,7 +25,7 @@ from ..checks.dispatch import IN_JUDGE_ENV
 from ..errors import CheckFailed
 from ..processes import Patience, kill_process_group, stop_process_group
 from ..runtime.clock import JUDGE_CLOCK_ENV
-from ..subject.forked import fork_subject
+from ..subject.forked import fork_subject, forkable
 
 #: JSON list put in front of every subject's command (the grader's sandbox).
 SUBJECT_PREFIX_ENV = 'ROS2NB_SUBJECT_PREFIX'
@@ -147,7 +147,7 @@ class SubjectProcess:
         os.set_blocking(self._acks, False)
         prefix, environment, first = subject_prefix(), env or subject_env(), next(_STARTED) == 0
         try:
-            if prefix or first:  # a sandbox of its own, or this process's first: afresh
+            if prefix or first or not forkable():  # sandboxed, the first, ...: afresh
                 argv = [*prefix, sys.executable, '-m', 'ros2nb.subject', str(to_subject),
                         str(from_subject)]
                 self.proc: Any = subprocess.Popen(

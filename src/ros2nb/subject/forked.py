@@ -46,6 +46,19 @@ _context = multiprocessing.get_context('forkserver')
 _context.set_forkserver_preload(PRELOAD)
 
 
+def forkable() -> bool:
+    """Whether subjects forked from this process start clean.  multiprocessing runs the
+    parent's main module again in each child, as ``__mp_main__``, unless it is ``-c`` code or
+    a package's ``__main__`` (a judge's ``python -m ros2nb.judge``, pytest's and its
+    workers'): a judge run from a script file (a benchmark, ``tests/corpora.py``) starts its
+    subjects afresh, so that no code of its own runs in them."""
+    main = sys.modules['__main__']
+    name = getattr(getattr(main, '__spec__', None), 'name', None)
+    if name is not None:
+        return name == '__main__' or name.endswith('.__main__')
+    return getattr(main, '__file__', None) is None
+
+
 class ForkedProcess:
     """A subject forked by the fork server, with the part of :class:`subprocess.Popen` the
     judge and :mod:`ros2nb.processes` use: ``pid`` (also its process group), ``stdout``,
