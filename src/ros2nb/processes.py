@@ -194,10 +194,10 @@ class Patience:
     seconds passed on the wall clock while it sat waiting: less than :data:`BUSY_SHARE` of a
     CPU over the last :data:`BUSY_WINDOW_S` seconds, counting the time its threads stood
     ready on the run queue for a CPU (:func:`queued_seconds`), or one of them stood ready in
-    :data:`READY_SHARE` of the looks.  A program the scheduler starves is working, not waiting: beside two CPU burners
-    and a test run, a starting program was measured at 0.07 s of CPU and 8.7 s queued in its
-    first 10 s.  A tree that keeps working slowly is cut after ``WALL_LIMIT_FACTOR * limit_s``
-    seconds.
+    :data:`READY_SHARE` of the looks.  A program the scheduler starves is working, not
+    waiting: beside two CPU burners and a test run, a starting program was measured at
+    0.07 s of CPU and 8.7 s queued in its first 10 s.  A tree that keeps working slowly is
+    cut after ``WALL_LIMIT_FACTOR * limit_s`` seconds.
 
     :param pid: the process at the top of the tree (a sandbox's own process is fine).
     :param limit_s: seconds of CPU time, or of waiting, the tree is given.

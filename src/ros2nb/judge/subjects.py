@@ -147,7 +147,7 @@ class SubjectProcess:
         os.set_blocking(self._acks, False)
         prefix, environment, first = subject_prefix(), env or subject_env(), next(_STARTED) == 0
         try:
-            if prefix or first or not forkable():  # sandboxed, the first, ...: afresh
+            if prefix or first or not forkable():  # sandboxed, the first, a script's: afresh
                 argv = [*prefix, sys.executable, '-m', 'ros2nb.subject', str(to_subject),
                         str(from_subject)]
                 self.proc: Any = subprocess.Popen(
