@@ -122,14 +122,19 @@ def compress_for_ever(data=bytes(range(256)) * 4096):
         zlib.compress(data, 9)  # in C, without the GIL: this thread runs or stands ready
 
 threading.Thread(target=compress_for_ever, daemon=True).start()
-limit = float(sys.argv[1])
-sleeper = subprocess.Popen([sys.executable, '-c', 'import time\\ntime.sleep(3600)'])
+limit, cut = float(sys.argv[1]), float(sys.argv[2])
+sleeper = subprocess.Popen([sys.executable, '-c', 'import time\\nprint("asleep", flush=True)\\n'
+                            'time.sleep(3600)'], stdout=subprocess.PIPE, text=True)
+sleeper.stdout.readline()  # its start is work (a busy machine queues it): watch it asleep
 patience, began = Patience(sleeper.pid, limit), time.monotonic()
-while not patience.exhausted() and time.monotonic() - began < 4 * limit:
+while not (gave_up := patience.exhausted()) and time.monotonic() - began < cut * limit:
     time.sleep(0.1)
-print(round(time.monotonic() - began, 1))
+print('gave up' if gave_up else 'still waiting', round(time.monotonic() - began, 1))
 sleeper.kill()
 """
+#: Where the watcher stops waiting for Patience itself (times the limit): the failure
+#: prevented stood ready in every look and waited until WALL_LIMIT_FACTOR (10) times.
+CUT = 6
 
 
 def test_a_busy_watcher_does_not_make_a_waiting_program_look_busy():
@@ -138,10 +143,12 @@ def test_a_busy_watcher_does_not_make_a_waiting_program_look_busy():
     every look, and a main() that never starts ROS was given ten times its limit (124 s
     instead of 20 beside two CPU burners). Here the watcher's own thread computes without
     the GIL while the program it watches sleeps for an hour."""
-    done = subprocess.run([sys.executable, '-c', WATCHER, str(LIMIT_S)], capture_output=True,
-                          text=True, timeout=60)
-    waited = float(done.stdout.strip() or 'nan')
-    assert LIMIT_S <= waited < 2 * LIMIT_S, (done.stdout, done.stderr[-500:])
+    done = subprocess.run([sys.executable, '-c', WATCHER, str(LIMIT_S), str(CUT)],
+                          capture_output=True, text=True, timeout=120)
+    verdict, _, waited = done.stdout.strip().rpartition(' ')
+    # Patience gave up on its own, at its limit or soon after (never a fixed number of
+    # seconds: how soon depends on how busy the machine is); the failure waited on.
+    assert verdict == 'gave up' and float(waited) >= LIMIT_S, (done.stdout, done.stderr[-500:])
 
 
 @pytest.mark.timeout(2 * PATIENCE_S)
