@@ -22,6 +22,7 @@ from ..checks.base import ARRIVAL_TIMEOUT_S, learner_error
 from ..errors import CheckFailed
 from ..processes import Patience, kill_process_group
 from ..runtime.clock import JUDGE_CLOCK_QOS
+from ..runtime.core import QUIET_PUBLISHER
 from .observer import Observer
 from .subjects import REPLY_TIMEOUT_S, SubjectProcess
 
@@ -37,7 +38,8 @@ class JudgeClock:
 
     def __init__(self, observer: Observer) -> None:
         self._observer = observer
-        self._publisher = observer.node.create_publisher(Clock, '/clock', JUDGE_CLOCK_QOS)
+        self._publisher = observer.node.create_publisher(Clock, '/clock', JUDGE_CLOCK_QOS,
+                                                         event_callbacks=QUIET_PUBLISHER)
         self._publish()
 
     @property

@@ -26,6 +26,7 @@ from .. import domains
 from ..checks.base import ARRIVAL_TIMEOUT_S
 from ..errors import CheckFailed
 from ..runtime import node_serving_nothing
+from ..runtime.core import QUIET_SUBSCRIPTION
 from ..runtime.services import call_until_answered
 
 
@@ -96,7 +97,8 @@ class Observer:
         self._stop = False
         self._thread = threading.Thread(target=self._spin, name='ros2nb-judge', daemon=True)
         self._thread.start()
-        self.node.create_subscription(Log, '/rosout', self._on_log, ROSOUT_QOS)
+        self.node.create_subscription(Log, '/rosout', self._on_log, ROSOUT_QOS,
+                                      event_callbacks=QUIET_SUBSCRIPTION)
 
     def _spin(self) -> None:
         """Run the node's callbacks until :meth:`close` (which wakes the wait at once)."""
@@ -130,7 +132,8 @@ class Observer:
                     store.append(Heard(self.now_ns, keep(msg)))
                     self.changed.notify_all()
 
-            self.node.create_subscription(msg_type, topic, note, EVERY_MESSAGE)
+            self.node.create_subscription(msg_type, topic, note, EVERY_MESSAGE,
+                                          event_callbacks=QUIET_SUBSCRIPTION)
         return self.heard[topic]
 
     def quiet_node(self) -> Any:

@@ -36,6 +36,8 @@ INTERNAL_NODE_NAME = '_ros2nb'
 #: For ros2nb's own subscriptions: no QoS event handlers (rclpy's default warns of
 #: incompatible QoS, which the kernel's own subscriptions choose to accept).
 QUIET_SUBSCRIPTION = SubscriptionEventCallbacks(use_default_callbacks=False)
+#: For ros2nb's own publishers: no QoS event handlers either.
+QUIET_PUBLISHER = PublisherEventCallbacks(use_default_callbacks=False)
 
 
 def node_serving_nothing(name: str, **kwargs: Any) -> Node:
@@ -46,12 +48,24 @@ def node_serving_nothing(name: str, **kwargs: Any) -> Node:
 
     For the kernel's hidden node, the judge's node and the QoS trials' nodes (not for learners).
 
+    Nor does its ``/parameter_events`` publisher (every rclpy node has one) keep rclpy's
+    default QoS event handlers: two more entities in each wait, only to warn of a QoS that
+    does not match.  The judge's node waited with eight such handlers; without them (and
+    with quiet subscriptions and ``/clock``) a simulated hour of notebook 03 costs the judge
+    1.5 CPU-s instead of 2.1.
+
     :param name: the node's name.
     :param kwargs: passed on to :class:`rclpy.node.Node` (e.g. ``context``, ``enable_rosout``).
     """
-    return Node(name, start_parameter_services=False,
+    node = Node(name, start_parameter_services=False,
                 parameter_overrides=[Parameter('start_type_description_service',
                                                Parameter.Type.BOOL, False)], **kwargs)
+    for publisher in node.publishers:
+        for handler in publisher.event_handlers:
+            node.remove_waitable(handler)
+            handler.destroy()
+        publisher.event_handlers = []
+    return node
 
 
 def enable_field_checks() -> None:
@@ -88,7 +102,7 @@ class Runtime(LogLines, Spinning, NodeKeeping, SimulatedClock):
         # The kernel's own node serves nothing and logs nothing.
         self.node = node_serving_nothing(INTERNAL_NODE_NAME, enable_rosout=False)
         self._clock_publisher = self.node.create_publisher(
-            Clock, '/clock', 10, event_callbacks=PublisherEventCallbacks(use_default_callbacks=False))
+            Clock, '/clock', 10, event_callbacks=QUIET_PUBLISHER)
         rosout_qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE,
                                 durability=DurabilityPolicy.TRANSIENT_LOCAL)
         self.node.create_subscription(Log, '/rosout', self._on_log, rosout_qos,
