@@ -17,7 +17,6 @@ from ..checks.base import bind_judge
 from ..checks.dispatch import IN_JUDGE_ENV, captured
 from ..processes import end_this_process
 from ..terminal.workspace import default_workspace
-from .flags import notebook_flags
 from .grading import grade
 from .session import Session
 
@@ -36,6 +35,9 @@ def main(argv: list[str]) -> int:
             function = getattr(checks, argv[1])
             result: Any = captured(lambda: function(**json.loads(argv[2])))
         else:
+            # Only grading flags code (the flags parse cells with IPython: 40 ms of imports
+            # that every check of a learner's kernel would pay).
+            from .flags import notebook_flags
             source, submission = (json.loads(Path(p).read_text()) for p in argv[1:])
             result = {'results': grade(source, submission),
                       'flags': notebook_flags(submission, session.workspace)}
