@@ -163,7 +163,6 @@ def test_the_judges_observer_closes_at_once_however_long_its_wait(monkeypatch):
     assert wait_until(closed.is_set), "close() waited for the spin thread's wait to time out"
 
 
-
 def test_the_judges_node_waits_only_for_what_it_hears():
     """The judge's executor waits once or twice per step of its clock, thousands of times
     per check, and each wait walks every entity of its node. rclpy's default QoS event
@@ -180,6 +179,7 @@ def test_the_judges_node_waits_only_for_what_it_hears():
         assert len(list(watching.node.subscriptions)) == 2  # /rosout and /temperature
     finally:
         watching.close()
+
 
 ENDS_WITH_AN_EXIT_HANDLER = """
 import atexit, sys
