@@ -93,11 +93,13 @@ image-tool:
 # Three steps, always all three (tests/run_steps.sh): tests/ with pytest-xdist, and nbval
 # over solutions/ and notebooks/ alongside it; one failure never hides the others, the
 # results come together at the end, and make fails if any step failed.
-# Six workers: much of a test's time is a judge and its subject waiting on each other step by
-# step, and four left the two cores idle between steps; on a loaded machine more workers also
-# keep more of the CPU. Beside two CPU burners at a515b0f, tests/ took 557 s with four and
-# 510 s with six (memory is no limit: each worker holds a few hundred MB).
-TEST_WORKERS ?= 6
+# Eight workers: much of a test's time is a judge and its subject waiting on each other step
+# by step, and four left the two cores idle between steps; on a loaded machine more workers
+# also keep more of the CPU. Beside two CPU burners (fresh clones, src/ as at a515b0f),
+# tests/ took 557 s with four workers, 499-515 s with six and 459 s with eight, where grading
+# the sample class (one worker, about 415 s) is the longest chain. Memory is no limit: each
+# worker holds a few hundred MB.
+TEST_WORKERS ?= 8
 
 test: $(STAMP) bytecode sandbox-tool browser-tool graph-tool image-tool
 	@tests/run_steps.sh $(PY) $(TEST_WORKERS)
