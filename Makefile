@@ -93,13 +93,12 @@ image-tool:
 # Three steps, always all three (tests/run_steps.sh): tests/ with pytest-xdist, and nbval
 # over solutions/ and notebooks/ alongside it; one failure never hides the others, the
 # results come together at the end, and make fails if any step failed.
-# Eight workers: much of a test's time is a judge and its subject waiting on each other step
-# by step, and four left the two cores idle between steps; on a loaded machine more workers
-# also keep more of the CPU. Beside two CPU burners (fresh clones, src/ as at a515b0f),
-# tests/ took 557 s with four workers, 499-515 s with six and 459 s with eight, where grading
-# the sample class (one worker, about 415 s) is the longest chain. Memory is no limit: each
-# worker holds a few hundred MB.
-TEST_WORKERS ?= 8
+# Six workers: much of a test's time is a judge and its subject waiting on each other step by
+# step, and four left the two cores idle between steps. Beside two CPU burners (fresh clones
+# of a515b0f) tests/ took 557 s with four workers and 510 s with six; idle, a fresh clone's
+# make test took 409 s with six (77abb11). Eight were slower idle (455 s, 66ca55b): beside
+# burners started from the same shell they only took more CPU from the burners.
+TEST_WORKERS ?= 6
 
 test: $(STAMP) bytecode sandbox-tool browser-tool graph-tool image-tool
 	@tests/run_steps.sh $(PY) $(TEST_WORKERS)
