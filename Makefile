@@ -95,9 +95,10 @@ image-tool:
 # results come together at the end, and make fails if any step failed.
 # Six workers: much of a test's time is a judge and its subject waiting on each other step by
 # step, and four left the two cores idle between steps. Beside two CPU burners (fresh clones
-# of a515b0f) tests/ took 557 s with four workers and 510 s with six; idle, a fresh clone's
-# make test took 409 s with six (77abb11). Eight were slower idle (455 s, 66ca55b): beside
-# burners started from the same shell they only took more CPU from the burners.
+# of a515b0f) tests/ took 557 s with four workers and 510 s with six; idle, fresh clones took
+# 409-457 s with six (478 s with four at a95c744). Eight took 455-459 s beside burners started
+# from the same shell, but part of that is CPU they took from the burners (one autogroup):
+# idle they were no faster (455 s).
 TEST_WORKERS ?= 6
 
 test: $(STAMP) bytecode sandbox-tool browser-tool graph-tool image-tool
