@@ -25,8 +25,7 @@ from rclpy.signals import SignalHandlerOptions
 from .. import domains
 from ..checks.base import ARRIVAL_TIMEOUT_S
 from ..errors import CheckFailed
-from ..runtime import node_serving_nothing
-from ..runtime.core import QUIET_SUBSCRIPTION
+from ..runtime import QUIET_SUBSCRIPTION, node_serving_nothing
 from ..runtime.services import call_until_answered
 
 
