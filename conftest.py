@@ -2,7 +2,8 @@
 
 - No ``ROS_DOMAIN_ID`` is set: every process that brings ROS up (this pytest process,
   each nbval kernel, each judge) claims a free domain of its own (ros2nb.domains), so two
-  runs never see each other's topics. Discovery stays on this machine.
+  runs never see each other's topics. Discovery stays on this machine, with the course's
+  Fast DDS profile (ros2nb.domains.DISCOVERY_PROFILE).
 - The course workspace goes to a temporary folder removed at the end, so tests never
   touch a learner's ``workspace/``.  So do the files every kernel writes (IPython's
   history, Jupyter's connection files): tests run side by side (pytest-xdist, one
@@ -25,6 +26,7 @@ from pathlib import Path
 import pytest
 
 import ros2nb_instructor  # noqa: F401 - first, so nbformat's jsonschema skips rfc3987_syntax (see there)
+from ros2nb import domains  # noqa: E402 - after ros2nb_instructor (see there)
 
 # A shell's background job (`make test &` in a script) starts with Ctrl+C ignored, and every
 # process started from it inherits that: the tests that press Ctrl+C (for a node process, for
@@ -33,6 +35,7 @@ if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
 os.environ.pop('ROS_DOMAIN_ID', None)
 os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+domains.use_discovery_profile()  # the tests' own nodes find peers as the course's processes do
 _SCRATCH = Path(tempfile.mkdtemp(prefix='ros2nb-test-'))
 os.environ['ROS2NB_WORKSPACE'] = str(_SCRATCH / 'ROS2_and_RL_Tutorials')
 os.environ['IPYTHONDIR'] = str(_SCRATCH / 'ipython')

@@ -1,8 +1,12 @@
 """Small real nodes the unit tests hand to ros2nb."""
 
+import os
 import random
+import subprocess
+import sys
+import time
 from contextlib import contextmanager
-from typing import Iterator
+from typing import Any, Iterator
 
 import rclpy
 from rclpy.node import Node
@@ -81,3 +85,37 @@ def name_without_endpoints(name: str, domain_id: int) -> Iterator[Node]:
     finally:
         node.destroy_node()
         rclpy.try_shutdown(context=context)
+
+
+#: A program that makes one node named ``argv[1]``, prints the moment it was made
+#: (``time.monotonic()``, one clock for every process of the machine) and leaves ROS cleanly
+#: when its standard input ends, as the course's processes end.
+NEWCOMER = '''
+import sys, time
+import rclpy
+rclpy.init()
+node = rclpy.create_node(sys.argv[1])
+print(time.monotonic(), flush=True)
+sys.stdin.read()
+node.destroy_node()
+rclpy.shutdown()
+'''
+
+
+def join_times(observer: Any, count: int, env: dict[str, str]) -> list[float]:
+    """Seconds each of ``count`` new processes' node (started one after another, each with
+    ``env``) took to appear in the judge's graph (``observer``, a
+    :class:`ros2nb.judge.observer.Observer`), counted from when the process made it; 30
+    when it never did within 30 s."""
+    times = []
+    for index in range(count):
+        name = f'newcomer_{os.getpid()}_{index}'
+        proc = subprocess.Popen([sys.executable, '-c', NEWCOMER, name], env=env, text=True,
+                                stdin=subprocess.PIPE, stdout=subprocess.PIPE)
+        try:
+            made = float(proc.stdout.readline())
+            seen = observer.wait_until(lambda: observer.has_node(name), 30.0)
+            times.append(time.monotonic() - made if seen else 30.0)
+        finally:
+            proc.communicate('', timeout=30)
+    return times

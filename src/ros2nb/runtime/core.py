@@ -22,6 +22,7 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 from rosgraph_msgs.msg import Clock
 
+from .. import domains
 from ..errors import SHUT_DOWN_MESSAGE, Ros2nbError
 from ..processes import child_pids
 from .callers import use_cheaper_caller_lookup
@@ -94,6 +95,7 @@ class Runtime(LogLines, Spinning, NodeKeeping, SimulatedClock):
         SimulatedClock.__init__(self, sim_time)
         self._participant: Optional[bytes] = None
         use_cheaper_caller_lookup()  # the same /rosout messages, without reading source files
+        domains.use_discovery_profile()  # also with a domain given: read as ROS comes up
         rclpy.init(args=['--ros-args', '--disable-stdout-logs', '--disable-external-lib-logs'],
                    domain_id=domain_id, signal_handler_options=SignalHandlerOptions.NO)
         self.context = rclpy.get_default_context()
