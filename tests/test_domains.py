@@ -210,10 +210,10 @@ def test_another_users_kernel_gets_another_domain():
         shutil.rmtree(tmp_path, ignore_errors=True)
 
 
-def test_a_new_node_joins_the_graph_of_a_running_process_within_two_seconds():
-    """Every process of the course announces itself every half second (the course's Fast
-    DDS profile, ros2nb.domains.DISCOVERY_PROFILE), so a node a check starts appears in its
-    judge's graph within a second. With Fast DDS's default of 3 s, a newcomer whose first
+def test_a_new_node_joins_the_graph_of_a_running_process_without_waiting_3_s():
+    """Every process of the course announces itself every second (the course's Fast DDS
+    profile, ros2nb.domains.DISCOVERY_PROFILE), so a node a check starts appears in its
+    judge's graph within about a second. With Fast DDS's default of 3 s, a newcomer whose first
     exchange with the judge was lost waited for the judge's next announcement: in five runs
     of eight starts on an idle machine, the slowest took 2.6-3.0 s every time
     (benchmarks/discovery.py measures both)."""
@@ -226,6 +226,6 @@ def test_a_new_node_joins_the_graph_of_a_running_process_within_two_seconds():
         times = join_times(observer, 10, subject_env())
     finally:
         observer.close()
-    assert max(times) < 2.0, (
+    assert max(times) < 2.2, (
         f'new nodes took {", ".join(f"{t:.2f}" for t in times)} s to appear in the graph of '
         f'a running process; {domains.PROFILE_ENV}={os.environ.get(domains.PROFILE_ENV)!r}')

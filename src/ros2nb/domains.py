@@ -16,7 +16,7 @@ it is created world-writable with the sticky bit, like ``/tmp``.
 Every process of the course finds its peers with the course's Fast DDS profile
 (:data:`DISCOVERY_PROFILE`, put into the environment by :func:`domain_id`, which every way
 ros2nb brings ROS up goes through first): a new node appears in the graph of the processes
-already running within a second, not after 2-3 s.  No ROS import here.
+already running within about a second, not after 2-3 s.  No ROS import here.
 """
 
 from __future__ import annotations
@@ -47,7 +47,7 @@ PORT_BASE, PORT_PER_DOMAIN = 7400, 250
 PARTICIPANTS_PROBED = 16
 #: Where Fast DDS (2.x, Jazzy's) reads the default profile of every participant it makes.
 PROFILE_ENV = 'FASTRTPS_DEFAULT_PROFILES_FILE'
-#: The course's profile: each participant announces itself every 0.5 s, not every 3 s
+#: The course's profile: each participant announces itself every second, not every 3 s
 #: (the file says why); nothing else changes.
 DISCOVERY_PROFILE = Path(__file__).with_name('fastdds_profile.xml')
 
