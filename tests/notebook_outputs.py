@@ -65,12 +65,13 @@ def differences(stored: nbformat.NotebookNode, ran: nbformat.NotebookNode) -> li
             for i in want if got.get(i) != want[i]]
 
 
-def kernel_env(domain: Optional[int] = None) -> dict[str, str]:
-    """A kernel's environment: a workspace of its own (a new learner's), in a folder that
-    tests/sanitize.cfg masks; no ROS domain unless one is forced."""
+def kernel_env(parent: Path, domain: Optional[int] = None) -> dict[str, str]:
+    """A kernel's environment: a workspace of its own (a new learner's) under ``parent`` (a
+    test's ``tmp_path``, which pytest removes), in a folder that tests/sanitize.cfg masks;
+    no ROS domain unless one is forced."""
     import tempfile
     env = {k: v for k, v in os.environ.items() if k != 'ROS_DOMAIN_ID'}
-    scratch = Path(tempfile.mkdtemp(prefix='ros2nb-test-'))
+    scratch = Path(tempfile.mkdtemp(prefix='ros2nb-test-', dir=parent))
     env['ROS2NB_WORKSPACE'] = str(scratch / 'ROS2_and_RL_Tutorials')
     if domain is not None:
         env['ROS_DOMAIN_ID'] = str(domain)

@@ -10,8 +10,6 @@ the bag verbs gets one line.
 import os
 import re
 import sys
-import tempfile
-from pathlib import Path
 
 import pytest
 
@@ -74,13 +72,13 @@ def test_an_untouched_cell_gets_one_line(kernel):
         assert str(caught.value).startswith(f'{name}() still raises NotImplementedError')
 
 
-def test_a_bag_opens_with_readers_the_course_does_not_own(kernel):
+def test_a_bag_opens_with_readers_the_course_does_not_own(kernel, tmp_path):
     """mcap's own reader (with mcap-ros2-support's decoder) and rosbags' AnyReader."""
     from mcap.reader import make_reader
     from mcap_ros2.decoder import DecoderFactory
     from rosbags.highlevel import AnyReader
 
-    bag = Path(tempfile.mkdtemp(prefix='ros2nb-bag-')) / 'hour'
+    bag = tmp_path / 'hour'
     defined(ANSWERS['record_hour'])['record_hour'](bag)
     recorded = ros2nb.bag_info(bag)
     assert recorded['/temperature'] == 3600 and recorded['/rosout'] == 7200

@@ -37,19 +37,19 @@ def up_to(nb: nbformat.NotebookNode, marker: str) -> nbformat.NotebookNode:
     return nb
 
 
-def test_three_course_kernels_at_once_each_print_their_stored_outputs():
+def test_three_course_kernels_at_once_each_print_their_stored_outputs(tmp_path):
     stored03, stored04 = (nbformat.read(p, as_version=4) for p in (NB03, NB04))
     runs = [without_final_stop(stored03), copy.deepcopy(stored04), copy.deepcopy(stored04)]
-    run_at_once([(nb, kernel_env()) for nb in runs])
+    run_at_once([(nb, kernel_env(tmp_path)) for nb in runs])
     assert differences(without_final_stop(stored03), runs[0]) == []
     assert differences(stored04, runs[1]) == []
     assert differences(stored04, runs[2]) == []
 
 
-def test_companion_one_shared_domain_shows_the_cross_talk():
+def test_companion_one_shared_domain_shows_the_cross_talk(tmp_path):
     """Before: every kernel on one domain. Two kernels of 04 then hear each other."""
     stored = up_to(nbformat.read(NB04, as_version=4), "times_s, temps_c = ros2nb.record(")
     runs = [copy.deepcopy(stored), copy.deepcopy(stored)]
-    run_at_once([(nb, kernel_env(domain=77)) for nb in runs])
+    run_at_once([(nb, kernel_env(tmp_path, domain=77)) for nb in runs])
     changed = differences(stored, runs[0]) + differences(stored, runs[1])
     assert changed, 'two kernels on one domain printed exactly their stored outputs'
