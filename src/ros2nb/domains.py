@@ -14,9 +14,9 @@ same for all course kernels on the machine, also those of other users on one Jup
 it is created world-writable with the sticky bit, like ``/tmp``.
 
 Every process of the course finds its peers with the course's Fast DDS profile
-(:data:`DISCOVERY_PROFILE`, put into the environment by :func:`domain_id`, which every way
-ros2nb brings ROS up goes through first): a new node appears in the graph of the processes
-already running within about a second, not after 2-3 s.  No ROS import here.
+(:data:`DISCOVERY_PROFILE`, put into the environment by :func:`use_discovery_profile`, which
+:func:`domain_id` and the runtime call before ROS comes up): a new node appears in the graph
+of the processes already running within about a second, not after 2-3 s.  No ROS import here.
 """
 
 from __future__ import annotations
