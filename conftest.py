@@ -6,10 +6,9 @@
   Fast DDS profile (ros2nb.domains.DISCOVERY_PROFILE).
 - The course workspace goes to a temporary folder removed at the end, so tests never
   touch a learner's ``workspace/``.  So do the files every kernel writes (IPython's
-  history, Jupyter's connection files; under nbval, its temporary files too): tests run
-  side by side (pytest-xdist, one process per worker, each with this set-up of its own),
-  and while one of them checks that grading leaves the repository byte-identical no other
-  may write into it.
+  history, Jupyter's connection files): tests run side by side (pytest-xdist, one
+  process per worker, each with this set-up of its own), and while one of them checks
+  that grading leaves the repository byte-identical no other may write into it.
 - Cells tagged ``learner-check`` (a Challenge's check) must raise ``CheckFailed`` with its
   friendly message in ``notebooks/`` (the challenge is unsolved there) and must pass in
   ``solutions/``.
@@ -43,15 +42,6 @@ os.environ['IPYTHONDIR'] = str(_SCRATCH / 'ipython')
 os.environ['JUPYTER_RUNTIME_DIR'] = str(_SCRATCH / 'jupyter-runtime')
 
 LEARNER_CHECK_TAG = 'learner-check'
-
-
-def pytest_configure(config) -> None:
-    # nbval stops its kernels with a kill: what a notebook keeps in a TemporaryDirectory
-    # (08's parameter file, 10's bags) would stay in /tmp for good; here it goes with _SCRATCH.
-    if config.getoption('nbval', False) or config.getoption('nbval_lax', False):
-        (_SCRATCH / 'tmp').mkdir(exist_ok=True)
-        os.environ['TMPDIR'] = str(_SCRATCH / 'tmp')
-        tempfile.tempdir = None  # this process reads TMPDIR again
 
 
 def pytest_sessionfinish(session, exitstatus) -> None:
