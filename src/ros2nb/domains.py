@@ -9,9 +9,11 @@ an exclusive ``flock`` on ``<lock folder>/<domain>.lock``.  The kernel holds the
 until it ends; the operating system releases it even when the kernel is killed.  Every
 process the kernel starts inherits the domain through ``ROS_DOMAIN_ID``.
 
-The lock folder (``$ROS2NB_DOMAIN_LOCKS``, default ``/tmp/ros2nb-domains``) must be the
-same for all course kernels on the machine, also those of other users on one JupyterHub;
-it is created world-writable with the sticky bit, like ``/tmp``.
+The lock folder (``$ROS2NB_DOMAIN_LOCKS``, default ``ros2nb-domains`` in the temporary
+folder: ``$TMPDIR``, usually ``/tmp``) must be the same for all course kernels on the
+machine, also those of other users on one JupyterHub: kernels that see different
+``TMPDIR`` values need ``ROS2NB_DOMAIN_LOCKS`` set.  It is created world-writable with the
+sticky bit, like ``/tmp``.
 
 Every process of the course finds its peers with the course's Fast DDS profile
 (:data:`DISCOVERY_PROFILE`, put into the environment by :func:`use_discovery_profile`, which
