@@ -76,6 +76,11 @@ class Sampler(Sampling):
         known = self.seen.get(key)
         kind = kind_of(argv) if argv else (known[0] if known else 'other')  # a zombie has none
         self.seen[key] = (kind, (int(stat[11]) + int(stat[12])) / TICKS_PER_S)
+        self.read_stat(key, stat)
+
+    def read_stat(self, key: tuple[str, str], stat: list[str]) -> None:
+        """What a subclass keeps of a process's ``/proc/PID/stat`` fields (after the name),
+        read once per sample with the rest: nothing here."""
 
     def by_kind(self) -> list[tuple[str, float, int]]:
         """(kind, CPU seconds, processes), most CPU first."""

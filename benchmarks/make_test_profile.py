@@ -30,7 +30,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from grading_profile import TICKS_PER_S, Sampler, busy_cpu_s  # noqa: E402
+from grading_profile import Sampler, busy_cpu_s  # noqa: E402
 from timing_plugin import LOG_ENV  # noqa: E402
 
 
@@ -42,16 +42,10 @@ class Family(Sampler):
         super().__init__()
         self.family: dict[tuple[str, str], tuple[str, float, float]] = {}
 
-    def _read(self, pid: str) -> None:
-        try:
-            stat = Path(f'/proc/{pid}/stat').read_text().rsplit(')', 1)[1].split()
-        except OSError:  # ended meanwhile
-            return
-        key = (pid, stat[19])
+    def read_stat(self, key: tuple[str, str], stat: list[str]) -> None:
         # the parent when first seen: an orphan's parent becomes 1 (or a subreaper) later
         parent, seen, _cpu = self.family.get(key, (stat[1], time.monotonic(), 0.0))
-        self.family[key] = (parent, seen, (int(stat[11]) + int(stat[12])) / TICKS_PER_S)
-        super()._read(pid)
+        self.family[key] = (parent, seen, self.seen[key][1])
 
 
 def during(tests: list[tuple[float, float, str]], seen: float) -> str | None:
@@ -140,9 +134,9 @@ def main() -> int:
     for test, cpu in per_test.items():
         files[test.split('::')[0]] += cpu
         file_wall[test.split('::')[0]] += walls.get(test, 0.0)
-    print(f'{" ".join(options.command)} exited {done.returncode} after {wall:.0f} s; '
-          f'the machine was busy '
-          f'{busy:.0f} CPU-s, {sum(per_test.values()):.0f} of them charged to a test')
+    print(f'{" ".join(options.command)} exited {done.returncode} after {wall:.0f} s; the '
+          f'machine was busy {busy:.0f} CPU-s, {sum(per_test.values()):.0f} of them charged '
+          'to a test')
     print(f'{"CPU-s":>8} {"wall-s":>7}  test file (wall: its tests\' seconds, summed)')
     for name, cpu in files.most_common():
         print(f'{cpu:8.1f} {file_wall[name]:7.1f}  {name}')
