@@ -35,7 +35,7 @@ SAMPLE_S = 0.05
 #: Process kinds, by a word of their command line (the first that matches names it).
 KINDS = ('sandboxed.runner', 'ipykernel', 'ros2nb.subject', 'ros2nb.judge', 'colcon',
          'setup.py', 'nbgrader', 'ros2nb-grade', 'temperature_publisher',
-         'temperature_subscriber', 'bwrap')
+         'temperature_subscriber', 'bwrap', 'pytest', 'jupyterhub', 'chromium')
 
 
 def kind_of(argv: list[str]) -> str:

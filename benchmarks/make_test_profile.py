@@ -143,6 +143,9 @@ def main() -> int:
     print(f'\n{"CPU-s":>8} {"wall-s":>7}  the {top} costliest tests')
     for test, cpu in per_test.most_common(top):
         print(f'{cpu:8.1f} {walls.get(test, 0.0):7.1f}  {test[:150]}')
+    print(f'\n{"CPU-s":>8} {"processes":>9}  kind (every process seen, charged or not)')
+    for kind, seconds, processes in sampler.by_kind()[:top]:
+        print(f'{seconds:8.1f} {processes:9d}  {kind}')
     print(f'\nno test started {sum(unclaimed.values()):.1f} CPU-s: ' + ', '.join(
         f'{kind} {cpu:.1f}' for kind, cpu in unclaimed.most_common(6)))
     return done.returncode

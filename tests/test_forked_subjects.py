@@ -13,6 +13,7 @@ import os
 import signal
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -92,10 +93,11 @@ def test_a_forked_subject_is_stopped_and_reaped_as_a_started_one(tmp_path):
 SCRIPT_JUDGE = '''
 import sys
 from pathlib import Path
+from pathlib import Path
 print('the judge script ran')
 if __name__ == '__main__':
     from ros2nb.judge.subjects import SubjectProcess
-    for _ in range(2):  # the process's first subject is started afresh in any case
+    for _ in range(2):  # the first started afresh, the second forked from a server
         subject = SubjectProcess(Path(sys.argv[1]))
         subject.request('exec_cells', sources=['import os\\nprint("parent", os.getppid())'])
         subject.close()
@@ -104,9 +106,9 @@ if __name__ == '__main__':
 
 
 def test_a_judge_run_from_a_script_file_never_runs_it_in_its_subjects(tmp_path):
-    """multiprocessing runs the parent's main module again in each forked child: a judge
-    whose main module is a script file (a benchmark, tests/corpora.py) starts its subjects
-    afresh, so that none of its code runs in them."""
+    """The fork server never runs its parent's main module (multiprocessing's ran it again
+    in each child): a judge whose main module is a script file (a benchmark,
+    tests/corpora.py) forks its subjects too, and none of its code runs in them."""
     script = tmp_path / 'judge_script.py'
     script.write_text(SCRIPT_JUDGE)
     judge = subprocess.Popen([sys.executable, str(script), str(tmp_path)], text=True,
@@ -115,4 +117,33 @@ def test_a_judge_run_from_a_script_file_never_runs_it_in_its_subjects(tmp_path):
     said = [line for line in out.splitlines() if line.startswith('subject said:')]
     assert len(said) == 2 and judge.returncode == 0, out
     assert all('the judge script ran' not in line for line in said), out
-    assert all(f'parent {judge.pid}' in line for line in said), out  # both started afresh
+    assert f'parent {judge.pid}' in said[0] and f'parent {judge.pid}' not in said[1], out
+
+
+SERVING_JUDGE = '''
+import json, os, sys
+from pathlib import Path
+from ros2nb.subject.forked import serve_from_here
+serve_from_here()  # as python -m ros2nb.judge does, first thing
+sys.path.insert(0, sys.argv[2])
+from test_forked_subjects import SUBJECT_PREFIX_ENV, view
+forked, subject = view(Path(sys.argv[1]), os.getpid())
+os.environ[SUBJECT_PREFIX_ENV] = json.dumps(['env'])  # a prefix: started afresh
+started, _ = view(Path(sys.argv[1]), os.getpid())
+print('SEEN', json.dumps([forked, started, subject.proc.wait(5)]))
+'''
+
+
+def test_a_judge_forks_even_its_first_subject_from_itself(tmp_path, monkeypatch):
+    """A judge process forks its fork server from itself as it starts: its first subject is
+    forked too, sees what a started one sees, and its exit code comes back."""
+    monkeypatch.delenv('ROS_PYTHON_CHECK_FIELDS', raising=False)
+    script = tmp_path / 'serving_judge.py'
+    script.write_text(SERVING_JUDGE)
+    judge = subprocess.run([sys.executable, str(script), str(tmp_path), str(Path(__file__).parent)],
+                           capture_output=True, text=True, timeout=60)
+    lines = [line for line in judge.stdout.splitlines() if line.startswith('SEEN ')]
+    assert len(lines) == 1, judge.stdout + judge.stderr
+    forked, started, code = json.loads(lines[0][len('SEEN '):])
+    assert not forked.pop('parent is the judge') and started.pop('parent is the judge')
+    assert code == 0 and forked == started

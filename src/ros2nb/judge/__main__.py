@@ -16,9 +16,11 @@ from .. import checks
 from ..checks.base import bind_judge
 from ..checks.dispatch import IN_JUDGE_ENV, captured
 from ..processes import end_this_process
+from ..subject.forked import serve_from_here
 from ..terminal.workspace import default_workspace
 from .grading import grade
 from .session import Session
+from .subjects import subject_prefix
 
 
 def main(argv: list[str]) -> int:
@@ -28,6 +30,8 @@ def main(argv: list[str]) -> int:
         print('Usage: python -m ros2nb.judge check NAME KWARGS_JSON | grade SOURCE '
               'SUBMISSION', file=sys.stderr)
         return 2
+    if not subject_prefix():  # subjects not sandboxed: forked from here, before ROS starts
+        serve_from_here()
     session = Session(default_workspace())
     bind_judge(session)
     try:

@@ -25,7 +25,7 @@ from ..checks.dispatch import IN_JUDGE_ENV
 from ..errors import CheckFailed
 from ..processes import Patience, kill_process_group, stop_process_group
 from ..runtime.clock import JUDGE_CLOCK_ENV
-from ..subject.forked import fork_subject, forkable
+from ..subject.forked import fork_subject, has_server
 
 #: JSON list put in front of every subject's command (the grader's sandbox).
 SUBJECT_PREFIX_ENV = 'ROS2NB_SUBJECT_PREFIX'
@@ -42,10 +42,10 @@ REPLY_TIMEOUT_S = 30.0
 POLL_S = 0.25
 #: Lines of a subject's own output kept for hints.
 KEPT_OUTPUT_LINES = 200
-#: Subjects this process has started.  The first starts afresh; later ones, unless
-#: sandboxed, are forked from a server that has imported ROS (:mod:`ros2nb.subject.forked`):
-#: a check in the learner's kernel starts one subject, which would not repay the server's
-#: start, while a judge that grades a notebook starts a dozen.
+#: Subjects this process has started.  Unless sandboxed, they are forked from a server
+#: that has imported ROS (:mod:`ros2nb.subject.forked`): all of them in a judge process,
+#: which forks its server from itself as it starts; elsewhere all but the first, which
+#: would not repay starting a server afresh (a test that starts one subject).
 _STARTED = itertools.count()
 
 
@@ -147,7 +147,7 @@ class SubjectProcess:
         os.set_blocking(self._acks, False)
         prefix, environment, first = subject_prefix(), env or subject_env(), next(_STARTED) == 0
         try:
-            if prefix or first or not forkable():  # sandboxed, the first, a script's: afresh
+            if prefix or (first and not has_server()):  # sandboxed, or the first: afresh
                 argv = [*prefix, sys.executable, '-m', 'ros2nb.subject', str(to_subject),
                         str(from_subject)]
                 self.proc: Any = subprocess.Popen(

@@ -4,13 +4,20 @@ Part of the subjects (:mod:`ros2nb.subject`); the judge (:mod:`ros2nb.judge.subj
 starts its subjects here when it runs them without a sandbox command.
 
 A subject spends most of its CPU time starting: Python, ``rclpy`` (with PyYAML and the
-message types) and ``ros2nb`` take about 0.2 CPU-s to import, measured, of a subject's
-0.3-0.45 CPU-s in ``make test``, where a judge starts hundreds.  multiprocessing's fork
-server (:mod:`multiprocessing.forkserver`) imports them once per judge process and forks
-each subject from there: the subject is then the process ``python -m ros2nb.subject`` would
-be (its own session, working folder, environment, ``sys.path`` and output pipe), without
-the imports.  The server never runs the learner's code, never starts ROS and holds no
-thread, so every fork starts from the same clean state.
+message types) and ``ros2nb`` take about 0.3 CPU-s to import and start, of a short
+subject's 0.35-0.45 CPU-s, where ``make test`` starts hundreds.  A fork server (a
+:class:`ForkServer`) holds those imports and forks each subject from there: the subject is
+then the process ``python -m ros2nb.subject`` would be (its own session, working folder,
+environment, ``sys.path`` and output pipe), without the imports.  The server never runs the
+learner's code, never starts ROS and holds no thread, so every fork starts from the same
+clean state.
+
+A judge process (``python -m ros2nb.judge``, what a check in the learner's kernel starts)
+forks its server from itself first thing (:func:`serve_from_here`), before ROS or any
+thread starts: a few milliseconds, so even a check's one subject is forked.  Elsewhere
+(a test process that judges, a script) the server is started afresh with the first forked
+subject (``python -m ros2nb.subject.forked``), which repays itself from the second subject
+on.  The server answers on a socket of its parent's only and ends when its parent does.
 
 While grading, each subject runs in a sandbox of its own (the judge's
 ``ROS2NB_SUBJECT_PREFIX``), which a fork cannot enter: the judge starts those afresh.
@@ -20,20 +27,23 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import importlib
 import io
 import json
-import multiprocessing
 import os
+import select
+import signal
+import socket
 import subprocess
 import sys
+import threading
 import time
-from multiprocessing.connection import Connection
 from typing import IO, Optional
 
-#: What the fork server imports before it forks the first subject: the subject's own
-#: modules and what rclpy imports when the first node starts (the parameter services' types,
-#: numpy for their arrays, rosidl's type support with its parser).  numpy starts no thread
-#: with ``OPENBLAS_NUM_THREADS=1``, which every way of running the course sets.
+#: What an afresh-started server imports before it forks the first subject: the subject's
+#: own modules and what rclpy imports when the first node starts (the parameter services'
+#: types, numpy for their arrays, rosidl's type support with its parser).  numpy starts no
+#: thread with ``OPENBLAS_NUM_THREADS=1``, which every way of running the course sets.
 PRELOAD = ['ros2nb.subject.__main__', 'rclpy.node', 'rcl_interfaces.srv', 'numpy',
            'rosidl_generator_py.import_type_support_impl', 'std_msgs.msg']
 #: The variable generated message modules read once, when imported (rosidl_generator_py):
@@ -41,53 +51,151 @@ PRELOAD = ['ros2nb.subject.__main__', 'rclpy.node', 'rcl_interfaces.srv', 'numpy
 CHECK_FIELDS_ENV = 'ROS_PYTHON_CHECK_FIELDS'
 #: Seconds a forked subject gets to become the leader of its own session.
 SESSION_WAIT_S = 5.0
-
-_context = multiprocessing.get_context('forkserver')
-_context.set_forkserver_preload(PRELOAD)
-
-
-def forkable() -> bool:
-    """Whether subjects forked from this process start clean.  multiprocessing runs the
-    parent's main module again in each child, as ``__mp_main__``, unless it is ``-c`` code or
-    a package's ``__main__`` (a judge's ``python -m ros2nb.judge``, pytest's and its
-    workers'): a judge run from a script file (a benchmark, ``tests/corpora.py``) starts its
-    subjects afresh, so that no code of its own runs in them."""
-    main = sys.modules['__main__']
-    name = getattr(getattr(main, '__spec__', None), 'name', None)
-    if name is not None:
-        return name == '__main__' or name.endswith('.__main__')
-    return getattr(main, '__file__', None) is None
+#: Largest request the server reads (a subject's whole environment, as JSON).
+MAX_REQUEST_BYTES = 1 << 20
 
 
 class ForkedProcess:
     """A subject forked by the fork server, with the part of :class:`subprocess.Popen` the
     judge and :mod:`ros2nb.processes` use: ``pid`` (also its process group), ``stdout``,
-    ``poll()`` and ``wait(timeout)``."""
+    ``returncode``, ``poll()`` and ``wait(timeout)``.  Its exit code comes from the server,
+    its parent, on a pipe of its own."""
 
-    def __init__(self, process: multiprocessing.process.BaseProcess, stdout: IO[str]) -> None:
-        self._process = process
-        self.pid: int = process.pid  # type: ignore[assignment]
+    def __init__(self, pid: int, stdout: IO[str], status: int) -> None:
+        self.pid = pid
         self.stdout = stdout
         self.args = ['python', '-m', 'ros2nb.subject']
+        #: The exit code once it ended (negative: the signal that ended it), else None.
+        self.returncode: Optional[int] = None
+        self._status = status
+        self._said = b''
 
-    @property
-    def returncode(self) -> Optional[int]:
-        """The exit code once it ended (negative: the signal that ended it), else None."""
-        return self._process.exitcode
+    def _read_status(self, timeout: Optional[float]) -> None:
+        if self.returncode is not None:
+            return
+        ready, _, _ = select.select([self._status], [], [], timeout)
+        if not ready:
+            return
+        chunk = os.read(self._status, 64)
+        self._said += chunk
+        if chunk:
+            return
+        os.close(self._status)
+        # The server writes the code, then closes; nothing at all: the server itself ended
+        # (killed with its judge's process group), and so was its subject's reaper.
+        self.returncode = int(self._said) if self._said.strip() else -signal.SIGKILL
 
     def poll(self) -> Optional[int]:
         """The exit code (negative: the signal that ended it), or None while it runs."""
-        return self._process.exitcode
+        self._read_status(0)
+        return self.returncode
 
     def wait(self, timeout: Optional[float] = None) -> int:
         """Wait for the exit code, at most ``timeout`` seconds.
 
         :raises subprocess.TimeoutExpired: when it still runs after ``timeout`` seconds.
         """
-        self._process.join(timeout)
-        if self._process.exitcode is None:
-            raise subprocess.TimeoutExpired(self.args, timeout or 0.0)
-        return self._process.exitcode
+        deadline = None if timeout is None else time.monotonic() + timeout
+        while self.returncode is None:
+            left = None if deadline is None else deadline - time.monotonic()
+            if left is not None and left <= 0:
+                raise subprocess.TimeoutExpired(self.args, timeout or 0.0)
+            self._read_status(left)
+        return self.returncode
+
+
+class ForkServer:
+    """The parent's end of a fork server: a socket to ask for subjects on.
+
+    :param sock: the connected socket (``SOCK_SEQPACKET``: one request, one answer).
+    :param process: the server when it was started afresh (None when forked from here).
+    """
+
+    def __init__(self, sock: socket.socket, process: Optional[subprocess.Popen] = None,
+                 pid: Optional[int] = None) -> None:
+        self._sock, self._process = sock, process
+        self._lock = threading.Lock()
+        self._failed = False
+        #: The server's process id.
+        self.pid = process.pid if process is not None else pid
+
+    def alive(self) -> bool:
+        """Whether the server still answers (as far as this side knows)."""
+        return not self._failed and (self._process is None or self._process.poll() is None)
+
+    def fork(self, fds: tuple[int, ...], request: dict) -> tuple[int, int]:
+        """Ask for a subject; return its pid and the read end of its exit-code pipe.
+
+        :param fds: the subject's pipes (command, reply, acknowledgement, output).
+        :raises OSError: when the server is gone.
+        """
+        status_read, status_write = os.pipe()
+        try:
+            with self._lock:
+                socket.send_fds(self._sock, [json.dumps(request).encode()],
+                                [*fds, status_write])
+                answer = self._sock.recv(64)
+            if not answer:
+                raise OSError('the fork server ended')
+        except BaseException:
+            self._failed = True
+            os.close(status_read)
+            raise
+        finally:
+            os.close(status_write)
+        return int(answer), status_read
+
+
+_server: Optional[ForkServer] = None
+_server_lock = threading.Lock()
+
+
+def serve_from_here() -> None:
+    """Fork this process's fork server from itself, now.
+
+    Call it first thing in a process whose imports are a subject's (the judge's main),
+    before ROS or any thread starts: the fork costs milliseconds and every subject of this
+    process is then forked, the first too.  Never in a process with threads.
+    """
+    global _server
+    if threading.active_count() > 1:
+        return  # a fork would hold only this thread, and any lock another one held
+    parent_end, server_end = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
+    pid = os.fork()
+    if pid == 0:
+        try:
+            parent_end.close()
+            # Not the parent's output: whoever reads that waits for its end, not the server's.
+            devnull = os.open(os.devnull, os.O_RDWR)
+            for fd in (0, 1, 2):
+                os.dup2(devnull, fd)
+            os.close(devnull)
+            _preload()
+            _serve(server_end)
+        finally:
+            os._exit(0)
+    server_end.close()
+    _server = ForkServer(parent_end, pid=pid)
+
+
+def has_server() -> bool:
+    """Whether this process has a fork server already (its subjects are all forked)."""
+    return _server is not None and _server.alive()
+
+
+def _started_server() -> ForkServer:
+    """This process's fork server, started afresh (``python -m ros2nb.subject.forked``) the
+    first time."""
+    global _server
+    with _server_lock:
+        if _server is None or not _server.alive():
+            parent_end, server_end = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
+            process = subprocess.Popen(
+                [sys.executable, '-m', 'ros2nb.subject.forked', str(server_end.fileno())],
+                pass_fds=(server_end.fileno(),), stdin=subprocess.DEVNULL)
+            server_end.close()
+            _server = ForkServer(parent_end, process)
+        return _server
 
 
 def fork_subject(fds: tuple[int, int, int], cwd: str, env: dict[str, str],
@@ -104,39 +212,97 @@ def fork_subject(fds: tuple[int, int, int], cwd: str, env: dict[str, str],
     :raises OSError: when the fork server cannot be started.
     """
     read_output, write_output = os.pipe()
-    pipes = [Connection(os.dup(fd)) for fd in (*fds, write_output)]
+    request = {'cwd': cwd, 'env': env, 'clock_env': clock_env, 'site_path': _site_path()}
     try:
-        process = _context.Process(target=_become_subject, name='ros2nb.subject', daemon=False,
-                                   args=(*pipes, cwd, env, clock_env, _site_path()))
-        process.start()
+        try:
+            pid, status = (_server if has_server() else _started_server()).fork(
+                (*fds, write_output), request)
+        except OSError:  # the server went away (killed?): a new one, once
+            pid, status = _started_server().fork((*fds, write_output), request)
+    except BaseException:
+        os.close(read_output)
+        raise
     finally:
-        for pipe in pipes:
-            pipe.close()
         os.close(write_output)
+    process = ForkedProcess(pid, os.fdopen(read_output, 'r'), status)
     _await_session(process)
-    return ForkedProcess(process, os.fdopen(read_output, 'r'))
+    return process
 
 
-def _await_session(process: multiprocessing.process.BaseProcess) -> None:
+def _await_session(process: ForkedProcess) -> None:
     """Wait until the forked subject leads its own process group (so that the judge can
     signal the group, as with ``start_new_session``) or has ended."""
     deadline = time.monotonic() + SESSION_WAIT_S
-    while time.monotonic() < deadline and process.exitcode is None:
+    while time.monotonic() < deadline and process.poll() is None:
         try:
-            if os.getpgid(process.pid) == process.pid:  # type: ignore[arg-type]
+            if os.getpgid(process.pid) == process.pid:
                 return
         except ProcessLookupError:
             return
         time.sleep(0.001)
 
 
-def _become_subject(commands: Connection, replies: Connection, acks: Connection,
-                    output: Connection, cwd: str, env: dict[str, str], clock_env: str,
-                    site_path: list[str]) -> None:
+def _serve(sock: socket.socket) -> None:
+    """The fork server: fork a subject for each request on ``sock``, tell each one's exit
+    code on the pipe that came with it, and end when the parent closes its end (never
+    returns).  Ctrl+C in the terminal is its parent's to handle, not the server's."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    wake_read, wake_write = os.pipe()
+    for fd in (wake_read, wake_write):
+        os.set_blocking(fd, False)
+    signal.set_wakeup_fd(wake_write)
+    signal.signal(signal.SIGCHLD, lambda *_: None)
+    status: dict[int, int] = {}  # subject's pid -> the write end of its exit-code pipe
+    while True:
+        ready, _, _ = select.select([sock, wake_read], [], [])
+        if wake_read in ready:
+            with contextlib.suppress(BlockingIOError):
+                os.read(wake_read, 4096)
+        _reap(status)
+        if sock not in ready:
+            continue
+        try:
+            message, fds, _, _ = socket.recv_fds(sock, MAX_REQUEST_BYTES, 5)
+        except OSError:
+            message, fds = b'', []
+        if not message or len(fds) != 5:
+            os._exit(0)  # the parent is gone: its subjects are its to end
+        pid = os.fork()
+        if pid == 0:
+            sock.detach()  # closed with the server's other files in _become_subject
+            signal.set_wakeup_fd(-1)
+            signal.signal(signal.SIGCHLD, signal.SIG_DFL)
+            signal.signal(signal.SIGINT, signal.default_int_handler)
+            request = json.loads(message)
+            _become_subject(*fds[:4], request['cwd'], request['env'], request['clock_env'],
+                            request['site_path'])
+        for fd in fds[:4]:
+            os.close(fd)
+        status[pid] = fds[4]
+        sock.send(str(pid).encode())
+
+
+def _reap(status: dict[int, int]) -> None:
+    """Tell the exit code of every subject that ended, on its pipe."""
+    while status:
+        try:
+            pid, code = os.waitpid(-1, os.WNOHANG)
+        except ChildProcessError:
+            return
+        if pid == 0:
+            return
+        fd = status.pop(pid, None)
+        if fd is not None:
+            with contextlib.suppress(OSError):
+                os.write(fd, str(os.waitstatus_to_exitcode(code)).encode())
+            os.close(fd)
+
+
+def _become_subject(in_fd: int, out_fd: int, acks_fd: int, out: int, cwd: str,
+                    env: dict[str, str], clock_env: str, site_path: list[str]) -> None:
     """In the forked child: become ``python -m ros2nb.subject IN OUT`` started in ``cwd``
     with ``env``, then run it to its end (this never returns)."""
     os.setsid()
-    out = _take(output)
     devnull = os.open(os.devnull, os.O_RDONLY)
     os.dup2(devnull, 0)
     os.dup2(out, 1)
@@ -144,7 +310,6 @@ def _become_subject(commands: Connection, replies: Connection, acks: Connection,
     os.close(devnull)
     os.close(out)
     os.chdir(cwd)
-    in_fd, out_fd, acks_fd = _take(commands), _take(replies), _take(acks)
     os.environ.clear()
     os.environ.update({**env, clock_env: str(acks_fd)})
     _standard_streams(unbuffered=bool(env.get('PYTHONUNBUFFERED')))
@@ -182,13 +347,6 @@ def _close_all_but(kept: set[int]) -> None:
                 os.close(fd)
 
 
-def _take(pipe: Connection) -> int:
-    """The file descriptor a pipe came as, as this process's own (the wrapper is closed)."""
-    fd = os.dup(pipe.fileno())
-    pipe.close()
-    return fd
-
-
 @functools.lru_cache(maxsize=1)
 def _site_path() -> list[str]:
     """The ``sys.path`` this Python gives a new process after its first entry, without
@@ -199,3 +357,20 @@ def _site_path() -> list[str]:
     done = subprocess.run([sys.executable, '-c', program], env=env, capture_output=True,
                           text=True, check=True)
     return json.loads(done.stdout)
+
+
+def _preload() -> None:
+    """Import what every subject imports (:data:`PRELOAD`), once, in the server."""
+    for module in PRELOAD:
+        importlib.import_module(module)
+
+
+def main(argv: list[str]) -> int:
+    """``python -m ros2nb.subject.forked SOCKET_FD``: a fork server started afresh."""
+    _preload()
+    _serve(socket.socket(fileno=int(argv[0])))
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main(sys.argv[1:]))
