@@ -147,3 +147,42 @@ def test_a_judge_forks_even_its_first_subject_from_itself(tmp_path, monkeypatch)
     forked, started, code = json.loads(lines[0][len('SEEN '):])
     assert not forked.pop('parent is the judge') and started.pop('parent is the judge')
     assert code == 0 and forked == started
+
+
+#: main() of a learner's program that ends in each way a program can end.
+ENDINGS = {
+    'returns': 'def main():\n    print("done")\n',
+    'returns 3': 'def main():\n    return 3\n',
+    'sys.exit with text': 'import sys\n\ndef main():\n    sys.exit("stopped: no sensor")\n',
+    'raises': 'def main():\n    raise ValueError("no such topic")\n',
+    'Ctrl+C not caught': 'def main():\n    raise KeyboardInterrupt\n',
+    'a thread and an exit handler': (
+        'import atexit, threading, time\n\n'
+        'def main():\n'
+        '    atexit.register(print, "exit handler ran")\n'
+        '    threading.Thread(target=lambda: (time.sleep(0.3), print("thread ended"))).start()\n'),
+}
+
+
+@pytest.mark.parametrize('ending', ENDINGS)
+def test_a_forked_program_ends_as_a_started_one(tmp_path, monkeypatch, ending):
+    """A learner's main() forked from the fork server (ros2nb.subject.program) ends as the
+    same program started afresh: its exit code (a signal's too), its traceback's last line
+    and what its threads and exit handlers print."""
+    from ros2nb.judge.session import Session
+    program = tmp_path / 'program.py'
+    program.write_text(ENDINGS[ending])
+    session = Session(tmp_path)
+    seen = []
+    try:
+        for prefix in ('', json.dumps(['env'])):  # forked, then started afresh
+            monkeypatch.setenv(SUBJECT_PREFIX_ENV, prefix)
+            proc, output = session.start_program(program)
+            code = proc.wait(30)
+            lines = [line for line in output.text().splitlines()
+                     if not line.startswith('  ')]  # a traceback's frames differ in their start
+            seen.append((code, lines[:1] + lines[-2:]))
+    finally:
+        session.close()
+    assert seen[0] == seen[1]
+    assert ending != 'Ctrl+C not caught' or seen[0][0] == -signal.SIGINT

@@ -13,7 +13,6 @@ from __future__ import annotations
 import ast
 import re
 import signal
-import sys
 from pathlib import Path
 from typing import Any, Optional
 
@@ -73,8 +72,7 @@ def _stop_run(judge: Judge, path: Path, node_name: str, part: int, sig: int,
               stand_in: Optional[str] = None) -> None:
     """One run of ``main()`` stopped with ``sig`` (its node class replaced by the stand-in
     when given)."""
-    argv = [sys.executable, '-m', 'ros2nb.subject.program', str(path)]
-    proc, output = judge.start(argv + ([stand_in] if stand_in else []), cwd=judge.workspace)
+    proc, output = judge.start_program(path, stand_in)
     try:
         _watch_stop(judge.observer, path, node_name, part, proc, output, sig)
     finally:

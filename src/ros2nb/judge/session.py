@@ -28,6 +28,7 @@ from ..checks.nodes import parts_verdict
 from ..errors import CheckFailed
 from ..processes import kill_process_group
 from ..runtime.clock import JUDGE_TOPICS_ENV
+from ..subject.forked import fork_program
 from ..terminal.workspace import WORKSPACE_ENV
 from .clock import JudgeClock
 from .observer import Observer
@@ -187,6 +188,22 @@ class Session:
         proc = subprocess.Popen([*prefix, *argv], cwd=cwd, env=env or subject_env(),
                                 text=True, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                                 stderr=subprocess.STDOUT, start_new_session=True)
+        return proc, Output(proc.stdout)
+
+    def start_program(self, path: Path, stand_in: Optional[str] = None
+                      ) -> tuple[Any, Output]:
+        """Start the learner's ``main()`` in ``path`` as ``ros2 run`` would, in the learner's
+        workspace, as :mod:`ros2nb.subject.program` does it (its node class replaced by the
+        course's stand-in ``stand_in`` when given): sandboxed while grading, else forked from
+        the fork server (:mod:`ros2nb.subject.forked`), the process ``python -m`` would be.
+
+        :return: the process, and its output (stdout and stderr), collected as it comes.
+        """
+        args = [str(path), *([stand_in] if stand_in else [])]
+        if subject_prefix():
+            return self.start([sys.executable, '-m', 'ros2nb.subject.program', *args],
+                              cwd=self.workspace)
+        proc = fork_program(args, str(self.workspace), subject_env())
         return proc, Output(proc.stdout)
 
     def run(self, argv: list[str], *, seconds: float, cwd: Path,

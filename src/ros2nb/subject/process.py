@@ -55,7 +55,7 @@ def load(request: dict) -> tuple[dict, dict]:
 
     Called before the command loop exists: code of the learner's that looks up the stack
     while it is imported finds this function's frame, the process's ``main()`` and what
-    started the process (``runpy``, or the fork server's, :mod:`.forked`), never the loop.
+    started the process (``runpy``, or the fork server's, :mod:`.fork_server`), never the loop.
     """
     op = request.get('op')
     namespace: dict[str, Any] = {'__name__': '__main__'}
