@@ -186,3 +186,14 @@ def test_a_forked_program_ends_as_a_started_one(tmp_path, monkeypatch, ending):
         session.close()
     assert seen[0] == seen[1]
     assert ending != 'Ctrl+C not caught' or seen[0][0] == -signal.SIGINT
+
+
+def test_a_subject_in_a_missing_folder_fails_as_a_started_one(tmp_path, monkeypatch):
+    """Popen raises FileNotFoundError in the judge for a working folder that is not there; a
+    fork does the same (the check then says the grader could not finish it), never a subject
+    that just ended."""
+    SubjectProcess(tmp_path).close()  # this process's first subject, if no test started one yet
+    for prefix in ('', json.dumps(['env'])):  # forked, then started afresh
+        monkeypatch.setenv(SUBJECT_PREFIX_ENV, prefix)
+        with pytest.raises(FileNotFoundError):
+            SubjectProcess(tmp_path / 'gone')

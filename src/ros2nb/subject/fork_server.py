@@ -21,6 +21,7 @@ import signal
 import socket
 import sys
 import threading
+import traceback
 from typing import Callable, NoReturn
 
 #: What the server imports before it forks the first child: the subject's own modules and
@@ -72,7 +73,11 @@ def serve(sock: socket.socket) -> None:
             signal.set_wakeup_fd(-1)
             signal.signal(signal.SIGCHLD, signal.SIG_DFL)
             signal.signal(signal.SIGINT, signal.default_int_handler)
-            _become(json.loads(message), fds[:-2], fds[-2])
+            try:
+                _become(json.loads(message), fds[:-2], fds[-2])
+            finally:  # it could not become the child (its folder went away?): say why
+                traceback.print_exc()
+                os._exit(1)
         for fd in fds[:-1]:
             os.close(fd)
         status[pid] = fds[-1]

@@ -24,6 +24,7 @@ While grading, each subject and program runs in a sandbox of its own (the judge'
 
 from __future__ import annotations
 
+import errno
 import functools
 import json
 import os
@@ -214,7 +215,12 @@ def fork_program(args: list[str], cwd: str, env: dict[str, str]) -> ForkedProces
 
 
 def _fork(request: dict, fds: tuple[int, ...]) -> ForkedProcess:
-    """Ask the fork server (this process's, started if need be) for a child."""
+    """Ask the fork server (this process's, started if need be) for a child.
+
+    :raises FileNotFoundError: when its folder does not exist (as ``subprocess.Popen``).
+    """
+    if not os.path.isdir(request['cwd']):
+        raise FileNotFoundError(errno.ENOENT, os.strerror(errno.ENOENT), request['cwd'])
     read_output, write_output = os.pipe()
     request['site_path'] = _site_path()
     try:
