@@ -67,6 +67,7 @@ def serve(sock: socket.socket) -> None:
             message, fds = b'', []
         if not message or len(fds) < 2:
             os._exit(0)  # the parent is gone: its children are its to end
+        preload()  # once, and only in a server that forks something
         pid = os.fork()
         if pid == 0:
             sock.detach()  # closed with the server's other files in _become
@@ -198,9 +199,10 @@ def _close_all_but(kept: set[int]) -> None:
 
 
 def preload() -> None:
-    """Import what every child imports (:data:`PRELOAD`), once, in the server."""
+    """Import what every child imports (:data:`PRELOAD`), in the server (again: nothing)."""
     for module in PRELOAD:
-        importlib.import_module(module)
+        if module not in sys.modules:
+            importlib.import_module(module)
 
 
 def main(argv: list[str]) -> int:

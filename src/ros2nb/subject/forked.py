@@ -158,7 +158,6 @@ def serve_from_here() -> None:
             for fd in (0, 1, 2):
                 os.dup2(devnull, fd)
             os.close(devnull)
-            fork_server.preload()
             fork_server.serve(server_end)
         finally:
             os._exit(0)
