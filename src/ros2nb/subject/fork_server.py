@@ -52,7 +52,7 @@ def serve(sock: socket.socket) -> None:
         os.set_blocking(fd, False)
     signal.set_wakeup_fd(wake_write)
     signal.signal(signal.SIGCHLD, lambda *_: None)
-    status: dict[int, int] = {}  # subject's pid -> the write end of its exit-code pipe
+    status: dict[int, int] = {}  # a child's pid -> the write end of its exit-code pipe
     while True:
         ready, _, _ = select.select([sock, wake_read], [], [])
         if wake_read in ready:
@@ -86,7 +86,7 @@ def serve(sock: socket.socket) -> None:
 
 
 def _reap(status: dict[int, int]) -> None:
-    """Tell the exit code of every subject that ended, on its pipe."""
+    """Tell the exit code of every child that ended, on its pipe."""
     while status:
         try:
             pid, code = os.waitpid(-1, os.WNOHANG)
