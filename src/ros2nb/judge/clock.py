@@ -28,6 +28,10 @@ from .subjects import REPLY_TIMEOUT_S, SubjectProcess
 
 #: Seconds between two looks at a subject that is neither answering nor acknowledging.
 POLL_S = 0.05
+#: Seconds a subject is quiet before its work is read from /proc, and between two reads
+#: (:class:`~ros2nb.processes.Patience`: every process's stat, milliseconds on a busy
+#: machine, where a step often takes longer than POLL_S).
+PATIENCE_LOOK_S = 0.25
 
 
 class JudgeClock:
@@ -94,10 +98,11 @@ class JudgeClock:
                timeout: float, what: str, arguments: dict) -> dict:
         step_ns, limit_ns = round(step_s * 1e9), self.now_ns + round(limit_s * 1e9)
         subject.send(op, **arguments)
-        # Patience reads /proc: it starts only once the subject has been quiet for POLL_S
-        # (an hour of steps would otherwise read it 7200 times).
+        # Patience reads /proc: it starts only once the subject has been quiet for
+        # PATIENCE_LOOK_S (an hour of steps would otherwise read it 7200 times), and looks
+        # again every PATIENCE_LOOK_S.
         patience: Optional[Patience] = None
-        quiet_since = time.monotonic()
+        quiet_since = looked = time.monotonic()
         while True:
             reply = subject.poll_reply(POLL_S)
             ack = subject.take_ack()
@@ -119,12 +124,15 @@ class JudgeClock:
                                       'long as the task says.')
                 self.step_to(self.now_ns + step_ns)
                 patience, quiet_since = None, time.monotonic()
-            elif time.monotonic() - quiet_since < POLL_S:
+            elif time.monotonic() - max(quiet_since, looked) < PATIENCE_LOOK_S:
                 continue
             elif patience is None:
-                patience = Patience(subject.proc.pid, timeout, started=quiet_since)
+                patience, looked = Patience(subject.proc.pid, timeout,
+                                            started=quiet_since), time.monotonic()
             elif patience.exhausted():
                 raise subject.given_up(timeout)
+            else:
+                looked = time.monotonic()
 
     def _settle(self, ack: dict, base: tuple[dict[str, int], dict[str, int]]) -> None:
         """Wait until what the subject announced in ``ack`` (all it published and logged
