@@ -1,7 +1,7 @@
-"""A subject forked from the fork server is the process a started one is.
+"""A subject or program forked from the fork server is the process a started one is.
 
-After the first, a judge forks its unsandboxed subjects from a server that has imported ROS
-(``ros2nb.subject.forked``): 0.06 CPU-s each instead of 0.23.  What the learner's code can
+A judge forks its unsandboxed subjects and the learner's main() from a server that has
+imported ROS (``ros2nb.subject.forked``), 0.2-0.3 CPU-s less each.  What the learner's code can
 see of its process must not change with it: environment, working folder, ``sys.path``, its own
 session, standard streams, and rclpy's field checks, which generated message modules read
 from the environment once, when the server imported them (the judge's own environment, here
@@ -92,7 +92,6 @@ def test_a_forked_subject_is_stopped_and_reaped_as_a_started_one(tmp_path):
 
 SCRIPT_JUDGE = '''
 import sys
-from pathlib import Path
 from pathlib import Path
 print('the judge script ran')
 if __name__ == '__main__':

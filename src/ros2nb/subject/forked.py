@@ -70,7 +70,7 @@ class ForkedProcess:
             return
         os.close(self._status)
         # The server writes the code, then closes; nothing at all: the server itself ended
-        # (killed with its judge's process group), and so was its subject's reaper.
+        # (killed with its judge's process group), and so was its child's reaper.
         self.returncode = int(self._said) if self._said.strip() else -signal.SIGKILL
 
     def poll(self) -> Optional[int]:
@@ -93,28 +93,26 @@ class ForkedProcess:
 
 
 class ForkServer:
-    """The parent's end of a fork server: a socket to ask for subjects on.
+    """The parent's end of a fork server: a socket to ask for children on.
 
     :param sock: the connected socket (``SOCK_SEQPACKET``: one request, one answer).
     :param process: the server when it was started afresh (None when forked from here).
     """
 
-    def __init__(self, sock: socket.socket, process: Optional[subprocess.Popen] = None,
-                 pid: Optional[int] = None) -> None:
+    def __init__(self, sock: socket.socket, process: Optional[subprocess.Popen] = None) -> None:
         self._sock, self._process = sock, process
         self._lock = threading.Lock()
         self._failed = False
-        #: The server's process id.
-        self.pid = process.pid if process is not None else pid
 
     def alive(self) -> bool:
         """Whether the server still answers (as far as this side knows)."""
         return not self._failed and (self._process is None or self._process.poll() is None)
 
     def fork(self, fds: tuple[int, ...], request: dict) -> tuple[int, int]:
-        """Ask for a subject; return its pid and the read end of its exit-code pipe.
+        """Ask for a child; return its pid and the read end of its exit-code pipe.
 
-        :param fds: the subject's pipes (command, reply, acknowledgement, output).
+        :param fds: the child's own pipes (a subject's command, reply and acknowledgement),
+            then its output.
         :raises OSError: when the server is gone.
         """
         status_read, status_write = os.pipe()
@@ -149,8 +147,7 @@ def serve_from_here() -> None:
     if threading.active_count() > 1:
         return  # a fork would hold only this thread, and any lock another one held
     parent_end, server_end = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
-    pid = os.fork()
-    if pid == 0:
+    if os.fork() == 0:
         try:
             parent_end.close()
             # Not the parent's output: whoever reads that waits for its end, not the server's.
@@ -162,7 +159,7 @@ def serve_from_here() -> None:
         finally:
             os._exit(0)
     server_end.close()
-    _server = ForkServer(parent_end, pid=pid)
+    _server = ForkServer(parent_end)
 
 
 def has_server() -> bool:
@@ -262,5 +259,3 @@ def _site_path() -> list[str]:
     done = subprocess.run([sys.executable, '-c', program], env=env, capture_output=True,
                           text=True, check=True)
     return json.loads(done.stdout)
-
-
