@@ -47,7 +47,7 @@ from .gradebook import collect_zip, score_and_feedback, set_up_course, write_res
 from .judging import Judges
 from .learners import grade_learner
 from .report import write_report
-from .settings import CELL_TIMEOUT_S, JOBS, NOTEBOOK_TIMEOUT_S, Settings
+from .settings import CELL_TIMEOUT_S, JOBS, NOTEBOOK_TIMEOUT_S, SCORE_BATCH, Settings
 from .submissions import Learner, find_learners
 
 
@@ -85,10 +85,11 @@ def _grade_all(course: Path, learners: list[Learner], notebooks: list[str],
                settings: Settings, jobs: int) -> None:
     """Grade every learner, ``jobs`` at a time, each notebook's judge beside the next run.
 
-    nbgrader scores them in two batches: once the last learner has started, those already
-    graded are scored while the others still run; then the rest.  A class's longest
-    learner (every notebook, one after another) is then followed by nbgrader scoring that
-    learner and a few others, not the whole class.
+    nbgrader scores the learners in batches while the others still run: a batch once
+    ``SCORE_BATCH`` learners are done (one start of nbgrader costs about 1 CPU-s), and once
+    the last learner has started, whoever is done each time nbgrader is free.  A class's
+    longest learner (every notebook, one after another) is then followed by nbgrader
+    scoring that learner and the few who ended with it, not half the class.
     """
     with tempfile.TemporaryDirectory(prefix='ros2nb-grading-') as scratch_root:
         Path(scratch_root).chmod(0o711)
@@ -109,18 +110,30 @@ def _grade_all(course: Path, learners: list[Learner], notebooks: list[str],
         try:
             with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
                 jobs_of = {pool.submit(grade, learner): learner for learner in ordered}
-                all_started.wait()
-                first = {learner.id for job, learner in jobs_of.items() if job.done()}
-                _score(course, learners, first)
+                _score_while_grading(course, learners, jobs_of, all_started)
                 for job, learner in jobs_of.items():
                     try:
                         job.result()
                     except Exception as error:  # noqa: BLE001 - that learner's, in a note
                         learner.note('_folder', f'the grader could not grade this learner '
                                                 f'({type(error).__name__}: {str(error)[:200]})')
-            _score(course, learners, {learner.id for learner in learners} - first)
         finally:
             judges.close()
+
+
+def _score_while_grading(course: Path, learners: list[Learner],
+                         jobs_of: dict[concurrent.futures.Future, Learner],
+                         all_started: threading.Event) -> None:
+    """Score learners as their jobs end (in batches, :func:`_grade_all`) until all are scored."""
+    scored: set[str] = set()
+    while len(scored) < len(jobs_of):
+        running = [job for job in jobs_of if not job.done()]
+        waiting = {learner.id for job, learner in jobs_of.items() if job.done()} - scored
+        if waiting and (all_started.is_set() or len(waiting) >= SCORE_BATCH):
+            _score(course, learners, waiting)
+            scored |= waiting
+        else:  # polled: the last learner starts in a job, without a job of its own ending
+            concurrent.futures.wait(running, timeout=1, return_when='FIRST_COMPLETED')
 
 
 class Progress:
