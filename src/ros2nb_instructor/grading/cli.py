@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import argparse
 import concurrent.futures
-import itertools
 import json
 import os
 import shutil
@@ -43,11 +42,11 @@ from typing import Optional
 
 from ..paths import ROOT
 from . import sandbox
-from .gradebook import collect_zip, score_and_feedback, set_up_course, write_results
+from .gradebook import Scoring, collect_zip, set_up_course, write_results
 from .judging import Judges
 from .learners import grade_learner
 from .report import write_report
-from .settings import CELL_TIMEOUT_S, JOBS, NOTEBOOK_TIMEOUT_S, SCORE_BATCH, Settings
+from .settings import CELL_TIMEOUT_S, JOBS, NOTEBOOK_TIMEOUT_S, Settings
 from .submissions import Learner, find_learners
 
 
@@ -85,32 +84,38 @@ def _grade_all(course: Path, learners: list[Learner], notebooks: list[str],
                settings: Settings, jobs: int) -> None:
     """Grade every learner, ``jobs`` at a time, each notebook's judge beside the next run.
 
-    nbgrader scores the learners in batches while the others still run: a batch once
-    ``SCORE_BATCH`` learners are done (one start of nbgrader costs about 1 CPU-s), and once
-    the last learner has started, whoever is done each time nbgrader is free.  A class's
-    longest learner (every notebook, one after another) is then followed by nbgrader
-    scoring that learner and the few who ended with it, not half the class.
+    nbgrader scores each learner as soon as they are done (with whoever else is done by
+    then), in one process for the class (:class:`.gradebook.Scoring`), while the others
+    still run: a class's longest learner (every notebook, one after another) is then
+    followed by nbgrader scoring that learner alone, not half the class.
     """
     with tempfile.TemporaryDirectory(prefix='ros2nb-grading-') as scratch_root:
         Path(scratch_root).chmod(0o711)
         judges = Judges(jobs)
         # Most notebooks first, so the longest learner does not start last.
         ordered = sorted(learners, key=lambda learner: -len(learner.files))
-        started, all_started = itertools.count(1), threading.Event()
         progress = Progress(sum(len(learner.files) for learner in learners), len(learners))
 
         def grade(learner: Learner) -> None:
-            if next(started) == len(ordered):
-                all_started.set()
             try:
                 grade_learner(course, Path(scratch_root), learner, notebooks, settings, judges)
             finally:
                 print(progress.learner_done(learner), flush=True)
 
         try:
-            with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
+            with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool, \
+                    Scoring(course) as scoring:
                 jobs_of = {pool.submit(grade, learner): learner for learner in ordered}
-                _score_while_grading(course, learners, jobs_of, all_started)
+                scored: set[str] = set()
+                while len(scored) < len(jobs_of):
+                    waiting = {learner.id for job, learner in jobs_of.items()
+                               if job.done()} - scored
+                    if waiting:
+                        _score(scoring, learners, waiting)
+                        scored |= waiting
+                    else:
+                        concurrent.futures.wait([job for job in jobs_of if not job.done()],
+                                                return_when='FIRST_COMPLETED')
                 for job, learner in jobs_of.items():
                     try:
                         job.result()
@@ -119,21 +124,6 @@ def _grade_all(course: Path, learners: list[Learner], notebooks: list[str],
                                                 f'({type(error).__name__}: {str(error)[:200]})')
         finally:
             judges.close()
-
-
-def _score_while_grading(course: Path, learners: list[Learner],
-                         jobs_of: dict[concurrent.futures.Future, Learner],
-                         all_started: threading.Event) -> None:
-    """Score learners as their jobs end (in batches, :func:`_grade_all`) until all are scored."""
-    scored: set[str] = set()
-    while len(scored) < len(jobs_of):
-        running = [job for job in jobs_of if not job.done()]
-        waiting = {learner.id for job, learner in jobs_of.items() if job.done()} - scored
-        if waiting and (all_started.is_set() or len(waiting) >= SCORE_BATCH):
-            _score(course, learners, waiting)
-            scored |= waiting
-        else:  # polled: the last learner starts in a job, without a job of its own ending
-            concurrent.futures.wait(running, timeout=1, return_when='FIRST_COMPLETED')
 
 
 class Progress:
@@ -174,10 +164,10 @@ def _duration(seconds: float) -> str:
     return f'{seconds} s'
 
 
-def _score(course: Path, learners: list[Learner], batch: set[str]) -> None:
+def _score(scoring: Scoring, learners: list[Learner], batch: set[str]) -> None:
     """nbgrader scores the learners whose ids are in ``batch`` and writes their feedback."""
     if any(learner.files for learner in learners if learner.id in batch):
-        score_and_feedback(course, exclude=[l.id for l in learners if l.id not in batch])
+        scoring.score(exclude=[l.id for l in learners if l.id not in batch])
 
 
 def _report(out: Path, learners: list[Learner], rows: list[list[str]],

@@ -7,9 +7,11 @@ for the scoring run: every notebook was run in a sandbox and judged before).
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import hashlib
 import html
+import json
 import os
 import shutil
 import subprocess
@@ -17,7 +19,7 @@ import sys
 import tempfile
 from importlib import metadata
 from pathlib import Path
-from typing import Iterable
+from typing import Iterable, Optional
 
 from nbgrader.api import Gradebook, MissingEntry
 
@@ -43,11 +45,16 @@ def _run_logged(course: Path, argv: list[str], log: Path) -> int:
     """Run ``argv`` (nbgrader, or the course's code that drives it) in the course folder, with
     the course's own Jupyter settings and the course's Python first on PATH; its output is
     appended to ``log``.  Return its exit code."""
-    env = dict(os.environ, JUPYTER_CONFIG_DIR=str(course / '.jupyter'),
-               PATH=os.pathsep.join([str(Path(sys.executable).parent), os.environ['PATH']]))
     with open(log, 'a') as out:
-        return subprocess.run(argv, cwd=course, env=env, stdout=out, stderr=subprocess.STDOUT,
-                              stdin=subprocess.DEVNULL).returncode
+        return subprocess.run(argv, cwd=course, env=_course_env(course), stdout=out,
+                              stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL).returncode
+
+
+def _course_env(course: Path) -> dict[str, str]:
+    """The environment nbgrader runs in for ``course``: its own Jupyter settings, the
+    course's Python first on PATH (nbgrader runs ``alembic`` by name)."""
+    return dict(os.environ, JUPYTER_CONFIG_DIR=str(course / '.jupyter'),
+                PATH=os.pathsep.join([str(Path(sys.executable).parent), os.environ['PATH']]))
 
 
 def set_up_course(course: Path) -> list[str]:
@@ -173,13 +180,56 @@ def spreadsheet_safe(text: str) -> str:
     return f"'{text}" if text.startswith(FORMULA_STARTS) else text
 
 
-def score_and_feedback(course: Path, exclude: Iterable[str] = ()) -> None:
-    """nbgrader scores what was filed (executing nothing), then writes the feedback.
+class Scoring:
+    """nbgrader scoring a class batch by batch, in one process (:mod:`.scoring`), its log
+    appended to ``course/grading.log``.  A context manager: the process ends with the block.
 
-    Both in one process (:mod:`.scoring`), its log appended to ``course/grading.log``.
-
-    :param exclude: nbgrader ids of learners left out (not yet graded, or scored before);
-        ids never hold a comma (:func:`.submissions.find_learners`).
+    Introduced for ``ros2nb-grade`` (:mod:`.cli`), which scores learners as they are done.
     """
-    _run_logged(course, [sys.executable, '-m', 'ros2nb_instructor.grading.scoring', str(course),
-                         ','.join(sorted(exclude))], log=course / 'grading.log')
+
+    def __init__(self, course: Path) -> None:
+        self._course = course
+        self._process: Optional[subprocess.Popen] = None
+
+    def __enter__(self) -> 'Scoring':
+        return self
+
+    def __exit__(self, *_: object) -> None:
+        self._end()
+
+    def score(self, exclude: Iterable[str]) -> bool:
+        """nbgrader scores what was filed for every learner but ``exclude`` (executing
+        nothing), then writes their feedback; True when both worked.
+
+        :param exclude: nbgrader ids of learners left out (not yet graded, or scored before).
+        """
+        for _attempt in range(2):  # a process that ended meanwhile: once more, in a new one
+            process = self._started()
+            try:
+                assert process.stdin is not None and process.stdout is not None
+                process.stdin.write(json.dumps(sorted(exclude)) + '\n')
+                process.stdin.flush()
+                answer = process.stdout.readline()
+            except OSError:
+                answer = ''
+            if answer:
+                return bool(json.loads(answer).get('ok'))
+            self._end()
+        return False
+
+    def _started(self) -> subprocess.Popen:
+        if self._process is None:
+            with open(self._course / 'grading.log', 'a') as log:
+                self._process = subprocess.Popen(
+                    [sys.executable, '-m', 'ros2nb_instructor.grading.scoring',
+                     str(self._course)], cwd=self._course, env=_course_env(self._course),
+                    stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=log, text=True)
+        return self._process
+
+    def _end(self) -> None:
+        process, self._process = self._process, None
+        if process is not None:
+            with contextlib.suppress(OSError):
+                process.stdin.close()  # type: ignore[union-attr]
+            process.wait()
+            process.stdout.close()  # type: ignore[union-attr]

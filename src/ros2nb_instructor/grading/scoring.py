@@ -1,16 +1,21 @@
-"""nbgrader scores a batch of learners, then writes their feedback, in one process.
+"""nbgrader scores batches of learners, then writes their feedback, in one process.
 
-``python -m ros2nb_instructor.grading.scoring COURSE [EXCLUDED_IDS]``, started by
-:func:`.gradebook.score_and_feedback` on the instructor's host (trusted: it executes
-nothing of the learners').  nbgrader's own converters do the work its ``autograde`` and
-``generate_feedback`` commands do, one after the other, as nbgrader's API (the
-Formgrader's) runs them: one start of nbgrader per batch instead of two (1.1 CPU-s each).
-Autograde only scores: every notebook was run in a sandbox and judged before, so its
-Execute and ClearOutput steps are off.
+``python -m ros2nb_instructor.grading.scoring COURSE``, started by
+:class:`.gradebook.Scoring` on the instructor's host (trusted: it executes nothing of the
+learners').  Each line on its standard input is one batch: a JSON list of the ids nbgrader
+leaves out (every learner not in the batch); it answers each with a line ``{"ok": BOOL}``
+once scored, and ends at the end of its input.  nbgrader's own converters do the work its
+``autograde`` and ``generate_feedback`` commands do, one after the other, as nbgrader's API
+(the Formgrader's) runs them.  One process serves the whole class: nbgrader starts once
+(about 1.5 CPU-s: its imports, its templates), and a batch then costs about 0.1 CPU-s and
+0.2 CPU-s per notebook, so learners are scored as soon as each is done.  Autograde only
+scores: every notebook was run in a sandbox and judged before, so its Execute and
+ClearOutput steps are off.
 """
 
 from __future__ import annotations
 
+import json
 import logging
 import sys
 from pathlib import Path
@@ -41,25 +46,34 @@ def score_only_config(course: Path, excluded: str) -> Config:
     return config
 
 
-def main(argv: list[str]) -> int:
-    """Score, then write the feedback; 0 when both worked.  nbgrader's log goes to standard
-    error, which the grader appends to ``COURSE/grading.log`` (as its command lines' did)."""
-    if len(argv) not in (1, 2):
-        print('Usage: python -m ros2nb_instructor.grading.scoring COURSE [EXCLUDED_IDS]',
-              file=sys.stderr)
-        return 2
-    course = Path(argv[0])
-    config = score_only_config(course, argv[1] if len(argv) == 2 else '')
-    logging.basicConfig(stream=sys.stderr, level=logging.INFO,
-                        format='[%(name)s | %(levelname)s] %(message)s')
+def score(course: Path, excluded: str) -> bool:
+    """Score, then write the feedback of, every learner of ``course`` but the comma-separated
+    ``excluded`` ids; True when both worked (nbgrader logs which notebook failed and why)."""
+    config = score_only_config(course, excluded)
     coursedir = CourseDirectory(config=config)
-    failed = False
+    worked = True
     for step in (Autograde, GenerateFeedback):
         try:
             step(coursedir=coursedir, config=config, log=logging.getLogger(step.__name__)).start()
-        except NbGraderException:  # nbgrader logged which notebook and why
-            failed = True
-    return 1 if failed else 0
+        except NbGraderException:
+            worked = False
+    return worked
+
+
+def main(argv: list[str]) -> int:
+    """Score each batch read on standard input (module docstring); nbgrader's log goes to
+    standard error, which the grader appends to ``COURSE/grading.log``."""
+    if len(argv) != 1:
+        print('Usage: python -m ros2nb_instructor.grading.scoring COURSE '
+              '(batches on standard input: a JSON list of the ids to leave out, one per line)',
+              file=sys.stderr)
+        return 2
+    logging.basicConfig(stream=sys.stderr, level=logging.INFO,
+                        format='[%(name)s | %(levelname)s] %(message)s')
+    for line in sys.stdin:
+        excluded = json.loads(line)
+        print(json.dumps({'ok': score(Path(argv[0]), ','.join(excluded))}), flush=True)
+    return 0
 
 
 if __name__ == '__main__':

@@ -16,9 +16,6 @@ NOTEBOOK_TIMEOUT_S = 600
 JUDGE_TIMEOUT_S = 600
 #: Notebooks graded at the same time: one more than the CPUs (a notebook often waits).
 JOBS = (os.cpu_count() or 1) + 1
-#: Learners done before nbgrader scores them while others still run (each start of nbgrader
-#: costs about 1 CPU-s); once the last learner has started, it scores whoever is done.
-SCORE_BATCH = 10
 
 
 @dataclass(frozen=True)
