@@ -6,6 +6,8 @@ by side under pytest-xdist (``--dist loadfile`` keeps a file on one worker).
 
 import csv
 import os
+import shutil
+import signal
 import subprocess
 import sys
 import zipfile
@@ -15,7 +17,11 @@ import pytest
 
 from grading_samples import LEARNER, NB01, SOLUTION
 
+from nbgrader.api import Gradebook
+
 from ros2nb_instructor.grading import sandbox
+from ros2nb_instructor.grading.gradebook import Scoring, set_up_course
+from ros2nb_instructor.paths import ASSIGNMENT, gradebook_url
 
 #: The instructor's grading command, as the course's venv installs it.
 GRADE = str(Path(sys.executable).with_name('ros2nb-grade'))
@@ -110,3 +116,35 @@ def test_without_a_sandbox_grading_refuses_unless_told(tmp_path):
                            "install bubblewrap); grading runs learners' code, so it stops. For "
                            "work you trust, run again with NO_SANDBOX=1 (--no-sandbox).\n")
 
+
+
+def test_a_scoring_process_that_ended_is_started_again(tmp_path):
+    """nbgrader scores a class batch by batch in one process (gradebook.Scoring); one that
+    ended between two batches (killed, crashed) is started again for the next batch, whose
+    learner is scored all the same (without the new start, that batch was lost: 0 points)."""
+    course = tmp_path / 'nbgrader'
+    course.mkdir()
+    set_up_course(course)
+    for learner in ('ada', 'bo'):
+        folder = course / 'submitted' / learner / ASSIGNMENT
+        folder.mkdir(parents=True)
+        shutil.copy(SOLUTION[NB01], folder / f'{NB01}.ipynb')  # its check's output: passed
+    with Scoring(course) as scoring:
+        assert scoring.score(exclude=['bo'])
+        scorers = [pid for pid in os.listdir('/proc') if pid.isdigit() and _runs(
+            pid, b'ros2nb_instructor.grading.scoring', str(course).encode())]
+        assert len(scorers) == 1, scorers
+        os.kill(int(scorers[0]), signal.SIGKILL)
+        assert scoring.score(exclude=['ada'])
+    with Gradebook(gradebook_url(course)) as gradebook:
+        assert [gradebook.find_submission_notebook(NB01, ASSIGNMENT, learner).score
+                for learner in ('ada', 'bo')] == [1, 1]
+
+
+def _runs(pid: str, *words: bytes) -> bool:
+    """Whether process ``pid``'s command line holds every one of ``words``."""
+    try:
+        command = Path(f'/proc/{pid}/cmdline').read_bytes()
+    except OSError:
+        return False
+    return all(word in command for word in words)
