@@ -216,6 +216,35 @@ def test_a_part_run_out_of_order_is_named_by_the_check(session):
         restore(session, PUB)
 
 
+#: The monitor's main() with rclpy's SIGTERM race made certain.  rclpy (Jazzy) handles SIGTERM
+#: in a thread of its own that wakes the spin, then shuts the context down; here the shutdown
+#: comes from a thread of the program's, with nothing woken, as when the spin had looked
+#: again in between (seen once in make test beside two CPU burners).
+RACED_SHUTDOWN = ('    rclpy.init(args=args)\n', '''    import signal, threading
+    from rclpy.signals import SignalHandlerOptions
+    signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGTERM})  # every thread from here on
+    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.SIGINT)
+
+    def shut_down_from_outside():
+        signal.sigwait({signal.SIGTERM})
+        rclpy.get_default_context().handle.shutdown()  # rcl's own: no spin is woken
+
+    threading.Thread(target=shut_down_from_outside, daemon=True).start()
+''')
+
+
+def test_a_shutdown_from_outside_that_the_spin_missed_still_ends_it(session):
+    """An honest main() whose spin missed the shutdown from outside still passes: the judge
+    calls its node once (mains.WAKE_AFTER_S), the spin wakes and ends with
+    ExternalShutdownException.  Without that call it waited until the check gave up, and an
+    honest learner was told their main() did not stop."""
+    mutated(session, SUB, *RACED_SHUTDOWN)
+    try:
+        checks.check_monitor_main()
+    finally:
+        restore(session, SUB)
+
+
 def test_package_checks(session, capsys):
     setup_py = session.workspace / course.SETUP_PY_FILE
     setup_cfg = session.workspace / course.SETUP_CFG_FILE

@@ -13,6 +13,7 @@ from __future__ import annotations
 import ast
 import re
 import signal
+import subprocess
 from pathlib import Path
 from typing import Any, Optional
 
@@ -30,6 +31,13 @@ EXIT_AFTER_CTRL_C_S = 20.0
 START_PATIENCE_S = 10.0
 #: Seconds between two looks at how much the program has worked.
 LOOK_AGAIN_S = 0.5
+#: Seconds a program has to end after a shutdown from outside before the judge calls its node
+#: once.  rclpy (Jazzy) handles SIGTERM in a thread of its own: it wakes the spin, then shuts
+#: the context down.  A spin that woke and looked in between (a busy machine) waits on with a
+#: context already shut down, until something arrives: a node that only subscribes hung there
+#: (seen once in make test beside two CPU burners).  The call is that something; it ends
+#: nothing that a shutdown from outside would not end.
+WAKE_AFTER_S = 2.0
 #: How a running node is stopped, in turn: Ctrl+C in its terminal, and a shutdown from
 #: outside (SIGTERM, as ``ros2 launch`` after its grace period, systemd or docker stop send).
 #: On Jazzy the first ends the spin with KeyboardInterrupt, the second with
@@ -96,7 +104,7 @@ def _watch_stop(observer: Any, path: Path, node_name: str, part: int, proc: Any,
                           'until Ctrl+C.')
     interrupt(proc, sig)
     pressed = STOPPING_SIGNALS[sig]
-    code = wait_patiently(proc, EXIT_AFTER_CTRL_C_S)
+    code = _wait_for_exit(observer, proc, node_name, sig)
     if code is None:
         raise CheckFailed(f'{path.name} did not stop within {EXIT_AFTER_CTRL_C_S:g} s of '
                           f'{pressed}: let {STOP_EXCEPTIONS[sig]} end the spin.')
@@ -119,6 +127,18 @@ def _watch_stop(observer: Any, path: Path, node_name: str, part: int, proc: Any,
         what = f'{pressed} had already shut rclpy down' if already else last
         raise CheckFailed(f'{path.name} exited with code {code} after {pressed} ({what}): '
                           f'{_ctrl_c_advice(path, already)}.')
+
+
+def _wait_for_exit(observer: Any, proc: Any, node_name: str, sig: int) -> Optional[int]:
+    """The program's exit code once it ended after ``sig``, or None when it had
+    :data:`EXIT_AFTER_CTRL_C_S` (of its work) and still runs; after a shutdown from outside,
+    its node is called once if it still runs after :data:`WAKE_AFTER_S`."""
+    if sig == signal.SIGTERM:
+        try:
+            return proc.wait(WAKE_AFTER_S)
+        except subprocess.TimeoutExpired:
+            observer.spins(node_name, seconds=WAKE_AFTER_S)  # its answer does not matter
+    return wait_patiently(proc, EXIT_AFTER_CTRL_C_S)
 
 
 def _wait_for_node(observer: Any, proc: Any, node_name: str) -> bool:
