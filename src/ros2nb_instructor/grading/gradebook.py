@@ -213,7 +213,9 @@ class Scoring:
             except OSError:
                 answer = ''
             if answer:
-                return bool(json.loads(answer).get('ok'))
+                with contextlib.suppress(ValueError, AttributeError):
+                    return bool(json.loads(answer).get('ok'))
+                return False
             self._end()
         return False
 

@@ -70,9 +70,11 @@ def main(argv: list[str]) -> int:
         return 2
     logging.basicConfig(stream=sys.stderr, level=logging.INFO,
                         format='[%(name)s | %(levelname)s] %(message)s')
+    answers, sys.stdout = sys.stdout, sys.stderr  # what nbgrader prints goes to the log
     for line in sys.stdin:
         excluded = json.loads(line)
-        print(json.dumps({'ok': score(Path(argv[0]), ','.join(excluded))}), flush=True)
+        print(json.dumps({'ok': score(Path(argv[0]), ','.join(excluded))}), file=answers,
+              flush=True)
     return 0
 
 
