@@ -168,8 +168,8 @@ def has_server() -> bool:
 
 
 def _started_server() -> ForkServer:
-    """This process's fork server, started afresh (``python -m ros2nb.subject.fork_server``)
-    the first time."""
+    """This process's fork server: the one it has (forked from here, or started before), else
+    one started afresh (``python -m ros2nb.subject.fork_server``)."""
     global _server
     with _server_lock:
         if _server is None or not _server.alive():
@@ -221,8 +221,7 @@ def _fork(request: dict, fds: tuple[int, ...]) -> ForkedProcess:
     request['site_path'] = _site_path()
     try:
         try:
-            pid, status = (_server if has_server() else _started_server()).fork(
-                (*fds, write_output), request)
+            pid, status = _started_server().fork((*fds, write_output), request)
         except OSError:  # the server went away (killed?): a new one, once
             pid, status = _started_server().fork((*fds, write_output), request)
     except BaseException:
