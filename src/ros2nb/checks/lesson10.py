@@ -262,8 +262,11 @@ def _statuses_follow_readings(said: list[tuple[int, float, str]],
     if not said:
         raise CheckFailed(f'{course.MONITOR_NODE} logged no status while {label} ran: add your '
                           'monitor, so it hears the readings.')
+    by_step: dict[int, list[tuple[float, str]]] = {}
+    for t, r, s in said:  # grouped once: an hour's 3600 readings each looked up, not searched
+        by_step.setdefault(t, []).append((r, s))
     for index, (t_ns, value) in enumerate(heard, start=1):
-        mine = [(r, s) for t, r, s in said if t == t_ns]
+        mine = by_step.get(t_ns, [])
         want = (round(value, 2), course.monitor_status(value))
         if len(mine) != 1 or (round(mine[0][0], 2), mine[0][1]) != want:
             got = ', '.join(f'{r:.2f} {s}' for r, s in mine) or 'nothing'
