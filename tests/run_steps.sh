@@ -11,14 +11,16 @@
 # if any step failed.  A step still running after STEP_LIMIT_S seconds (a hang that every
 # per-test limit missed) is stopped and says so: make test always ends with its results.
 #
-# Steps 2 and 3 run at a lower priority (nice NBVAL_NICE): the CPU is the bottleneck on
-# two cores, step 1 holds the longest chain (grading the sample class), and steps 2 and 3
-# end well before it.  Nice only orders the work: every step still gets CPU all along.
+# Every step runs at the same priority (NBVAL_NICE=0).  Steps 2 and 3 once ran at nice 5, so
+# that the grading of the sample class (step 1's longest chain) went first; since the class is
+# scored as each learner ends, tests/ is CPU-bound across all its workers, not held up by one
+# chain, and a lower priority only gave other programs on the machine a larger share of the
+# two cores (beside two CPU burners, nice weighs steps 2 and 3 at a third of a burner each).
 # Usage: tests/run_steps.sh PYTHON WORKERS
 set -u
 python=$1 workers=$2
 STEP_LIMIT_S=${STEP_LIMIT_S:-3000}
-NBVAL_NICE=${NBVAL_NICE:-5}
+NBVAL_NICE=${NBVAL_NICE:-0}
 logs=$(mktemp -d "${TMPDIR:-/tmp}/ros2nb-make-test-XXXXXX")
 trap 'rm -rf "$logs"' EXIT
 
