@@ -51,9 +51,10 @@ EXPECTED = {
                      {n: '' for n in NB}),  # nothing to note
     'solved-only-04': Case({NB03: 0, NB04: 5}, {}, {NB03: 'not attempted'}),
     'handed-in-only-05': Case({NB05: 4}, {NB05: 'ros2 run starts both entry points'}),
-    # ---- the verdict is out of the learner's reach (a publisher with the 10.2 floor: 3 of 6)
-    'replaces-the-checks': Case({NB03: 3}, {NB03: "the tutorial's floor of 10.2"}),
-    'input-transformer': Case({NB03: 3}, {NB03: "the tutorial's floor of 10.2"}),
+    # ---- the verdict is out of the learner's reach (the tutorial's /Documents path: 0 of 1;
+    # notebook 01, whose one check costs a second, not 03, whose hour of the sensor costs ten)
+    'replaces-the-checks': Case({NB01: 0}, {NB01: 'is not inside your home folder'}),
+    'input-transformer': Case({NB01: 0}, {NB01: 'is not inside your home folder'}),
     'forges-the-gradebook': Case({NB01: 0}, {NB01: 'gradebooks changed: []'}),
     # ---- nothing escapes a graded notebook
     'rewrites-the-course': Case({NB01: 1}, {NB01: 'Read-only file system'}),
@@ -443,17 +444,18 @@ def build(folder: Path, *, grading_out: Path, submissions: Path, decoy_gradebook
         else:
             nbformat.write(nb, target)
 
-    floor_10_2 = ('max(MIN_TEMPERATURE_C,', 'max(10.2,')
+    tutorial_path = ("Path('~/Documents/ROS2_and_RL_Tutorials').expanduser()",
+                     "Path('/Documents/ROS2_and_RL_Tutorials')")
     for notebook in NB:
         put('untouched', notebook, LEARNER[notebook])
         put('complete', notebook, SOLUTION[notebook])
     put('solved-only-04', NB03, LEARNER[NB03])
     put('solved-only-04', NB04, SOLUTION[NB04])
     put('handed-in-only-05', NB05, SOLUTION[NB05])
-    put('replaces-the-checks', NB03, _replaced(
-        _with_cells(SOLUTION[NB03], {3: REPLACE_THE_CHECKS}), *floor_10_2))
-    put('input-transformer', NB03, _replaced(
-        _with_cells(SOLUTION[NB03], {3: INPUT_TRANSFORMER}), *floor_10_2))
+    put('replaces-the-checks', NB01, _replaced(
+        _with_cells(SOLUTION[NB01], {3: REPLACE_THE_CHECKS}), *tutorial_path))
+    put('input-transformer', NB01, _replaced(
+        _with_cells(SOLUTION[NB01], {3: INPUT_TRANSFORMER}), *tutorial_path))
     gradebooks = [str(grading_out / 'nbgrader' / 'gradebook.db'), str(decoy_gradebook),
                   str(ROOT / 'grading' / 'nbgrader' / 'gradebook.db'), '../gradebook.db',
                   '../../gradebook.db']
