@@ -13,6 +13,8 @@ import time
 import pytest
 import rclpy
 from rclpy.node import Node
+from rcl_interfaces.msg import ParameterEvent
+from rclpy.qos import DurabilityPolicy, QoSProfile
 from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float32
 
@@ -20,7 +22,7 @@ import ros2nb
 from ros2nb.errors import Ros2nbError, UsageError
 
 from nodes import PERIOD_S, Broken, Monitor, Sensor
-from waiting import PATIENCE_S, wait_until
+from waiting import PATIENCE_S, wait_for, wait_until
 
 rt_module = importlib.import_module('ros2nb.runtime.current')
 
@@ -186,6 +188,33 @@ def test_add_prints_what_the_node_logs_while_it_starts(ros, capsys):
     capsys.readouterr()
     ros2nb.add(Sensor())
     assert capsys.readouterr().out == '[INFO] [temperature_sensor]: started\n'
+
+
+def test_a_handed_over_node_warns_of_qos_on_its_own_topics_only(ros, capsys):
+    """rclpy's QoS warnings stay on the learner's publishers (notebook 09); what rclpy made for
+    the node itself (its /parameter_events publisher, its time source's /clock subscription)
+    loses its two handlers each, entities in every wait of the executor."""
+    sensor = ros2nb.add(Sensor())
+    handlers = {e.topic_name: len(e.event_handlers) for e in (*sensor.publishers,
+                                                              *sensor.subscriptions)}
+    assert handlers == {'/temperature': 2, '/parameter_events': 0, '/clock': 0}
+    assert len(list(sensor.waitables)) == 2
+    latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    listener = rclpy.create_node('qos_listener', context=ros.context)
+    try:  # both publishers are volatile: each subscription asks for what they do not offer
+        listener.create_subscription(ParameterEvent, '/parameter_events', print, latched)
+        listener.create_subscription(Float32, '/temperature', print, latched)
+        shown = []
+
+        def warned() -> bool:
+            ros2nb.spin(1)
+            shown.append(capsys.readouterr().out)
+            return 'incompatible QoS' in shown[-1]
+
+        assert wait_for(warned, "the sensor's warning of an incompatible subscription")
+        assert "topic 'temperature'" in ''.join(shown)
+    finally:
+        listener.destroy_node()
 
 
 def test_stop_one_and_all(ros):

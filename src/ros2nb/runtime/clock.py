@@ -33,6 +33,8 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.time import Time
 from rosgraph_msgs.msg import Clock
 
+from .nodes import drop_qos_warnings, rclpys_own_entities
+
 #: Longest silence a simulated-time run skips in one step when no timer is due (s).
 MAX_SIM_STEP_S = 1.0
 #: Set by a judge for its subjects: the file descriptor its runtime writes one line to for
@@ -274,6 +276,11 @@ class SimulatedClock:
                 node.set_parameters([Parameter('use_sim_time', Parameter.Type.BOOL, sim)])
             if sim and self.judge_time is not None:
                 _deaf_to_clock(node)
+            # rclpy's own endpoints without their QoS warnings: a kernel's simulated hour of a
+            # sensor and a monitor costs 1.6 CPU-s instead of 2.0 (a judge's subject of
+            # notebook 10, whose nodes have no time source, 4.1 instead of 4.2); the learner's
+            # own publishers and subscriptions keep theirs (notebook 09).
+            drop_qos_warnings(node, rclpys_own_entities(node))
             (self._on_sim.add if sim else self._on_sim.discard)(name)
             changed.append(node)
         if not changed:

@@ -28,7 +28,7 @@ from ..processes import child_pids
 from .callers import use_cheaper_caller_lookup
 from .clock import SimulatedClock
 from .logs import LogLines
-from .nodes import NodeKeeping, destroy_stray_nodes, logs_elsewhere
+from .nodes import NodeKeeping, destroy_stray_nodes, drop_qos_warnings, logs_elsewhere
 from .spinning import Spinning
 
 #: Hidden name of the kernel's own node (names starting with ``_`` are hidden
@@ -61,11 +61,7 @@ def node_serving_nothing(name: str, **kwargs: Any) -> Node:
     node = Node(name, start_parameter_services=False,
                 parameter_overrides=[Parameter('start_type_description_service',
                                                Parameter.Type.BOOL, False)], **kwargs)
-    for publisher in node.publishers:
-        for handler in publisher.event_handlers:
-            node.remove_waitable(handler)
-            handler.destroy()
-        publisher.event_handlers = []
+    drop_qos_warnings(node)
     return node
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 import contextlib
 import gc
 import os
-from typing import Iterator, Optional, Union
+from typing import Any, Iterable, Iterator, Optional, Union
 
 import rclpy
 from rclpy.node import Node
@@ -24,6 +24,33 @@ NodeOrName = Union[Node, str]
 #: until the process ends, so its /rosout publisher, with its transient-local history, stays
 #: for a judge whose subscription matches late.
 KEEP_STOPPED_ENV = 'ROS2NB_KEEP_STOPPED_NODES'
+
+
+def drop_qos_warnings(node: Node, entities: Optional[Iterable[Any]] = None) -> None:
+    """Destroy the QoS event handlers of ``entities`` (publishers or subscriptions of
+    ``node``; every publisher of ``node`` when None).
+
+    rclpy gives each publisher and subscription two by default, whose only work is a warning
+    when the other side asks for an incompatible QoS or type.  Each handler is one more
+    entity in every wait of the executor, which waits several times per step of simulated
+    time.
+    """
+    for entity in (node.publishers if entities is None else entities):
+        if entity is None:
+            continue
+        for handler in entity.event_handlers:
+            node.remove_waitable(handler)
+            handler.destroy()
+        entity.event_handlers = []
+
+
+def rclpys_own_entities(node: Node) -> list[Any]:
+    """What rclpy made for ``node`` itself, with rclpy's QoS (never the learner's): its
+    ``/parameter_events`` publisher, and its time source's ``/clock`` subscription when the
+    node is on simulated time.  A QoS warning of theirs could only ever be about another
+    program's endpoint."""
+    source = getattr(node, '_time_source', None)
+    return [getattr(node, '_parameter_event_publisher', None), getattr(source, '_clock_sub', None)]
 
 
 class NodeKeeping:
@@ -48,6 +75,7 @@ class NodeKeeping:
                 self._retire(old)
             self._nodes[name] = node
             self.own_logger(node.get_logger().name)
+            drop_qos_warnings(node, rclpys_own_entities(node))
             self.executor.add_node(node)
             self._set_clock([node], self.sim_time)
             self.drain()
