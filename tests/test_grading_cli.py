@@ -117,7 +117,6 @@ def test_without_a_sandbox_grading_refuses_unless_told(tmp_path):
                            "work you trust, run again with NO_SANDBOX=1 (--no-sandbox).\n")
 
 
-
 def test_a_scoring_process_that_ended_is_started_again(tmp_path):
     """nbgrader scores a class batch by batch in one process (gradebook.Scoring); one that
     ended between two batches (killed, crashed) is started again for the next batch, whose
