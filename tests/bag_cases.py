@@ -12,8 +12,9 @@ and the two halves run side by side.
 from __future__ import annotations
 
 import os
+from typing import Optional
 
-from ros2nb import checks
+from ros2nb import checks, course
 
 from judging import answer_cells
 
@@ -58,6 +59,29 @@ MISTAKES = [
      r'^read_temperatures\(\) returned list; return two lists: \(times_s, temperatures_c\)\.$'),
 ]
 MISTAKE_IDS = [f'{m[0]}: {m[1]}' for m in MISTAKES]
+
+#: Simulated seconds a mistake of ``record_hour`` records, unless the mistake is the length
+#: itself: ``course.RECORD_S`` and the notebook's ``HOUR_S`` are both set to it for that test.
+#: Which line a mistake gets does not depend on how long the recording runs, and the full
+#: hour of the sensor and the monitor cost each mistake about 3 CPU-s in the kernel and 7 in
+#: the judge and its subject.  ``test_the_solutions_pass`` records the full hour, both ways.
+SHORT_RECORD_S = 120
+#: The grading context's line that sets the hour (the course's own length).
+HOUR_LINE = f'HOUR_S = {int(course.RECORD_S)}\n'
+
+
+def recording_length(name: str, old: str) -> Optional[int]:
+    """The shorter length (s) the mistake ``old`` of answer ``name`` records, or None for
+    the full hour (any other answer, or a mistake in the length itself)."""
+    return SHORT_RECORD_S if name == 'record_hour' and 'HOUR_S' not in old else None
+
+
+def with_hour(context: str, seconds: Optional[int]) -> str:
+    """The grading context with its ``HOUR_S`` set to ``seconds`` (None: as it is)."""
+    if seconds is None:
+        return context
+    assert HOUR_LINE in context, HOUR_LINE
+    return context.replace(HOUR_LINE, f'HOUR_S = {seconds}\n')
 
 
 def edited(name: str, old: str, new: str) -> str:

@@ -18,7 +18,9 @@ from ros2nb.checks.base import AnswerRef  # noqa: E402
 from ros2nb.errors import CheckFailed  # noqa: E402
 from ros2nb.judge.session import Session  # noqa: E402
 
-from bag_cases import ANSWERS, CHECKS, CONTEXT, MISTAKE_IDS, MISTAKES, edited  # noqa: E402
+import ros2nb  # noqa: E402
+from bag_cases import (ANSWERS, CHECKS, CONTEXT, MISTAKE_IDS, MISTAKES, edited,  # noqa: E402
+                       recording_length, with_hour)
 from judging import judge_session  # noqa: E402
 
 
@@ -29,9 +31,9 @@ def session(tmp_path_factory):
         yield session
 
 
-def judge(session: Session, name: str, answer: str) -> None:
+def judge(session: Session, name: str, answer: str, context: str = CONTEXT) -> None:
     """Run the check of ``name`` on the answer's source, in a subject of this judge."""
-    ref = AnswerRef(name, (CONTEXT, answer))
+    ref = AnswerRef(name, (context, answer))
     try:
         CHECKS[name](ref)
     finally:
@@ -45,8 +47,11 @@ def test_the_solutions_pass(session, capsys):
 
 
 @pytest.mark.parametrize('name, label, old, new, pattern', MISTAKES, ids=MISTAKE_IDS)
-def test_a_mistake_gets_one_line(session, name, label, old, new, pattern):
+def test_a_mistake_gets_one_line(session, name, label, old, new, pattern, monkeypatch):
+    seconds = recording_length(name, old)
+    if seconds is not None:
+        monkeypatch.setattr(ros2nb.course, 'RECORD_S', float(seconds))
     with pytest.raises(CheckFailed) as caught:
-        judge(session, name, edited(name, old, new))
+        judge(session, name, edited(name, old, new), with_hour(CONTEXT, seconds))
     message = str(caught.value)
     assert '\n' not in message and re.search(pattern, message), message

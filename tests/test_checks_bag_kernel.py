@@ -24,7 +24,7 @@ from ros2nb.errors import CheckFailed, Ros2nbError, UsageError  # noqa: E402
 from ros2nb.terminal.workspace import WORKSPACE_ENV  # noqa: E402
 
 from bag_cases import (ANSWERS, CHECKS, CONTEXT_WITHOUT_START, LEARNER, MISTAKE_IDS,  # noqa: E402
-                       MISTAKES, edited)
+                       MISTAKES, edited, recording_length, with_hour)
 from judging import answer_cells  # noqa: E402
 
 
@@ -42,10 +42,10 @@ def kernel(tmp_path_factory):
         ros2nb.shutdown()
 
 
-def defined(answer: str) -> dict:
+def defined(answer: str, context: str = CONTEXT_WITHOUT_START) -> dict:
     """The names an answer cell defines, run after the grading context as the kernel runs it."""
     namespace: dict = {}
-    exec(CONTEXT_WITHOUT_START + '\n' + answer, namespace)
+    exec(context + '\n' + answer, namespace)
     return namespace
 
 
@@ -56,9 +56,13 @@ def test_the_solutions_pass(kernel, capsys):
 
 
 @pytest.mark.parametrize('name, label, old, new, pattern', MISTAKES, ids=MISTAKE_IDS)
-def test_a_mistake_gets_one_line(kernel, name, label, old, new, pattern):
+def test_a_mistake_gets_one_line(kernel, name, label, old, new, pattern, monkeypatch):
+    seconds = recording_length(name, old)
+    if seconds is not None:
+        monkeypatch.setattr(ros2nb.course, 'RECORD_S', float(seconds))
+    context = with_hour(CONTEXT_WITHOUT_START, seconds)
     with pytest.raises(CheckFailed) as caught:
-        CHECKS[name](defined(edited(name, old, new))[name])
+        CHECKS[name](defined(edited(name, old, new), context)[name])
     message = str(caught.value)
     assert '\n' not in message and re.search(pattern, message), message
 
