@@ -5,8 +5,9 @@ learners as the course's solution notebook with some answer cells written anothe
 :func:`grade_learner` grades one the way ``make grade`` does after the learner's notebook
 ran: the workspace holds what the notebook's ``%%part`` cells write on top of what
 ``catch_up`` writes while grading (no reference node: the grader hides them), and the judge's
-own :func:`ros2nb.judge.grading.grade` runs every graded cell of the course's notebook, hidden
-tests included, on the submission.  Only the learner's kernel is left out: a notebook's
+own command (``python -m ros2nb.judge grade``, in a process and session of its own:
+``judge_apart.py``) runs every graded cell of the course's notebook, hidden tests included,
+on the submission.  Only the learner's kernel and the sandboxes are left out: a notebook's
 answer cells reach the judge as its files and its answer cells, which is all the judge reads.
 
 ``python tests/corpora.py [NAME ...]`` prints ``name<TAB>score<TAB>failed grade ids``, one
@@ -17,11 +18,12 @@ scores the same learners with that checkout's judge (the closing notes' "before"
 from __future__ import annotations
 
 import contextlib
-import copy
 import io
 import json
+import os
 import re
 import shlex
+import subprocess
 import sys
 import tempfile
 from dataclasses import dataclass, field
@@ -32,6 +34,8 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / 'tests'))  # judging.py, the corpora
 SOLUTIONS = ROOT / 'solutions'
 NOTEBOOKS = {p.stem[:2]: p for p in SOLUTIONS.glob('*.ipynb')}
+#: Seconds one learner's judge may take (below the corpora's test limit of 300 s).
+JUDGE_TIMEOUT_S = 270
 #: A cell's new text, or (old, new) replacements in it.
 Change = Union[str, list[tuple[str, str]]]
 
@@ -165,24 +169,41 @@ def learner_workspace(learner: Learner, root: Path) -> Iterator[tuple[Path, dict
         yield ws, nb
 
 
-def grade_learner(learner: Learner, root: Path) -> dict[str, dict]:
-    """Grade one learner's notebook in a fresh workspace under ``root``.
+def grade_learner(learner: Learner, root: Path, *, knows_nothing: bool = False
+                  ) -> dict[str, dict]:
+    """Grade one learner's notebook in a fresh workspace under ``root``, with the judge's
+    own command in a process and session of its own (``judge_apart.py``), as the grader
+    runs it.
 
+    :param knows_nothing: the judge's reader of the learner's text finds nothing.
     :return: ``{grade id without NN-: result}`` (``passed``, and ``message`` when failed).
+    :raises AssertionError: when the judge printed no result (its output in the message).
     """
-    from ros2nb.checks.base import bind_judge
-    from ros2nb.judge.grading import grade
-    from ros2nb.judge.session import Session
-    source = json.loads(NOTEBOOKS[learner.notebook].read_text())
-    with learner_workspace(learner, root) as (ws, nb), \
-            contextlib.redirect_stdout(io.StringIO()):
-        session = Session(ws)
-        bind_judge(session)
-        try:
-            results = grade(source, copy.deepcopy(nb))
-        finally:
-            bind_judge(None)
-            session.close()
+    from ros2nb import domains
+    from ros2nb.checks.dispatch import IN_JUDGE_ENV
+    from ros2nb.course import GRADING_ENV
+    from ros2nb.processes import kill_process_group
+    from ros2nb.terminal.workspace import WORKSPACE_ENV
+    with learner_workspace(learner, root) as (ws, nb):
+        pass  # written: the judge reads it from its own process
+    given = root / 'given'
+    given.mkdir()
+    (given / 'source.ipynb').write_text(NOTEBOOKS[learner.notebook].read_text())
+    (given / 'submission.ipynb').write_text(json.dumps(nb))
+    env = {k: v for k, v in os.environ.items() if k != domains.DOMAIN_ENV}
+    env.update({IN_JUDGE_ENV: '1', WORKSPACE_ENV: str(ws), GRADING_ENV: '1'})
+    command = [sys.executable, str(ROOT / 'tests' / 'judge_apart.py'),
+               *(['--knows-nothing'] if knows_nothing else []),
+               str(given / 'source.ipynb'), str(given / 'submission.ipynb')]
+    judge = subprocess.Popen(command, env=env, cwd=root, text=True, stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, start_new_session=True)
+    try:
+        out, err = judge.communicate(timeout=JUDGE_TIMEOUT_S)
+    finally:
+        kill_process_group(judge)  # what it left (nothing, once it answered)
+    lines = out.strip().splitlines()
+    assert lines and lines[-1].startswith('{'), f'the judge printed no result: {out}{err}'
+    results = json.loads(lines[-1])['results']
     return {gid[3:]: result for gid, result in results.items()}
 
 

@@ -13,28 +13,28 @@ from __future__ import annotations
 
 import pytest
 
-from ros2nb.checks import source
 from corpora import grade_learner
 from corpus_attacks import ATTACKS
-from corpus_checks import KnowsNothing, failed, scores_what_its_twin_scores, within
-from corpus_wrong import WRONG
+from corpus_checks import failed, scores_what_its_twin_scores
 
 pytestmark = pytest.mark.timeout(300)
-
-
-def test_the_text_reader_only_words_failures(tmp_path, monkeypatch):
-    """A wrong learner graded with a reader that knows nothing loses the same part as with
-    the reader: the text chose the words of its line, never whether the part passed.  With
-    the reader it is graded in ``test_corpus_wrong_03_06.py``, which asserts the same parts
-    (grading it a second time here cost a worker 25 s, 100 s beside two CPU burners)."""
-    learner = WRONG[0]  # the timer as dead code: the reader names it, the judge fails it
-    assert learner in within(WRONG, '03', '06')
-    monkeypatch.setattr(source.TEXT, 'read', KnowsNothing().read)
-    without = failed(grade_learner(learner, tmp_path / 'without'))
-    assert set(without) == set(learner.loses), without
-
-
 TWINS = {learner.name: learner for learner in ATTACKS}
+
+
+def test_the_text_reader_only_words_failures(tmp_path):
+    """A learner graded with a reader of their text that knows nothing loses the same part as
+    with the reader: the text chose the words of its line, never whether the part passed.
+    The sensor without a timer: the reader names what is missing, and without it the line
+    says only what the judge saw (which also shows the reader was replaced in the judge)."""
+    learner = TWINS['03 twin: no timer']
+    lost = {knows_nothing: failed(grade_learner(learner, tmp_path / str(knows_nothing),
+                                                knows_nothing=knows_nothing))
+            for knows_nothing in (False, True)}
+    assert set(lost[False]) == set(lost[True]) == set(learner.loses), lost
+    assert 'TemperatureSensor has no timer' in lost[False]['sensor-constructor'], lost
+    assert 'has no timer' not in lost[True]['sensor-constructor'], lost
+
+
 #: Attacks the wire can tell from honest code (the rest are flagged: tests/test_flags.py).
 WIRE_ATTACKS = [a for a in ATTACKS if a.twin and not a.same_on_the_wire]
 

@@ -10,5 +10,5 @@ LEARNERS = within(HONEST, '03', '05')
 
 
 @pytest.mark.parametrize('learner', LEARNERS, ids=[learner.name for learner in LEARNERS])
-def test_an_honest_learner_gets_full_marks_without_the_text_reader(learner, tmp_path, monkeypatch):
-    full_marks_without_the_text_reader(learner, tmp_path, monkeypatch)
+def test_an_honest_learner_gets_full_marks_without_the_text_reader(learner, tmp_path):
+    full_marks_without_the_text_reader(learner, tmp_path)

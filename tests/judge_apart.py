@@ -1,0 +1,44 @@
+"""The judge's own command, ``python -m ros2nb.judge grade SOURCE SUBMISSION``, for the corpora.
+
+``python tests/judge_apart.py [--knows-nothing] SOURCE SUBMISSION`` grades one submission as
+the grader's judge does (a process of its own, started in a session of its own, the course's
+reference nodes hidden by ``ROS2NB_GRADING``), and prints the judge's one JSON line.  With
+``--knows-nothing`` the judge's reader of the learner's text (:data:`ros2nb.checks.source.TEXT`)
+finds nothing: no point may depend on reading the learner's code.
+
+The corpora's tests (``corpora.py``) start it rather than judging in the test process: a judge
+steps its subject's clock one simulated second at a time, each step a turn of each process,
+and in pytest-xdist's worker the judge shared the worker's scheduling group (its session) with
+every other worker: beside two CPU burners started from the same shell, one hour of notebook
+03 took its test 80 s instead of 5.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Optional
+
+from ros2nb.checks import source
+
+
+class KnowsNothing(source.TextReader):
+    """A reader of the learner's text that never finds anything."""
+
+    def read(self, path: Path) -> Optional[str]:
+        return None
+
+
+def main(argv: list[str]) -> int:
+    """Grade SOURCE's graded cells on SUBMISSION, as ``python -m ros2nb.judge grade``."""
+    knows_nothing = '--knows-nothing' in argv
+    paths = [arg for arg in argv if arg != '--knows-nothing']
+    if knows_nothing:  # the one reader's method: modules hold the reader itself
+        source.TEXT.read = KnowsNothing().read  # type: ignore[method-assign]
+    from ros2nb.judge.__main__ import main as judge
+    return judge(['grade', *paths])
+
+
+if __name__ == '__main__':
+    from ros2nb.processes import end_this_process
+    end_this_process(main(sys.argv[1:]))
