@@ -15,6 +15,7 @@ from pathlib import Path
 
 from corpora import Learner, expected_score, grade_learner, score
 
+
 def failed(results: dict) -> dict[str, str]:
     """grade id -> message, of the parts that failed."""
     return {gid: r.get('message', '') for gid, r in results.items() if not r['passed']}
