@@ -4,8 +4,9 @@ Playwright's own browser download is not reachable from our machines, so the bro
 Debian's ``chromium`` (``make test`` installs it through the Makefile's ``browser-tool``).
 Where it is missing, browser tests skip with the one line :func:`problem` gives.
 
-Use the ``page`` fixture (``from browser import page`` in a test module), or
-:func:`chromium` for a browser of your own.
+Use the ``page`` fixture (``from browser import module_chromium, page`` in a test module:
+each test's page in a context of its own, of one chromium per module), or :func:`chromium`
+for a browser of your own.
 """
 
 from __future__ import annotations
@@ -46,13 +47,21 @@ def chromium() -> Iterator:
             browser.close()
 
 
-@pytest.fixture
-def page():
-    """A fresh page in a fresh headless chromium; skips the test where there is no browser."""
+@pytest.fixture(scope='module')
+def module_chromium():
+    """One headless chromium for a test module's pages (a launch costs about 5 CPU-s);
+    skips the tests where there is no browser."""
     why = problem()
     if why:
         pytest.skip(why)
     with chromium() as browser:
-        context = browser.new_context()
-        yield context.new_page()
-        context.close()
+        yield browser
+
+
+@pytest.fixture
+def page(module_chromium):
+    """A fresh page, in a browser context of its own (its own cookies and storage), of the
+    module's chromium."""
+    context = module_chromium.new_context()
+    yield context.new_page()
+    context.close()

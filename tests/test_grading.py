@@ -23,7 +23,7 @@ from pathlib import Path
 
 import pytest
 
-from browser import page  # noqa: F401 - the fixture
+from browser import module_chromium, page  # noqa: F401 - the fixtures
 from grading_samples import (EXPECTED, FULL, GRADE_WITH_FAULTS, MARK, NB01, NOT_UTF8, PWNED, ROOT,
                              SOLUTION, STAGES, build)
 
