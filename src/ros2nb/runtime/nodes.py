@@ -36,8 +36,6 @@ def drop_qos_warnings(node: Node, entities: Optional[Iterable[Any]] = None) -> N
     time.
     """
     for entity in (node.publishers if entities is None else entities):
-        if entity is None:
-            continue
         for handler in entity.event_handlers:
             node.remove_waitable(handler)
             handler.destroy()
@@ -50,7 +48,8 @@ def rclpys_own_entities(node: Node) -> list[Any]:
     node is on simulated time.  A QoS warning of theirs could only ever be about another
     program's endpoint."""
     source = getattr(node, '_time_source', None)
-    return [getattr(node, '_parameter_event_publisher', None), getattr(source, '_clock_sub', None)]
+    made = (getattr(node, '_parameter_event_publisher', None), getattr(source, '_clock_sub', None))
+    return [entity for entity in made if entity is not None]
 
 
 class NodeKeeping:
