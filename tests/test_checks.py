@@ -245,14 +245,17 @@ def test_a_shutdown_from_outside_that_the_spin_missed_still_ends_it(session):
         restore(session, SUB)
 
 
-def test_package_checks(session, capsys):
+@pytest.fixture
+def package_files(session):
+    """setup.py and setup.cfg as pkg_create wrote them, and a writer of console_scripts lines;
+    both files (and the publisher) are put back afterwards.  The package's checks are split in
+    two tests: each builds the package five to seven times, and together they outran one test's
+    time limit on a busy machine."""
     setup_py = session.workspace / course.SETUP_PY_FILE
     setup_cfg = session.workspace / course.SETUP_CFG_FILE
     generated_py, generated_cfg = setup_py.read_text(), setup_cfg.read_text()
     empty = "        'console_scripts': [\n        ],\n"
     assert empty in generated_py
-    publisher = "'temperature_publisher = sensor_simulator.temperature_publisher:main'"
-    subscriber = "'temperature_subscriber = sensor_simulator.temperature_subscriber:main'"
 
     def entries(*lines: str) -> None:
         """setup.py as pkg_create wrote it, with these lines in its console_scripts list."""
@@ -260,47 +263,60 @@ def test_package_checks(session, capsys):
             f'            {line}\n' for line in lines) + '        ],\n'))
 
     try:
-        entries('# YOUR CODE HERE', 'raise NotImplementedError()')
-        fails(checks.check_entry_points, r'setup.py still holds the placeholder')
-        entries()
-        fails(checks.check_entry_points, r'ros2 run sensor_simulator temperature_publisher: No '
-                                         r'executable found: console_scripts has no entry named '
-                                         r'temperature_publisher')
-        entries(publisher, subscriber + ',')  # no comma after the first
-        fails(checks.check_entry_points, r'is two entries run together: end each string in the '
-                                         r'console_scripts list with a comma')
-        entries("'temperature_publisher = sensor_simulator/temperature_publisher.py:main',")
-        fails(checks.check_entry_points, r'is not written NAME = package.module:function: the '
-                                         r'module is written with dots')
-        entries("'temperature_publisher = sensor_simulator.publisher:main',", subscriber + ',')
-        fails(checks.check_entry_points, r'did not start main\(\) of '
-                                         r'sensor_simulator.temperature_publisher: .*'
-                                         r'temperature_publisher = sensor_simulator.publisher:main: '
-                                         r'it should start main\(\) in sensor_simulator/temperature_publisher.py')
-        entries(publisher + ',', subscriber + ',')
-        setup_cfg.write_text(generated_cfg.replace('$base/lib/sensor_simulator', '$base/bin'))
-        fails(checks.check_setup_cfg, r'\[develop\] script_dir is \$base/bin; ros2 run looks in '
-                                      r'\$base/lib/sensor_simulator')
-        setup_cfg.write_text(generated_cfg.replace('=$base/lib/sensor_simulator',
-                                                   '=$base/lib/sensor_simulator/'))
-        checks.check_setup_cfg()  # a trailing slash: the same folder, ros2 run finds them
-        setup_cfg.write_text(generated_cfg.replace('script_dir', 'script-dir'))  # older template
-        fails(checks.check_setup_cfg, r'^setup.cfg spells script-dir with a dash: .*setuptools 78 '
-                                      r'and later refuse it .*: write script_dir\.$')
-        setup_cfg.unlink()
-        fails(checks.check_setup_cfg, r'setup.cfg is missing')
-        setup_cfg.write_text(generated_cfg)
-        # The grader's stand-ins take the place of the nodes: a broken node costs nothing here.
-        (session.workspace / PUB).write_text('raise SystemExit("broken")\n')
-        capsys.readouterr()
-        checks.check_entry_points()
-        checks.check_setup_cfg()
-        checks.check_package_runs()
-        assert capsys.readouterr().out.count('Check passed:') == 3
+        yield setup_cfg, generated_cfg, entries
     finally:
         setup_py.write_text(generated_py)
         setup_cfg.write_text(generated_cfg)
         restore(session, PUB)
+
+
+PUBLISHER_ENTRY = "'temperature_publisher = sensor_simulator.temperature_publisher:main'"
+SUBSCRIBER_ENTRY = "'temperature_subscriber = sensor_simulator.temperature_subscriber:main'"
+
+
+def test_entry_point_checks(package_files):
+    _, _, entries = package_files
+    entries('# YOUR CODE HERE', 'raise NotImplementedError()')
+    fails(checks.check_entry_points, r'setup.py still holds the placeholder')
+    entries()
+    fails(checks.check_entry_points, r'ros2 run sensor_simulator temperature_publisher: No '
+                                     r'executable found: console_scripts has no entry named '
+                                     r'temperature_publisher')
+    entries(PUBLISHER_ENTRY, SUBSCRIBER_ENTRY + ',')  # no comma after the first
+    fails(checks.check_entry_points, r'is two entries run together: end each string in the '
+                                     r'console_scripts list with a comma')
+    entries("'temperature_publisher = sensor_simulator/temperature_publisher.py:main',")
+    fails(checks.check_entry_points, r'is not written NAME = package.module:function: the '
+                                     r'module is written with dots')
+    entries("'temperature_publisher = sensor_simulator.publisher:main',", SUBSCRIBER_ENTRY + ',')
+    fails(checks.check_entry_points, r'did not start main\(\) of '
+                                     r'sensor_simulator.temperature_publisher: .*'
+                                     r'temperature_publisher = sensor_simulator.publisher:main: '
+                                     r'it should start main\(\) in sensor_simulator/temperature_publisher.py')
+
+
+def test_setup_cfg_checks(session, package_files, capsys):
+    setup_cfg, generated_cfg, entries = package_files
+    entries(PUBLISHER_ENTRY + ',', SUBSCRIBER_ENTRY + ',')
+    setup_cfg.write_text(generated_cfg.replace('$base/lib/sensor_simulator', '$base/bin'))
+    fails(checks.check_setup_cfg, r'\[develop\] script_dir is \$base/bin; ros2 run looks in '
+                                  r'\$base/lib/sensor_simulator')
+    setup_cfg.write_text(generated_cfg.replace('=$base/lib/sensor_simulator',
+                                               '=$base/lib/sensor_simulator/'))
+    checks.check_setup_cfg()  # a trailing slash: the same folder, ros2 run finds them
+    setup_cfg.write_text(generated_cfg.replace('script_dir', 'script-dir'))  # older template
+    fails(checks.check_setup_cfg, r'^setup.cfg spells script-dir with a dash: .*setuptools 78 '
+                                  r'and later refuse it .*: write script_dir\.$')
+    setup_cfg.unlink()
+    fails(checks.check_setup_cfg, r'setup.cfg is missing')
+    setup_cfg.write_text(generated_cfg)
+    # The grader's stand-ins take the place of the nodes: a broken node costs nothing here.
+    (session.workspace / PUB).write_text('raise SystemExit("broken")\n')
+    capsys.readouterr()
+    checks.check_entry_points()
+    checks.check_setup_cfg()
+    checks.check_package_runs()
+    assert capsys.readouterr().out.count('Check passed:') == 3
 
 
 def test_no_message_prints_the_answer():
