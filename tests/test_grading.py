@@ -71,7 +71,8 @@ def survivors() -> list[str]:
 @contextlib.contextmanager
 def disk_watched(folder: Path):
     """The most bytes the file system of ``folder`` grew by while the block ran (polled),
-    as ``peak[0]``."""
+    as ``peak[0]``.  Everything else writing to that file system counts too: give a folder
+    on one that only the watched program writes to (:func:`grader_tmp`)."""
     base, peak, stop = shutil.disk_usage(folder).used, [0], threading.Event()
 
     def watch() -> None:
@@ -87,6 +88,26 @@ def disk_watched(folder: Path):
         watcher.join()
 
 
+@contextlib.contextmanager
+def grader_tmp():
+    """A TMPDIR for the grader, on a file system the rest of make test leaves alone.
+
+    The grader's own copies go to TMPDIR (the learners' capped folders are tmpfs mounts of
+    their own there, not counted).  The host's disk is shared with everything else make test
+    runs (a podman build beside the class once wrote 2.3 GB to it while the class was graded),
+    so its growth says nothing about the grader.  /dev/shm is a tmpfs that only ROS's shared
+    memory segments (a few MB) use besides; the growth is measured there, in the grader's folder.
+    """
+    shm = Path('/dev/shm')
+    folder = Path(tempfile.mkdtemp(prefix='ros2nb-test-grader-tmp-',
+                                   dir=shm if shm.is_dir() else None))
+    folder.chmod(0o1777)  # as /tmp: the sandboxes' own user passes through to its folders
+    try:
+        yield folder
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+
+
 @pytest.fixture(scope='module')
 def graded(tmp_path_factory):
     root = tmp_path_factory.mktemp('grading')
@@ -100,10 +121,11 @@ def graded(tmp_path_factory):
                         decoy_gradebook=decoy, home_file=home_file, forged=forged)
     before = fingerprint(ROOT), decoy.read_bytes()
     started = time.monotonic()
-    with disk_watched(Path(tempfile.gettempdir())) as peak:  # where the grader's copies go
+    with grader_tmp() as tmp, disk_watched(tmp) as peak:  # where the grader's copies go
         done = subprocess.run(  # ros2nb-grade, with a fault planted for five learners
             [sys.executable, '-c', GRADE_WITH_FAULTS, str(submissions), '--out', str(out),
-             '--jobs', str(CLASS_JOBS)], capture_output=True, text=True, timeout=1200)
+             '--jobs', str(CLASS_JOBS)], capture_output=True, text=True, timeout=1200,
+            env=dict(os.environ, TMPDIR=str(tmp)))
     (root / 'disk-peak').write_text(str(peak[0]))
     print(f'graded {len(EXPECTED)} learners in {time.monotonic() - started:.0f} s')
     left = survivors()
