@@ -142,11 +142,11 @@ def test_grading_exits_0(graded):
 
 def test_the_grader_copies_stay_within_the_caps(graded):
     """A learner whose every notebook fills the 1 GiB workspace: each judge's snapshot of
-    it is on a capped tmpfs, freed once judged, never on the host's disk (before, each
-    stayed in TMPDIR until the learner's last notebook was judged: 2 GiB here)."""
+    it is on a capped tmpfs, freed once judged, never in the grader's TMPDIR on the host
+    (before, each stayed there until the learner's last notebook was judged: 2 GiB here)."""
     out, *_ = graded
     peak = int((out.parent / 'disk-peak').read_text())
-    assert peak < HOME_BYTES // 2, f'the host disk grew by {peak >> 20} MiB while grading'
+    assert peak < HOME_BYTES // 2, f'the grader\'s TMPDIR grew by {peak >> 20} MiB while grading'
 
 
 def test_every_score_and_csv_row(graded):
