@@ -30,7 +30,11 @@ from grading_samples import (EXPECTED, FULL, GRADE_WITH_FAULTS, MARK, NB01, NOT_
 from ros2nb_instructor.grading import sandbox
 from ros2nb_instructor.grading.scratch import HOME_BYTES
 
-pytestmark = [pytest.mark.timeout(1200),
+#: The longest the class may take to grade (s): a hang detector, not a speed target (make bench
+#: is that). On 2 cores the class took 828-921 s in make test on a machine three times slower
+#: than usual, idle or beside two CPU burners; 1200 s left too little room.
+CLASS_LIMIT_S = 1800
+pytestmark = [pytest.mark.timeout(CLASS_LIMIT_S),
               pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))]
 #: The class is graded by ros2nb-grade's own main (GRADE_WITH_FAULTS: five learners meet a
 #: planted fault) with its default limits per cell and per notebook: an honest notebook must
@@ -124,7 +128,7 @@ def graded(tmp_path_factory):
     with grader_tmp() as tmp, disk_watched(tmp) as peak:  # where the grader's copies go
         done = subprocess.run(  # ros2nb-grade, with a fault planted for five learners
             [sys.executable, '-c', GRADE_WITH_FAULTS, str(submissions), '--out', str(out),
-             '--jobs', str(CLASS_JOBS)], capture_output=True, text=True, timeout=1200,
+             '--jobs', str(CLASS_JOBS)], capture_output=True, text=True, timeout=CLASS_LIMIT_S,
             env=dict(os.environ, TMPDIR=str(tmp)))
     (root / 'disk-peak').write_text(str(peak[0]))
     print(f'graded {len(EXPECTED)} learners in {time.monotonic() - started:.0f} s')
