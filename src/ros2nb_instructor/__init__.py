@@ -14,7 +14,8 @@ import sys
 
 # Every tool here reads notebooks with nbformat, which imports jsonschema, which imports
 # rfc3987_syntax if it can: that package builds a parser for IRIs at import, 2.5 CPU-s in
-# each process (ros2nb-grade, its sandboxed runners, the hub's and the lab's servers) for a
-# format no notebook uses.  Marked absent, jsonschema goes without it, as it does wherever
-# the package is not installed (nbgrader's own processes: nbgrader_cli).
+# each process (ros2nb-grade, its sandboxed runners, the hub's learner servers) for a format
+# no notebook uses.  Marked absent, jsonschema goes without it, as it does wherever the
+# package is not installed (programs of others the tools start, nbgrader and the lab's
+# server: ``programs``).
 sys.modules.setdefault('rfc3987_syntax', None)  # its absence is an ImportError jsonschema expects

@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import MutableMapping, NoReturn, Optional
 
 from .paths import NOTEBOOKS, ROOT
+from .programs import program_argv
 
 #: The learner's working folder for ``make lab`` (git ignores it); ``$ROS2NB_WORK`` moves it.
 WORK = ROOT / 'work'
@@ -104,7 +105,6 @@ def main(argv: Optional[list[str]] = None) -> NoReturn:
     Any other argument is passed to ``jupyter lab``.
     """
     args = sys.argv[1:] if argv is None else list(argv)
-    jupyter = Path(sys.executable).parent / 'jupyter'
     if '--instructor' in args:
         args.remove('--instructor')
         root, default_url = ROOT, '/lab/tree/notebooks'
@@ -119,9 +119,11 @@ def main(argv: Optional[list[str]] = None) -> NoReturn:
     # Localhost unless told otherwise (the course's image listens on every interface of its
     # container: `make lab LAB_ARGS=--ServerApp.ip=0.0.0.0`); traitlets refuses two values.
     given_ip = any(a.startswith(('--ServerApp.ip', '--ip')) for a in args)
-    os.execv(jupyter, [str(jupyter), 'lab', *([] if given_ip else ['--ServerApp.ip=127.0.0.1']),
-                       f'--ServerApp.root_dir={root}', f'--LabApp.default_url={default_url}',
-                       *(['--allow-root'] if os.geteuid() == 0 else []), *args])
+    argv = program_argv('jupyter-lab', 'jupyterlab.labapp',
+                        *([] if given_ip else ['--ServerApp.ip=127.0.0.1']),
+                        f'--ServerApp.root_dir={root}', f'--LabApp.default_url={default_url}',
+                        *(['--allow-root'] if os.geteuid() == 0 else []), *args)
+    os.execv(argv[0], argv)
 
 
 if __name__ == '__main__':

@@ -20,7 +20,7 @@ import tempfile
 from pathlib import Path
 from typing import Optional
 
-from ..nbgrader_cli import nbgrader_argv
+from ..programs import nbgrader_argv
 from ..paths import ASSIGNMENT, NOTEBOOKS, ROOT, SOLUTIONS, gradebook_url
 
 

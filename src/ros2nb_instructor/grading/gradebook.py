@@ -23,7 +23,7 @@ from typing import Iterable, Optional
 
 from nbgrader.api import Gradebook, MissingEntry
 
-from ..nbgrader_cli import nbgrader_argv
+from ..programs import nbgrader_argv
 from ..paths import ASSIGNMENT, ROOT, SOLUTIONS, gradebook_url
 from . import feedback
 from .submissions import Learner, screen_zip
