@@ -57,20 +57,29 @@ def _course_env(course: Path) -> dict[str, str]:
                 PATH=os.pathsep.join([str(Path(sys.executable).parent), os.environ['PATH']]))
 
 
-def set_up_course(course: Path) -> list[str]:
-    """Create the nbgrader course (source with hidden tests, release, gradebook).
+def kept_course() -> Path:
+    """The nbgrader course of the current solutions (source with hidden tests, release,
+    gradebook), made by nbgrader's ``generate_assignment`` once per version of the
+    solutions and kept in ``.cache/grading-courses/<digest>/``; return its folder.
 
-    nbgrader's ``generate_assignment`` runs once per version of the solutions: its result
-    is kept in ``.cache/grading-courses/<digest>/`` and copied from there (the gradebook
-    then holds the assignment and its cells, and no learner yet).
+    ``make test`` makes it before the tests start (the Makefile's ``grading-course``).
 
-    :return: the notebooks' names (``NN-title``), in course order.
+    :raises SystemExit: when ``generate_assignment`` failed (the message names its log).
     """
-    digest = _solutions_digest()
-    kept = SET_UP_CACHE / digest
+    kept = SET_UP_CACHE / _solutions_digest()
     if not (kept / 'gradebook.db').is_file():
         _generate_course(kept)
-    shutil.copytree(kept, course, dirs_exist_ok=True)
+    return kept
+
+
+def set_up_course(course: Path) -> list[str]:
+    """Create the nbgrader course in ``course``: a copy of :func:`kept_course` (its
+    gradebook holds the assignment and its cells, and no learner yet).
+
+    :return: the notebooks' names (``NN-title``), in course order.
+    :raises SystemExit: when ``generate_assignment`` failed (the message names its log).
+    """
+    shutil.copytree(kept_course(), course, dirs_exist_ok=True)
     return sorted(p.stem for p in (course / 'source' / ASSIGNMENT).glob('*.ipynb'))
 
 
