@@ -79,7 +79,7 @@ def test_the_learners_lab_turns_off_the_instructor_tools_and_the_news():
 def test_the_lab_server_starts_without_the_iri_parser(monkeypatch, tmp_path):
     """``ros2nb-lab`` becomes JupyterLab's server in a Python where jsonschema goes without
     rfc3987_syntax, which builds a parser for IRIs at import (the lab's server answered after
-    2.3-3.1 CPU-s with it, 1.1-1.2 without).  Each program is asked only for its help, which
+    2.3-3.9 CPU-s with it, 1.1-1.2 without).  Each program is asked only for its help, which
     it gives after importing its server; ``-X importtime`` lists what it imported."""
     execs = []
 

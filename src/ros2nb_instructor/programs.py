@@ -2,8 +2,8 @@
 
 Each is its own entry point, with one change: jsonschema (which nbformat and Jupyter's
 server import) would import ``rfc3987_syntax`` if it could, and that builds a parser for
-IRIs at import, one to two CPU-s for a format no notebook uses (the lab's server took 2.7-3.9
-CPU-s to answer with it, on a slow machine).  Marked absent, jsonschema goes without it, as
+IRIs at import, for a format no notebook uses (the lab's server answered after 2.3-3.9 CPU-s
+with it, 1.1-1.2 without, on a slow machine).  Marked absent, jsonschema goes without it, as
 it does wherever that package is not installed; in the course's own processes
 ``ros2nb_instructor`` marks it (see there).
 """
