@@ -16,6 +16,6 @@ import sys
 # rfc3987_syntax if it can: that package builds a parser for IRIs at import, 2.5 CPU-s in
 # each process (ros2nb-grade, its sandboxed runners, the hub's learner servers) for a format
 # no notebook uses.  Marked absent, jsonschema goes without it, as it does wherever the
-# package is not installed (programs of others the tools start, nbgrader and the lab's
-# server: ``programs``).
+# package is not installed.  Programs of others the tools start (nbgrader, the lab's server)
+# import this package first (``programs``).
 sys.modules.setdefault('rfc3987_syntax', None)  # its absence is an ImportError jsonschema expects

@@ -4,15 +4,15 @@ Each is its own entry point, with one change: jsonschema (which nbformat and Jup
 server import) would import ``rfc3987_syntax`` if it could, and that builds a parser for
 IRIs at import, for a format no notebook uses (the lab's server answered after 2.3-3.9 CPU-s
 with it, 1.1-1.2 without, on a slow machine).  Marked absent, jsonschema goes without it, as
-it does wherever that package is not installed; in the course's own processes
-``ros2nb_instructor`` marks it (see there).
+it does wherever that package is not installed.  ``ros2nb_instructor`` marks it as it is
+imported (see there): each program imports it first.
 """
 
 from __future__ import annotations
 
 import sys
 
-_MAIN = ("import sys; sys.modules.setdefault('rfc3987_syntax', None); "
+_MAIN = ("import sys, ros2nb_instructor; "
          "sys.argv[0] = {name!r}; from {module} import main; sys.exit(main())")
 
 
