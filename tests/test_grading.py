@@ -163,9 +163,18 @@ def test_every_score_and_csv_row(graded):
     for learner, case in EXPECTED.items():
         row = in_the_csv(learner)
         for notebook in NOTEBOOKS:
-            assert got[row, notebook] == case.scores.get(notebook, 0), (learner, notebook)
+            assert got[row, notebook] == case.scores.get(notebook, 0), \
+                (learner, notebook, failure_lines(out, learner, notebook))
         assert got[row, 'TOTAL'] == sum(case.scores.values()), learner
     assert maxima == {**{n: float(p) for n, p in FULL.items()}, 'TOTAL': float(sum(FULL.values()))}
+
+
+def failure_lines(out: Path, learner: str, notebook: str) -> list[str]:
+    """The verdicts of failed cells on a learner's feedback page (what a wrong score is about)."""
+    page = out / 'feedback' / learner / f'{notebook}.html'
+    if not page.is_file():
+        return ['no feedback page']
+    return re.findall(r'\b\w*(?:Failed|Error|Hung): .{0,300}', shown(page))
 
 
 def as_text(learner: str) -> str:

@@ -245,8 +245,12 @@ def _runs(judge: Judge, ws: Path) -> Optional[str]:
     finally:
         for proc, _out in procs:
             kill_process_group(proc)
-    if codes != [0, 0]:
-        return f'After Ctrl+C the executables exited with {codes}, expected [0, 0].'
+    for name, out, code in ((course.PUBLISHER_EXECUTABLE, sensor_out, codes[0]),
+                            (course.SUBSCRIBER_EXECUTABLE, monitor_out, codes[1])):
+        if code != 0:
+            return (f'After Ctrl+C, ros2 run {course.PACKAGE} {name} exited with '
+                    f'{"no exit (killed)" if code is None else f"code {code}"}, expected 0 '
+                    f'({last_line(out.text())}).')
     return None
 
 
