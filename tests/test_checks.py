@@ -11,6 +11,8 @@ import contextlib
 import json
 import re
 import shutil
+import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -18,6 +20,7 @@ import pytest
 from ros2nb import checks, course
 from ros2nb.checks.dispatch import IN_JUDGE_ENV
 from ros2nb.errors import CheckFailed, LearnerCodeError
+from ros2nb.judge.subjects import SubjectHung
 
 from waiting import wait_for
 from judging import judge_session
@@ -243,6 +246,31 @@ def test_a_shutdown_from_outside_that_the_spin_missed_still_ends_it(session):
         checks.check_monitor_main()
     finally:
         restore(session, SUB)
+
+
+#: A program that works for 1.5 CPU seconds at a third of a CPU, as beside two CPU burners.
+SLOW_PROGRAM = """
+import time
+start = time.process_time()
+while time.process_time() - start < 1.5:
+    burst = time.process_time()
+    while time.process_time() - burst < 0.02:
+        pass
+    time.sleep(0.04)
+"""
+
+
+def test_a_program_the_judge_runs_is_given_work_not_wall_time(session, tmp_path):
+    """What the judge runs itself (notebook 05's colcon build, its sourcing) may take longer
+    than its seconds on a busy machine: they count its work.  A program that only waits is
+    ended once it waited them."""
+    began = time.monotonic()
+    code, _output = session.run([sys.executable, '-c', SLOW_PROGRAM], seconds=2, cwd=tmp_path)
+    assert code == 0 and time.monotonic() - began > 2  # a limit on the wall clock cut it
+    began = time.monotonic()
+    with pytest.raises(SubjectHung, match=r'^sleep did not finish within 2 s\.$'):
+        session.run(['sleep', '3600'], seconds=2, cwd=tmp_path)
+    assert 2 <= time.monotonic() - began < 60
 
 
 @pytest.fixture

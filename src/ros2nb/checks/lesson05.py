@@ -28,13 +28,13 @@ from std_msgs.msg import Float32
 
 from .. import course
 from ..errors import CheckFailed, Ros2nbError
-from ..processes import interrupt, kill_process_group, wait_patiently
+from ..processes import Patience, interrupt, kill_process_group, wait_patiently
 from ..terminal.colcon import build_cause, venv_tool
 from ..terminal.files import saved_parts
 from ..terminal.pkg_templates import SETUP_CFG, render_setup_py
 from ..terminal.run import find_executable
 from .base import ARRIVAL_TIMEOUT_S, Judge, judged
-from .mains import EXIT_AFTER_CTRL_C_S, last_line
+from .mains import EXIT_AFTER_CTRL_C_S, LOOK_AGAIN_S, last_line
 from .package_stand_ins import EXECUTABLES
 from .source import TEXT
 
@@ -141,7 +141,7 @@ def _built(judge: Judge, *, setup_py: Optional[str] = None,
     colcon = venv_tool('colcon')
     if colcon is None:
         raise Ros2nbError('colcon is not installed: run `make lab` or `make test`.')
-    code, output = judge.run([colcon, 'build'], seconds=300, cwd=ws)
+    code, output = judge.run([colcon, 'build'], seconds=300, cwd=ws, what='colcon build')
     if code != 0:  # a console_scripts string setuptools cannot read says more than its error
         held = [n for n, given in (('setup.py', setup_py), ('setup.cfg', setup_cfg))
                 if given is None and PLACEHOLDER in (TEXT.read(source / n) or '')]
@@ -169,7 +169,8 @@ def _sourced(judge: Judge, ws: Path) -> dict[str, str]:
     learner's setup.py (a package may declare hooks of its own): the judge never runs them
     itself, it reads what they gave as data.
     """
-    code, output = judge.run(['bash', '-c', SOURCED_ENV, sys.executable], seconds=60, cwd=ws)
+    code, output = judge.run(['bash', '-c', SOURCED_ENV, sys.executable], seconds=60,
+                             cwd=ws, what='source install/setup.bash')
     try:
         env = json.loads(output.splitlines()[-1]) if code == 0 else None
     except (IndexError, ValueError):
@@ -227,9 +228,13 @@ def _runs(judge: Judge, ws: Path) -> Optional[str]:
         except CheckFailed as problem:
             return str(problem)
         (sensor, sensor_out), (monitor, monitor_out) = procs
-        observer.wait_until(lambda: heard in observer.lines_of(course.MONITOR_NODE, mark)
-                            or sensor.poll() is not None or monitor.poll() is not None,
-                            ARRIVAL_TIMEOUT_S)
+        # until the monitor logs the reading, one of them ends, or both had their patience
+        patience = [Patience(proc.pid, ARRIVAL_TIMEOUT_S) for proc in (sensor, monitor)]
+        while not observer.wait_until(
+                lambda: heard in observer.lines_of(course.MONITOR_NODE, mark)
+                or sensor.poll() is not None or monitor.poll() is not None, LOOK_AGAIN_S):
+            if all([each.exhausted() for each in patience]):  # each looks every time
+                break
         if heard not in observer.lines_of(course.MONITOR_NODE, mark):
             if not any(round(h.value, 3) == given for h in readings[first:]):
                 name, out = course.PUBLISHER_EXECUTABLE, sensor_out

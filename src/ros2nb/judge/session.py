@@ -26,7 +26,7 @@ from .. import course
 from ..checks.base import AnswerRef, learner_error
 from ..checks.nodes import parts_verdict
 from ..errors import CheckFailed
-from ..processes import kill_process_group
+from ..processes import kill_process_group, wait_patiently
 from ..runtime.clock import JUDGE_TOPICS_ENV
 from ..subject.forked import fork_program
 from ..terminal.workspace import WORKSPACE_ENV
@@ -207,15 +207,19 @@ class Session:
         return proc, Output(proc.stdout)
 
     def run(self, argv: list[str], *, seconds: float, cwd: Path,
-            env: Optional[dict[str, str]] = None) -> tuple[int, str]:
-        """Run a program of the learner's (sandboxed while grading); return code and output."""
+            env: Optional[dict[str, str]] = None, what: Optional[str] = None) -> tuple[int, str]:
+        """Run a program of the learner's (sandboxed while grading); return code and output.
+
+        :param seconds: what the program gets (:func:`~ros2nb.processes.wait_patiently`):
+            seconds of its work while it works, of the wall clock while it waits.
+        :param what: the program as its failure names it (default: its file's name).
+        :raises SubjectHung: when it had them and still runs.
+        """
         proc, output = self.start(argv, cwd=cwd, env=env)
-        try:
-            code = proc.wait(seconds)
-        except subprocess.TimeoutExpired:
-            code = kill_process_group(proc)
-            raise SubjectHung(f'{Path(argv[-1]).name} did not finish within {seconds:g} s.') \
-                from None
+        code = wait_patiently(proc, seconds)
+        if code is None:
+            kill_process_group(proc)
+            raise SubjectHung(f'{what or Path(argv[0]).name} did not finish within {seconds:g} s.')
         return code, output.text()
 
     def hand_over(self, prefix: str, files: dict[str, bytes]) -> Path:
