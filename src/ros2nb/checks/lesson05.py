@@ -28,13 +28,13 @@ from std_msgs.msg import Float32
 
 from .. import course
 from ..errors import CheckFailed, Ros2nbError
-from ..processes import Patience, interrupt, kill_process_group, wait_patiently
+from ..processes import interrupt, kill_process_group, wait_patiently
 from ..terminal.colcon import build_cause, venv_tool
 from ..terminal.files import saved_parts
 from ..terminal.pkg_templates import SETUP_CFG, render_setup_py
 from ..terminal.run import find_executable
 from .base import ARRIVAL_TIMEOUT_S, Judge, judged
-from .mains import EXIT_AFTER_CTRL_C_S, LOOK_AGAIN_S, last_line
+from .mains import EXIT_AFTER_CTRL_C_S, last_line, wait_while_working
 from .package_stand_ins import EXECUTABLES
 from .source import TEXT
 
@@ -228,13 +228,9 @@ def _runs(judge: Judge, ws: Path) -> Optional[str]:
         except CheckFailed as problem:
             return str(problem)
         (sensor, sensor_out), (monitor, monitor_out) = procs
-        # until the monitor logs the reading, one of them ends, or both had their patience
-        patience = [Patience(proc.pid, ARRIVAL_TIMEOUT_S) for proc in (sensor, monitor)]
-        while not observer.wait_until(
-                lambda: heard in observer.lines_of(course.MONITOR_NODE, mark)
-                or sensor.poll() is not None or monitor.poll() is not None, LOOK_AGAIN_S):
-            if all([each.exhausted() for each in patience]):  # each looks every time
-                break
+        wait_while_working(observer, lambda: heard in observer.lines_of(course.MONITOR_NODE, mark)
+                           or sensor.poll() is not None or monitor.poll() is not None,
+                           [sensor, monitor], ARRIVAL_TIMEOUT_S)
         if heard not in observer.lines_of(course.MONITOR_NODE, mark):
             if not any(round(h.value, 3) == given for h in readings[first:]):
                 name, out = course.PUBLISHER_EXECUTABLE, sensor_out
