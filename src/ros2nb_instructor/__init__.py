@@ -17,5 +17,7 @@ import sys
 # each process (ros2nb-grade, its sandboxed runners, the hub's learner servers) for a format
 # no notebook uses.  Marked absent, jsonschema goes without it, as it does wherever the
 # package is not installed.  Programs of others the tools start (nbgrader, the lab's server)
-# import this package first (``programs``).
+# import this package first (``programs``).  The pip route pins jsonschema below 4.25
+# (environment/requirements.txt), which does not install the package at all; the mark stays
+# for the other routes (RoboStack), where jsonschema is not pinned.
 sys.modules.setdefault('rfc3987_syntax', None)  # its absence is an ImportError jsonschema expects
