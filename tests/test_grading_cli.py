@@ -17,10 +17,7 @@ import pytest
 
 from grading_samples import LEARNER, NB01, SOLUTION
 
-from nbgrader.api import Gradebook
-
 from ros2nb_instructor.grading import sandbox
-from ros2nb_instructor.grading.gradebook import Scoring, set_up_course
 from ros2nb_instructor.paths import ASSIGNMENT, gradebook_url
 
 #: The instructor's grading command, as the course's venv installs it.
@@ -121,6 +118,10 @@ def test_a_scoring_process_that_ended_is_started_again(tmp_path):
     """nbgrader scores a class batch by batch in one process (gradebook.Scoring); one that
     ended between two batches (killed, crashed) is started again for the next batch, whose
     learner is scored all the same (without the new start, that batch was lost: 0 points)."""
+    # Here, not at the top: nbgrader's package imports its server extensions (1 CPU-s), and
+    # every pytest-xdist worker imports each test file while it collects.
+    from nbgrader.api import Gradebook
+    from ros2nb_instructor.grading.gradebook import Scoring, set_up_course
     course = tmp_path / 'nbgrader'
     course.mkdir()
     set_up_course(course)
