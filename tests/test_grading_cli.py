@@ -16,6 +16,7 @@ from pathlib import Path
 import pytest
 
 from grading_samples import LEARNER, NB01, SOLUTION
+from waiting import PATIENCE_S, wait_for
 
 from ros2nb_instructor.grading import sandbox
 from ros2nb_instructor.paths import ASSIGNMENT, gradebook_url
@@ -148,3 +149,48 @@ def _runs(pid: str, *words: bytes) -> bool:
     except OSError:
         return False
     return all(word in command for word in words)
+
+
+
+@pytest.mark.parametrize('locked', [True, False], ids=['with the lock', 'without it'])
+def test_a_grading_waits_for_the_course_another_is_making(locked, tmp_path, monkeypatch):
+    """The nbgrader course is made once per version of the solutions (``kept_course``): a
+    grading that asks while another is making it waits for that one (``make test`` makes it
+    as its tests start, and the tests that grade ask at once).  Without the lock the second
+    made it again (nbgrader's generate_assignment: about 10 CPU-s).  generate_assignment is
+    played by a stand-in that holds until the test lets it finish."""
+    import fcntl
+    import threading
+
+    from ros2nb_instructor.grading import gradebook
+    monkeypatch.setattr(gradebook, 'SET_UP_CACHE', tmp_path)
+    made, at_lock, finish = [], [], threading.Event()
+    real_flock = fcntl.flock
+
+    def flock(fd, operation):
+        at_lock.append(operation)
+        if locked:
+            real_flock(fd, operation)
+
+    def generate(kept):
+        made.append(kept)
+        finish.wait(PATIENCE_S)
+        kept.mkdir(exist_ok=True)
+        (kept / 'gradebook.db').write_bytes(b'')
+
+    monkeypatch.setattr(fcntl, 'flock', flock)
+    monkeypatch.setattr(gradebook, '_generate_course', generate)
+    found = []
+    graders = [threading.Thread(target=lambda: found.append(gradebook.kept_course()))
+               for _ in range(2)]
+    graders[0].start()
+    wait_for(lambda: made, 'the first grading making the course')
+    graders[1].start()
+    wait_for(lambda: len(at_lock) == 2, 'the second grading at the lock')
+    if not locked:
+        wait_for(lambda: len(made) == 2, 'the second grading making the course too')
+    finish.set()
+    for grader in graders:
+        grader.join(PATIENCE_S)
+    assert len(made) == (1 if locked else 2)
+    assert found == [tmp_path / gradebook._solutions_digest()] * 2

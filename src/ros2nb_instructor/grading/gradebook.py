@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import fcntl
 import hashlib
 import html
 import json
@@ -62,13 +63,19 @@ def kept_course() -> Path:
     gradebook), made by nbgrader's ``generate_assignment`` once per version of the
     solutions and kept in ``.cache/grading-courses/<digest>/``; return its folder.
 
-    ``make test`` makes it before the tests start (the Makefile's ``grading-course``).
+    One grading makes it at a time: another that asks meanwhile waits for that one (a lock
+    beside it), rather than making a second copy.  ``make test`` starts making it as its
+    steps start (``tests/run_steps.sh``), so the tests that grade find it made.
 
     :raises SystemExit: when ``generate_assignment`` failed (the message names its log).
     """
     kept = SET_UP_CACHE / _solutions_digest()
     if not (kept / 'gradebook.db').is_file():
-        _generate_course(kept)
+        kept.parent.mkdir(parents=True, exist_ok=True)
+        with open(kept.parent / f'{kept.name}.lock', 'a') as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+            if not (kept / 'gradebook.db').is_file():
+                _generate_course(kept)
     return kept
 
 
@@ -93,7 +100,6 @@ def _solutions_digest() -> str:
 
 def _generate_course(kept: Path) -> None:
     """nbgrader's ``generate_assignment`` in a fresh folder, then in place at ``kept``."""
-    kept.parent.mkdir(parents=True, exist_ok=True)
     fresh = Path(tempfile.mkdtemp(prefix='.making-', dir=kept.parent))
     source = fresh / 'source' / ASSIGNMENT
     source.mkdir(parents=True)
