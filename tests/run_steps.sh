@@ -44,25 +44,12 @@ run() {  # run NAME NICENESS ARGS...: pytest ARGS, exit code to $logs/NAME.rc, s
 # took seconds more to discover each other, and a check that waits for a node could time out.
 "$(dirname "$python")/fastdds" shm clean > /dev/null 2>&1 || echo "=== make test: fastdds shm clean failed (going on)"
 
-# The nbgrader course of the current solutions (generate_assignment, kept per version of the
-# solutions in .cache/grading-courses/: ros2nb_instructor.grading.gradebook.kept_course), made
-# alongside the steps' start: pytest-xdist's workers collect the tests for longer than that.
-# A test that grades meanwhile waits for it (a lock) rather than making a second one.  Made by
-# no one beforehand, the first test that graded made it at make test's busiest moment, and the
-# sample class (tests/'s longest chain) waited 226 s for its first learner beside two burners.
-"$python" -c 'from ros2nb_instructor.grading.gradebook import kept_course; kept_course()' \
-    > "$logs/grading-course.log" 2>&1 &
-
 run solutions "$NBVAL_NICE" --nbval solutions --nbval-current-env --nbval-sanitize-with tests/sanitize.cfg \
     > "$logs/solutions.log" 2>&1 &
 run notebooks "$NBVAL_NICE" --nbval-lax notebooks --nbval-current-env > "$logs/notebooks.log" 2>&1 &
 echo "=== make test: tests/ (nbval over solutions/ and notebooks/ runs alongside)"
 run tests 0 tests -n "$workers" --dist loadfile --no-loadscope-reorder --durations=15
 wait
-if [ -s "$logs/grading-course.log" ]; then  # it says nothing when it worked
-    echo "=== make test: what making the grading course printed:"
-    cat "$logs/grading-course.log"
-fi
 for name in solutions notebooks; do
     echo "=== make test: nbval $name/ (ran alongside tests/)"
     cat "$logs/$name.log"

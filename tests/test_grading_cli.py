@@ -155,10 +155,9 @@ def _runs(pid: str, *words: bytes) -> bool:
 @pytest.mark.parametrize('locked', [True, False], ids=['with the lock', 'without it'])
 def test_a_grading_waits_for_the_course_another_is_making(locked, tmp_path, monkeypatch):
     """The nbgrader course is made once per version of the solutions (``kept_course``): a
-    grading that asks while another is making it waits for that one (``make test`` makes it
-    as its tests start, and the tests that grade ask at once).  Without the lock the second
-    made it again (nbgrader's generate_assignment: about 10 CPU-s).  generate_assignment is
-    played by a stand-in that holds until the test lets it finish."""
+    grading that asks while another is making it waits for that one.  Without the lock the
+    second made it again (nbgrader's generate_assignment: about 10 CPU-s).  generate_assignment
+    is played by a stand-in that holds until the test lets it finish."""
     import fcntl
     import threading
 

@@ -63,9 +63,10 @@ def kept_course() -> Path:
     gradebook), made by nbgrader's ``generate_assignment`` once per version of the
     solutions and kept in ``.cache/grading-courses/<digest>/``; return its folder.
 
-    One grading makes it at a time: another that asks meanwhile waits for that one (a lock
-    beside it), rather than making a second copy.  ``make test`` starts making it as its
-    steps start (``tests/run_steps.sh``), so the tests that grade find it made.
+    ``make test`` makes it before the tests start (the Makefile's ``grading-course``).  One
+    grading makes it at a time: another that asks meanwhile (tests run without make, two
+    classes graded at once) waits for that one (a lock beside it) rather than making a
+    second copy.
 
     :raises SystemExit: when ``generate_assignment`` failed (the message names its log).
     """
