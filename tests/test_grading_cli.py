@@ -151,7 +151,6 @@ def _runs(pid: str, *words: bytes) -> bool:
     return all(word in command for word in words)
 
 
-
 @pytest.mark.parametrize('locked', [True, False], ids=['with the lock', 'without it'])
 def test_a_grading_waits_for_the_course_another_is_making(locked, tmp_path, monkeypatch):
     """The nbgrader course is made once per version of the solutions (``kept_course``): a
