@@ -5,11 +5,13 @@ by side under pytest-xdist (``--dist loadfile`` keeps a file on one worker).
 """
 
 import csv
+import fcntl
 import os
 import shutil
 import signal
 import subprocess
 import sys
+import threading
 import zipfile
 from pathlib import Path
 
@@ -157,9 +159,6 @@ def test_a_grading_waits_for_the_course_another_is_making(locked, tmp_path, monk
     grading that asks while another is making it waits for that one.  Without the lock the
     second made it again (nbgrader's generate_assignment: about 10 CPU-s).  generate_assignment
     is played by a stand-in that holds until the test lets it finish."""
-    import fcntl
-    import threading
-
     from ros2nb_instructor.grading import gradebook
     monkeypatch.setattr(gradebook, 'SET_UP_CACHE', tmp_path)
     made, at_lock, finish = [], [], threading.Event()
