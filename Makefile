@@ -24,7 +24,7 @@ export UV_SYSTEM_CERTS := 1
 # numpy (rclpy's message types), and none of them does linear algebra: 0.05-0.1 CPU-s each.
 export OPENBLAS_NUM_THREADS := 1
 
-.PHONY: image image-tool lab lab-instructor test setup bytecode sandbox-tool browser-tool graph-tool grading-course solutions learner-notebooks bench grade clean
+.PHONY: image image-tool lab lab-instructor check test setup bytecode sandbox-tool browser-tool graph-tool grading-course solutions learner-notebooks bench grade clean
 
 setup: $(STAMP)
 
@@ -90,18 +90,22 @@ image-tool:
 	  || { apt-get update -q >/dev/null 2>&1 && apt-get install -y -q podman runc debootstrap >/dev/null 2>&1; } || true
 	@command -v podman >/dev/null || echo "podman is not installed (sudo apt-get install podman runc debootstrap): the image test skips."
 
-# Three steps, always all three (tests/run_steps.sh): tests/ with pytest-xdist, and nbval
-# over solutions/ and notebooks/ alongside it; one failure never hides the others, the
-# results come together at the end, and make fails if any step failed.
-# Six workers: much of a test's time is a judge and its subject waiting on each other step by
-# step, and four left the two cores idle between steps. Beside two CPU burners (fresh clones
-# of a515b0f) tests/ took 557 s with four workers and 510 s with six; idle, fresh clones took
-# 409-457 s with six (478 s with four at a95c744). Eight took 455-459 s beside burners started
-# from the same shell, but part of that is CPU they took from the burners (one autogroup):
-# idle they were no faster (455 s).
+# The fast lane (docs/developing.md): ruff over the course's Python, then the tests that need
+# only Python (no ROS process, kernel, sandbox, browser, image or hub: tests/conftest.py's
+# lanes), notebook structure and layer rules among them.  Run it while you work.
+check: $(STAMP) bytecode
+	@$(VENV)/bin/ruff check --quiet .
+	@$(PY) -m pytest --lane check -q
+
+# Everything: the fast lane first (a lint error or a broken rule stops here, in a minute),
+# then three steps, always all three (tests/run_steps.sh): the slow lane of tests/ with
+# pytest-xdist, and nbval over solutions/ and notebooks/ alongside it; one failure never
+# hides the others, the results come together at the end, and make fails if any step failed.
+# Six workers: much of a slow test's time is a judge and its subject waiting on each other
+# step by step, and fewer left the cores idle between steps (docs/decisions.md).
 TEST_WORKERS ?= 6
 
-test: $(STAMP) bytecode sandbox-tool browser-tool graph-tool image-tool grading-course
+test: check $(STAMP) bytecode sandbox-tool browser-tool graph-tool image-tool grading-course
 	@tests/run_steps.sh $(PY) $(TEST_WORKERS)
 
 # The nbgrader course of the current solutions (generate_assignment, kept per version of the

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `make test`: the three test steps, every time, then their results together.
 #
-#   1. tests/ with pytest-xdist (in the foreground: its output is what you watch);
+#   1. the slow lane of tests/ with pytest-xdist (in the foreground: its output is what you
+#      watch; `make check` ran the fast lane before);
 #   2. nbval over solutions/ (every deterministic output compared);
 #   3. nbval over notebooks/ (every check of an unwritten part must fail with its message).
 #
@@ -10,6 +11,8 @@
 # and shown once step 1 has ended.  One failure never hides another: the exit code is 1
 # if any step failed.  A step still running after STEP_LIMIT_S seconds (a hang that every
 # per-test limit missed) is stopped and says so: make test always ends with its results.
+# Each result gives the step's wall seconds and the CPU seconds of its processes (those its
+# pytest process and their descendants reaped: bash's `times` in the step's own subshell).
 #
 # Every step runs at the same priority (NBVAL_NICE=0).  Steps 2 and 3 once ran at nice 5, so
 # that the grading of the sample class (step 1's longest chain) went first; since the class is
@@ -24,19 +27,27 @@ NBVAL_NICE=${NBVAL_NICE:-0}
 logs=$(mktemp -d "${TMPDIR:-/tmp}/ros2nb-make-test-XXXXXX")
 trap 'rm -rf "$logs"' EXIT
 
-run() {  # run NAME NICENESS ARGS...: pytest ARGS, exit code to $logs/NAME.rc, seconds to $logs/NAME.s
-    local name=$1 niceness=$2 began=$SECONDS
-    shift 2
-    # --foreground: Ctrl+C at the terminal still reaches pytest; SIGINT lets it say where it was.
-    timeout --foreground --signal=INT --kill-after=60 "$STEP_LIMIT_S" \
-        nice -n "$niceness" "$python" -m pytest "$@"
-    local rc=$?
-    if [ $((SECONDS - began)) -ge "$STEP_LIMIT_S" ]; then
-        echo "=== make test: $name was still running after $STEP_LIMIT_S s and was stopped" \
-             "(a hang no test limit caught: its output above ends where it hung)"
-    fi
-    echo "$rc" > "$logs/$name.rc"
-    echo $((SECONDS - began)) > "$logs/$name.s"
+run() {  # run NAME NICENESS ARGS... in a subshell of its own: pytest ARGS; its exit code to
+         # $logs/NAME.rc, its wall seconds to $logs/NAME.s, its processes' CPU seconds to $logs/NAME.cpu
+    (
+        name=$1 niceness=$2 began=$SECONDS
+        shift 2
+        # --foreground: Ctrl+C at the terminal still reaches pytest; SIGINT lets it say where it was.
+        timeout --foreground --signal=INT --kill-after=60 "$STEP_LIMIT_S" \
+            nice -n "$niceness" "$python" -m pytest "$@"
+        rc=$?
+        if [ $((SECONDS - began)) -ge "$STEP_LIMIT_S" ]; then
+            echo "=== make test: $name was still running after $STEP_LIMIT_S s and was stopped" \
+                 "(a hang no test limit caught: its output above ends where it hung)"
+        fi
+        echo "$rc" > "$logs/$name.rc"
+        echo $((SECONDS - began)) > "$logs/$name.s"
+        # `times` (a builtin: run here, not in a pipe's subshell): this subshell's own, then its
+        # children's user and system time, as "1m2.345s 0m0.678s"
+        times > "$logs/$name.times"
+        awk 'NR == 2 { s = 0; for (i = 1; i <= 2; i++) { split($i, t, /[ms]/); s += t[1] * 60 + t[2] }
+                       printf "%.0f\n", s }' "$logs/$name.times" > "$logs/$name.cpu"
+    )
 }
 
 # Fast DDS's own cleaner of the shared-memory files that ROS processes killed earlier left in
@@ -47,8 +58,8 @@ run() {  # run NAME NICENESS ARGS...: pytest ARGS, exit code to $logs/NAME.rc, s
 run solutions "$NBVAL_NICE" --nbval solutions --nbval-current-env --nbval-sanitize-with tests/sanitize.cfg \
     > "$logs/solutions.log" 2>&1 &
 run notebooks "$NBVAL_NICE" --nbval-lax notebooks --nbval-current-env > "$logs/notebooks.log" 2>&1 &
-echo "=== make test: tests/ (nbval over solutions/ and notebooks/ runs alongside)"
-run tests 0 tests -n "$workers" --dist loadfile --no-loadscope-reorder --durations=15
+echo "=== make test: the slow lane of tests/ (nbval over solutions/ and notebooks/ runs alongside)"
+run tests 0 tests --lane slow -n "$workers" --dist loadfile --no-loadscope-reorder --durations=15
 wait
 for name in solutions notebooks; do
     echo "=== make test: nbval $name/ (ran alongside tests/)"
@@ -60,6 +71,7 @@ for name in tests solutions notebooks; do
     rc=$(cat "$logs/$name.rc" 2>/dev/null || echo 'none')
     label=$([ "$name" = tests ] && echo 'tests/' || echo "nbval $name/")
     if [ "$rc" = 0 ]; then result=passed; else result="FAILED (exit $rc)"; failed=1; fi
-    printf '  %-17s %s in %s s\n' "$label" "$result" "$(cat "$logs/$name.s" 2>/dev/null || echo '?')"
+    printf '  %-17s %s in %s s (%s CPU-s)\n' "$label" "$result" \
+        "$(cat "$logs/$name.s" 2>/dev/null || echo '?')" "$(cat "$logs/$name.cpu" 2>/dev/null || echo '?')"
 done
 exit $failed

@@ -32,7 +32,7 @@ import pytest
 import browser
 from waiting import PATIENCE_S, wait_for
 
-pytestmark = pytest.mark.timeout(600)
+pytestmark = [pytest.mark.browser, pytest.mark.kernel, pytest.mark.timeout(600)]
 
 ROOT = Path(__file__).resolve().parent.parent
 NOTEBOOK = '01-create-a-workspace.ipynb'

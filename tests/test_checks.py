@@ -23,22 +23,14 @@ from ros2nb.errors import CheckFailed, LearnerCodeError
 from ros2nb.judge.subjects import SubjectHung
 
 from waiting import wait_for
-from judging import judge_session
 
-pytestmark = pytest.mark.timeout(300)
+pytestmark = [pytest.mark.judge, pytest.mark.timeout(300)]
 
 PUB, SUB = course.PUBLISHER_FILE, course.SUBSCRIBER_FILE
 #: Fragments of the answers that no failure message may contain.
 ANSWER_CODE = ('create_publisher(', 'create_timer(', 'create_subscription(', 'random.uniform(',
                'max(MIN_TEMPERATURE_C', '.publish(msg)', 'elif ', 'rclpy.spin(node)')
 MESSAGES: list[str] = []
-
-
-@pytest.fixture(scope='module')
-def session(tmp_path_factory):
-    """A judge session (this process is the judge) on a workspace with the course's package."""
-    with judge_session(tmp_path_factory.mktemp('checks'), 5) as judge:
-        yield judge
 
 
 def strangers(session) -> list[str]:

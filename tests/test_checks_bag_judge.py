@@ -10,7 +10,8 @@ import sys
 
 import pytest
 
-pytestmark = [pytest.mark.timeout(600),
+pytestmark = [pytest.mark.judge,
+              pytest.mark.timeout(600),
               pytest.mark.skipif(sys.version_info < (3, 11),
                                  reason='bags need Python 3.11 or newer (rosbags needs apsw)')]
 
@@ -21,14 +22,10 @@ from ros2nb.judge.session import Session  # noqa: E402
 import ros2nb  # noqa: E402
 from bag_cases import (ANSWERS, CHECKS, CONTEXT, MISTAKE_IDS, MISTAKES, edited,  # noqa: E402
                        recording_length, with_hour)
-from judging import judge_session  # noqa: E402
 
 
-@pytest.fixture(scope='module')
-def session(tmp_path_factory):
-    """A judge session on a workspace caught up to notebook 10: this process is the judge."""
-    with judge_session(tmp_path_factory.mktemp('checks10'), 10) as session:
-        yield session
+#: The judge session's workspace is caught up to notebook 10 (tests/conftest.py: session).
+CAUGHT_UP_TO = 10
 
 
 def judge(session: Session, name: str, answer: str, context: str = CONTEXT) -> None:

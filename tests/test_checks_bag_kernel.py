@@ -13,7 +13,8 @@ import sys
 
 import pytest
 
-pytestmark = [pytest.mark.timeout(600),
+pytestmark = [pytest.mark.ros,
+              pytest.mark.timeout(600),
               pytest.mark.skipif(sys.version_info < (3, 11),
                                  reason='bags need Python 3.11 or newer (rosbags needs apsw)')]
 

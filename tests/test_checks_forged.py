@@ -20,9 +20,9 @@ from grading_samples import FORGED_TIMER, MAIN_GUARD, REWRITING_READER, TIMER_LI
 from nodes import name_without_endpoints
 from waiting import wait_for
 from judging import FIND_SUBJECT
-from test_checks import PUB, SUB, fails, mutated, restore, session  # noqa: F401 (fixture)
+from test_checks import PUB, SUB, fails, mutated, restore
 
-pytestmark = pytest.mark.timeout(300)
+pytestmark = [pytest.mark.judge, pytest.mark.timeout(300)]
 
 #: The callback's work done by the request handler: each ``advance`` steps the walk,
 #: publishes and logs the reading itself, while publish_temperature does nothing.

@@ -15,9 +15,8 @@ import pytest
 
 from ros2nb import checks, course
 from ros2nb.errors import CheckFailed
-from judging import judge_session
 
-pytestmark = pytest.mark.timeout(300)
+pytestmark = [pytest.mark.judge, pytest.mark.timeout(300)]
 
 SOLUTION = os.path.join(os.path.dirname(__file__), '..', 'solutions', '08-parameters.ipynb')
 SUB = course.SUBSCRIBER_FILE
@@ -35,13 +34,6 @@ def solution_monitor() -> str:
 
 
 REFERENCE = solution_monitor()
-
-
-@pytest.fixture(scope='module')
-def session(tmp_path_factory):
-    """A judge session (this process is the judge) on a workspace with the course's package."""
-    with judge_session(tmp_path_factory.mktemp('checks08'), 5) as judge:
-        yield judge
 
 
 def write_monitor(session, text: str) -> None:

@@ -19,7 +19,7 @@ from ros2nb.checks.dispatch import IN_JUDGE_ENV
 from ros2nb.errors import CheckFailed
 from ros2nb.judge.session import Session
 
-pytestmark = pytest.mark.timeout(300)
+pytestmark = [pytest.mark.judge, pytest.mark.ros, pytest.mark.timeout(300)]
 
 from judging import answer_cells  # noqa: E402
 

@@ -17,7 +17,7 @@ from corpora import grade_learner
 from corpus_attacks import ATTACKS
 from corpus_checks import failed, scores_what_its_twin_scores
 
-pytestmark = pytest.mark.timeout(300)
+pytestmark = [pytest.mark.judge, pytest.mark.timeout(300)]
 TWINS = {learner.name: learner for learner in ATTACKS}
 
 

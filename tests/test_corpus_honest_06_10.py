@@ -5,7 +5,7 @@ import pytest
 from corpus_checks import full_marks_without_the_text_reader, within
 from corpus_honest import HONEST
 
-pytestmark = pytest.mark.timeout(300)
+pytestmark = [pytest.mark.judge, pytest.mark.timeout(300)]
 LEARNERS = within(HONEST, '06', '10')
 
 

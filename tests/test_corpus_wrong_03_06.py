@@ -5,7 +5,7 @@ import pytest
 from corpus_checks import loses_exactly_its_part, within
 from corpus_wrong import WRONG
 
-pytestmark = pytest.mark.timeout(300)
+pytestmark = [pytest.mark.judge, pytest.mark.timeout(300)]
 LEARNERS = within(WRONG, '03', '06')
 
 

@@ -144,6 +144,7 @@ def taken_before(locks, domain):
                 os.close(fd)
 
 
+@pytest.mark.ros
 def test_a_domain_used_by_a_ros_program_outside_the_course_is_skipped(locks):
     """A terminal's `ros2 run` on a domain holds no lock, but its discovery port is taken."""
     outside, domain = outside_program('outside_the_course')
@@ -157,6 +158,7 @@ def test_a_domain_used_by_a_ros_program_outside_the_course_is_skipped(locks):
         outside.wait()
 
 
+@pytest.mark.ros
 def test_a_ros_program_that_is_not_the_first_on_its_domain_is_seen_too(locks):
     """Fast DDS numbers the participants of a domain on one machine; when the first one
     ends, the second keeps its number and port. The claim used to look at the first port
@@ -210,6 +212,7 @@ def test_another_users_kernel_gets_another_domain():
         shutil.rmtree(tmp_path, ignore_errors=True)
 
 
+@pytest.mark.ros
 def test_a_new_node_joins_the_graph_of_a_running_process_without_waiting_3_s():
     """Every process of the course announces itself every second (the course's Fast DDS
     profile, ros2nb.domains.DISCOVERY_PROFILE), so a node a check starts appears in its

@@ -20,7 +20,7 @@ import pytest
 from ros2nb.judge.subjects import SUBJECT_PREFIX_ENV, SubjectProcess, subject_env
 from ros2nb.processes import kill_process_group
 
-pytestmark = pytest.mark.timeout(120)
+pytestmark = [pytest.mark.judge, pytest.mark.timeout(120)]
 
 VIEW = '''
 import json, os, sys, tempfile

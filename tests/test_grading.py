@@ -23,7 +23,6 @@ from pathlib import Path
 
 import pytest
 
-from browser import module_chromium, page  # noqa: F401 - the fixtures
 from grading_samples import (EXPECTED, FULL, GRADE_WITH_FAULTS, MARK, NB01, NOT_UTF8, PWNED, ROOT,
                              SOLUTION, STAGES, build)
 
@@ -34,7 +33,8 @@ from ros2nb_instructor.grading.scratch import HOME_BYTES
 #: is that). On 2 cores the class took 828-921 s in make test on a machine three times slower
 #: than usual, idle or beside two CPU burners; 1200 s left too little room.
 CLASS_LIMIT_S = 1800
-pytestmark = [pytest.mark.timeout(CLASS_LIMIT_S),
+pytestmark = [pytest.mark.sandbox, pytest.mark.judge, pytest.mark.kernel,
+              pytest.mark.timeout(CLASS_LIMIT_S),
               pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))]
 #: The class is graded by ros2nb-grade's own main (GRADE_WITH_FAULTS: five learners meet a
 #: planted fault) with its default limits per cell and per notebook: an honest notebook must

@@ -26,10 +26,15 @@ from ros2nb_instructor.paths import ASSIGNMENT, gradebook_url
 #: The instructor's grading command, as the course's venv installs it.
 GRADE = str(Path(sys.executable).with_name('ros2nb-grade'))
 
-pytestmark = [pytest.mark.timeout(1200),
-              pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))]
+pytestmark = pytest.mark.timeout(1200)
+#: ros2nb-grade refuses to start without a sandbox (unless told: NO_SANDBOX=1).
+NEEDS_A_SANDBOX = pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))
 
 
+@pytest.mark.sandbox
+@pytest.mark.judge
+@pytest.mark.kernel
+@NEEDS_A_SANDBOX
 def test_zip_from_a_learning_platform(tmp_path):
     """A learner is a folder at the archive's top (below one export folder); nested archives
     are refused, and nothing below a learner's folder names another learner.
@@ -72,6 +77,7 @@ def test_zip_from_a_learning_platform(tmp_path):
     assert 'appears in' not in done.stdout
 
 
+@NEEDS_A_SANDBOX
 def test_force_replaces_an_earlier_grading_only_once_complete(tmp_path):
     """FORCE=1 with a grading that cannot finish (here: no learner) keeps the earlier one.
 
@@ -89,6 +95,7 @@ def test_force_replaces_an_earlier_grading_only_once_complete(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ['class', 'grading']  # nothing left
 
 
+@NEEDS_A_SANDBOX
 def test_bad_input_gets_one_line(tmp_path):
     def grade(*args):
         return subprocess.run([GRADE, *args],

@@ -78,6 +78,7 @@ def test_results_are_read_without_following_a_link(tmp_path, host):
     assert read_regular(tmp_path / 'out', 'fine', 1000) == b'{}'
 
 
+@pytest.mark.sandbox
 @pytest.mark.skipif(os.geteuid() != 0, reason='a size-capped scratch needs root (the grader is)')
 def test_a_learners_home_holds_a_bounded_total(scratch):
     """Files each under the size limit still stop at the home's total: the learner's own
@@ -157,6 +158,8 @@ def package_dependencies(package_xml: Path) -> list[str]:
 PLANTED = ('sitecustomize.py', 'DEFAULT_FASTRTPS_PROFILES.xml')
 
 
+@pytest.mark.sandbox
+@pytest.mark.judge
 @pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))
 @pytest.mark.timeout(300)
 def test_a_subject_writes_nowhere_its_judge_reads(scratch, monkeypatch):
@@ -205,6 +208,8 @@ export PATH="$HOME/bin:$PATH"
 '''
 
 
+@pytest.mark.sandbox
+@pytest.mark.judge
 @pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))
 @pytest.mark.timeout(300)
 def test_a_learners_build_scripts_never_run_in_the_judge(scratch, monkeypatch):

@@ -10,12 +10,7 @@ import ros2nb
 from nodes import Monitor, Sensor
 from waiting import wait_for
 
-
-@pytest.fixture
-def ros():
-    ros2nb.start(sim_time=True)
-    yield
-    ros2nb.shutdown()
+pytestmark = pytest.mark.ros
 
 
 def test_node_list_hides_internal_node(ros, capsys):

@@ -26,6 +26,7 @@ TAG = 'localhost/ros2-course-test:latest'
 CONF = ROOT / 'environment' / 'containers.conf'
 
 pytestmark = [
+    pytest.mark.image,
     pytest.mark.timeout(1200),
     pytest.mark.skipif(os.geteuid() != 0 or not all(shutil.which(t) for t in
                                                      ('podman', 'runc', 'debootstrap')),

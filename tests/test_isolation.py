@@ -14,7 +14,7 @@ import pytest
 
 from notebook_outputs import ROOT, differences, kernel_env, run_at_once
 
-pytestmark = pytest.mark.timeout(900)
+pytestmark = [pytest.mark.kernel, pytest.mark.timeout(900)]
 
 NB03 = ROOT / 'solutions' / '03-write-the-publisher.ipynb'
 NB04 = ROOT / 'solutions' / '04-write-the-subscriber.ipynb'

@@ -66,7 +66,7 @@ HUB_START_S = SERVER_START_S = CELL_S = API_S = PATIENCE_S
 #: Variables of the test's environment the hub must not see (conftest.py sets them).
 NOT_FOR_THE_HUB = ('ROS_DOMAIN_ID', 'ROS2NB_WORKSPACE')
 
-pytestmark = pytest.mark.timeout(6 * PATIENCE_S)  # 20-55 s on 2 idle cores
+pytestmark = [pytest.mark.hub, pytest.mark.kernel, pytest.mark.timeout(6 * PATIENCE_S)]
 
 if not (os.access(PROXY, os.X_OK) and shutil.which('node')):
     pytest.skip('configurable-http-proxy is not installed (make hub-proxy needs node, npm and '

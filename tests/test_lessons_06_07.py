@@ -12,20 +12,21 @@ import pytest
 
 from ros2nb import checks, course
 from ros2nb.errors import CheckFailed
-from judging import FIND_SUBJECT, judge_session
+from judging import FIND_SUBJECT
 
-pytestmark = pytest.mark.timeout(300)
+pytestmark = [pytest.mark.judge, pytest.mark.timeout(300)]
+#: The judge session's workspace is caught up to notebook 07 (tests/conftest.py: session).
+CAUGHT_UP_TO = 7
 
 FAN, PROMISES, PLOT = course.FAN_FILE, course.PROMISES_FILE, course.LIVE_PLOT_FILE
 
 
 @pytest.fixture(scope='module')
-def session(tmp_path_factory):
-    """A judge session on a workspace with the course's package and its 06 files."""
-    with judge_session(tmp_path_factory.mktemp('lesson06'), 7) as judge:
-        for relative in (FAN, PROMISES, PLOT):
-            restore(judge, relative)
-        yield judge
+def session(session):
+    """tests/conftest.py's judge session, caught up to notebook 07, with the 06 files."""
+    for relative in (FAN, PROMISES, PLOT):
+        restore(session, relative)
+    return session
 
 
 def restore(session, relative: str) -> None:

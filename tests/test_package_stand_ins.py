@@ -10,8 +10,12 @@ import os
 import subprocess
 import sys
 
+import pytest
+
 from ros2nb import domains
 from ros2nb.checks.package_stand_ins import RCLPY_SHUTDOWN_RACE, STAND_IN
+
+pytestmark = pytest.mark.ros
 
 #: A stand-in whose timer meets the race at its first tick.
 RACING = dict(name='racing_sensor', does='meets the race at its first tick',

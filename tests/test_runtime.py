@@ -26,11 +26,7 @@ from waiting import PATIENCE_S, wait_for, wait_until
 rt_module = importlib.import_module('ros2nb.runtime.current')
 
 
-@pytest.fixture
-def ros():
-    rt = ros2nb.start(sim_time=True)
-    yield rt
-    ros2nb.shutdown()
+pytestmark = pytest.mark.ros
 
 
 def test_import_does_nothing():

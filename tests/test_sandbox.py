@@ -19,13 +19,13 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parent.parent
 from ros2nb_instructor.grading import sandbox
 from ros2nb_instructor.grading.sandbox import Limits, Sandbox
 from waiting import PATIENCE_S
 
+ROOT = Path(__file__).resolve().parent.parent
 PROBLEM = sandbox.problem()
-pytestmark = pytest.mark.skipif(PROBLEM is not None, reason=str(PROBLEM))
+pytestmark = [pytest.mark.sandbox, pytest.mark.skipif(PROBLEM is not None, reason=str(PROBLEM))]
 PY = sys.executable
 ENV = {'PATH': '/usr/bin:/bin', 'HOME': '/tmp', 'LANG': 'C.UTF-8'}
 DOMAIN = str(150 + os.getpid() % 11)

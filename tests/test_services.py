@@ -7,6 +7,7 @@ request is never delivered; the one sent again once the server is there is answe
 
 import threading
 
+import pytest
 import rclpy
 from rcl_interfaces.srv import ListParameters
 from rclpy.executors import SingleThreadedExecutor
@@ -16,6 +17,8 @@ from rclpy.signals import SignalHandlerOptions
 from ros2nb import domains
 from ros2nb.runtime.services import call_until_answered
 from waiting import PATIENCE_S, wait_until
+
+pytestmark = pytest.mark.ros
 
 
 def test_a_lost_request_is_asked_again_and_answered():

@@ -19,6 +19,8 @@ from ros2nb.judge.subjects import SubjectHung, SubjectProcess
 from ros2nb.processes import BUSY_SHARE, Patience, tree_cpu_seconds
 from waiting import PATIENCE_S, wait_until
 
+pytestmark = pytest.mark.judge
+
 #: Seconds the subject is given in these tests.
 LIMIT_S = 2.0
 

@@ -153,12 +153,14 @@ def test_part_markers_of_the_course_are_left_out(tmp_path):
     assert path.read_text() == 'x = 1\ny = 2\n'
 
 
+@pytest.mark.ros
 def test_colcon_build_installs_entry_points(built):
     lib = built / 'install' / 'sensor_simulator' / 'lib' / 'sensor_simulator'
     assert sorted(p.name for p in lib.iterdir()) == ['temperature_publisher',
                                                      'temperature_subscriber']
 
 
+@pytest.mark.ros
 def test_colcon_build_failure_names_cause(built, capsys):
     with pytest.raises(ros2nb.ColconBuildError, match='found no package'):
         ros2nb.colcon_build('--packages-select', 'no_such_package')
@@ -172,12 +174,14 @@ def test_colcon_build_failure_names_cause(built, capsys):
         setup_py.write_text(good)
 
 
+@pytest.mark.ros
 def test_source_workspace_adds_prefix(built, capsys):
     env = ros2nb.source_workspace(show=True)
     assert str(built / 'install' / 'sensor_simulator') in env['AMENT_PREFIX_PATH'].split(':')
     assert 'AMENT_PREFIX_PATH: added ws/install/sensor_simulator' in capsys.readouterr().out
 
 
+@pytest.mark.ros
 def test_ros2_run_errors_match_cli(built):
     with pytest.raises(ros2nb.Ros2nbError, match=r"^Package 'no_such_pkg' not found$"):
         ros2nb.ros2_run(('no_such_pkg', 'x'))
@@ -185,6 +189,7 @@ def test_ros2_run_errors_match_cli(built):
         ros2nb.ros2_run(('sensor_simulator', 'no_such_exe'))
 
 
+@pytest.mark.ros
 def test_ros2_run_two_processes_and_ctrl_c(built, capsys):
     codes = ros2nb.ros2_run(('sensor_simulator', 'temperature_publisher'),
                             ('sensor_simulator', 'temperature_subscriber'), seconds=4)
@@ -195,6 +200,7 @@ def test_ros2_run_two_processes_and_ctrl_c(built, capsys):
     assert '^C' in out and 'Traceback' not in out
 
 
+@pytest.mark.ros
 def test_missing_setup_cfg_gives_no_executable(built, tmp_path):
     scratch = tmp_path / 'nocfg'
     shutil.copytree(built / 'src' / 'sensor_simulator', scratch / 'src' / 'sensor_simulator')
@@ -204,6 +210,7 @@ def test_missing_setup_cfg_gives_no_executable(built, tmp_path):
         ros2nb.ros2_run(('sensor_simulator', 'temperature_publisher'), workspace_path=scratch)
 
 
+@pytest.mark.ros
 def test_import_file_reloads(built):
     path = 'scripts/reloaded.py'
     ros2nb.write_file(path, 'VALUE = 1\n')
@@ -214,6 +221,7 @@ def test_import_file_reloads(built):
         ros2nb.import_file('src/nothing.py')
 
 
+@pytest.mark.ros
 def test_processes_inherit_the_kernels_domain(built, capsys):
     from ros2nb import domains
     domain = domains.domain_id()
@@ -234,6 +242,7 @@ except KeyboardInterrupt:
 """
 
 
+@pytest.mark.ros
 def test_ctrl_c_waits_until_every_process_has_started(capsys):
     """Ctrl+C's countdown starts once a process has printed its first line: before, 1 s
     after launch it landed in the start-up and the program died with a traceback."""
@@ -243,6 +252,7 @@ def test_ctrl_c_waits_until_every_process_has_started(capsys):
     assert out.index('ready') < out.index('^C') < out.index('stopped cleanly')
 
 
+@pytest.mark.ros
 def test_ros2_run_defers_to_a_real_ros2_on_path(built, tmp_path, monkeypatch, capsys):
     """With a `ros2` on PATH, `ros2 run` itself is started (a recording stand-in shows it)."""
     stub = tmp_path / 'ros2'
