@@ -29,7 +29,8 @@ time; grading <= 10 s per notebook for a complete learner.
 6. Only when asked (``--only class``): a whole class of ``--learners`` complete learners
    graded at once (``tools/grade.py``'s default jobs), minutes in all and seconds per notebook.
 
-Usage: ``make bench`` or ``python benchmarks/bench.py [--reps N] [--only sim|first|grading|idle|interrupt]``;
+Usage: ``make bench`` or
+``python benchmarks/bench.py [--reps N] [--only sim|first|grading|idle|interrupt]``;
 ``make bench BENCH_ARGS='--only class --learners 30'`` for a class.
 """
 

@@ -1,8 +1,8 @@
 """What ``make bench`` times, one measurement per run: ``python benchmarks/peers.py WHAT``.
 
 Each run is a fresh process (its own ROS domain, nothing warm), prints one JSON line with
-its wall-clock seconds (and, for the simulated hour, the CPU seconds of the process), and is started by ``benchmarks/bench.py``, which interleaves the
-peers and repeats them.
+its wall-clock seconds (and, for the simulated hour, the CPU seconds of the process),
+and is started by ``benchmarks/bench.py``, which interleaves the peers and repeats them.
 
 - ``sim-hour-ros2nb``: one simulated hour of the course's sensor recorded in a kernel's way
   (``ros2nb.start(sim_time=True)``, ``ros2nb.add``, ``ros2nb.record``), as notebook 03 does.

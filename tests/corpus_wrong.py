@@ -11,7 +11,8 @@ WRONG = [
         '        if False:\n            self.timer = self.create_timer(')]},
         loses=('sensor-constructor',)),
     Learner('03 a step of up to one degree', '03', {'sensor-callback': [(
-        'random.uniform(-MAX_STEP_C, MAX_STEP_C)', 'random.uniform(-2 * MAX_STEP_C, 2 * MAX_STEP_C)')]},
+        'random.uniform(-MAX_STEP_C, MAX_STEP_C)',
+        'random.uniform(-2 * MAX_STEP_C, 2 * MAX_STEP_C)')]},
         loses=('sensor-callback', 'sensor-hour')),
     Learner('04 boundaries counted as High and Low', '04', {'monitor-callback': [
         ('temperature_c > HIGH_ABOVE_C', 'temperature_c >= HIGH_ABOVE_C'),

@@ -152,7 +152,8 @@ PWNED = 'pwned-by-a-learner'
 
 def _with_cells(source: Path, cells: dict[int, str], markdown: bool = False
                 ) -> nbformat.NotebookNode:
-    """The notebook with code cells inserted: {position: source}; -1 means before the first check."""
+    """The notebook with code cells inserted: {position: source}; -1 means before the
+    first check."""
     nb = nbformat.read(source, as_version=4)
     for position, code in sorted(cells.items(), reverse=True):
         if position == -1:
@@ -269,8 +270,8 @@ for pid in os.listdir('/proc'):
             command = open(f'/proc/{pid}/cmdline', 'rb').read()
         except OSError:
             continue
-        if any(word in command for word in (b'ros2nb-grade', b'ros2nb_instructor', b'pytest', b'nbgrader',
-                                              b'judge')):
+        if any(word in command for word in (b'ros2nb-grade', b'ros2nb_instructor', b'pytest',
+                                              b'nbgrader', b'judge')):
             os.kill(int(pid), signal.SIGKILL)
             killed.append(pid)
 print('killed:', killed)

@@ -53,9 +53,9 @@ def judge_session(root: Path, notebook: int) -> Iterator[Session]:
             session.close()
 
 
-#: A forging learner's module code that finds the subject's request loop from the learner's import and keeps
-#: its handlers and its Subject (nothing happens when the file runs as a program).  The loop is
-#: the frame with both names: a forked subject's stack also holds the fork server's frames.
+#: A forging learner's module code that finds the subject's request loop from the learner's import
+#: and keeps its handlers and its Subject (nothing happens when the file runs as a program).  The
+#: loop is the frame with both names: a forked subject's stack also holds the fork server's frames.
 FIND_SUBJECT = '''
 import sys as _sys
 _frame = _sys._getframe()

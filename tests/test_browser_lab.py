@@ -95,7 +95,8 @@ def lab(tmp_path_factory):
     base = f'http://127.0.0.1:{port}'
     try:
         wait_for(lambda: server.poll() is not None or answers(f'{base}/api/status?token={token}'),
-                 'the learner\'s lab answering', seen=lambda: (home / 'server.log').read_text()[-800:])
+                 'the learner\'s lab answering',
+                 seen=lambda: (home / 'server.log').read_text()[-800:])
         assert server.poll() is None, (home / 'server.log').read_text()
         shots = Path(tmp_path_factory.mktemp('lab-screenshots'))
         print(f'\nscreenshots: {shots}')
@@ -129,14 +130,16 @@ def prompts(page) -> list[str]:
 
 def test_no_instructor_tool_and_no_news_popup(lab):
     page, shots, work = lab
-    labels = page.eval_on_selector_all('.lm-MenuBar-itemLabel', 'els => els.map(e => e.textContent)')
+    labels = page.eval_on_selector_all('.lm-MenuBar-itemLabel',
+                                       'els => els.map(e => e.textContent)')
     assert {'File', 'Run', 'Kernel'} <= set(labels), labels  # the menu bar is there, and read
     assert 'Nbgrader' not in labels, labels
     shown = page.inner_text('body')
     for text in INSTRUCTOR_TEXTS:
         assert text not in shown, text
     assert page.locator('button:has-text("Validate"), jp-button:has-text("Validate")').count() == 0
-    news = page.evaluate("JSON.parse(document.getElementById('jupyter-config-data').textContent).news")
+    news = page.evaluate("JSON.parse(document.getElementById('jupyter-config-data')"
+                         ".textContent).news")
     assert news == {'disabled': True}
     assert NEWS_TEXT not in shown
     assert (work / '00-setup-and-the-pubsub-idea.ipynb').is_file()  # the course's, copied in
@@ -181,4 +184,5 @@ def test_interrupt_stops_a_spin_with_one_line(lab):
     print(f'\nInterrupt stopped the spin in {took:.2f} s')
     lines = cell.locator('.jp-OutputArea').inner_text().strip().splitlines()
     page.screenshot(path=str(shots / 'learner-lab-01-interrupted.png'))
-    assert lines[0] == 'spinning' and len(lines) == 2 and lines[1].startswith('Interrupted after '), lines
+    assert (lines[0] == 'spinning' and len(lines) == 2
+            and lines[1].startswith('Interrupted after ')), lines

@@ -88,55 +88,82 @@ def test_reference_nodes_pass(session, capsys):
 
 
 SENSOR_MISTAKES = [
-    ('placeholder', "        self.publisher_ = self.create_publisher", "        raise NotImplementedError()\n        self.publisher_ = self.create_publisher",
-     checks.check_sensor_constructor, r'still raises NotImplementedError: write your code where it says YOUR CODE HERE'),
+    ('placeholder', "        self.publisher_ = self.create_publisher",
+     "        raise NotImplementedError()\n        self.publisher_ = self.create_publisher",
+     checks.check_sensor_constructor, r'still raises NotImplementedError: write your code where '
+                                      r'it says YOUR CODE HERE'),
     ('topic typo', "TOPIC = 'temperature'", "TOPIC = 'temprature'",
-     checks.check_sensor_constructor, r'no publisher on /temperature \(it has: /temprature \[std_msgs/msg/Float32\]\): did you mean /temperature\?'),
-    ('message type', 'from std_msgs.msg import Float32', 'from std_msgs.msg import Float64 as Float32',
-     checks.check_sensor_constructor, r'uses std_msgs/msg/Float64, but the topic carries std_msgs/msg/Float32'),
+     checks.check_sensor_constructor, r'no publisher on /temperature \(it has: /temprature '
+                                      r'\[std_msgs/msg/Float32\]\): did you mean /temperature\?'),
+    ('message type', 'from std_msgs.msg import Float32',
+     'from std_msgs.msg import Float64 as Float32',
+     checks.check_sensor_constructor, r'uses std_msgs/msg/Float64, but the topic carries '
+                                      r'std_msgs/msg/Float32'),
     ('period', 'PUBLISH_PERIOD_S = 1.0 ', 'PUBLISH_PERIOD_S = 2.0 ',
-     checks.check_sensor_constructor, r'Readings came 2 s apart on the grader.s clock; the sensor publishes every 1.0 s: give the timer PUBLISH_PERIOD_S'),
+     checks.check_sensor_constructor, r'Readings came 2 s apart on the grader.s clock; the sensor '
+                                      r'publishes every 1.0 s: give the timer PUBLISH_PERIOD_S'),
     ('start value', 'self.temperature = START_TEMPERATURE_C', 'self.temperature = 0.0',
-     checks.check_sensor_constructor, r'The first reading is 18.00 °C: the walk starts at START_TEMPERATURE_C = 22.0 °C \(set self.temperature to it in __init__\)'),
+     checks.check_sensor_constructor, r'The first reading is 18.00 °C: the walk '
+                                      r'starts at START_TEMPERATURE_C = 22.0 °C \(set '
+                                      r'self.temperature to it in __init__\)'),
     ('callback called before part 4 exists',
-     ('self.create_timer(PUBLISH_PERIOD_S, self.publish_temperature)', 'def publish_temperature(self):'),
-     ('self.create_timer(PUBLISH_PERIOD_S, self.publish_temperature())', 'def not_yet_written(self):'),
-     checks.check_sensor_constructor, r'timer whose callback is None, not a function: pass the method itself'),
+     ('self.create_timer(PUBLISH_PERIOD_S, self.publish_temperature)',
+      'def publish_temperature(self):'),
+     ('self.create_timer(PUBLISH_PERIOD_S, self.publish_temperature())',
+      'def not_yet_written(self):'),
+     checks.check_sensor_constructor, r'timer whose callback is None, not a function: '
+                                      r'pass the method itself'),
     ('class typo', 'class TemperatureSensor(Node):', 'class TemperaturSensor(Node):',
-     checks.check_sensor_constructor, r'defines no class TemperatureSensor \(it defines TemperaturSensor'),
+     checks.check_sensor_constructor, r'defines no class TemperatureSensor \(it '
+                                      r'defines TemperaturSensor'),
     ("the tutorial's floor", 'max(MIN_TEMPERATURE_C,', 'max(10.2,',
-     checks.check_sensor_callback, r"below MIN_TEMPERATURE_C = 18.0 °C \(the tutorial's floor of 10.2 °C"),
+     checks.check_sensor_callback, r"below MIN_TEMPERATURE_C = 18.0 °C \(the "
+                                   r"tutorial's floor of 10.2 °C"),
     ('no clamp', '''max(MIN_TEMPERATURE_C,
-                               min(MAX_TEMPERATURE_C, self.temperature + step))''', 'self.temperature + step',
+                               min(MAX_TEMPERATURE_C, self.temperature + step))''',
+     'self.temperature + step',
      checks.check_sensor_callback, r'above MAX_TEMPERATURE_C = 28.0 °C: clamp every new reading'),
     ('step too big', 'random.uniform(-MAX_STEP_C, MAX_STEP_C)', 'random.uniform(-2.0, 2.0)',
      checks.check_sensor_callback, r'one step of at most ±0.5 °C|one step is at most ±0.5 °C'),
     ('no step', 'step = random.uniform(-MAX_STEP_C, MAX_STEP_C)', 'step = 0.0',
      checks.check_sensor_callback, r'Every reading is 22.00 °C: add a random step'),
     ('int message', 'msg.data = self.temperature', 'msg.data = int(self.temperature)',
-     checks.check_sensor_callback, r"Float32's field 'data' takes \d+\.0 or float\(\.\.\.\), not int \d+.*temperature_publisher.py line \d+: msg.data = int"),
+     checks.check_sensor_callback, r"Float32's field 'data' takes \d+\.0 or float\(\.\.\.\), not "
+                                   r"int \d+.*temperature_publisher.py line \d+: msg.data = int"),
     ('never published', '        self.publisher_.publish(msg)\n', '',
      checks.check_sensor_callback, r'publish_temperature ran but nothing arrived on /temperature'),
-    ('self.TOPIC', 'self.create_publisher(Float32, TOPIC, QUEUE_DEPTH)', 'self.create_publisher(Float32, self.TOPIC, QUEUE_DEPTH)',
-     checks.check_sensor_constructor, r'TemperatureSensor\(\) raised: TOPIC is a constant of the file, not of the node: write TOPIC, not self.TOPIC'),
+    ('self.TOPIC', 'self.create_publisher(Float32, TOPIC, QUEUE_DEPTH)',
+     'self.create_publisher(Float32, self.TOPIC, QUEUE_DEPTH)',
+     checks.check_sensor_constructor, r'TemperatureSensor\(\) raised: TOPIC is a constant of the '
+                                      r'file, not of the node: write TOPIC, not self.TOPIC'),
     ('part 4 not indented', '    def publish_temperature(self):', 'def publish_temperature(self):',
-     checks.check_sensor_callback, r'publish_temperature is written outside the class TemperatureSensor: indent its part by four spaces'),
-    ('log line without the reading', "self.get_logger().info(f'Publishing: {self.temperature:.2f}C')",
+     checks.check_sensor_callback, r'publish_temperature is written outside the class '
+                                   r'TemperatureSensor: indent its part by four spaces'),
+    ('log line without the reading',
+     "self.get_logger().info(f'Publishing: {self.temperature:.2f}C')",
      "self.get_logger().info('Publishing a reading')",
-     checks.check_sensor_callback, r'publish_temperature logged "Publishing a reading" for a reading of \d+\.\d\d °C: show the reading in its line'),
+     checks.check_sensor_callback, r'publish_temperature logged "Publishing a reading" for a '
+                                   r'reading of \d+\.\d\d °C: show the reading in its line'),
     ('main() crashes before its spin', '    rclpy.init(args=args)\n', '',
-     checks.check_sensor_main, r"crashed before Ctrl\+C at line \d+ \(node = TemperatureSensor\(\)\) \(NotInitializedException: .*\): fix that line"),
-    ('shutdown instead of try_shutdown', 'rclpy.try_shutdown()  # rclpy.shutdown() would raise', 'rclpy.shutdown()  # rclpy.shutdown() would raise',
-     checks.check_sensor_main, r'exited with code 1 after Ctrl\+C \(Ctrl\+C had already shut rclpy down\): shut down with rclpy.try_shutdown\(\) instead of rclpy.shutdown\(\)'),
+     checks.check_sensor_main, r"crashed before Ctrl\+C at line \d+ "
+                               r"\(node = TemperatureSensor\(\)\) "
+                               r"\(NotInitializedException: .*\): fix that line"),
+    ('shutdown instead of try_shutdown', 'rclpy.try_shutdown()  # rclpy.shutdown() would raise',
+     'rclpy.shutdown()  # rclpy.shutdown() would raise',
+     checks.check_sensor_main, r'exited with code 1 after Ctrl\+C \(Ctrl\+C had already shut '
+                               r'rclpy down\): shut down with rclpy.try_shutdown\(\) instead '
+                               r'of rclpy.shutdown\(\)'),
     ("the tutorial's main", '''    except (KeyboardInterrupt, ExternalShutdownException):
         pass  # Ctrl+C or a shutdown from outside: leave quietly
     finally:
         node.destroy_node()
-        rclpy.try_shutdown()  # rclpy.shutdown() would raise if Ctrl+C already shut down''', '''    except KeyboardInterrupt:
+        rclpy.try_shutdown()  # rclpy.shutdown() would raise if Ctrl+C already shut down''',
+     '''    except KeyboardInterrupt:
         pass
     node.destroy_node()
     rclpy.shutdown()''',
-     checks.check_sensor_main, r'exited with code 1 after Ctrl\+C \(Ctrl\+C had already shut rclpy down\): catch ExternalShutdownException around the spin'),
+     checks.check_sensor_main, r'exited with code 1 after Ctrl\+C \(Ctrl\+C had already shut rclpy '
+                               r'down\): catch ExternalShutdownException around the spin'),
 ]
 
 
@@ -161,24 +188,35 @@ MONITOR_MISTAKES = [
      checks.check_monitor_callback, r'For 26.0 °C the monitor said High; it should say Normal'),
     ('lower case', "status = 'High'", "status = 'high'",
      checks.check_monitor_callback, r'write the status High, with a capital letter'),
-    ('arguments out of order', 'Float32, TOPIC, self.temperature_callback, QUEUE_DEPTH)', 'Float32, TOPIC, QUEUE_DEPTH, self.temperature_callback)',
-     checks.check_monitor_constructor, r'TemperatureMonitor\(\) raised: the arguments are in the wrong order: create_subscription takes the message type, the topic, the callback and the queue depth'),
+    ('arguments out of order', 'Float32, TOPIC, self.temperature_callback, QUEUE_DEPTH)',
+     'Float32, TOPIC, QUEUE_DEPTH, self.temperature_callback)',
+     checks.check_monitor_constructor, r'TemperatureMonitor\(\) raised: the arguments are in the '
+                                       r'wrong order: create_subscription takes the message type, '
+                                       r'the topic, the callback and the queue depth'),
     ('the message for its value', 'temperature_c = msg.data', 'temperature_c = msg',
-     checks.check_monitor_callback, r'temperature_callback raised for 19.99 °C: a Float32 message is not its value: use its field \(data\), e.g. msg.data'),
-    ('callback left unwritten', '        temperature_c = msg.data\n', '        raise NotImplementedError()\n',
-     checks.check_monitor_callback, r'temperature_callback still raises NotImplementedError: write your code'),
-    ('two lines', "        self.get_logger().info(f'Temperature: {temperature_c:.2f}C - Status: {status}')",
-     "        self.get_logger().info(f'Temperature: {temperature_c:.2f}C')\n        self.get_logger().info(f'Status: {status}')",
+     checks.check_monitor_callback, r'temperature_callback raised for 19.99 °C: a Float32 message '
+                                    r'is not its value: use its field \(data\), e.g. msg.data'),
+    ('callback left unwritten', '        temperature_c = msg.data\n',
+     '        raise NotImplementedError()\n',
+     checks.check_monitor_callback, r'temperature_callback still raises '
+                                    r'NotImplementedError: write your code'),
+    ('two lines',
+     "        self.get_logger().info(f'Temperature: {temperature_c:.2f}C - Status: {status}')",
+     "        self.get_logger().info(f'Temperature: {temperature_c:.2f}C')\n"
+     "        self.get_logger().info(f'Status: {status}')",
      checks.check_monitor_callback, r'logged 2 lines; log exactly one per message'),
     ('wrong topic', "TOPIC = 'temperature'", "TOPIC = 'temp'",
-     checks.check_monitor_constructor, r'no subscription on /temperature \(it has: /temp \[std_msgs/msg/Float32\]\)'),
+     checks.check_monitor_constructor, r'no subscription on /temperature \(it has: /temp '
+                                       r'\[std_msgs/msg/Float32\]\)'),
     ("the tutorial's main", ('''    except (KeyboardInterrupt, ExternalShutdownException):
         pass  # Ctrl+C or a shutdown from outside: leave quietly
     finally:
         node.destroy_node()   # the tutorial's subscriber never did this
         rclpy.try_shutdown()  # nor this'''), ('''    except KeyboardInterrupt:
         pass'''),
-     checks.check_monitor_main, r'exited with code 1 after a shutdown from outside \(SIGTERM\) \(.*ExternalShutdownException.*\): catch ExternalShutdownException around the spin'),
+     checks.check_monitor_main, r'exited with code 1 after a shutdown from outside '
+                                r'\(SIGTERM\) \(.*ExternalShutdownException.*\): catch '
+                                r'ExternalShutdownException around the spin'),
 ]
 
 
@@ -204,8 +242,8 @@ def test_a_part_run_out_of_order_is_named_by_the_check(session):
     (session.workspace / PUB).write_text(part3)
     session.drop(('file', PUB))
     try:
-        fails(checks.check_sensor_constructor, r'temperature_publisher.py is missing parts 1, 2: run '
-                                               r'the %%part cells for them')
+        fails(checks.check_sensor_constructor, r'temperature_publisher.py is missing parts 1, 2: '
+                                               r'run the %%part cells for them')
     finally:
         record.unlink()
         restore(session, PUB)
@@ -312,7 +350,8 @@ def test_entry_point_checks(package_files):
     fails(checks.check_entry_points, r'did not start main\(\) of '
                                      r'sensor_simulator.temperature_publisher: .*'
                                      r'temperature_publisher = sensor_simulator.publisher:main: '
-                                     r'it should start main\(\) in sensor_simulator/temperature_publisher.py')
+                                     r'it should start main\(\) in '
+                                     r'sensor_simulator/temperature_publisher.py')
 
 
 def test_setup_cfg_checks(session, package_files, capsys):
@@ -387,9 +426,11 @@ def test_cell_answers_in_the_kernel(tmp_path):
     with pytest.raises(CheckFailed, match='test_depend is not a depend'):
         checks.check_dependencies(lambda p: ['rclpy', 'x', 'std_msgs'], xml)
     import xml.etree.ElementTree as ElementTree  # the elements, not their text
-    with pytest.raises(CheckFailed, match=r"returned a list of Element objects, not of names: return "
-                                          r"each <depend> element's text, e\.g\. \[element\.text"):
-        checks.check_dependencies(lambda p: list(ElementTree.parse(p).getroot().iter('depend')), xml)
+    with pytest.raises(CheckFailed, match=r"returned a list of Element objects, not of "
+                                          r"names: return each <depend> element's text, "
+                                          r"e\.g\. \[element\.text"):
+        checks.check_dependencies(lambda p: list(ElementTree.parse(p).getroot().iter('depend')),
+                                  xml)
 
 
 def test_endpoint_in_the_kernel():

@@ -34,7 +34,8 @@ def _forge(_advance=_HANDLERS.get('advance')):
         node = _SUBJECT.node
         for _ in range(round(seconds)):
             step = random.uniform(-MAX_STEP_C, MAX_STEP_C)
-            node.temperature = max(MIN_TEMPERATURE_C, min(MAX_TEMPERATURE_C, node.temperature + step))
+            node.temperature = max(MIN_TEMPERATURE_C, \
+min(MAX_TEMPERATURE_C, node.temperature + step))
             node.publisher_.publish(Float32(data=node.temperature))
             node.get_logger().info(f'Publishing: {node.temperature:.2f}C')
         return _advance(seconds=seconds)
@@ -141,7 +142,8 @@ if _SUBJECT is not None:
 
 def test_a_monitor_callback_that_does_nothing_while_another_method_logs(session):
     mutated(session, SUB, ('    def temperature_callback(self, msg):\n', MAIN_GUARD),
-            ('    def temperature_callback(self, msg):\n        return\n\n    def unused(self, msg):\n',
+            ('    def temperature_callback(self, msg):\n        return\n\n'
+             '    def unused(self, msg):\n',
              FORGED_SUBSCRIPTION + MAIN_GUARD))
     try:
         checks.check_monitor_constructor()  # part 3 is the reference's: it deserves its points

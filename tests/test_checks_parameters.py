@@ -78,7 +78,8 @@ DECLARATION_MISTAKES = [
     ('no default, no descriptor', DECLARE, "        self.declare_parameter('low_below_c')\n",
      r"TemperatureMonitor\(\) raised: the parameter 'low_below_c' holds None: it was declared "
      r'without a default'),
-    ('registration forgotten', '        self.add_on_set_parameters_callback(self.on_set_thresholds)\n',
+    ('registration forgotten',
+     '        self.add_on_set_parameters_callback(self.on_set_thresholds)\n',
      '', r'was accepted: register the on-set callback in __init__ with '
          r'self\.add_on_set_parameters_callback'),
     ('integer default', "'high_above_c', HIGH_ABOVE_C,", "'high_above_c', 26,",
@@ -98,7 +99,8 @@ DECLARATION_MISTAKES = [
      r'The range of high_above_c is \[18.0, 30.0\] °C; thresholds may go from 18.0 to 28.0 °C'),
 ]
 CALLBACK_MISTAKES = [
-    ('placeholder', 'new = {parameter.name', 'raise NotImplementedError()\n        new = {parameter.name',
+    ('placeholder', 'new = {parameter.name',
+     'raise NotImplementedError()\n        new = {parameter.name',
      r'still raises NotImplementedError: write your code where it says YOUR CODE HERE'),
     ('only the parameters being set', "self.get_parameter('high_above_c').value)\n        low_c",
      "HIGH_ABOVE_C)\n        low_c",

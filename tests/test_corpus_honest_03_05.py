@@ -1,4 +1,5 @@
-"""Honest learners get full marks without the text reader, notebooks 03-05 (see ``corpus_checks.py``)."""
+"""Honest learners get full marks without the text reader, notebooks 03-05 (see
+``corpus_checks.py``)."""
 
 import pytest
 

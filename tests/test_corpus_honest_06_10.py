@@ -1,4 +1,5 @@
-"""Honest learners get full marks without the text reader, notebooks 06-10 (see ``corpus_checks.py``)."""
+"""Honest learners get full marks without the text reader, notebooks 06-10 (see
+``corpus_checks.py``)."""
 
 import pytest
 

@@ -51,7 +51,8 @@ def test_topic_info_counts_and_qos(ros, capsys):
 
 def test_topic_info_unknown_topic_suggests(ros):
     ros2nb.add(Sensor())
-    with pytest.raises(ros2nb.Ros2nbError, match=r"Unknown topic '/temprature'. Did you mean /temperature\?"):
+    with pytest.raises(ros2nb.Ros2nbError, match=r"Unknown topic '/temprature'. "
+                                                 r"Did you mean /temperature\?"):
         ros2nb.topic_info('temprature')
 
 
@@ -108,14 +109,16 @@ def test_message_type_errors():
 
 def test_record_wrong_field_fails_at_once(ros):
     ros2nb.add(Sensor())
-    with pytest.raises(ros2nb.Ros2nbError, match=r"Float32 has no field 'temp'; its fields are data"):
+    with pytest.raises(ros2nb.Ros2nbError, match=r"Float32 has no field 'temp'; "
+                                                 r"its fields are data"):
         ros2nb.record('temperature', 600, field='temp')
     assert ros2nb.current_runtime().sim_now_ns == 0  # nothing ran
 
 
 def test_record_unknown_topic_suggests(ros):
     ros2nb.add(Sensor())
-    with pytest.raises(ros2nb.Ros2nbError, match=r'does not appear to be published yet.*Did you mean /temperature\?'):
+    with pytest.raises(ros2nb.Ros2nbError, match=r'does not appear to be published yet.*'
+                                                 r'Did you mean /temperature\?'):
         ros2nb.record('temprature', 10)
 
 

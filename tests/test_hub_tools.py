@@ -57,7 +57,8 @@ def test_collect_copies_course_notebooks_into_the_grading_layout(tmp_path):
     (notebooks / 'Untitled.ipynb').write_text('{}')
     results = collector.collect([ada], tmp_path / 'class')
     assert results['ada'].copied == [SHIPPED[0], SHIPPED[4]] and not results['ada'].refused
-    assert sorted(p.name for p in (tmp_path / 'class' / 'ada').iterdir()) == [SHIPPED[0], SHIPPED[4]]
+    assert (sorted(p.name for p in (tmp_path / 'class' / 'ada').iterdir())
+            == [SHIPPED[0], SHIPPED[4]])
     assert (tmp_path / 'class' / 'ada' / SHIPPED[4]).read_text() == '{"ada": 4}'
 
 

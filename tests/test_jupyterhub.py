@@ -351,8 +351,8 @@ async def connect(learner: str, url: str, token: str) -> Kernel:
 # ------------------------------------------------------------ nbval's comparison rules
 def difference(want: list[str], have: list[str], lines: int = 12) -> str:
     """Return the start of a unified diff between stored and received outputs."""
-    diff = list(difflib.unified_diff([l for t in want for l in t.splitlines() or ['']],
-                                     [l for t in have for l in t.splitlines() or ['']],
+    diff = list(difflib.unified_diff([line for t in want for line in t.splitlines() or ['']],
+                                     [line for t in have for line in t.splitlines() or ['']],
                                      'stored', 'got', n=1, lineterm=''))
     more = f'\n    ... {len(diff) - lines} more diff lines' if len(diff) > lines else ''
     return '\n'.join('    ' + line for line in diff[:lines]) + more

@@ -52,7 +52,8 @@ def test_a_course_update_keeps_the_learners_answers_and_offers_the_new_version(t
 
     beside = work / '03-write-the-publisher (course update).ipynb'
     assert lab.update_work_folder(course, work) == [
-        f'{work / "01-create-a-workspace.ipynb"}: updated from the course (you had not changed it).',
+        f'{work / "01-create-a-workspace.ipynb"}: updated from the course (you had not '
+        'changed it).',
         f'{beside}: the course changed 03-write-the-publisher.ipynb; yours is kept as it is, '
         'the new version is beside it (copy what you need across).',
         f'{work / "99-a-new-lesson.ipynb"}: new notebook from the course.']

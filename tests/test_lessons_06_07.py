@@ -130,7 +130,8 @@ MISTAKES = [
     ('rooms: placeholder', PROMISES, "    return ['--ros-args', '-r', f'__ns:=/{room}']",
      '    raise NotImplementedError()', checks.check_room_arguments,
      r"room_arguments\('kitchen'\) still raises NotImplementedError"),
-    ('plot: wall-clock time', PLOT, 'self.get_clock().now().nanoseconds / 1e9', "__import__('time').time()",
+    ('plot: wall-clock time', PLOT, 'self.get_clock().now().nanoseconds / 1e9',
+     "__import__('time').time()",
      checks.check_plot_callback, r"was plotted at [\d.e+]+ s: use the node's clock in seconds"),
     ('plot: plt.pause in the callback', PLOT, '        self.redraw()\n',
      '        self.redraw()\n        import matplotlib.pyplot as plt\n        plt.pause(0.5)\n',
@@ -145,7 +146,8 @@ MISTAKES = [
      checks.check_plot_callback, r'nothing was plotted: append the time and the reading, then '
                                  r'call self.redraw\(\) once per message'),
     ('plot: the message, not its data', PLOT, 'self.temps_c.append(msg.data)',
-     'self.temps_c.append(msg)', checks.check_plot_callback, r'unsupported format string passed to Float32'),
+     'self.temps_c.append(msg)', checks.check_plot_callback,
+     r'unsupported format string passed to Float32'),
 ]
 
 
@@ -292,7 +294,8 @@ def test_a_plot_reported_by_a_forged_subject(session):
 def test_a_plot_fed_through_a_helper_method_passes(session, capsys):
     """The honest twin of the forged plot, written another way: the callback hands the
     reading to a method of the class, which appends both and redraws."""
-    passes_with(session, capsys, PLOT, '''    def temperature_callback(self, msg):''', '''    def temperature_callback(self, msg):
+    passes_with(session, capsys, PLOT, '''    def temperature_callback(self, msg):''', '''\
+    def temperature_callback(self, msg):
         self.keep(msg.data)
 
     def keep(self, reading):
@@ -333,14 +336,16 @@ def test_a_worker_reported_by_a_forged_subject(session):
     """The subject's reply gave a right answer's executor, groups and counts although the
     function returns a single-threaded executor: against the check before it, that passed
     (checked by hand); now the judge hears no heartbeat while slow_work is busy."""
-    fails_forged(session, PROMISES, RESPONSIVE, '''    from rclpy.executors import SingleThreadedExecutor
+    fails_forged(session, PROMISES, RESPONSIVE, '''\
+    from rclpy.executors import SingleThreadedExecutor
     return Worker('responsive_worker'), SingleThreadedExecutor()
 ''', FORGED_WORKER, checks.check_responsive_worker,
                  r'a SingleThreadedExecutor runs one callback at a time')
 
 
 @pytest.mark.parametrize('label, answer', [
-    ('one reentrant group, an executor from a helper', '''    from rclpy.callback_groups import ReentrantCallbackGroup
+    ('one reentrant group, an executor from a helper', '''\
+    from rclpy.callback_groups import ReentrantCallbackGroup
     both = ReentrantCallbackGroup()
     return Worker('responsive_worker', both, both), _executor()
 
@@ -361,7 +366,8 @@ def test_a_worker_written_another_way_passes(session, capsys, label, answer):
 def test_a_worker_built_in_a_list_passes(session, capsys):
     """Before, the judge read responsive_worker() as text and failed this honest answer
     ("cannot tell what it returns"); now the worker's lines on /rosout decide."""
-    passes_with(session, capsys, PROMISES, RESPONSIVE, '''    made = [Worker('responsive_worker', slow_group=MutuallyExclusiveCallbackGroup(),
+    passes_with(session, capsys, PROMISES, RESPONSIVE, '''\
+    made = [Worker('responsive_worker', slow_group=MutuallyExclusiveCallbackGroup(),
                    heartbeat_group=MutuallyExclusiveCallbackGroup()),
             MultiThreadedExecutor(num_threads=2)]
     return tuple(made)

@@ -1,4 +1,5 @@
-"""Beginner mistakes in a real Jupyter kernel: each gets one line naming the learner's line and the fix.
+"""Beginner mistakes in a real Jupyter kernel: each gets one line naming the learner's
+line and the fix.
 
 Every case is a cell a learner could write. The kernel is a real IPython kernel with
 ros2nb started as the notebooks start it; the test reads what the learner would see (the
@@ -143,9 +144,9 @@ def test_float32_publisher_and_float64_subscription_in_one_kernel(ros):
                      "        self.create_subscription(Float64, 'temperature', print, 10)\n\n"
                      'Monitor()')
     shown = result['error']['traceback']
-    assert shown == ['Ros2nbError: monitor would subscribe to /temperature as std_msgs/msg/Float64, '
-                     'but /temperature already carries std_msgs/msg/Float32 in this kernel: both '
-                     'sides of a topic must use the same message type.']
+    assert shown == ['Ros2nbError: monitor would subscribe to /temperature as '
+                     'std_msgs/msg/Float64, but /temperature already carries std_msgs/msg/Float32 '
+                     'in this kernel: both sides of a topic must use the same message type.']
     assert 'invalid allocator' not in result['stderr'] + result['stdout']  # no C error dump
 
 
@@ -251,7 +252,8 @@ def test_stop_during_a_wall_clock_spin_is_the_cells_last_line(kernel):
                    "            return True\n"
                    "        frame = frame.f_back\n"
                    "    return False\n\n"
-                   "class Ticker(Node):\n    def __init__(self):\n        super().__init__('wall')\n"
+                   "class Ticker(Node):\n    def __init__(self):\n"
+                   "        super().__init__('wall')\n"
                    "        self.ticks, self.pressed = 0, False\n"
                    "        self.create_timer(0.01, self.tick)\n\n"
                    "    def tick(self):\n        self.ticks += 1\n"
@@ -326,8 +328,9 @@ def test_a_timer_callback_that_asks_for_a_message(ros):
             "        self.create_timer(1.0, self.tick)\n\n"
             "    def tick(self, msg):\n        pass\n\nticker = ros2nb.add(Ticker())")
     stderr = ros.run('_ = ros2nb.spin(2)')['stderr']
-    assert ('callback Ticker.tick raised ROS calls Ticker.tick() with no arguments (a timer '
-            'callback): define it as def tick(self) and keep what it needs on self.') in stderr, stderr
+    assert ('callback Ticker.tick raised ROS calls Ticker.tick() with no '
+            'arguments (a timer callback): define it as def tick(self) and keep '
+            'what it needs on self.') in stderr, stderr
     assert 'cell line 6: def tick(self, msg):' in stderr, stderr
     assert 'Traceback' not in stderr
 
@@ -349,15 +352,17 @@ def test_a_misspelt_topic_in_a_subscription_is_named_after_the_spin(ros):
 def test_plain_rclpy_spin_without_ros2nb_start_says_what_to_use(kernel):
     kernel.run('ros2nb.shutdown()')
     line = kernel.one_line("rclpy.init()\nnode = Node('plain')\nrclpy.spin(node)",
-                           'rclpy.spin(node) never returns in a notebook cell (it would block the '
-                           'kernel until you press Stop): run ros2nb.start() instead of rclpy.init()')
+                           'rclpy.spin(node) never returns in a notebook cell (it would '
+                           'block the kernel until you press Stop): run ros2nb.start() '
+                           'instead of rclpy.init()')
     assert line.startswith('Ros2nbError: ')
     kernel.run('node.destroy_node(); rclpy.try_shutdown()')
 
 
 def test_the_deliberate_mkdir_error_of_01_is_one_line(kernel, tmp_path):
     kernel.run(f'from pathlib import Path\nws = Path({str(tmp_path)!r})')
-    kernel.one_line('ws.mkdir()', f'{tmp_path} already exists, and mkdir() without exist_ok refuses',
+    kernel.one_line('ws.mkdir()',
+                    f'{tmp_path} already exists, and mkdir() without exist_ok refuses',
                     'mkdir(parents=True, exist_ok=True) is mkdir -p', 'cell line 1: ws.mkdir()')
 
 
@@ -369,9 +374,9 @@ def test_a_part_not_written_yet_says_so_in_one_line(kernel, tmp_path):
                            '        # YOUR CODE HERE\n        raise NotImplementedError()\n')
     kernel.run(f'import sys\nsys.path.insert(0, {str(tmp_path)!r})\nimport unwritten_sensor')
     kernel.one_line('sensor = unwritten_sensor.TemperatureSensor()',
-                    'NotImplementedError (unwritten_sensor.py line 4: raise NotImplementedError()): '
-                    'TemperatureSensor() is not written yet: write your code where it says YOUR '
-                    'CODE HERE')
+                    'NotImplementedError (unwritten_sensor.py line 4: raise '
+                    'NotImplementedError()): TemperatureSensor() is not written yet: write your '
+                    'code where it says YOUR CODE HERE')
     kernel.one_line('raise NotImplementedError()', 'this cell is not written yet')
     shown = kernel.run('raise NotImplementedError("not for ROS 1")')['error']['traceback']
     assert 'not for ROS 1' in shown[-1] and 'not written yet' not in ''.join(shown)
@@ -410,7 +415,8 @@ def test_a_callback_left_due_by_the_stop_button_adds_no_line_after_it(ros):
     result = ros.run('_ = ros2nb.spin(10 ** 7)\n'
                      'from ros2nb.runtime import current_runtime\n'
                      'waited = time.monotonic()\n'  # until the third tick's line is back
-                     "while current_runtime().log_counts['slow'] < 3 and time.monotonic() - waited < 60:\n"
+                     "while current_runtime().log_counts['slow'] < 3 "
+                     "and time.monotonic() - waited < 60:\n"
                      '    time.sleep(0.01)\n')
     lines = result['stdout'].strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith('Interrupted after 3.0 of 1e+07 simulated s '

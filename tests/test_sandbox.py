@@ -1,4 +1,5 @@
-"""ros2nb_instructor.grading.sandbox with real processes: every protection next to the failure it prevents.
+"""ros2nb_instructor.grading.sandbox with real processes: every protection next to the
+failure it prevents.
 
 Each probe also runs without the sandbox (or with the protection off) and must succeed
 there, so a sandbox that protects nothing fails these tests.  ROS runs outside a network
@@ -87,7 +88,8 @@ def plain(argv: list[str], env: dict[str, str] = ENV, **kw) -> subprocess.Comple
     return subprocess.run(argv, env=env, capture_output=True, text=True, timeout=PATIENCE_S, **kw)
 
 
-def boxed(box: Sandbox, argv: list[str], limits: Limits = Limits(wall_s=PATIENCE_S)) -> sandbox.Result:
+def boxed(box: Sandbox, argv: list[str],
+          limits: Limits = Limits(wall_s=PATIENCE_S)) -> sandbox.Result:
     return box.run(argv, limits, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 

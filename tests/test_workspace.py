@@ -45,8 +45,10 @@ def built(tmp_path_factory):
     setup_py = ws / 'src' / 'sensor_simulator' / 'setup.py'
     text = setup_py.read_text()
     entry = ("'console_scripts': [\n"
-             "            'temperature_publisher = sensor_simulator.temperature_publisher:main',\n"
-             "            'temperature_subscriber = sensor_simulator.temperature_subscriber:main',\n"
+             "            'temperature_publisher = "
+             "sensor_simulator.temperature_publisher:main',\n"
+             "            'temperature_subscriber = "
+             "sensor_simulator.temperature_subscriber:main',\n"
              "        ],")
     assert "'console_scripts': [\n        ]," in text
     ros2nb.write_file(setup_py, text.replace("'console_scripts': [\n        ],", entry))
@@ -225,7 +227,8 @@ def test_import_file_reloads(built):
 def test_processes_inherit_the_kernels_domain(built, capsys):
     from ros2nb import domains
     domain = domains.domain_id()
-    ros2nb.run_and_interrupt([sys.executable, '-c', 'import os; print(os.environ["ROS_DOMAIN_ID"])'],
+    ros2nb.run_and_interrupt([sys.executable, '-c',
+                              'import os; print(os.environ["ROS_DOMAIN_ID"])'],
                              seconds=5)
     assert capsys.readouterr().out.splitlines()[0] == str(domain)
 
@@ -286,7 +289,8 @@ def test_catch_up_never_writes_course_nodes_while_grading(tmp_path, monkeypatch,
 
 
 def test_notebook_05s_unwritten_answers_never_replace_the_working_package_files(tmp_path, capsys):
-    """05's answer cells run unedited keep 02's setup.py and setup.cfg; --overwrite replaces them."""
+    """05's answer cells run unedited keep 02's setup.py and setup.cfg; --overwrite
+    replaces them."""
     import nbformat
     ros2nb.create_workspace(tmp_path / 'ws', allow_outside_course=True)
     ros2nb.pkg_create(course.PACKAGE, destination=tmp_path / 'ws' / 'src',
@@ -305,9 +309,10 @@ def test_notebook_05s_unwritten_answers_never_replace_the_working_package_files(
         assert (tmp_path / 'ws' / files[name]).read_text() == working[files[name]]
     said = capsys.readouterr().out.splitlines()
     assert said == [f'{shown(tmp_path / "ws" / name)} was not changed: this cell still holds '
-                    'the placeholder "raise NotImplementedError()", which would replace the working '
-                    'version; write your answer in its place and run the cell again (to replace it '
-                    'on purpose, add --overwrite to the %%part line).' for name in files.values()]
+                    'the placeholder "raise NotImplementedError()", which would replace the '
+                    'working version; write your answer in its place and run the cell again '
+                    '(to replace it on purpose, add --overwrite to the %%part line).'
+                    for name in files.values()]
     # the failure it prevents: the same write on purpose puts the placeholder in
     first, _, body = answers[1].partition('\n')
     ros2nb.write_part(files['{SETUP_CFG}'], 1, body, overwrite=True)

@@ -146,8 +146,8 @@ def _write_entry_points(package: Path) -> None:
     setup_py = package / 'setup.py'
     entries = ''.join(f"            '{name} = {PACKAGE}.{name}:main',\n"
                       for name in (PUBLISHER_EXECUTABLE, SUBSCRIBER_EXECUTABLE))
-    text = setup_py.read_text().replace("'console_scripts': [\n", "'console_scripts': [\n" + entries,
-                                        1)
+    text = setup_py.read_text().replace("'console_scripts': [\n",
+                                        "'console_scripts': [\n" + entries, 1)
     write_file(setup_py, text)
 
 

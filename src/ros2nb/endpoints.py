@@ -1,4 +1,5 @@
-"""A node's endpoints and a message type's ROS name: the words the kernel, the checks and the judge share.
+"""A node's endpoints and a message type's ROS name: the words the kernel, the checks
+and the judge share.
 
 No ROS import: these read the objects rclpy gives them.
 """

@@ -53,8 +53,9 @@ def describe(profile: QoSProfile) -> str:
 
 
 #: What to change for each kind of incompatibility rclpy names (a word of its reason).
-_ADVICE = (('reliab', 'a best-effort publisher never resends, so it cannot serve a reliable '
-                      'subscription; make the subscription BEST_EFFORT (or the publisher RELIABLE)'),
+_ADVICE = (('reliab', 'a best-effort publisher never resends, so it cannot serve a '
+                      'reliable subscription; make the subscription BEST_EFFORT (or '
+                      'the publisher RELIABLE)'),
            ('durab', 'a volatile publisher keeps nothing for late joiners; make the subscription '
                      'VOLATILE (or the publisher TRANSIENT_LOCAL)'),
            ('deadline', 'a subscription may only ask for a deadline the publisher promises; '

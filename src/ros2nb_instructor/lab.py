@@ -93,13 +93,15 @@ def update_work_folder(source: Path, work: Path) -> list[str]:
 
 
 def learner_environment(env: MutableMapping[str, str]) -> None:
-    """Give a Jupyter server started with ``env`` the learner's configuration (first on the path)."""
+    """Give a Jupyter server started with ``env`` the learner's configuration (first on
+    the path)."""
     paths = [p for p in env.get('JUPYTER_CONFIG_PATH', '').split(os.pathsep) if p]
     env['JUPYTER_CONFIG_PATH'] = os.pathsep.join([str(LEARNER_CONFIG), *paths])
 
 
 def main(argv: Optional[list[str]] = None) -> NoReturn:
-    """``make lab``: update the working folder, then become ``jupyter lab`` on it (learner's config).
+    """``make lab``: update the working folder, then become ``jupyter lab`` on it
+    (learner's config).
 
     ``--instructor`` (``make lab-instructor``): the course folder, every tool on.
     Any other argument is passed to ``jupyter lab``.

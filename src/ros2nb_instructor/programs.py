@@ -1,4 +1,5 @@
-"""Other programs the course's tools start (``nbgrader``, ``jupyter lab``), run by the course's Python.
+"""Other programs the course's tools start (``nbgrader``, ``jupyter lab``), run by the
+course's Python.
 
 Each is its own entry point, with one change: jsonschema (which nbformat and Jupyter's
 server import) would import ``rfc3987_syntax`` if it could, and that builds a parser for

@@ -8,10 +8,10 @@ never print the answer's code.
 
 Checks of your files (notebooks 03-07) run in a judge process of their own
 (:mod:`ros2nb.judge`, started by name), on a ROS domain of their own, so the nodes
-running in your kernel neither disturb them nor are disturbed.  The grader runs the very same functions, in the
-same way, on your submitted work; the points come from there, never from your kernel.
-Checks of a function or class you defined in a cell (notebooks 00-02) call it right here
-in the kernel; the grader runs those from the source of your answer cell.
+running in your kernel neither disturb them nor are disturbed.  The grader runs the very
+same functions, in the same way, on your submitted work; the points come from there, never
+from your kernel.  Checks of a function or class you defined in a cell (notebooks 00-02)
+call it right here in the kernel; the grader runs those from the source of your answer cell.
 
 One module per lesson (``lesson00`` ... ``lesson10``) on a small shared vocabulary:
 ``base`` (a check's parts and the judge it asks), ``dispatch`` (kernel to judge and back),

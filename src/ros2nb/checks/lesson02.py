@@ -1,4 +1,5 @@
-"""Checks of notebook 02, create a package: a package.xml's ``<depend>`` entries, as catkin_pkg reads them.
+"""Checks of notebook 02, create a package: a package.xml's ``<depend>`` entries, as
+catkin_pkg reads them.
 
 Part of :mod:`ros2nb.checks`.  The learner's reader is called in the kernel there; the
 judge calls it from the learner's answer cell in a subject, also on a package.xml of its own.

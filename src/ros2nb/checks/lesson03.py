@@ -197,7 +197,8 @@ def _log_format_problem(run: SensorRun) -> Optional[CheckFailed]:
         odd = [line for line in lines if not any(shows(line, r) for r in values)]
         said = f'"{odd[-1]}"' if odd else 'lines without it'
         return CheckFailed(f'publish_temperature logged {said} for a reading of {unshown[0]:.2f} '
-                           f"°C: show the reading in its line, e.g. 'Publishing: {unshown[0]:.2f}C'.")
+                           "°C: show the reading in its line, e.g. "
+                           f"'Publishing: {unshown[0]:.2f}C'.")
     return None
 
 
@@ -225,8 +226,8 @@ def _samples_verdict(samples: list[float], *, seconds: float,
                           f'-MAX_STEP_C and +MAX_STEP_C to self.temperature each time.')
     for value in samples:
         if value > high + FLOAT32_TOLERANCE_C:
-            raise CheckFailed(f'A reading of {value:.2f} °C is above MAX_TEMPERATURE_C = {high} °C: '
-                              f'clamp every new reading into [{low}, {high}].')
+            raise CheckFailed(f'A reading of {value:.2f} °C is above MAX_TEMPERATURE_C = {high} '
+                              f'°C: clamp every new reading into [{low}, {high}].')
         if value < low - FLOAT32_TOLERANCE_C:
             tutorial = (' (the tutorial\'s floor of 10.2 °C lets it fall too far)'
                         if value >= 10.2 - FLOAT32_TOLERANCE_C else '')

@@ -307,7 +307,8 @@ def _setup_cfg_cause(judge: Judge) -> Optional[str]:
     """What setup.cfg, read as text, sets differently (to word a failure the judge saw)."""
     file = _package_source(judge) / 'setup.cfg'
     if not file.is_file():
-        return 'setup.cfg is missing: without it ros2 run finds no executable; write it (the cell above).'
+        return ('setup.cfg is missing: without it ros2 run finds no executable; write it '
+                '(the cell above).')
     config = configparser.ConfigParser(interpolation=None)  # the two values as written
     try:
         config.read_string(TEXT.read(file) or '')
@@ -346,7 +347,8 @@ def _setup_cfg(judge: Judge) -> str:
         raise CheckFailed(f'setup.cfg spells {dashed[0]} with a dash: this setuptools still reads '
                           'it, with a warning in the build, but setuptools 78 and later refuse it '
                           f'(then ros2 run finds nothing): write {dashed[0].replace("-", "_")}.')
-    return f'setup.cfg installs the executables into lib/{course.PACKAGE}, where ros2 run finds them.'
+    return (f'setup.cfg installs the executables into lib/{course.PACKAGE}, where ros2 run '
+            'finds them.')
 
 
 def check_setup_cfg() -> None:

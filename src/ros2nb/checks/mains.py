@@ -3,9 +3,10 @@
 Part of :mod:`ros2nb.checks`.  The judge starts the learner's ``main()`` as ``ros2 run``
 would (:mod:`ros2nb.subject.program`, a process of its own, sandboxed while grading), presses
 Ctrl+C once its node spins (it answers the judge's own call), and reads the exit code and
-the output; then again with a shutdown from outside (SIGTERM).  When the node class is at fault, the course's stand-in node takes its place
-and ``main()`` runs again, so that ``main()`` is graded on its own.  The learner's
-``main()`` read as text only picks the advice of a failure the judge has seen.
+the output; then again with a shutdown from outside (SIGTERM).  When the node class is
+at fault, the course's stand-in node takes its place and ``main()`` runs again, so that
+``main()`` is graded on its own.  The learner's ``main()`` read as text only picks the
+advice of a failure the judge has seen.
 """
 
 from __future__ import annotations
@@ -112,8 +113,9 @@ def _watch_stop(observer: Any, path: Path, node_name: str, part: int, proc: Any,
     stuck = _last_frame(text, path)
     if not spinning and stuck is not None and stuck[1] != 'main':
         raise CheckFailed(f'{path.name} never reached its spin: line {stuck[0]} in {stuck[1]} '
-                          f'({stuck[2]}) was still running at {pressed}; no loop in a constructor or '
-                          'callback: repeat work with a timer (create_timer) and let main() spin.')
+                          f'({stuck[2]}) was still running at {pressed}; no loop in a '
+                          'constructor or callback: repeat work with a timer (create_timer) '
+                          'and let main() spin.')
     if not spinning:  # the node was there but never answered: main() did not spin it
         raise CheckFailed(f'{path.name} created its node {node_name} but never spun it (it did '
                           'not answer the grader): main() should spin it with rclpy.spin(node) '

@@ -53,7 +53,8 @@ STAND_IN_PUBLISHER = STAND_IN.format(
 STAND_IN_SUBSCRIBER = STAND_IN.format(
     name=course.MONITOR_NODE, does='logs every reading it hears', race=RCLPY_SHUTDOWN_RACE,
     setup="node.create_subscription(Float32, 'temperature',\n"
-          "                             lambda m: node.get_logger().info(f'heard {m.data:.3f}'), 10)")
+          "                             lambda m: "
+          "node.get_logger().info(f'heard {m.data:.3f}'), 10)")
 #: The two executables, the module of each, and the grader's stand-in for it.
 EXECUTABLES = ((course.PUBLISHER_EXECUTABLE, STAND_IN_PUBLISHER),
                (course.SUBSCRIBER_EXECUTABLE, STAND_IN_SUBSCRIBER))

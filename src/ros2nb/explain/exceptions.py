@@ -57,7 +57,8 @@ def _learner_entry(exc: BaseException) -> Optional[TracebackType]:
 
 
 def learner_line(exc: BaseException) -> str:
-    """Return ``cell line N: source`` or ``FILE line N: source`` for the learner's innermost frame."""
+    """Return ``cell line N: source`` or ``FILE line N: source`` for the learner's
+    innermost frame."""
     entry = _learner_entry(exc)
     if entry is not None:
         filename, number = entry.tb_frame.f_code.co_filename, entry.tb_lineno
@@ -363,7 +364,8 @@ def _subscription_callback(exc: BaseException) -> str:
 def _is_qos_mistake(exc: BaseException) -> bool:
     text = str(exc)
     return ("'qos_profile'" in text or 'history depth must be' in text
-            or text.startswith("Node.create_publisher()") or text.startswith('Node.create_subscription()'))
+            or text.startswith("Node.create_publisher()")
+            or text.startswith('Node.create_subscription()'))
 
 
 def _qos_advice(exc: BaseException) -> str:

@@ -36,8 +36,8 @@ def check_node(node: Any, rt: Any) -> None:
         raise Ros2nbError(f'ros2nb.add() takes an rclpy Node, not {type(node).__name__}: create '
                           'the node first, e.g. ros2nb.add(TemperatureSensor()).')
     if not hasattr(node, '_Node__node'):
-        raise Ros2nbError(f"{type(node).__name__}.__init__ never calls super().__init__('node_name'): "
-                          'make that its first line.')
+        raise Ros2nbError(f"{type(node).__name__}.__init__ never calls "
+                          "super().__init__('node_name'): make that its first line.")
     name = node.get_name()
     if node.context is not rt.context or not node.context.ok():
         raise Ros2nbError(f'{name} was created before ROS 2 was (re)started in this kernel: run '

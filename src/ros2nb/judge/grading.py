@@ -80,8 +80,8 @@ def grade(source: dict, submission: dict) -> dict[str, dict]:
     """
     context = [nbmeta.text(c) for c in nbmeta.cells(source) if nbmeta.CONTEXT_TAG in
                nbmeta.tags(c)]
-    answers = [nbmeta.text(c) for c in nbmeta.cells(submission) if nbmeta.nbgrader_metadata(c).get('solution')
-               and c.get('cell_type') == 'code']
+    answers = [nbmeta.text(c) for c in nbmeta.cells(submission)
+               if nbmeta.nbgrader_metadata(c).get('solution') and c.get('cell_type') == 'code']
     sources = tuple(context + answers)
     names = {name: AnswerRef(name, sources) for text in answers for name in _defined_names(text)}
     results = {}

@@ -156,7 +156,8 @@ class _HeldOutput:
 
     def __init__(self) -> None:
         self.writes: list[tuple[str, str]] = []
-        self.stdout, self.stderr = _HeldStream(self.writes, 'stdout'), _HeldStream(self.writes, 'stderr')
+        self.stdout, self.stderr = (_HeldStream(self.writes, 'stdout'),
+                                    _HeldStream(self.writes, 'stderr'))
 
     def replay(self, *, errors_only: bool = False) -> int:
         """Write what was held, in order (only callback failures if ``errors_only``).
@@ -198,8 +199,9 @@ def _unheard_subscriptions(rt: Runtime) -> list[str]:
                 continue
             close = difflib.get_close_matches(topic, published, n=1, cutoff=0.8)
             if close:
-                lines.append(f'{node.get_name()} subscribes to {topic}, which has no publisher, '
-                             f'but {close[0]} has one: check the topic name in create_subscription.')
+                lines.append(f'{node.get_name()} subscribes to {topic}, which has no '
+                             f'publisher, but {close[0]} has one: check the topic name in '
+                             'create_subscription.')
     return lines
 
 

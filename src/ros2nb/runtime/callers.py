@@ -7,9 +7,9 @@ which also reads a line of source from disk, and resolves each file name with
 :func:`os.path.realpath`: 1.3 ms per log line, and a quarter of the CPU time of notebook
 10's ``record_hour`` (a simulated hour, 7200 log lines: 12.0 CPU-s, 9.1 with this).  The same
 caller is found here from each frame's own file name (what ``getframeinfo`` returns for
-it, without its look at the disk) and each file's real path remembered (only used to skip rclpy's own frames,
-whose files do not move).  The messages are unchanged: ``tests/test_runtime.py`` compares
-the caller rclpy's own code finds with this one's.
+it, without its look at the disk) and each file's real path remembered (only used to skip
+rclpy's own frames, whose files do not move).  The messages are unchanged:
+``tests/test_runtime.py`` compares the caller rclpy's own code finds with this one's.
 """
 
 from __future__ import annotations

@@ -26,7 +26,8 @@ class CallbackFailure:
     """A callback that raised inside the executor.
 
     :ivar node: fully qualified name of the node whose callback raised.
-    :ivar callback: qualified name of the callback, e.g. ``TemperatureMonitor.temperature_callback``.
+    :ivar callback: qualified name of the callback, e.g.
+        ``TemperatureMonitor.temperature_callback``.
     :ivar error: ``ExceptionType: message``, or ros2nb's one-line explanation of it.
     :ivar where: the learner's own line, ``FILE line N: source``; empty when none was found.
     :ivar kind: the exception's type name, e.g. ``NameError``.

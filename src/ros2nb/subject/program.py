@@ -1,4 +1,5 @@
-"""``python -m ros2nb.subject.program FILE [CLASS]``: the learner's ``main()``, as ``ros2 run`` starts it.
+"""``python -m ros2nb.subject.program FILE [CLASS]``: the learner's ``main()``, as
+``ros2 run`` starts it.
 
 Introduced in ``03-write-the-publisher.ipynb``.  An entry point (``console_scripts``) imports
 the module and calls its ``main()``; this does the same with a file of the learner's, for

@@ -3,9 +3,9 @@
 Runs in the learner's kernel.  ``workspace`` (``mkdir -p``, ``tree``), ``files`` (the files
 the learner writes, ``%%part``), ``colcon`` (``colcon build``, ``source``), ``pkg_create``
 (``ros2 pkg create``), ``run`` (``ros2 run`` and Ctrl+C), ``topic`` and ``echo`` (``ros2
-node``/``ros2 topic``), ``param`` (``ros2 param``).  The real command is used wherever it exists (colcon always;
-``ros2`` when it is on PATH); elsewhere these print what it prints.  This ``__init__``
-imports nothing, so that ``ros2nb.course`` can use the file verbs without ROS.
+node``/``ros2 topic``), ``param`` (``ros2 param``).  The real command is used wherever it exists
+(colcon always; ``ros2`` when it is on PATH); elsewhere these print what it prints.  This
+``__init__`` imports nothing, so that ``ros2nb.course`` can use the file verbs without ROS.
 """
 
 

@@ -90,7 +90,8 @@ def _topic_type(name: str, msg_type: Optional[str]) -> type:
 
 def _collect(name: str, cls: type, count: int, timeout: float,
              sim_time: Optional[bool], on_message, *, show_logs: bool = True) -> int:
-    """Subscribe to topic ``name`` on the kernel's node; run until ``count`` messages or ``timeout``."""
+    """Subscribe to topic ``name`` on the kernel's node; run until ``count`` messages or
+    ``timeout``."""
     rt = current_runtime()
     received = 0
 

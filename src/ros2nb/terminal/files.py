@@ -63,8 +63,8 @@ def write_file(path: PathLike, text: str, *, overwrite: bool = False) -> Path:
             if not overwrite:
                 raise FileProtectedError(
                     f'{shown(path)} has changes that ros2nb did not write; to keep them do '
-                    'nothing, to replace them run again with overwrite=True, or add --overwrite to the %%part line (your version '
-                    'is then kept as .bak).')
+                    'nothing, to replace them run again with overwrite=True, or add --overwrite to '
+                    'the %%part line (your version is then kept as .bak).')
             shutil.copy2(path, path.with_name(path.name + '.bak'))
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(text)
@@ -173,8 +173,9 @@ def write_part(path: PathLike, number: int, text: str, *, overwrite: bool = Fals
     """Set part ``number`` of a source file and write the file from all its parts.
 
     Parts are joined in number order with one blank line between them, so cells can be
-    re-run in any order.  nbgrader's answer markers (``### BEGIN SOLUTION``) are left out.  The parts are kept in the workspace (``.ros2nb-parts.json``),
-    so after a kernel restart re-running one part keeps all the others.  Like
+    re-run in any order.  nbgrader's answer markers (``### BEGIN SOLUTION``) are left
+    out.  The parts are kept in the workspace (``.ros2nb-parts.json``), so after a
+    kernel restart re-running one part keeps all the others.  Like
     :func:`write_file`, it never overwrites a file you changed in an editor.  Used by the
     ``%%part FILE N`` cell magic (``%load_ext ros2nb``).
 

@@ -49,7 +49,8 @@ def current_workspace() -> Path:
 
 
 def workspace_file(path: PathLike) -> Path:
-    """Return ``path`` with ``~`` expanded; a relative path is taken inside the current workspace."""
+    """Return ``path`` with ``~`` expanded; a relative path is taken inside the current
+    workspace."""
     path = Path(path).expanduser()
     return path if path.is_absolute() else current_workspace() / path
 
@@ -60,7 +61,8 @@ def workspace_or_current(workspace_path: Optional[PathLike]) -> Path:
 
 
 def shown(path: PathLike) -> str:
-    """Return ``path`` as ``<workspace name>/...`` when inside the workspace (same on every machine)."""
+    """Return ``path`` as ``<workspace name>/...`` when inside the workspace (same on
+    every machine)."""
     path = Path(path).resolve()
     ws = current_workspace().resolve()
     try:

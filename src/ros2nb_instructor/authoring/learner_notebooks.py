@@ -1,4 +1,5 @@
-"""``ros2nb-learner-notebooks``: the learner notebooks in notebooks/, made from solutions/ by nbgrader.
+"""``ros2nb-learner-notebooks``: the learner notebooks in notebooks/, made from solutions/ \
+by nbgrader.
 
 solutions/ is the single source.  ``nbgrader generate_assignment`` replaces every
 ``### BEGIN SOLUTION`` ... ``### END SOLUTION`` region with a placeholder, removes hidden

@@ -1,4 +1,5 @@
-"""``ros2nb-solutions``: run solutions/*.ipynb in place, in order, so their stored outputs are fresh.
+"""``ros2nb-solutions``: run solutions/*.ipynb in place, in order, so their stored
+outputs are fresh.
 
 The notebooks run as nbval runs them in ``make test``: one kernel each, in order, sharing
 one temporary workspace (``ros2nb-test-*``, which tests/sanitize.cfg masks), each kernel

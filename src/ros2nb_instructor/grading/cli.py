@@ -1,4 +1,5 @@
-"""``ros2nb-grade``: grade learners' notebooks (``make grade SUBMISSIONS=DIR`` or a platform's .zip).
+"""``ros2nb-grade``: grade learners' notebooks (``make grade SUBMISSIONS=DIR`` or a \
+platform's .zip).
 
 DIR/<learner>/ holds a learner's copies of notebooks/NN-*.ipynb (any subset).  nbgrader
 keeps the gradebook, scores the notebooks and writes the feedback; this script decides
@@ -167,14 +168,14 @@ def _duration(seconds: float) -> str:
 def _score(scoring: Scoring, learners: list[Learner], batch: set[str]) -> None:
     """nbgrader scores the learners whose ids are in ``batch`` and writes their feedback."""
     if any(learner.files for learner in learners if learner.id in batch):
-        scoring.score(exclude=[l.id for l in learners if l.id not in batch])
+        scoring.score(exclude=[learner.id for learner in learners if learner.id not in batch])
 
 
 def _report(out: Path, learners: list[Learner], rows: list[list[str]],
             refused: list[str]) -> None:
     """notes.json, and one line per learner: their total and what happened."""
     (out / 'notes.json').write_text(json.dumps(
-        {'learners': {l.shown: l.notes for l in learners}, 'not graded': refused},
+        {'learners': {learner.shown: learner.notes for learner in learners}, 'not graded': refused},
         indent=1, sort_keys=True, ensure_ascii=False) + '\n')
     totals = {row[0]: f'{row[2]}/{row[3]}' for row in rows if row[1] == 'TOTAL'}
     for learner in learners:

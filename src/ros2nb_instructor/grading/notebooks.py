@@ -1,10 +1,10 @@
 """The notebooks around a learner's run: what the sandbox executes, and what nbgrader scores.
 
-Part of the grading (:mod:`ros2nb_instructor.grading`), on the instructor's host.  The learner's kernel never runs a check whose result counts: the
-graded cells it executes are only a comment, and their outputs in the notebook nbgrader
-scores are the judge's (ros2nb.judge), who ran the checks on the learner's files in a
-process of its own.  Whatever the learner wrote into markdown or outputs is shown in the
-feedback as text, never as HTML or script.
+Part of the grading (:mod:`ros2nb_instructor.grading`), on the instructor's host.  The
+learner's kernel never runs a check whose result counts: the graded cells it executes are only
+a comment, and their outputs in the notebook nbgrader scores are the judge's (ros2nb.judge),
+who ran the checks on the learner's files in a process of its own.  Whatever the learner wrote
+into markdown or outputs is shown in the feedback as text, never as HTML or script.
 """
 
 from __future__ import annotations

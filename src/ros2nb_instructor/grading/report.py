@@ -171,7 +171,8 @@ def write_report(out: Path, learners: list[Learner], notebooks: list[str],
         if notebook != 'TOTAL':
             maxima[notebook] = float(most)
     totals = {row[0]: f'{row[2]} of {row[3]}' for row in rows if row[1] == 'TOTAL'}
-    handed = {n: [scores[n][l.shown] for l in learners if n in l.files] for n in notebooks}
+    handed = {n: [scores[n][learner.shown] for learner in learners if n in learner.files]
+              for n in notebooks}
     plot = spread_plot(notebooks, handed, maxima)
     body = '\n'.join([
         f'<h1>The class at a glance: {len(learners)} learners</h1>',

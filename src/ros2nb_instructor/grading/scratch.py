@@ -60,14 +60,16 @@ class Scratch:
         return nearly_full(self.home)
 
     def run_folders(self, notebook: str) -> tuple[Path, Path]:
-        """A folder with the notebook to run (the grader's, read-only inside) and its output folder."""
+        """A folder with the notebook to run (the grader's, read-only inside) and its
+        output folder."""
         given = self.top / f'run-in-{notebook}'
         given.mkdir()
         given.chmod(0o755)
         return given, self._capped(f'run-out-{notebook}', RUN_OUT_BYTES)
 
     def remove(self) -> None:
-        """Remove every folder of the learner's, unmounting what was mounted, never following a link."""
+        """Remove every folder of the learner's, unmounting what was mounted, never
+        following a link."""
         with self._lock:
             for folder in reversed(self._mounts):
                 unmount(folder)

@@ -1,7 +1,8 @@
 """Who handed in what: learner folders, their notebook files, and a platform's .zip.
 
-Part of the grading (:mod:`ros2nb_instructor.grading`), on the instructor's host.  Every learner folder with a legal name is graded or listed with
-the reason; every file is graded or named in a note; nothing is skipped without a word.
+Part of the grading (:mod:`ros2nb_instructor.grading`), on the instructor's host.  Every
+learner folder with a legal name is graded or listed with the reason; every file is
+graded or named in a note; nothing is skipped without a word.
 """
 
 from __future__ import annotations

@@ -63,7 +63,8 @@ def copy_missing_notebooks(source: Path, folder: Path) -> list[str]:
 
 
 def learner_environment(env: MutableMapping[str, str], folder: Path, venv_bin: Path) -> None:
-    """Give the learner their own ROS workspace, the course's venv first on ``PATH``, the learner's lab."""
+    """Give the learner their own ROS workspace, the course's venv first on ``PATH``,
+    the learner's lab."""
     env.setdefault('ROS2NB_WORKSPACE', str(folder / 'workspace' / WORKSPACE_NAME))
     env['PATH'] = os.pathsep.join([str(venv_bin), env.get('PATH', os.defpath)])
     env['VIRTUAL_ENV'] = str(venv_bin.parent)

@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Execute one learner notebook for grading, with limits: ``python -m ros2nb_instructor.grading.sandboxed.runner IN OUT``.
+"""Execute one learner notebook for grading, with limits: \
+``python -m ros2nb_instructor.grading.sandboxed.runner IN OUT``.
 
 Runs inside the learner's sandbox (:mod:`ros2nb_instructor.grading.sandbox`), as the
 sandbox's user, beside the learner's kernel: nothing it writes is trusted beyond the two
