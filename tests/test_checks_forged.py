@@ -34,8 +34,8 @@ def _forge(_advance=_HANDLERS.get('advance')):
         node = _SUBJECT.node
         for _ in range(round(seconds)):
             step = random.uniform(-MAX_STEP_C, MAX_STEP_C)
-            node.temperature = max(MIN_TEMPERATURE_C, \
-min(MAX_TEMPERATURE_C, node.temperature + step))
+            walked = node.temperature + step
+            node.temperature = max(MIN_TEMPERATURE_C, min(MAX_TEMPERATURE_C, walked))
             node.publisher_.publish(Float32(data=node.temperature))
             node.get_logger().info(f'Publishing: {node.temperature:.2f}C')
         return _advance(seconds=seconds)

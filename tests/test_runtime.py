@@ -466,8 +466,8 @@ calls = 0
 
 def press(frame, event, _arg):
     global calls
-    if event == 'call' and frame.f_code.co_name == function \
-and frame.f_code.co_filename.endswith(file):
+    code = frame.f_code
+    if event == 'call' and code.co_name == function and code.co_filename.endswith(file):
         calls += 1
         if calls == 50:
             sys.setprofile(None)
