@@ -146,9 +146,16 @@ PULL    ?= missing
 # This machine's certificate authorities, handed to the build as a secret (behind a proxy
 # that re-signs HTTPS, pip needs them); an empty file when there are none.
 HOST_CA ?= $(firstword $(wildcard /etc/ssl/certs/ca-certificates.crt) /dev/null)
+# The wheels this checkout's set-up already downloaded (uv's cache), handed to podman's build
+# as an overlay at IMAGE_UV_CACHE (the build may add to it; the host's cache is never
+# written), so the image installs them without downloading them again.  docker's build takes
+# no volume: there the image downloads them.
+IMAGE_UV_CACHE := /var/cache/ros2-course-uv
 image:
 	@engine=$$(command -v podman || command -v docker) || { echo "Neither podman nor docker is installed: sudo apt install podman (Debian, Ubuntu), then make image again."; exit 1; }; \
-	  $$engine build --network host --pull=$(PULL) --build-arg BASE=$(BASE) \
+	  cache=; if [ "$$(basename $$engine)" = podman ] && [ -d "$(UV_CACHE_DIR)" ]; then \
+	    cache="--volume $(UV_CACHE_DIR):$(IMAGE_UV_CACHE):O"; fi; \
+	  $$engine build --network host --pull=$(PULL) --build-arg BASE=$(BASE) $$cache \
 	    --secret id=host-ca,src=$(HOST_CA) -f environment/Containerfile -t $(IMAGE) .
 
 # ---- Classroom server: JupyterHub on this machine (docs/classroom-server.md) --------------

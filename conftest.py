@@ -25,8 +25,7 @@ from pathlib import Path
 
 import pytest
 
-import ros2nb_instructor  # noqa: F401 - first, so nbformat's jsonschema skips rfc3987_syntax (see there)
-from ros2nb import domains  # noqa: E402 - after ros2nb_instructor (see there)
+from ros2nb import domains
 
 # A shell's background job (`make test &` in a script) starts with Ctrl+C ignored, and every
 # process started from it inherits that: the tests that press Ctrl+C (for a node process, for

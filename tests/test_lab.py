@@ -7,12 +7,8 @@ notebook, keeps the learner's answer as it is and offers the changed notebook be
 
 from __future__ import annotations
 
-import importlib.util
 import json
-import os
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import nbformat
@@ -75,40 +71,3 @@ def test_the_learners_lab_turns_off_the_instructor_tools_and_the_news():
     server = json.loads((lab.LEARNER_CONFIG / 'jupyter_server_config.json').read_text())
     assert not any(server['ServerApp']['jpserver_extensions'].values())
     assert server['LabApp']['news_url'] is None
-
-
-def test_the_lab_server_starts_without_the_iri_parser(monkeypatch, tmp_path):
-    """``ros2nb-lab`` becomes JupyterLab's server in a Python where jsonschema goes without
-    rfc3987_syntax, which builds a parser for IRIs at import (the lab's server answered after
-    2.3-3.9 CPU-s with it, 1.1-1.2 without).  Each program is asked only for its help, which
-    it gives after importing its server; ``-X importtime`` lists what it imported.  The pip
-    route pins jsonschema below 4.25, which does not install rfc3987_syntax: there neither
-    program builds the parser, and the cost `jupyter lab` would pay shows only where the
-    package is installed (another route, or the pin lifted)."""
-    execs = []
-
-    def execv(path, argv):
-        execs.append(list(argv))
-        raise SystemExit(0)
-
-    monkeypatch.setattr(os, 'execv', execv)
-    monkeypatch.setenv(lab.WORK_ENV, str(tmp_path / 'work'))
-    try:
-        lab.main([])
-    except SystemExit:
-        pass
-    python, *rest = execs[0]
-
-    def imported(argv):
-        done = subprocess.run([python, '-X', 'importtime', *argv, '--help'],
-                              capture_output=True, text=True, timeout=120)
-        assert done.returncode == 0, done.stderr[-2000:]
-        return {line.rsplit('|', 1)[-1].strip() for line in done.stderr.splitlines()
-                if line.startswith('import time:')}
-
-    parser = 'rfc3987_syntax.syntax_helpers'  # where the parsers are built (an absent
-    ours = imported(rest)                      # package is listed too, as tried)
-    assert 'jupyterlab.labapp' in ours and 'jsonschema._format' in ours
-    assert parser not in ours
-    if importlib.util.find_spec('rfc3987_syntax') is not None:  # what `jupyter lab` pays
-        assert parser in imported([str(Path(sys.executable).with_name('jupyter-lab'))])

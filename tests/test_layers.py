@@ -35,7 +35,7 @@ LAYERS: list[tuple[str, ...]] = [
     ('ros2nb.judge',),
     ('ros2nb',),
     # ros2nb_instructor: the instructor's host (and, for the runner, the learner's sandbox).
-    ('ros2nb_instructor.paths', 'ros2nb_instructor.programs'),
+    ('ros2nb_instructor.paths',),
     ('ros2nb_instructor.grading.sandboxed',),
     ('ros2nb_instructor.grading', 'ros2nb_instructor.authoring', 'ros2nb_instructor.hub',
      'ros2nb_instructor.lab'),

@@ -25,7 +25,6 @@ from pathlib import Path
 from typing import MutableMapping, NoReturn, Optional
 
 from .paths import NOTEBOOKS, ROOT
-from .programs import program_argv
 
 #: The learner's working folder for ``make lab`` (git ignores it); ``$ROS2NB_WORK`` moves it.
 WORK = ROOT / 'work'
@@ -121,10 +120,10 @@ def main(argv: Optional[list[str]] = None) -> NoReturn:
     # Localhost unless told otherwise (the course's image listens on every interface of its
     # container: `make lab LAB_ARGS=--ServerApp.ip=0.0.0.0`); traitlets refuses two values.
     given_ip = any(a.startswith(('--ServerApp.ip', '--ip')) for a in args)
-    argv = program_argv('jupyter-lab', 'jupyterlab.labapp',
-                        *([] if given_ip else ['--ServerApp.ip=127.0.0.1']),
-                        f'--ServerApp.root_dir={root}', f'--LabApp.default_url={default_url}',
-                        *(['--allow-root'] if os.geteuid() == 0 else []), *args)
+    argv = [str(Path(sys.executable).with_name('jupyter-lab')),
+            *([] if given_ip else ['--ServerApp.ip=127.0.0.1']),
+            f'--ServerApp.root_dir={root}', f'--LabApp.default_url={default_url}',
+            *(['--allow-root'] if os.geteuid() == 0 else []), *args]
     os.execv(argv[0], argv)
 
 

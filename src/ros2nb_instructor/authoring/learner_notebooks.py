@@ -13,43 +13,30 @@ from __future__ import annotations
 
 import argparse
 import filecmp
-import os
 import shutil
-import subprocess
 import sys
-import tempfile
 from pathlib import Path
 from typing import Optional
 
-from ..programs import nbgrader_argv
-from ..paths import ASSIGNMENT, NOTEBOOKS, ROOT, SOLUTIONS, gradebook_url
+from ..grading.gradebook import kept_course
+from ..paths import ASSIGNMENT, NOTEBOOKS, ROOT
 
 
 def generate(out: Path) -> list[Path]:
-    """Write learner versions of every solutions/*.ipynb into ``out``; return their paths."""
-    with tempfile.TemporaryDirectory(prefix='ros2nb-nbgrader-') as tmp:
-        course = Path(tmp)
-        source = course / 'source' / ASSIGNMENT
-        source.mkdir(parents=True)
-        for notebook in sorted(SOLUTIONS.glob('*.ipynb')):
-            shutil.copy2(notebook, source / notebook.name)
-        # nbgrader runs `alembic` by name: the venv's bin/ must come first on PATH.
-        env = dict(os.environ, JUPYTER_CONFIG_DIR=str(course / 'config'),
-                   JUPYTER_DATA_DIR=str(course / 'data'),
-                   PATH=os.pathsep.join([str(Path(sys.executable).parent), os.environ['PATH']]))
-        done = subprocess.run(
-            nbgrader_argv('generate_assignment', ASSIGNMENT,
-                          f'--CourseDirectory.root={course}', '--force', '--log-level=ERROR',
-                          f'--CourseDirectory.db_url={gradebook_url(course)}'),
-            cwd=course, env=env, capture_output=True, text=True)
-        if done.returncode != 0:
-            sys.exit(f'nbgrader generate_assignment failed:\n{done.stdout}{done.stderr}')
-        out.mkdir(parents=True, exist_ok=True)
-        written = []
-        for notebook in sorted((course / 'release' / ASSIGNMENT).glob('*.ipynb')):
-            shutil.copy2(notebook, out / notebook.name)
-            written.append(out / notebook.name)
-        return written
+    """Write learner versions of every solutions/*.ipynb into ``out``; return their paths.
+
+    They are the release of the nbgrader course of the current solutions, made once per
+    version of the solutions (:func:`~ros2nb_instructor.grading.gradebook.kept_course`): the
+    notebooks a grading hands out are these very files.
+
+    :raises SystemExit: when nbgrader's ``generate_assignment`` failed.
+    """
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for notebook in sorted((kept_course() / 'release' / ASSIGNMENT).glob('*.ipynb')):
+        shutil.copy2(notebook, out / notebook.name)
+        written.append(out / notebook.name)
+    return written
 
 
 def main(argv: Optional[list[str]] = None) -> int:
@@ -61,12 +48,12 @@ def main(argv: Optional[list[str]] = None) -> int:
         for path in generate(args.out):
             print(f'wrote {path.relative_to(ROOT) if ROOT in path.parents else path}')
         return 0
-    with tempfile.TemporaryDirectory() as tmp:
-        fresh = {p.name for p in generate(Path(tmp))}
-        shipped = {p.name for p in NOTEBOOKS.glob('*.ipynb')}
-        stale = sorted(name for name in fresh & shipped
-                       if not filecmp.cmp(Path(tmp) / name, NOTEBOOKS / name, shallow=False))
-        problems = stale + sorted(fresh ^ shipped)
+    release = kept_course() / 'release' / ASSIGNMENT
+    fresh = {p.name for p in release.glob('*.ipynb')}
+    shipped = {p.name for p in NOTEBOOKS.glob('*.ipynb')}
+    stale = sorted(name for name in fresh & shipped
+                   if not filecmp.cmp(release / name, NOTEBOOKS / name, shallow=False))
+    problems = stale + sorted(fresh ^ shipped)
     if problems:
         print('notebooks/ is out of sync with solutions/ for: ' + ', '.join(problems)
               + '. Run `make learner-notebooks` and commit the result.')

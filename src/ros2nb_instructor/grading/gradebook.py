@@ -24,11 +24,12 @@ from typing import Iterable, Optional
 
 from nbgrader.api import Gradebook, MissingEntry
 
-from ..programs import nbgrader_argv
 from ..paths import ASSIGNMENT, ROOT, SOLUTIONS, gradebook_url
 from . import feedback
 from .submissions import Learner, screen_zip
 
+#: nbgrader's command, from the course's venv (or conda environment).
+NBGRADER = str(Path(sys.executable).with_name('nbgrader'))
 #: Where the course's set-up is kept per version of the solutions (git-ignored).
 SET_UP_CACHE = ROOT / '.cache' / 'grading-courses'
 #: nbgrader settings of the course under grading/: feedback shows learners' content as text.
@@ -37,7 +38,7 @@ COURSE_CONFIG = 'c = get_config()  # noqa: F821\n'
 
 def nbgrader(course: Path, *args: str, log: Path) -> int:
     """Run ``nbgrader ARGS`` for the course folder (trusted: it executes nothing of learners')."""
-    argv = [*nbgrader_argv(*args), f'--CourseDirectory.root={course}',
+    argv = [NBGRADER, *args, f'--CourseDirectory.root={course}',
             f'--CourseDirectory.db_url={gradebook_url(course)}', '--log-level=INFO']
     return _run_logged(course, argv, log)
 

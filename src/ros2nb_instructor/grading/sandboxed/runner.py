@@ -21,17 +21,9 @@ import sys
 from pathlib import Path
 from typing import Any, Optional
 
-# nbformat imports jsonschema, which imports a checker for each string format whose package is
-# installed (Jupyter's server brings them, for its events).  nbformat checks no format, and
-# they cost each runner 40 ms of its 0.23 CPU-s of imports, in every notebook of every learner:
-# marked absent (an ImportError jsonschema expects), as ros2nb_instructor marks rfc3987_syntax.
-for _unused in ('isoduration', 'rfc3986_validator', 'rfc3339_validator', 'webcolors',
-                'jsonpointer', 'uri_template', 'fqdn', 'idna'):
-    sys.modules.setdefault(_unused, None)
-
-import nbformat  # noqa: E402 - after the marks above
-from nbclient import NotebookClient  # noqa: E402
-from nbclient.exceptions import DeadKernelError  # noqa: E402
+import nbformat
+from nbclient import NotebookClient
+from nbclient.exceptions import DeadKernelError
 
 #: Characters of text output one cell may keep (printed text, tracebacks, text/plain).
 MAX_CELL_OUTPUT_BYTES = 100_000
