@@ -35,7 +35,7 @@ def profile(name: str) -> tuple[float, float, list[tuple[str, float, int]], int]
     arguments = NBVAL.get(name, [f'tests/{name}'])
     with Sampler() as sampler:
         busy, started = busy_cpu_s(), time.monotonic()
-        done = subprocess.run([sys.executable, '-m', 'pytest', '-q', '-p', 'no:cacheprovider',
+        done = subprocess.run([sys.executable, '-m', 'pytest', '-q',
                                *arguments], cwd=ROOT, capture_output=True, text=True)
         wall, busy = time.monotonic() - started, busy_cpu_s() - busy
     return wall, busy, sampler.by_kind(), done.returncode

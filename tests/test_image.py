@@ -81,7 +81,7 @@ def test_the_image_opens_the_learners_lab_and_runs_a_notebook():
             names = {item['name'] for item in json.load(reply)['content']}
         assert '03-write-the-publisher.ipynb' in names, names  # the learner's copies, in the volume
         inside = podman('exec', name, 'bash', '-c',
-                        'cd /opt/ros2-course && .venv/bin/python -m pytest -q -p no:cacheprovider '
+                        'cd /opt/ros2-course && .venv/bin/python -m pytest -q '
                         '--nbval solutions/04-write-the-subscriber.ipynb --nbval-current-env '
                         '--nbval-sanitize-with tests/sanitize.cfg', check=False)
         assert inside.returncode == 0, inside.stdout[-3000:]

@@ -16,7 +16,7 @@ import pytest
 
 from ros2nb.judge import observer
 from ros2nb.judge.subjects import SubjectHung, SubjectProcess
-from ros2nb.processes import BUSY_SHARE, Patience, tree_cpu_seconds
+from ros2nb.processes import BUSY_SHARE, Patience, tree_cpu_seconds, wait_for_work
 from waiting import PATIENCE_S, wait_until
 
 pytestmark = pytest.mark.judge
@@ -111,6 +111,52 @@ def test_a_program_the_scheduler_starves_is_working_not_waiting():
         assert tree_cpu_seconds(starved.pid) - cpu_before < BUSY_SHARE * LIMIT_S
     finally:
         for process in (burner, starved):
+            process.kill()
+            process.wait()
+
+
+#: A program at the lowest priority beside a burner on its one CPU: it works WORK_S seconds
+#: of CPU (far longer on the wall clock), says so, waits a moment, says so, and then waits
+#: for ever.
+WORKS_WAITS_AND_HANGS = """
+import os, sys, time
+os.sched_setaffinity(0, {int(sys.argv[1])})
+os.nice(19)
+print('started', flush=True)
+begin = time.process_time()
+while time.process_time() - begin < float(sys.argv[2]):
+    pass
+print('worked', flush=True)
+time.sleep(float(sys.argv[3]))
+print('waited', flush=True)
+time.sleep(3600)
+"""
+
+
+def test_a_wait_lasts_while_its_program_works_and_counts_only_its_idle_time():
+    """The one wait for what processes do (``wait_for_work``): a line that a starved program
+    is slow to print is waited for well past the limit on the wall clock, a short wait
+    after its work is not its limit's end, and a program that waits for ever is given up
+    after the limit of idle time."""
+    limit, cpu = 1.5, min(os.sched_getaffinity(0))
+    burner = subprocess.Popen([sys.executable, '-c', 'import os\nos.sched_setaffinity(0, {%d})\n'
+                               'while True: pass' % cpu])
+    program = subprocess.Popen([sys.executable, '-c', WORKS_WAITS_AND_HANGS, str(cpu), '0.05',
+                                str(limit / 2)], text=True, stdout=subprocess.PIPE)
+    lines: list[str] = []
+    threading.Thread(target=lambda: lines.extend(program.stdout), daemon=True).start()
+    try:
+        assert wait_until(lambda: 'started\n' in lines)
+        began = time.monotonic()
+        assert wait_for_work(lambda: 'worked\n' in lines, [program.pid], limit)
+        worked = time.monotonic() - began
+        assert worked > limit  # the failure prevented: a wall-clock wait gave up before it
+        assert wait_for_work(lambda: 'waited\n' in lines, [program.pid], limit)
+        began = time.monotonic()
+        assert not wait_for_work(lambda: 'never\n' in lines, [program.pid], limit)
+        assert time.monotonic() - began >= limit
+    finally:
+        for process in (burner, program):
             process.kill()
             process.wait()
 

@@ -3,6 +3,7 @@
 import importlib
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -14,6 +15,7 @@ from ros2nb import course
 from ros2nb.terminal.workspace import shown
 
 ws_module = importlib.import_module('ros2nb.terminal.workspace')
+run_module = importlib.import_module('ros2nb.terminal.run')
 
 TUTORIAL_MAIN = '''
 import rclpy
@@ -253,6 +255,43 @@ def test_ctrl_c_waits_until_every_process_has_started(capsys):
     out = capsys.readouterr().out
     assert codes == [0], out
     assert out.index('ready') < out.index('^C') < out.index('stopped cleanly')
+
+
+#: A program whose clean-up after Ctrl+C takes 0.8 s of CPU on a CPU it shares with a burner:
+#: longer than that on the wall clock, as on a busy machine.
+SLOW_EXIT = """
+import os, sys, time
+os.sched_setaffinity(0, {int(sys.argv[1])})
+print('ready', flush=True)
+try:
+    while True:
+        time.sleep(0.05)
+except KeyboardInterrupt:
+    began, cpu = time.monotonic(), time.process_time()
+    while time.process_time() - cpu < 0.8:
+        pass
+    print(f'stopped cleanly after {time.monotonic() - began:.2f} s', flush=True)
+"""
+
+
+@pytest.mark.ros
+def test_a_slow_exit_after_ctrl_c_is_waited_for_while_it_works(capsys, monkeypatch):
+    """After Ctrl+C a program that works on its way out is waited for (processes.Patience),
+    not pressed again: with a fixed grace on the wall clock (here 1 s), the second Ctrl+C
+    landed in its clean-up, and it printed a traceback and another exit code."""
+    monkeypatch.setattr(run_module, 'STOP_GRACE_S', 1.0)
+    cpu = min(os.sched_getaffinity(0))
+    burner = subprocess.Popen([sys.executable, '-c', 'import os\nos.sched_setaffinity(0, {%d})\n'
+                               'while True: pass' % cpu])
+    try:
+        codes = ros2nb.run_and_interrupt([sys.executable, '-c', SLOW_EXIT, str(cpu)], seconds=0)
+    finally:
+        burner.kill()
+        burner.wait()
+    out = capsys.readouterr().out
+    assert codes == [0] and 'Traceback' not in out, out
+    took = float(re.search(r'stopped cleanly after ([\d.]+) s', out).group(1))
+    assert took > 1.0  # the failure prevented: the grace on the wall clock ran out first
 
 
 @pytest.mark.ros

@@ -1,8 +1,11 @@
 """Waiting in tests: poll for the state a test needs, never sleep for a guessed time.
 
-Every wait in ``tests/`` ends as soon as its state is there; the bound only matters when
-the state never comes (then the test fails and says what it last saw).  All bounds derive
-from :data:`PATIENCE_S`, so a slow machine needs one knob, not thirty.
+Every wait in ``tests/`` ends as soon as its state is there.  When the state never comes, the
+test fails and says what it last saw, once the processes the test started had
+:data:`PATIENCE_S` as the judge counts it (:func:`ros2nb.processes.wait_for_work`): seconds
+of their work while they work or stand in the queue for a CPU, of the wall clock while they
+sit idle.  So a busy machine makes a test slower, never wrong; and a slow machine needs one
+knob, not thirty.
 """
 
 from __future__ import annotations
@@ -11,21 +14,22 @@ import os
 import time
 from typing import Any, Callable, Optional
 
-#: The longest a test waits for a state that should come (s). Generous: on a machine
-#: with other work going on, starting a kernel or a JupyterHub server can take a minute.
+from ros2nb.processes import child_pids, wait_for_work
+
+#: The longest a test waits for a state that should come (s): of the work of the processes
+#: the test started, or of their idle waiting.  Generous: a bound matters only when the
+#: state never comes.
 PATIENCE_S = float(os.environ.get('ROS2NB_TEST_PATIENCE_S', '180'))
+#: Seconds between two looks at a condition.
+LOOK_S = 0.02
 
 
 def wait_until(condition: Callable[[], Any], seconds: float = PATIENCE_S,
-               interval: float = 0.02) -> bool:
-    """Poll ``condition()`` until it is true; return False if ``seconds`` pass first."""
-    deadline = time.monotonic() + seconds
-    while True:
-        if condition():
-            return True
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(interval)
+               interval: float = LOOK_S) -> bool:
+    """Poll ``condition()`` until it is true; return False once this test's processes had
+    ``seconds`` (with none, seconds of the wall clock)."""
+    return wait_for_work(condition, child_pids(os.getpid()), seconds,
+                         look=lambda check, s: _poll(check, s, interval))
 
 
 def wait_for(condition: Callable[[], Any], what: str, *, seconds: float = PATIENCE_S,
@@ -34,14 +38,27 @@ def wait_for(condition: Callable[[], Any], what: str, *, seconds: float = PATIEN
 
     :param what: the state waited for, e.g. ``"ada's server ready"``.
     :param seen: describes what was there instead, for the failure message.
-    :raises AssertionError: ``what: not after N s; last seen: ...`` when time runs out.
+    :raises AssertionError: ``what: not within N s ...; last seen: ...`` when this test's
+        processes had their patience.
     """
-    deadline = time.monotonic() + seconds
-    while True:
+    value: Any = None
+
+    def held() -> bool:
+        nonlocal value
         value = condition()
-        if value:
-            return value
-        if time.monotonic() > deadline:
-            last = seen() if seen is not None else value
-            raise AssertionError(f'{what}: not after {seconds:g} s; last seen: {last!r}')
+        return bool(value)
+
+    if wait_until(held, seconds, interval):
+        return value
+    last = seen() if seen is not None else value
+    raise AssertionError(f'{what}: not within {seconds:g} s of the work or idle waiting of the '
+                         f'processes this test started; last seen: {last!r}')
+
+
+def _poll(condition: Callable[[], Any], seconds: float, interval: float) -> bool:
+    deadline = time.monotonic() + seconds
+    while not condition():
+        if time.monotonic() >= deadline:
+            return False
         time.sleep(interval)
+    return True

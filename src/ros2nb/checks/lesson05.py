@@ -34,7 +34,7 @@ from ..terminal.files import saved_parts
 from ..terminal.pkg_templates import SETUP_CFG, render_setup_py
 from ..terminal.run import find_executable
 from .base import ARRIVAL_TIMEOUT_S, Judge, judged
-from .mains import EXIT_AFTER_CTRL_C_S, last_line, wait_while_working
+from .mains import EXIT_AFTER_CTRL_C_S, last_line
 from .package_stand_ins import EXECUTABLES
 from .source import TEXT
 
@@ -228,9 +228,9 @@ def _runs(judge: Judge, ws: Path) -> Optional[str]:
         except CheckFailed as problem:
             return str(problem)
         (sensor, sensor_out), (monitor, monitor_out) = procs
-        wait_while_working(observer, lambda: heard in observer.lines_of(course.MONITOR_NODE, mark)
-                           or sensor.poll() is not None or monitor.poll() is not None,
-                           [sensor, monitor], ARRIVAL_TIMEOUT_S)
+        observer.wait_until(lambda: heard in observer.lines_of(course.MONITOR_NODE, mark)
+                            or sensor.poll() is not None or monitor.poll() is not None,
+                            ARRIVAL_TIMEOUT_S)
         if heard not in observer.lines_of(course.MONITOR_NODE, mark):
             if not any(round(h.value, 3) == given for h in readings[first:]):
                 name, out = course.PUBLISHER_EXECUTABLE, sensor_out

@@ -16,10 +16,10 @@ import re
 import signal
 import subprocess
 from pathlib import Path
-from typing import Any, Callable, Optional
+from typing import Any, Optional
 
 from ..errors import CheckFailed
-from ..processes import Patience, interrupt, kill_process_group, wait_patiently
+from ..processes import interrupt, kill_process_group, wait_patiently
 from .base import Judge
 from .source import TEXT
 
@@ -143,27 +143,11 @@ def _wait_for_exit(observer: Any, proc: Any, node_name: str, sig: int) -> Option
     return wait_patiently(proc, EXIT_AFTER_CTRL_C_S)
 
 
-def wait_while_working(observer: Any, condition: Callable[[], bool], procs: list[Any],
-                       limit_s: float) -> bool:
-    """Wait until ``condition()`` holds (True), or until every process in ``procs`` had
-    ``limit_s`` (:class:`~ros2nb.processes.Patience`: seconds of its own work while it
-    works, of the wall clock while it waits; False).
-
-    Introduced in ``03-write-the-publisher.ipynb`` (the judge waits for a ``main()``).
-    """
-    patience = [Patience(proc.pid, limit_s) for proc in procs]
-    while not observer.wait_until(condition, LOOK_AGAIN_S):
-        if all([each.exhausted() for each in patience]):  # each looks every time
-            return False
-    return True
-
-
 def _wait_for_node(observer: Any, proc: Any, node_name: str) -> bool:
     """Wait until the node is in the judge's graph or the program ended: True then, False
-    once the program had :data:`START_PATIENCE_S` (:func:`wait_while_working`)."""
-    return wait_while_working(
-        observer, lambda: proc.poll() is not None or observer.has_node(node_name), [proc],
-        START_PATIENCE_S)
+    once the program had :data:`START_PATIENCE_S` (the judge's waits attend to its work)."""
+    return observer.wait_until(lambda: proc.poll() is not None or observer.has_node(node_name),
+                               START_PATIENCE_S)
 
 
 def _ended_early(path: Path, part: int, text: str, code: int) -> CheckFailed:

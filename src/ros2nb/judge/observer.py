@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import collections
 import contextlib
+import math
 import threading
 import time
 from dataclasses import dataclass
@@ -25,6 +26,7 @@ from rclpy.signals import SignalHandlerOptions
 from .. import domains
 from ..checks.base import ARRIVAL_TIMEOUT_S
 from ..errors import CheckFailed
+from ..processes import Patience, wait_for_work
 from ..runtime import QUIET_SUBSCRIPTION, node_serving_nothing
 from ..runtime.services import call_until_answered
 
@@ -44,6 +46,10 @@ EVERY_MESSAGE = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=Reliabili
 #: shortly before the judge matched them (rcl keeps each node's last lines).
 ROSOUT_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE,
                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
+
+
+class _GivenUp(Exception):
+    """The processes a wait attended to had their patience (:meth:`Observer.spins`)."""
 
 
 @dataclass(frozen=True)
@@ -96,6 +102,9 @@ class Observer:
         self.heard: dict[str, list[Heard]] = {}
         self._quiet: Any = None
         self._stop = False
+        #: The processes whose work the judge waits for (its subjects and the learner's
+        #: programs, given by the session): every wait of the judge's lasts while they work.
+        self.attending: Callable[[], list[int]] = list
         self._thread = threading.Thread(target=self._spin, name='ros2nb-judge', daemon=True)
         self._thread.start()
         self.node.create_subscription(Log, '/rosout', self._on_log, ROSOUT_QOS,
@@ -150,7 +159,13 @@ class Observer:
             return ({t: len(v) for t, v in self.heard.items()}, dict(self.log_counts))
 
     def wait_until(self, condition: Callable[[], bool], seconds: float) -> bool:
-        """Wait until ``condition()`` holds (checked whenever something arrives)."""
+        """Wait until ``condition()`` holds (looked at whenever something arrives), while the
+        processes the judge attends to work towards it: False once they had ``seconds``
+        (:func:`~ros2nb.processes.wait_for_work`: of their work, or of their idle waiting)."""
+        return wait_for_work(condition, self.attending(), seconds, look=self._wait_briefly)
+
+    def _wait_briefly(self, condition: Callable[[], bool], seconds: float) -> bool:
+        """Wait until ``condition()`` holds, at most ``seconds`` on the wall clock."""
         deadline = time.monotonic() + seconds
         with self.changed:
             while not condition():
@@ -180,19 +195,22 @@ class Observer:
         :raises CheckFailed: when ``seconds`` pass first (the line says what was seen).
         """
         want = {tuple(e) for e in expected}
-        deadline = time.monotonic() + seconds
-        while True:
+        owners: dict[bytes, set] = {}
+        found: set = set()
+
+        def covered() -> bool:
+            nonlocal owners, found
             owners = self._endpoints_by_process(name, namespace)
             # The process whose node holds what the subject made (exactly, if one does: an
             # earlier subject's node of that name may linger a moment after its process).
             covering = sorted((e for e in owners.values() if want <= e), key=len)
             found = covering[0] if covering else max(owners.values(), key=len, default=set())
-            if want <= found:
-                return sorted(e for e in found if e[1] not in ('/rosout', '/parameter_events',
-                                                                '/clock'))
-            if time.monotonic() > deadline:  # not the learner's mistake: say what happened
-                raise CheckFailed(self._unseen(name, len(owners), want, found, seconds))
-            time.sleep(0.02)
+            return want <= found
+
+        if not wait_for_work(covered, self.attending(), seconds):
+            # not the learner's mistake: say what happened
+            raise CheckFailed(self._unseen(name, len(owners), want, found, seconds))
+        return sorted(e for e in found if e[1] not in ('/rosout', '/parameter_events', '/clock'))
 
     def _endpoint_infos(self) -> list[tuple[str, str, Any]]:
         """Every topic endpoint DDS discovered on the domain: ``(kind, topic, info)``.
@@ -245,16 +263,22 @@ class Observer:
         """
         service = f'{namespace.rstrip("/")}/{name}/list_parameters'
         client = self.node.create_client(ListParameters, service)
+        patience = Patience(self.attending(), seconds)
+
+        def given_up() -> None:
+            if patience.exhausted():
+                raise _GivenUp
+
         try:
-            deadline = time.monotonic() + seconds
             while not client.wait_for_service(timeout_sec=0.1):
-                if time.monotonic() > deadline:
-                    return False
+                given_up()
             # Asked again now and then: a request goes only to the servers discovered when
             # it is sent (a node of that name that just ended may be one of them).
             return call_until_answered(lambda: client.call_async(ListParameters.Request()),
-                                       lambda f, s: self.wait_until(f.done, s),
-                                       max(0.0, deadline - time.monotonic())) is not None
+                                       lambda f, s: self._wait_briefly(f.done, s),
+                                       math.inf, between=given_up) is not None
+        except _GivenUp:
+            return False
         finally:
             self.node.destroy_client(client)
 

@@ -63,6 +63,7 @@ class Session:
         self._observer: Optional[Observer] = None
         self._clock: Optional[JudgeClock] = None
         self._subjects: dict[tuple, SubjectProcess] = {}
+        self._programs: list[Any] = []  # the learner's programs started (start, start_program)
         self._probe: Any = None
         self.builds: dict[str, Any] = {}
 
@@ -70,6 +71,7 @@ class Session:
     def observer(self) -> Observer:
         if self._observer is None:
             self._observer = Observer()
+            self._observer.attending = self.working_pids
             # The course's topics are heard from the start, before any subject: what a
             # subject announces it published there is waited for before each step of the
             # clock (JudgeClock.drive), so every message is stamped with the step it came in.
@@ -112,6 +114,13 @@ class Session:
                 self.drop(key)
                 raise
         return subject
+
+    def working_pids(self) -> list[int]:
+        """The processes of this session's subjects and of the learner's programs it started
+        that still run: those whose work every wait of the judge's attends to."""
+        self._programs = [proc for proc in self._programs if proc.poll() is None]
+        return [proc.pid for proc in (*(s.proc for s in self._subjects.values()),
+                                      *self._programs) if proc.poll() is None]
 
     def drop(self, key: tuple) -> None:
         subject = self._subjects.pop(key, None)
@@ -188,6 +197,7 @@ class Session:
         proc = subprocess.Popen([*prefix, *argv], cwd=cwd, env=env or subject_env(),
                                 text=True, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                                 stderr=subprocess.STDOUT, start_new_session=True)
+        self._programs.append(proc)
         return proc, Output(proc.stdout)
 
     def start_program(self, path: Path, stand_in: Optional[str] = None
@@ -204,6 +214,7 @@ class Session:
             return self.start([sys.executable, '-m', 'ros2nb.subject.program', *args],
                               cwd=self.workspace)
         proc = fork_program(args, str(self.workspace), subject_env())
+        self._programs.append(proc)
         return proc, Output(proc.stdout)
 
     def run(self, argv: list[str], *, seconds: float, cwd: Path,

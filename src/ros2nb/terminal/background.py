@@ -14,16 +14,20 @@ from __future__ import annotations
 import atexit
 import subprocess
 import threading
-import time
 from typing import Optional
 
 from ..errors import UsageError
-from ..processes import stop_process_group
+from ..processes import stop_process_group, wait_for_work
 from .colcon import source_workspace
 from .run import _command, node_process_env
 from .workspace import PathLike, workspace_or_current
 
 _running: list['NodeProcess'] = []
+
+
+def running_pids() -> list[int]:
+    """The processes started in the background that still run (what waits attend to)."""
+    return [node.proc.pid for node in _running if node.proc.poll() is None]
 
 
 class NodeProcess:
@@ -68,18 +72,22 @@ class NodeProcess:
             return sum(text in line for line in self.lines)
 
     def wait_for(self, text: str, *, count: int = 1, timeout: float = 60.0) -> bool:
-        """Wait until ``count`` of its lines contain ``text`` (wall-clock seconds at most).
+        """Wait until ``count`` of its lines contain ``text``, while the background processes
+        work towards it (``timeout``: seconds of their work, or of their idle waiting, as
+        :class:`~ros2nb.processes.Patience` counts: a busy machine is slow, not wrong).
 
         :return: True when they did; False on timeout or when the process ended first.
         """
-        deadline = time.monotonic() + timeout
+        def said() -> bool:
+            return self._ended or sum(text in line for line in self.lines) >= count
+
+        def look(condition, seconds: float) -> bool:
+            with self._changed:
+                return self._changed.wait_for(condition, seconds)
+
+        wait_for_work(said, running_pids(), timeout, look=look)
         with self._changed:
-            while sum(text in line for line in self.lines) < count:
-                left = deadline - time.monotonic()
-                if left <= 0 or self._ended:
-                    return False
-                self._changed.wait(min(left, 0.1))
-        return True
+            return sum(text in line for line in self.lines) >= count
 
     def new_lines(self) -> list[str]:
         """Print and return the lines that came since the last call, prefixed with the label."""

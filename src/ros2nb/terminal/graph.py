@@ -9,11 +9,12 @@ topics, subscribers right of them, no edge drawn across another when it can be h
 
 from __future__ import annotations
 
-import time
 from typing import Any, Iterable, Optional
 
 from ..errors import Ros2nbError
+from ..processes import wait_for_work
 from ..runtime import current_runtime
+from .background import running_pids
 from .topic import INFRASTRUCTURE_TOPICS, hidden
 
 #: Seconds :func:`graph_edges` waits for the nodes it is told to expect.
@@ -49,20 +50,23 @@ def graph_edges(*, expect: Iterable[str] = (),
     Introduced in ``06-five-promises.ipynb``.
 
     :param expect: full node names to wait for, e.g. ``['/temperature_sensor']``.
-    :param timeout: wall-clock seconds to wait for them at most.
+    :param timeout: seconds to wait for them at most: of the background processes' work
+        while they work, of the wall clock while they wait (:class:`~ros2nb.processes.Patience`).
     :raises Ros2nbError: if ROS is not up, or an expected node did not appear in time.
     """
     want = set(expect)
-    deadline = time.monotonic() + timeout
-    while True:
+    found: list[tuple[str, str, str]] = []
+
+    def shown() -> bool:
+        nonlocal found
         found = _endpoints_now()
+        return not want - {node for node, _, _ in found}
+
+    if not wait_for_work(shown, running_pids(), timeout):
         missing = want - {node for node, _, _ in found}
-        if not missing:
-            return sorted(found)
-        if time.monotonic() > deadline:
-            raise Ros2nbError(f'The graph shows no node {sorted(missing)[0]} with a topic after '
-                              f'{timeout:g} s: is it running?')
-        time.sleep(0.05)
+        raise Ros2nbError(f'The graph shows no node {sorted(missing)[0]} with a topic after '
+                          f'{timeout:g} s: is it running?')
+    return sorted(found)
 
 
 def graph_picture(edges: Optional[Iterable[tuple[str, str, str]]] = None, *,

@@ -22,11 +22,12 @@ from ament_index_python.packages import PackageNotFoundError, get_package_prefix
 
 from .. import domains, runtime
 from ..errors import Ros2nbError, UsageError
-from ..processes import STOP_GRACE_S, signal_group, stop_process_group
+from ..processes import STOP_GRACE_S, Patience, signal_group, stop_process_group
 from .colcon import source_workspace
 from .workspace import PathLike, workspace_or_current
 
-#: Seconds a process may take to print its first line before Ctrl+C's countdown starts anyway.
+#: Seconds a process may take to print its first line before Ctrl+C's countdown starts anyway:
+#: of its work while it works, of the wall clock while it waits (processes.Patience).
 START_UP_S = 60.0
 #: Console format for processes started by ros2nb (timestamps removed, as in the kernel).
 CONSOLE_FORMAT = '[{severity}] [{name}]: {message}'
@@ -206,31 +207,32 @@ def _relay(procs: list[subprocess.Popen], lines: queue.Queue, seconds: float) ->
 
     The countdown starts when every process has printed a line (or ended), as a person at
     a terminal waits for a program to start before timing it, so a busy machine does not
-    decide whether Ctrl+C lands in the start-up.  The kernel's own nodes keep running
-    meanwhile (:class:`_KernelNodes`).  Returns when every process has closed its output,
-    or :data:`STOP_GRACE_S` after Ctrl+C.
+    decide whether Ctrl+C lands in the start-up; a program that prints nothing gets
+    :data:`START_UP_S` (:class:`~ros2nb.processes.Patience`: of its work while it works, of
+    the wall clock while it waits).  The kernel's own nodes keep running meanwhile
+    (:class:`_KernelNodes`).  Returns when every process has closed its output, or once they
+    had :data:`STOP_GRACE_S` after Ctrl+C (patiently too: a slow exit is not a hang).
     """
     open_streams = len(procs)
     started: set[int] = set()
-    launched = time.monotonic()
+    starting = Patience([proc.pid for proc in procs], START_UP_S)
     deadline: Optional[float] = None
-    interrupted = False
+    stopping: Optional[Patience] = None
     kernel_nodes = _KernelNodes()
     while open_streams:
         kernel_nodes.tick()
-        if deadline is None and (len(started) == len(procs)
-                                 or time.monotonic() > launched + START_UP_S):
+        if deadline is None and (len(started) == len(procs) or starting.exhausted()):
             deadline = time.monotonic() + seconds
-        if not interrupted and deadline is not None and time.monotonic() >= deadline:
-            interrupted = True
+        if stopping is None and deadline is not None and time.monotonic() >= deadline:
             print(f'^C  (ros2nb sent SIGINT after {seconds:g} s, as Ctrl+C does)')
             for proc in procs:
                 if proc.poll() is None:
                     signal_group(proc, signal.SIGINT)
+            stopping = Patience([proc.pid for proc in procs], STOP_GRACE_S)
         try:
             index, line = lines.get(timeout=0.1)
         except queue.Empty:
-            if interrupted and time.monotonic() > deadline + STOP_GRACE_S:
+            if stopping is not None and stopping.exhausted():
                 return
             continue
         started.add(index)
