@@ -62,6 +62,7 @@ def _stays_in_its_lane(request: pytest.FixtureRequest, tmp_path_factory: pytest.
     locks = tmp_path_factory.mktemp('lane-domain-locks')
     ipython = tmp_path_factory.mktemp('lane-ipython')
     monkeypatch.setenv(domains.LOCKS_ENV, str(locks))
+    monkeypatch.delenv(domains.DOMAIN_ENV, raising=False)  # so that bringing ROS up claims one
     monkeypatch.setenv('IPYTHONDIR', str(ipython))
     yield
     started = [kind for kind, found in (('ros', any(locks.glob('*.lock'))),

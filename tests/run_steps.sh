@@ -11,8 +11,8 @@
 # and shown once step 1 has ended.  One failure never hides another: the exit code is 1
 # if any step failed.  A step still running after STEP_LIMIT_S seconds (a hang that every
 # per-test limit missed) is stopped and says so: make test always ends with its results.
-# Each result gives the step's wall seconds and the CPU seconds of its processes (those its
-# pytest process and their descendants reaped: bash's `times` in the step's own subshell).
+# Each result gives the step's wall seconds and the CPU seconds of all its processes
+# (tests/run_counted.py).
 #
 # Every step runs at the same priority (NBVAL_NICE=0).  Steps 2 and 3 once ran at nice 5, so
 # that the grading of the sample class (step 1's longest chain) went first; since the class is
@@ -27,27 +27,21 @@ NBVAL_NICE=${NBVAL_NICE:-0}
 logs=$(mktemp -d "${TMPDIR:-/tmp}/ros2nb-make-test-XXXXXX")
 trap 'rm -rf "$logs"' EXIT
 
-run() {  # run NAME NICENESS ARGS... in a subshell of its own: pytest ARGS; its exit code to
-         # $logs/NAME.rc, its wall seconds to $logs/NAME.s, its processes' CPU seconds to $logs/NAME.cpu
-    (
-        name=$1 niceness=$2 began=$SECONDS
-        shift 2
-        # --foreground: Ctrl+C at the terminal still reaches pytest; SIGINT lets it say where it was.
+run() {  # run NAME NICENESS ARGS...: pytest ARGS; its exit code to $logs/NAME.rc, its wall
+         # seconds to $logs/NAME.s, the CPU seconds of all its processes to $logs/NAME.cpu
+    local name=$1 niceness=$2 began=$SECONDS
+    shift 2
+    # --foreground: Ctrl+C at the terminal still reaches pytest; SIGINT lets it say where it was.
+    "$python" tests/run_counted.py "$logs/$name.cpu" \
         timeout --foreground --signal=INT --kill-after=60 "$STEP_LIMIT_S" \
-            nice -n "$niceness" "$python" -m pytest "$@"
-        rc=$?
-        if [ $((SECONDS - began)) -ge "$STEP_LIMIT_S" ]; then
-            echo "=== make test: $name was still running after $STEP_LIMIT_S s and was stopped" \
-                 "(a hang no test limit caught: its output above ends where it hung)"
-        fi
-        echo "$rc" > "$logs/$name.rc"
-        echo $((SECONDS - began)) > "$logs/$name.s"
-        # `times` (a builtin: run here, not in a pipe's subshell): this subshell's own, then its
-        # children's user and system time, as "1m2.345s 0m0.678s"
-        times > "$logs/$name.times"
-        awk 'NR == 2 { s = 0; for (i = 1; i <= 2; i++) { split($i, t, /[ms]/); s += t[1] * 60 + t[2] }
-                       printf "%.0f\n", s }' "$logs/$name.times" > "$logs/$name.cpu"
-    )
+        nice -n "$niceness" "$python" -m pytest "$@"
+    local rc=$?
+    if [ $((SECONDS - began)) -ge "$STEP_LIMIT_S" ]; then
+        echo "=== make test: $name was still running after $STEP_LIMIT_S s and was stopped" \
+             "(a hang no test limit caught: its output above ends where it hung)"
+    fi
+    echo "$rc" > "$logs/$name.rc"
+    echo $((SECONDS - began)) > "$logs/$name.s"
 }
 
 # Fast DDS's own cleaner of the shared-memory files that ROS processes killed earlier left in

@@ -67,7 +67,8 @@ def test_the_check_lane_fails_a_test_that_starts_ros_or_a_kernel_unmarked(tmp_pa
     (tmp_path / 'conftest.py').write_text((TESTS / 'conftest.py').read_text())
     (tmp_path / 'test_planted.py').write_text(PLANTED_TESTS)
     (tmp_path / 'pytest.ini').write_text('[pytest]\n')
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(TESTS), str(ROOT / 'src')]))
+    env = {k: v for k, v in os.environ.items() if k != 'ROS_DOMAIN_ID'}  # the lane's own
+    env['PYTHONPATH'] = os.pathsep.join([str(TESTS), str(ROOT / 'src')])
     done = subprocess.run([sys.executable, '-m', 'pytest', '-p', 'no:cacheprovider', '-p',
                            'no:warnings', '-q',
                            '-c', str(tmp_path / 'pytest.ini'), '--rootdir', str(tmp_path),

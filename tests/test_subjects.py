@@ -181,7 +181,7 @@ print('gave up' if gave_up else 'still waiting', round(time.monotonic() - began,
 sleeper.kill()
 """
 #: Where the watcher stops waiting for Patience itself (times the limit): the failure
-#: prevented stood ready in every look and waited until WALL_LIMIT_FACTOR (10) times.
+#: prevented stood ready in every look, so it never gave up.
 CUT = 6
 
 

@@ -82,8 +82,6 @@ BUSY_SHARE = 0.05
 #: Seconds between two looks at a process tree's work in /proc (each look reads every
 #: process's stat: milliseconds on a busy machine).
 LOOK_S = 0.25
-#: However busy it is, a process tree gets at most this many times its limit on the wall clock.
-WALL_LIMIT_FACTOR = 10.0
 _TICKS_PER_S = os.sysconf('SC_CLK_TCK')
 
 
@@ -191,8 +189,8 @@ class Patience:
     a CPU, counting the time their threads stood ready on the run queue, and none of their
     threads stands ready at the look (the kernel brings the time on the run queue up to
     date only when a thread runs).  A program the scheduler starves is working, not
-    waiting.  Trees that keep working slowly are cut after
-    ``WALL_LIMIT_FACTOR * limit_s`` seconds.
+    waiting, however long that takes: what bounds a machine that never runs it is outside
+    (a test's time limit, a sandbox's wall time, the learner's stop button).
 
     Introduced in ``03-write-the-publisher.ipynb`` (how long the judge waits for a subject).
 
@@ -227,8 +225,7 @@ class Patience:
         if not ready and cpu + queued - busy_then < BUSY_SHARE * (now - then):
             self.idle_s += now - then
         self._look = (now, cpu + queued)
-        self._verdict = (cpu - self.cpu_at_start >= self.limit_s or self.idle_s >= self.limit_s
-                         or now - self.started >= WALL_LIMIT_FACTOR * self.limit_s)
+        self._verdict = cpu - self.cpu_at_start >= self.limit_s or self.idle_s >= self.limit_s
         return self._verdict
 
 
