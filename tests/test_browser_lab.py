@@ -30,7 +30,7 @@ import nbformat
 import pytest
 
 import browser
-from waiting import PATIENCE_S, wait_for
+from waiting import wait_for
 
 pytestmark = [pytest.mark.browser, pytest.mark.kernel, pytest.mark.timeout(600)]
 
@@ -105,7 +105,8 @@ def lab(tmp_path_factory):
             page = context.new_page()
             page.goto(f'{base}/lab/tree/{NOTEBOOK}?token={token}')
             code_cells = sum(c.cell_type == 'code' for c in nbformat.read(work / NOTEBOOK, 4).cells)
-            page.wait_for_function(NOTEBOOK_READY, arg=code_cells, timeout=1000 * PATIENCE_S)
+            wait_for(lambda: page.evaluate(NOTEBOOK_READY, code_cells), 'the notebook shown',
+                     seen=lambda: page.content()[-800:])
             yield page, shots, work
             context.close()
     finally:
@@ -179,7 +180,8 @@ def test_interrupt_stops_a_spin_with_one_line(lab):
              seen=lambda: cell.inner_text())
     began = time.monotonic()
     page.click('.jp-NotebookPanel-toolbar [data-command="notebook:interrupt-kernel"]')
-    page.wait_for_function(CELL_DONE, arg=index, polling=10, timeout=1000 * 30)
+    wait_for(lambda: page.evaluate(CELL_DONE, index), 'the interrupted cell done', interval=0.01,
+             seen=lambda: cell.inner_text())
     took = time.monotonic() - began
     print(f'\nInterrupt stopped the spin in {took:.2f} s')
     lines = cell.locator('.jp-OutputArea').inner_text().strip().splitlines()

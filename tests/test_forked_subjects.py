@@ -19,6 +19,7 @@ import pytest
 
 from ros2nb.judge.subjects import SUBJECT_PREFIX_ENV, SubjectProcess, subject_env
 from ros2nb.processes import kill_process_group
+from waiting import run_to_end, wait_until
 
 pytestmark = [pytest.mark.judge, pytest.mark.timeout(120)]
 
@@ -112,7 +113,17 @@ def test_a_judge_run_from_a_script_file_never_runs_it_in_its_subjects(tmp_path):
     script.write_text(SCRIPT_JUDGE)
     judge = subprocess.Popen([sys.executable, str(script), str(tmp_path)], text=True,
                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
-    out, _ = judge.communicate(timeout=60)
+    out = ''
+
+    def ended() -> bool:
+        nonlocal out
+        try:
+            out = judge.communicate(timeout=0.25)[0]
+        except subprocess.TimeoutExpired:
+            return False
+        return True
+
+    assert wait_until(ended), 'the judge script never ended'
     said = [line for line in out.splitlines() if line.startswith('subject said:')]
     assert len(said) == 2 and judge.returncode == 0, out
     assert all('the judge script ran' not in line for line in said), out
@@ -139,8 +150,8 @@ def test_a_judge_forks_even_its_first_subject_from_itself(tmp_path, monkeypatch)
     monkeypatch.delenv('ROS_PYTHON_CHECK_FIELDS', raising=False)
     script = tmp_path / 'serving_judge.py'
     script.write_text(SERVING_JUDGE)
-    judge = subprocess.run([sys.executable, str(script), str(tmp_path), str(Path(__file__).parent)],
-                           capture_output=True, text=True, timeout=60)
+    judge = run_to_end([sys.executable, str(script), str(tmp_path), str(Path(__file__).parent)],
+                       'a judge that serves its own subjects')
     lines = [line for line in judge.stdout.splitlines() if line.startswith('SEEN ')]
     assert len(lines) == 1, judge.stdout + judge.stderr
     forked, started, code = json.loads(lines[0][len('SEEN '):])

@@ -14,6 +14,7 @@ import pytest
 
 from ros2nb import domains
 from ros2nb.checks.package_stand_ins import RCLPY_SHUTDOWN_RACE, STAND_IN
+from waiting import run_to_end
 
 pytestmark = pytest.mark.ros
 
@@ -30,8 +31,7 @@ def run(race: str, tmp_path) -> subprocess.CompletedProcess:
     script = tmp_path / 'stand_in.py'
     script.write_text(STAND_IN.format(race=race, **RACING) + '\nmain()\n')
     env = {**os.environ, 'ROS_DOMAIN_ID': str(domains.domain_id())}
-    return subprocess.run([sys.executable, str(script)], env=env, capture_output=True,
-                          text=True, timeout=120)
+    return run_to_end([sys.executable, str(script)], 'the stand-in', env=env)
 
 
 def test_a_stand_in_meeting_rclpys_race_exits_0(tmp_path):

@@ -17,7 +17,7 @@ import pytest
 from ros2nb.judge import observer
 from ros2nb.judge.subjects import SubjectHung, SubjectProcess
 from ros2nb.processes import BUSY_SHARE, Patience, tree_cpu_seconds, wait_for_work
-from waiting import PATIENCE_S, wait_until
+from waiting import PATIENCE_S, run_to_end, wait_until
 
 pytestmark = pytest.mark.judge
 
@@ -191,8 +191,7 @@ def test_a_busy_watcher_does_not_make_a_waiting_program_look_busy():
     every look, and a main() that never starts ROS was given ten times its limit (124 s
     instead of 20 beside two CPU burners). Here the watcher's own thread computes without
     the GIL while the program it watches sleeps for an hour."""
-    done = subprocess.run([sys.executable, '-c', WATCHER, str(LIMIT_S), str(CUT)],
-                          capture_output=True, text=True, timeout=120)
+    done = run_to_end([sys.executable, '-c', WATCHER, str(LIMIT_S), str(CUT)], 'the watcher')
     verdict, _, waited = done.stdout.strip().rpartition(' ')
     # Patience gave up on its own, at its limit or soon after (never a fixed number of
     # seconds: how soon depends on how busy the machine is); the failure waited on.
@@ -243,8 +242,8 @@ def test_a_process_ended_early_still_runs_its_exit_handlers_and_says_everything(
     normal exit does first still happens: with os._exit alone the exit handler would not
     run and most of the buffered output would be lost."""
     env = {k: v for k, v in os.environ.items() if k != 'PYTHONUNBUFFERED'}
-    done = subprocess.run([sys.executable, '-c', ENDS_WITH_AN_EXIT_HANDLER], env=env,
-                          capture_output=True, text=True, timeout=60)
+    done = run_to_end([sys.executable, '-c', ENDS_WITH_AN_EXIT_HANDLER], 'a program ended early',
+                      env=env)
     assert done.returncode == 3, done.stderr
     assert done.stdout == 'x' * 100_000 + 'exit handler ran\n'
 

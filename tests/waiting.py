@@ -11,10 +11,11 @@ knob, not thirty.
 from __future__ import annotations
 
 import os
+import subprocess
 import time
-from typing import Any, Callable, Optional
+from typing import Any, Callable, Optional, Sequence
 
-from ros2nb.processes import child_pids, wait_for_work
+from ros2nb.processes import child_pids, kill_process_group, wait_for_work
 
 #: The longest a test waits for a state that should come (s): of the work of the processes
 #: the test started, or of their idle waiting.  Generous: a bound matters only when the
@@ -53,6 +54,32 @@ def wait_for(condition: Callable[[], Any], what: str, *, seconds: float = PATIEN
     last = seen() if seen is not None else value
     raise AssertionError(f'{what}: not within {seconds:g} s of the work or idle waiting of the '
                          f'processes this test started; last seen: {last!r}')
+
+
+def run_to_end(argv: Sequence[str], what: str, *, seconds: float = PATIENCE_S,
+               **popen: Any) -> subprocess.CompletedProcess:
+    """``subprocess.run(argv, capture_output=True, text=True, **popen)``, given ``seconds`` as
+    the judge gives a program (of its work, or of its idle waiting), not of the wall clock.
+
+    :raises AssertionError: ``what`` and its output so far, when it had them and still runs.
+    """
+    proc = subprocess.Popen(list(argv), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, start_new_session=True, **popen)
+    out: list[str] = []
+
+    def ended() -> bool:
+        try:
+            out[:] = proc.communicate(timeout=LOOK_S)  # no output is lost on a retry
+        except subprocess.TimeoutExpired:
+            return False
+        return True
+
+    if not wait_for_work(ended, [proc.pid], seconds, look=lambda check, _s: check()):
+        kill_process_group(proc)
+        stdout, stderr = proc.communicate()
+        raise AssertionError(f'{what} still ran after {seconds:g} s of its work or idle '
+                             f'waiting: {(stdout + stderr)[-2000:]}')
+    return subprocess.CompletedProcess(proc.args, proc.returncode, *out)
 
 
 def _poll(condition: Callable[[], Any], seconds: float, interval: float) -> bool:
