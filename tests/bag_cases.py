@@ -57,6 +57,16 @@ MISTAKES = [
      r'the first reading'),
     ('read_temperatures', 'one list', 'return times_s, temperatures_c', 'return temperatures_c',
      r'^read_temperatures\(\) returned list; return two lists: \(times_s, temperatures_c\)\.$'),
+    ('read_temperatures', 'another type', 'reader.deserialize(raw, connection.msgtype)',
+     "reader.deserialize(raw, 'std_msgs/msg/Float64')",
+     r'this bag holds no std_msgs/msg/Float64 messages \(.*/temperature.*std_msgs/msg/Float32\): '
+     r'deserialize each message with the type its connection names, '
+     r'reader\.deserialize\(raw, connection\.msgtype\)\.(?: \(.*line \d+: .*\))?$'),
+    ('read_temperatures', 'every connection', 'reader.messages(chosen)',
+     'reader.messages(reader.connections)',
+     r"this message came from /rosout \(rcl_interfaces/msg/Log: a log line, with no data\): "
+     r"read only the /temperature connections, reader\.messages\(\[c for c in "
+     r"reader\.connections if c\.topic == '/temperature'\]\)\.(?: \(.*line \d+: .*\))?$"),
 ]
 MISTAKE_IDS = [f'{m[0]}: {m[1]}' for m in MISTAKES]
 

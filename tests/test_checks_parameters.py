@@ -78,6 +78,13 @@ DECLARATION_MISTAKES = [
     ('no default, no descriptor', DECLARE, "        self.declare_parameter('low_below_c')\n",
      r"TemperatureMonitor\(\) raised: the parameter 'low_below_c' holds None: it was declared "
      r'without a default'),
+    ('the callback called, not passed',
+     'self.add_on_set_parameters_callback(self.on_set_thresholds)',
+     'self.add_on_set_parameters_callback(self.on_set_thresholds())',
+     r'TemperatureMonitor\(\) raised: on_set_thresholds\(\) was called here, with nothing for its '
+     r'\w+, and add_on_set_parameters_callback would get what it returned: pass the method '
+     r'itself, without \(\): self\.on_set_thresholds; .*\(temperature_subscriber\.py line \d+: '
+     r'self\.add_on_set_parameters_callback\(self\.on_set_thresholds\(\)\)\)$'),
     ('registration forgotten',
      '        self.add_on_set_parameters_callback(self.on_set_thresholds)\n',
      '', r'was accepted: register the on-set callback in __init__ with '

@@ -125,8 +125,25 @@ MISTAKES = [
     ('rooms: room ignored', PROMISES, "f'__ns:=/{room}'", "'__ns:=/kitchen'",
      checks.check_room_arguments, r"room_arguments\('attic'\) the node runs as "
                                   r'/kitchen/temperature_sensor'),
-    ('rooms: bad remap', PROMISES, "f'__ns:=/{room}'", "f'__ns:={room}'",
-     checks.check_room_arguments, r'rclpy refused the arguments'),
+    ('rooms: a namespace without its slash', PROMISES, "f'__ns:=/{room}'", "f'__ns:={room}'",
+     checks.check_room_arguments, r"rclpy refused the arguments room_arguments\('kitchen'\) "
+                                  r"returned, \['--ros-args', '-r', '__ns:=kitchen'\]: ROS could "
+                                  r"not read the remap rule '-r __ns:=kitchen': a namespace starts "
+                                  r'with a slash: __ns:=/kitchen\.$'),
+    ('rooms: the namespace as a parameter', PROMISES, "['--ros-args', '-r', f'__ns:=/{room}']",
+     "['--ros-args', '-p', f'__ns:=/{room}']", checks.check_room_arguments,
+     r"ROS could not read the parameter override rule '-p __ns:=/kitchen': __ns is not a "
+     r'parameter but a remap: -r __ns:=/kitchen\.$'),
+    ('fan: a Bool given its value in order', FAN,
+     '        command = Bool()\n        command.data = msg.data > HIGH_ABOVE_C\n',
+     '        command = Bool(msg.data > HIGH_ABOVE_C)\n', checks.check_fan_controller,
+     r'a Bool message takes its fields by name, not in order: write '
+     r'Bool\(data=msg\.data > HIGH_ABOVE_C\) \(its fields: data\)\. \(fan_controller\.py line '
+     r'\d+: command = Bool\(msg\.data > HIGH_ABOVE_C\)\)$'),
+    ('counting: the count without self', PROMISES, '        self.received += 1\n',
+     '        received += 1\n', checks.check_counting_monitor,
+     r"received here is a new local name of this method, not the node's count \(the node keeps "
+     r'it as self\.received\): write self\.received .*\(promises\.py line \d+: received \+= 1\)$'),
     ('rooms: placeholder', PROMISES, "    return ['--ros-args', '-r', f'__ns:=/{room}']",
      '    raise NotImplementedError()', checks.check_room_arguments,
      r"room_arguments\('kitchen'\) still raises NotImplementedError"),

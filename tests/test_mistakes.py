@@ -9,10 +9,11 @@ error output's traceback lines, streams). docs/troubleshooting.md lists the same
 import os
 import queue
 import re
-import time
 
 import pytest
 from jupyter_client.manager import start_new_kernel
+
+from waiting import wait_until
 
 pytestmark = [pytest.mark.kernel, pytest.mark.timeout(300)]
 
@@ -25,18 +26,22 @@ class Kernel:
         env['ROS2NB_WORKSPACE'] = workspace
         self.manager, self.client = start_new_kernel(kernel_name='python3', env=env)
 
-    def run(self, code: str, timeout: float = 60) -> dict:
-        """Run a cell; return its error (ename, traceback) and its stream text."""
+    def run(self, code: str, seconds: float = 60) -> dict:
+        """Run a cell; return its error (ename, traceback) and its stream text.
+
+        :param seconds: for the whole cell (a node may print for ever): of the kernel's
+            work, or of its idle waiting (tests/waiting.py), not of the wall clock.
+        """
         msg_id = self.client.execute(code)
         result = {'error': None, 'stdout': '', 'stderr': ''}
-        deadline = time.monotonic() + timeout  # for the whole cell: a node may print for ever
-        while True:
+
+        def finished() -> bool:
             try:
-                msg = self.client.get_iopub_msg(timeout=max(0.0, deadline - time.monotonic()))
+                msg = self.client.get_iopub_msg(timeout=0.25)
             except queue.Empty:
-                raise AssertionError(f'the cell did not finish in {timeout} s: {code!r}') from None
+                return False
             if msg['parent_header'].get('msg_id') != msg_id:
-                continue
+                return False
             kind, content = msg['msg_type'], msg['content']
             if kind == 'error':
                 result['error'] = {'ename': content['ename'],
@@ -44,8 +49,11 @@ class Kernel:
                                                  for line in content['traceback']]}
             elif kind == 'stream':
                 result[content['name']] += content['text']
-            elif kind == 'status' and content['execution_state'] == 'idle':
-                return result
+            return kind == 'status' and content['execution_state'] == 'idle'
+
+        if not wait_until(finished, seconds, interval=0):
+            raise AssertionError(f'the cell did not finish within {seconds} s: {code!r}')
+        return result
 
     def one_line(self, code: str, *fragments: str) -> str:
         """Run a cell that must fail; check it shows one line with every fragment."""
@@ -503,6 +511,9 @@ class Thresholds(Node):
       "self.declare_parameter('high_above_c', default) first")),
     ("self.add_on_set_parameters_callback(self.on_parameters_set(None))", 'Thresholds()',
      ('add_on_set_parameters_callback takes the callback itself', 'without ()')),
+    ("self.add_on_set_parameters_callback(self.on_parameters_set())", 'Thresholds()',
+     ('on_parameters_set() was called here, with nothing for its parameters',
+      'pass the method itself, without (): self.on_parameters_set')),
     ("self.declare_parameter('high_above_c', 26.0)",
      "Thresholds(cli_args=['--ros-args', '-p', 'high_above_c:=25'])",
      ("the parameter 'high_above_c' holds a double", "'25' is an integer",
@@ -553,3 +564,32 @@ def test_python_used_the_way_another_tool_is_in_03(ros, cell, fragments):
     """01-05, new kinds: randint for a decimal step, a logger called like print, a method
     named without self."""
     ros.one_line(cell, *fragments)
+
+
+@pytest.mark.parametrize('cell, fragments', [
+    ('from std_msgs.msg import Bool\nHIGH_ABOVE_C = 26.0\n\ndef command(reading):\n'
+     '    return Bool(reading > HIGH_ABOVE_C)\n\ncommand(27.0)',
+     ('a Bool message takes its fields by name, not in order: write '
+      'Bool(data=reading > HIGH_ABOVE_C) (its fields: data)', 'cell line 5')),
+    ('class Counting:\n    def __init__(self):\n        self.received = 0\n\n'
+     '    def on_reading(self, msg):\n        received += 1\n\nCounting().on_reading(None)',
+     ("received here is a new local name of this method, not the node's count (the node keeps "
+      'it as self.received): write self.received', 'cell line 6')),
+])
+def test_python_used_the_way_another_tool_is_in_06(cell, fragments, kernel):
+    """06: a message given its field in order, a node's count without self.: Python's own
+    error, at the learner's line, with the fix."""
+    kernel.one_line(cell, *fragments)
+
+
+def test_plt_show_in_a_loop_is_one_line_not_a_copy_per_pass(ros):
+    """07: plt.show() in a loop (outside any callback) drew one more copy of the live figure
+    under the cell on every pass, silently; the second show of it in one cell is one line."""
+    ros.run('%matplotlib widget\nimport matplotlib.pyplot as plt\nfig, ax = plt.subplots()')
+    try:
+        ros.one_line('for _ in range(3):\n    plt.show()',
+                            'plt.show() showed this figure again in the same cell',
+                            'keep one figure and update it', 'fig.canvas.draw_idle()')
+        assert ros.run('plt.show()')['error'] is None  # the next cell shows it once, as asked
+    finally:
+        ros.run("plt.close('all')\n%matplotlib inline")

@@ -204,6 +204,50 @@ def test_ros2_run_two_processes_and_ctrl_c(built, capsys):
     assert '^C' in out and 'Traceback' not in out
 
 
+#: A node with notebook 08's threshold, a double, given on its command line as ros2 run does.
+THRESHOLD_NODE = """
+import sys
+import rclpy
+from rclpy.node import Node
+rclpy.init(args=sys.argv)
+node = Node('temperature_monitor')
+node.declare_parameter('high_above_c', 26.0)
+"""
+
+
+@pytest.mark.ros
+def test_a_parameter_of_the_wrong_type_gets_its_fix_after_the_traceback(capsys):
+    """08: `-p high_above_c:=25` makes an integer of a double parameter; the node's traceback
+    through rclpy ended the cell with `exited with code 1` and nothing after it."""
+    codes = ros2nb.run_and_interrupt([sys.executable, '-c', THRESHOLD_NODE, '--ros-args', '-p',
+                                      'high_above_c:=25'], labels=['temperature_subscriber'])
+    out = capsys.readouterr().out.strip().splitlines()
+    assert codes == [1] and out[-2] == 'temperature_subscriber exited with code 1', out
+    assert out[-1] == ("temperature_subscriber: the parameter 'high_above_c' holds a double (its "
+                       "default decides), and '25' is an integer: give it 25.0, e.g. -p "
+                       'high_above_c:=25.0.'), out
+
+
+@pytest.mark.ros
+def test_a_room_without_its_slash_is_named_by_the_graph_at_once(built, ros):
+    """06: a room's nodes started with `-r __ns:=kitchen` end at once; the graph's wait says
+    why (rcl's own line is 'Expected lexeme type 19, got 18'), not a minute later."""
+    started = [ros2nb.ros2_start('sensor_simulator', executable, '--ros-args', '-r',
+                                 '__ns:=kitchen')
+               for executable in ('temperature_publisher', 'temperature_subscriber')]
+    try:
+        with pytest.raises(ros2nb.Ros2nbError) as caught:
+            ros2nb.graph_edges(expect=['/kitchen/temperature_sensor'])
+    finally:
+        for node in started:
+            node.stop()
+    said = str(caught.value)
+    assert said.startswith('The graph shows no node /kitchen/temperature_sensor with a topic: '
+                           'temperature_publisher exited with code '), said
+    assert ("ROS could not read the remap rule '-r __ns:=kitchen': a namespace starts with a "
+            'slash: __ns:=/kitchen.') in said and 'lexeme' not in said, said
+
+
 @pytest.mark.ros
 def test_missing_setup_cfg_gives_no_executable(built, tmp_path):
     scratch = tmp_path / 'nocfg'

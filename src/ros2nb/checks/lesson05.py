@@ -41,7 +41,8 @@ from .source import TEXT
 # ------------------------------------------------------------------ the package
 PLACEHOLDER = 'raise NotImplementedError'
 #: setuptools' warning for a setup.cfg key spelt with a dash (``script-dir``), in a build's
-#: output; setuptools 78 and later refuse such keys.
+#: output: deprecated, refused by 78.0.0, read again with the warning from 78.0.2
+#: (pypa/setuptools#4911), and to be refused by a later release.
 DASHED_KEY = re.compile(r"Usage of dash-separated '([\w-]+)' will not be supported")
 #: The dash-spelt keys each successful build warned about, by its workspace.
 _DASHED: dict[Path, list[str]] = {}
@@ -344,9 +345,10 @@ def _setup_cfg(judge: Judge) -> str:
                           f'$base/lib/{course.PACKAGE}.')
     dashed = _DASHED.get(built)
     if dashed:
-        raise CheckFailed(f'setup.cfg spells {dashed[0]} with a dash: this setuptools still reads '
-                          'it, with a warning in the build, but setuptools 78 and later refuse it '
-                          f'(then ros2 run finds nothing): write {dashed[0].replace("-", "_")}.')
+        raise CheckFailed(f'setup.cfg spells {dashed[0]} with a dash: setuptools reads it with a '
+                          'deprecation warning in the build, but a coming release refuses it, as '
+                          '78.0.0 did until 78.0.2 took that back (then ros2 run finds nothing): '
+                          f'write {dashed[0].replace("-", "_")}.')
     return (f'setup.cfg installs the executables into lib/{course.PACKAGE}, where ros2 run '
             'finds them.')
 

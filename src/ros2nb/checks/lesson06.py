@@ -17,6 +17,7 @@ from std_msgs.msg import Bool
 
 from .. import course
 from ..errors import CheckFailed
+from ..explain.settings import ros_arguments_mistake
 from .base import ARRIVAL_TIMEOUT_S, Judge, judged, learner_error
 from .mains import run_main
 from .nodes import announced, caught_up, feed, new_node, reach
@@ -289,8 +290,10 @@ def _rooms(judge: Judge) -> str:
         reply = subject.request('room_nodes', arguments=arguments)
         if not reply['ok']:
             error = reply['error']
-            raise CheckFailed(f"rclpy refused the arguments {arguments}: {error['type']}: "
-                              f"{error['message'].splitlines()[0][:160]}")
+            kind, text = str(error.get('type')), str(error.get('message'))
+            why = ros_arguments_mistake(kind, text) or f'{kind}: {text.splitlines()[0][:160]}'
+            raise CheckFailed(f"rclpy refused the arguments {course.ROOMS_FUNCTION}('{room}') "
+                              f'returned, {arguments}: {why}')
         for name, namespace, endpoints in reply['nodes']:
             full = namespace.rstrip('/') + '/' + name
             found = judge.observer.endpoints(name, namespace, endpoints)

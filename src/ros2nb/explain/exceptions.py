@@ -13,53 +13,24 @@ from __future__ import annotations
 import linecache
 import os
 import re
-import site
-import sysconfig
 import traceback
 from pathlib import Path
-from types import TracebackType
 from typing import Any, Optional
 
 from rclpy.exceptions import NameValidationException, NotInitializedException
 
 from ..errors import SHUT_DOWN_MESSAGE
+from .bag_reading import bag_reading_mistake
+from .frames import frames_of, is_library_file, learner_entry, learner_frame, raised_in
+from .plain_python import python_mistake
 from .plots import plot_in_callback
 from .settings import qos_setting, settings_mistake
-
-#: The ros2nb package: its files are not the learner's.
-_HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-
-
-def _library_dirs() -> tuple[str, ...]:
-    dirs = {_HERE, *site.getsitepackages(), site.getusersitepackages()}
-    for key in ('stdlib', 'platstdlib', 'purelib', 'platlib'):
-        dirs.add(sysconfig.get_paths()[key])
-    return tuple(sorted(os.path.abspath(d) + os.sep for d in dirs if d))
-
-
-_LIBRARY_DIRS = _library_dirs()
-
-
-def is_library_file(path: str) -> bool:
-    """True for files of Python, installed packages (rclpy, messages, IPython) and ros2nb."""
-    path = os.path.abspath(path)
-    return path.startswith(_LIBRARY_DIRS) or path.startswith('<frozen')
-
-
-def _learner_entry(exc: BaseException) -> Optional[TracebackType]:
-    """The innermost traceback entry in the learner's own code (a cell or their file)."""
-    found, tb = None, exc.__traceback__
-    while tb is not None:
-        if not is_library_file(tb.tb_frame.f_code.co_filename):
-            found = tb
-        tb = tb.tb_next
-    return found
 
 
 def learner_line(exc: BaseException) -> str:
     """Return ``cell line N: source`` or ``FILE line N: source`` for the learner's
     innermost frame."""
-    entry = _learner_entry(exc)
+    entry = learner_entry(exc)
     if entry is not None:
         filename, number = entry.tb_frame.f_code.co_filename, entry.tb_lineno
     else:  # ROS called a function of the learner's wrongly (a callback's signature)
@@ -107,7 +78,7 @@ def describe_error(error: BaseException) -> dict:
 def _called_code(exc: BaseException) -> Any:
     """The code of the learner's function that rclpy called with the wrong arguments, or None."""
     match = _SIGNATURE.match(str(exc)) if isinstance(exc, TypeError) else None
-    frames = list(_frames(exc))
+    frames = list(frames_of(exc))
     if match is None or not frames or not is_library_file(frames[-1].f_code.co_filename):
         return None
     for value in frames[-1].f_locals.values():
@@ -119,20 +90,6 @@ def _called_code(exc: BaseException) -> Any:
     return None
 
 
-def _frames(exc: BaseException):
-    tb = exc.__traceback__
-    while tb is not None:
-        yield tb.tb_frame
-        tb = tb.tb_next
-
-
-def _raised_in(exc: BaseException, function: str) -> bool:
-    """True when the innermost frame of ``exc`` is a library function named ``function``."""
-    frames = list(_frames(exc))
-    return bool(frames) and frames[-1].f_code.co_name == function and \
-        is_library_file(frames[-1].f_code.co_filename)
-
-
 _FIELD_TYPE = re.compile(r"The '(\w+)' field must be of type '([\w.]+)'")
 _NUMBERS = {'float': 'a decimal number such as 22.0', 'int': 'a whole number such as 10',
             'str': "text such as 'hello'", 'bool': 'True or False'}
@@ -141,9 +98,9 @@ _NUMBERS = {'float': 'a decimal number such as 22.0', 'int': 'a whole number suc
 def _field_type(exc: AssertionError) -> Optional[str]:
     match = _FIELD_TYPE.search(str(exc))
     if not match:
-        return qos_setting(exc, list(_frames(exc)))
+        return qos_setting(exc, list(frames_of(exc)))
     field, wanted = match.groups()
-    frame = list(_frames(exc))[-1]
+    frame = list(frames_of(exc))[-1]
     message = frame.f_locals.get('self')
     value = frame.f_locals.get('value')
     owner = type(message).__name__ if message is not None else 'the message'
@@ -154,19 +111,13 @@ def _field_type(exc: AssertionError) -> Optional[str]:
             'convert the value before you put it into the message.')
 
 
-def _learner_frame(exc: BaseException) -> Any:
-    """The innermost frame of the learner's own code (a cell or their file), or None."""
-    entry = _learner_entry(exc)
-    return entry.tb_frame if entry is not None else None
-
-
 _NO_ATTRIBUTE = re.compile(r"^'(\w+)' object has no attribute '(\w+)'")
 
 
 def _missing_attribute(exc: AttributeError) -> Optional[str]:
     """``self.TOPIC`` for a module constant, or a method written outside its class."""
     match = _NO_ATTRIBUTE.match(str(exc))
-    frame = _learner_frame(exc)
+    frame = learner_frame(exc)
     if not match or frame is None:
         return None
     owner, name = match.groups()
@@ -184,7 +135,7 @@ def _missing_attribute(exc: AttributeError) -> Optional[str]:
 
 def _message_not_a_value(exc: TypeError) -> Optional[str]:
     """A message used where its number is meant: ``msg > 26`` instead of ``msg.data > 26``."""
-    frame = _learner_frame(exc)
+    frame = learner_frame(exc)
     if frame is None:
         return None
     for value in frame.f_locals.values():
@@ -198,7 +149,7 @@ def _message_not_a_value(exc: TypeError) -> Optional[str]:
 
 
 def _node_without_init(exc: AttributeError) -> Optional[str]:
-    for frame in _frames(exc):
+    for frame in frames_of(exc):
         if not frame.f_code.co_filename.endswith(os.path.join('rclpy', 'node.py')):
             continue
         obj = frame.f_locals.get('self')
@@ -230,7 +181,7 @@ def explain_exception(exc: BaseException, *, ros_started: bool = False) -> Optio
                 'number, e.g. self.create_timer(1.0, self.publish_temperature).')
     if isinstance(exc, (TypeError, ValueError)) and _is_qos_mistake(exc):
         return _qos_advice(exc)
-    if isinstance(exc, FileExistsError) and _raised_in(exc, 'mkdir'):
+    if isinstance(exc, FileExistsError) and raised_in(exc, 'mkdir'):
         return (f'{exc.filename} already exists, and mkdir() without exist_ok refuses an existing '
                 'folder, like mkdir without -p: mkdir(parents=True, exist_ok=True) is mkdir -p.')
     if type(exc) is NotImplementedError and not text:
@@ -244,10 +195,10 @@ def explain_exception(exc: BaseException, *, ros_started: bool = False) -> Optio
         return ('rclpy.init() was called, but ros2nb.start() already brought ROS 2 up in this '
                 'kernel: remove that call; to run a node here hand it to ros2nb.add(node) '
                 '(main() is for `ros2 run`, notebook 05).')
-    python = _python_mistake(exc, text)
+    python = python_mistake(exc, text) or bag_reading_mistake(exc, text)
     if python:
         return python
-    parameter = settings_mistake(exc, text, list(_frames(exc))) or plot_in_callback(exc, text)
+    parameter = settings_mistake(exc, text, list(frames_of(exc))) or plot_in_callback(exc, text)
     if parameter:
         return parameter
     if type(exc).__name__ == 'InvalidQoSProfileException':
@@ -270,32 +221,6 @@ def explain_exception(exc: BaseException, *, ros_started: bool = False) -> Optio
     return None
 
 
-_LOGGER_ARGUMENTS = re.compile(r'^RcutilsLogger\.(\w+)\(\) takes 2 positional arguments')
-_UNDEFINED = re.compile(r"^name '(\w+)' is not defined")
-
-
-def _python_mistake(exc: BaseException, text: str) -> Optional[str]:
-    """Python used the way another tool is: randint for a decimal step, a logger given
-    print's list of values, a method named without ``self.`` (notebooks 03 and 04)."""
-    if isinstance(exc, ValueError) and text.startswith('non-integer arg') \
-            and _raised_in(exc, 'randrange'):
-        return ('random.randint draws whole numbers only: for a step between -0.5 and 0.5 °C '
-                'use random.uniform(-0.5, 0.5).')
-    logger = _LOGGER_ARGUMENTS.match(text) if isinstance(exc, TypeError) else None
-    if logger:
-        return (f'get_logger().{logger.group(1)}() takes one string, not a list of values as '
-                f"print does: put the values into it, get_logger().{logger.group(1)}"
-                "(f'Temperature: {value:.2f}').")
-    undefined = _UNDEFINED.match(text) if isinstance(exc, NameError) else None
-    frame = _learner_frame(exc) if undefined else None
-    owner = frame.f_locals.get('self') if frame is not None else None
-    if undefined and owner is not None and callable(getattr(owner, undefined.group(1), None)):
-        name = undefined.group(1)
-        return (f'{name} is a method of {type(owner).__name__}: inside the class, name it '
-                f'self.{name}.')
-    return None
-
-
 def _wrong_message_published(text: str) -> str:
     """publish() given something other than its publisher's message type: the advice names
     that type (a ``Bool`` publisher gets ``Bool`` advice), and a message of another type is
@@ -313,7 +238,7 @@ def _wrong_message_published(text: str) -> str:
 
 def _placeholder(exc: BaseException) -> Optional[str]:
     """The line for a part the learner has not written yet (its ``raise NotImplementedError()``)."""
-    frame = _learner_frame(exc)
+    frame = learner_frame(exc)
     if frame is None:
         return None
     name = frame.f_code.co_qualname if hasattr(frame.f_code, 'co_qualname') \
@@ -344,7 +269,7 @@ def _callback_signature(exc: BaseException) -> str:
     assert match is not None
     name = match['name']
     short, me = name.rpartition('.')[2], ('self, ' if '.' in name else '')
-    given = list(_frames(exc))[-1].f_locals.get('args', ())
+    given = list(frames_of(exc))[-1].f_locals.get('args', ())
     if given:
         return (f'ROS calls {name}() with the message it received (a subscription callback): '
                 f'define it as def {short}({me}msg) and read msg.data.')
@@ -354,7 +279,7 @@ def _callback_signature(exc: BaseException) -> str:
 
 def _subscription_callback(exc: BaseException) -> str:
     """rclpy refused a subscription callback that cannot take the message."""
-    callback = list(_frames(exc))[-1].f_locals.get('value')
+    callback = list(frames_of(exc))[-1].f_locals.get('value')
     name = getattr(callback, '__qualname__', 'the callback')
     short, me = name.rpartition('.')[2], ('self, ' if '.' in name else '')
     return (f'the subscription\'s callback {name}() must take the message ROS hands it: define '

@@ -1,4 +1,5 @@
-"""``plt.pause()`` and ``plt.show()`` refused inside a node's callback, with one line.
+"""``plt.pause()`` and ``plt.show()`` refused inside a node's callback, and ``plt.show()`` of
+a figure the cell already showed, with one line.
 
 Part of :mod:`ros2nb.explain`; installed by :func:`ros2nb.start` in a kernel and in every
 judge's subject.  Called from a callback, ``plt.pause`` holds the executor up for its
@@ -28,9 +29,36 @@ class PlotInCallbackError(Ros2nbError):
     """``plt.pause()`` or ``plt.show()`` was called inside a node's callback."""
 
 
+class FigureShownAgainError(Ros2nbError):
+    """``plt.show()`` was called again for a figure the same cell already showed."""
+
+
 def plot_in_callback(exc: BaseException, text: str) -> Optional[str]:
-    """The line of a :class:`PlotInCallbackError` (its own message), or None."""
-    return text if isinstance(exc, PlotInCallbackError) else None
+    """The line of a :class:`PlotInCallbackError` or :class:`FigureShownAgainError` (its own
+    message), or None."""
+    return text if isinstance(exc, (PlotInCallbackError, FigureShownAgainError)) else None
+
+
+#: The figure manager each cell showed last: (its id, the cell's execution count).
+_shown: list[tuple[int, int]] = []
+
+
+def _shown_again(pyplot: Any) -> Optional[str]:
+    """The line for ``plt.show()`` of a figure this cell already showed (in a loop, say), or
+    None.  In a notebook each call draws one more copy of it under the cell (a widget
+    backend's ``show`` displays the canvas again); a loop wants one figure, updated."""
+    shell = getattr(sys.modules.get('IPython'), 'get_ipython', lambda: None)()
+    manager = pyplot.get_current_fig_manager() if pyplot.get_fignums() else None
+    if shell is None or manager is None:
+        return None
+    shown = (id(manager), shell.execution_count)
+    if shown in _shown:
+        return ('plt.show() showed this figure again in the same cell, and each call puts one '
+                'more copy of it under the cell: keep one figure and update it: show it once, '
+                'before the loop, and in the loop change its data (line.set_data(...)) and call '
+                'fig.canvas.draw_idle().')
+    _shown[:] = [shown]
+    return None
 
 
 def _in_callback() -> bool:
@@ -54,6 +82,9 @@ def _guard(pyplot: Any) -> None:
                 raise PlotInCallbackError(
                     f'plt.{_name}() in a callback {_WHY[_name]}: remove it; redraw() already '
                     'asks for a redraw without waiting (the plot updates between messages).')
+            again = _shown_again(pyplot) if _name == 'show' else None
+            if again:
+                raise FigureShownAgainError(again)
             return _original(*args, **kwargs)
 
         guarded.__doc__, guarded.__name__ = original.__doc__, name

@@ -84,7 +84,8 @@ def settings_mistake(exc: BaseException, text: str, frames: list[Any]) -> Option
 
     :param frames: the exception's frames, outermost first.
     """
-    return (parameter_mistake(exc, text) or ros_arguments_mistake(exc, text)
+    kind = type(exc).__name__
+    return (parameter_mistake(kind, text) or ros_arguments_mistake(kind, text)
             or zero_depth(exc, text) or unset_parameter(exc, text, frames))
 
 
@@ -116,13 +117,16 @@ _WRONG_PARAMETER_TYPE = re.compile(r"Trying to set parameter '(\w+)' to '([^']*)
                                    r"'(\w+)', expecting type '(\w+)'")
 
 
-def parameter_mistake(exc: BaseException, text: str) -> Optional[str]:
+def parameter_mistake(kind: str, text: str) -> Optional[str]:
     """The classic parameter mistakes, each with its fix: read before declared, the wrong type
     given with ``-p``, the on-set callback called instead of passed.  None for any other error.
 
     Introduced in ``08-parameters.ipynb``.
+
+    :param kind: the exception's class name (``InvalidParameterTypeException``): these are
+        told apart by name and message alone, also from the last line a process printed.
+    :param text: its message.
     """
-    kind = type(exc).__name__
     if kind == 'ParameterNotDeclaredException':
         name = text.rsplit(': ', 1)[-1]
         return (f"the parameter '{name}' was read (or set) before it was declared: call "
@@ -137,7 +141,7 @@ def parameter_mistake(exc: BaseException, text: str) -> Optional[str]:
         return (f"the parameter '{name}' holds a {wanted.lower()} (its default decides), and "
                 f"'{value}' is {'an' if given[0] in 'AEIOU' else 'a'} {given.lower()}: give it "
                 f'{fix}.')
-    if isinstance(exc, TypeError) and text.startswith("('Callback must be callable"):
+    if kind == 'TypeError' and text.startswith("('Callback must be callable"):
         return ('add_on_set_parameters_callback takes the callback itself, and was given what '
                 'calling it returned: pass self.on_parameters_set, without ().')
     return None
@@ -146,13 +150,17 @@ def parameter_mistake(exc: BaseException, text: str) -> Optional[str]:
 _ROS_RULE = re.compile(r"Couldn't parse (remap|parameter override) rule: '(-[rp]) ([^']*)'")
 
 
-def ros_arguments_mistake(exc: BaseException, text: str) -> Optional[str]:
+def ros_arguments_mistake(kind: str, text: str) -> Optional[str]:
     """rcl's refusal of a ``-r`` or ``-p`` rule (``Expected lexeme type 19...``), as the
     rule, what is wrong with it, and how it is written; None for any other error.
 
     Introduced in ``06-five-promises.ipynb`` (a room's namespace) and ``08-parameters.ipynb``.
+
+    :param kind: the exception's class name: ``RCLInvalidROSArgsError`` for a node's
+        arguments, ``RCLError`` for ``rclpy.init``'s (a program's command line).
+    :param text: its message.
     """
-    found = _ROS_RULE.search(text) if type(exc).__name__ == 'RCLInvalidROSArgsError' else None
+    found = _ROS_RULE.search(text) if kind in ('RCLInvalidROSArgsError', 'RCLError') else None
     if found is None:
         return None
     kind, flag, rule = found.groups()
@@ -169,3 +177,25 @@ def ros_arguments_mistake(exc: BaseException, text: str) -> Optional[str]:
     else:
         why = 'a parameter is written -p NAME:=VALUE, the name in letters, digits and _'
     return f"ROS could not read the {kind} rule '{flag} {rule}': {why}."
+
+
+#: The last line of a Python traceback: the exception's (dotted) class and its message.
+_ERROR_LINE = re.compile(r'^(?:\[[^\]]*\] )?(?:[A-Za-z_]\w*\.)*'  # ros2_run's [label-N]
+                         r'(?P<kind>[A-Za-z_]\w*(?:Error|Exception)): (?P<text>.*)$')
+
+
+def output_mistake(lines: list[str]) -> Optional[str]:
+    """The line for a known mistake behind the error a process printed last (the last line of
+    its traceback), or None: what a node that ``ros2 run`` started says is told apart by the
+    exception's name and message alone.
+
+    Introduced in ``08-parameters.ipynb`` (``-p high_above_c:=25`` for a double).
+
+    :param lines: the process's output, in order.
+    """
+    for line in reversed(lines):
+        found = _ERROR_LINE.match(line.strip())
+        if found:
+            kind, text = found['kind'], found['text']
+            return parameter_mistake(kind, text) or ros_arguments_mistake(kind, text)
+    return None

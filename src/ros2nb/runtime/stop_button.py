@@ -21,7 +21,7 @@ import threading
 from types import CodeType, FrameType
 from typing import Iterator, Optional
 
-from ..explain.exceptions import is_library_file
+from ..explain.frames import is_library_file
 
 
 class StopButton:

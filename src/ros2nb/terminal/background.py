@@ -17,6 +17,7 @@ import threading
 from typing import Optional
 
 from ..errors import UsageError
+from ..explain.settings import output_mistake
 from ..processes import stop_process_group, wait_for_work
 from .colcon import source_workspace
 from .run import _command, node_process_env
@@ -28,6 +29,12 @@ _running: list['NodeProcess'] = []
 def running_pids() -> list[int]:
     """The processes started in the background that still run (what waits attend to)."""
     return [node.proc.pid for node in _running if node.proc.poll() is None]
+
+
+def failures() -> list[str]:
+    """Why each process started in the background (and not stopped) ended by itself, one
+    line each (:meth:`NodeProcess.failure`)."""
+    return [said for said in (node.failure() for node in _running) if said]
 
 
 class NodeProcess:
@@ -88,6 +95,19 @@ class NodeProcess:
         wait_for_work(said, running_pids(), timeout, look=look)
         with self._changed:
             return sum(text in line for line in self.lines) >= count
+
+    def failure(self) -> Optional[str]:
+        """Why it ended by itself, in one line (``LABEL exited with code N: ...``, the fix for
+        a known mistake in its output, else its last line), or None while it runs or when it
+        ended cleanly.  Introduced in ``06-five-promises.ipynb``."""
+        code = self.proc.poll()
+        if code in (None, 0) or not self._ended:
+            return None
+        with self._changed:
+            lines = list(self.lines)
+        said = output_mistake(lines) or next((line for line in reversed(lines) if line.strip()),
+                                             'no output')
+        return f'{self.label} exited with code {code}: {said}'
 
     def new_lines(self) -> list[str]:
         """Print and return the lines that came since the last call, prefixed with the label."""

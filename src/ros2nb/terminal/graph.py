@@ -14,7 +14,7 @@ from typing import Any, Iterable, Optional
 from ..errors import Ros2nbError
 from ..processes import wait_for_work
 from ..runtime import current_runtime
-from .background import running_pids
+from .background import failures, running_pids
 from .topic import INFRASTRUCTURE_TOPICS, hidden
 
 #: Seconds :func:`graph_edges` waits for the nodes it is told to expect.
@@ -57,15 +57,18 @@ def graph_edges(*, expect: Iterable[str] = (),
     want = set(expect)
     found: list[tuple[str, str, str]] = []
 
-    def shown() -> bool:
+    def shown() -> bool:  # or every process started for it ended, some by themselves
         nonlocal found
         found = _endpoints_now()
-        return not want - {node for node, _, _ in found}
+        return not want - {node for node, _, _ in found} or \
+            (not running_pids() and bool(failures()))
 
-    if not wait_for_work(shown, running_pids(), timeout):
-        missing = want - {node for node, _, _ in found}
-        raise Ros2nbError(f'The graph shows no node {sorted(missing)[0]} with a topic after '
-                          f'{timeout:g} s: is it running?')
+    wait_for_work(shown, running_pids(), timeout)
+    missing = want - {node for node, _, _ in found}
+    if missing:
+        why = '; '.join(failures())
+        raise Ros2nbError(f'The graph shows no node {sorted(missing)[0]} with a topic'
+                          + (f': {why}' if why else f' after {timeout:g} s: is it running?'))
     return sorted(found)
 
 

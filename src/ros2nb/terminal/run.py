@@ -22,6 +22,7 @@ from ament_index_python.packages import PackageNotFoundError, get_package_prefix
 
 from .. import domains, runtime
 from ..errors import Ros2nbError, UsageError
+from ..explain.settings import output_mistake
 from ..processes import STOP_GRACE_S, Patience, signal_group, stop_process_group
 from .colcon import source_workspace
 from .workspace import PathLike, workspace_or_current
@@ -182,6 +183,7 @@ def run_and_interrupt(*argvs: Sequence[str], labels: Optional[Sequence[str]] = N
     labels = list(labels) if labels is not None else [Path(a[0]).name for a in argvs]
     lines: queue.Queue = queue.Queue()
     procs = []
+    said: list[list[str]] = [[] for _ in argvs]  # each process's lines, for its last error
     try:
         for number, (label, argv) in enumerate(zip(labels, argvs), start=1):
             proc = subprocess.Popen(list(argv), env=env, text=True, stdout=subprocess.PIPE,
@@ -190,20 +192,25 @@ def run_and_interrupt(*argvs: Sequence[str], labels: Optional[Sequence[str]] = N
             prefix = f'[{label}-{number}] ' if len(argvs) > 1 else ''
             threading.Thread(target=stream_lines, args=(proc, number - 1, prefix, lines),
                              daemon=True).start()
-        _relay(procs, lines, seconds)
+        _relay(procs, lines, seconds, said)
     except KeyboardInterrupt:
         print('Interrupted: stopping the processes.')
     finally:
         for proc in procs:
             stop_process_group(proc)
     codes = [proc.wait() for proc in procs]
-    for label, code in zip(labels, codes):
+    for label, code, output in zip(labels, codes, said):
         print(f'{label} exited with code {code}')
+        mistake = output_mistake(output) if code not in (0, -signal.SIGINT) else None
+        if mistake:
+            print(f'{label}: {mistake}')
     return codes
 
 
-def _relay(procs: list[subprocess.Popen], lines: queue.Queue, seconds: float) -> None:
-    """Print the processes' lines as they come; press Ctrl+C for them after ``seconds``.
+def _relay(procs: list[subprocess.Popen], lines: queue.Queue, seconds: float,
+           said: list[list[str]]) -> None:
+    """Print the processes' lines as they come (and keep each one's in ``said``); press
+    Ctrl+C for them after ``seconds``.
 
     The countdown starts when every process has printed a line (or ended), as a person at
     a terminal waits for a program to start before timing it, so a busy machine does not
@@ -240,3 +247,4 @@ def _relay(procs: list[subprocess.Popen], lines: queue.Queue, seconds: float) ->
             open_streams -= 1
         else:
             print(line, flush=True)
+            said[index].append(line)
