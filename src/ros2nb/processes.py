@@ -285,6 +285,36 @@ def _name(pid: int) -> str:
         return ''
 
 
+def _state(pid: int) -> str:
+    """A process's state as /proc shows its main thread: R running or ready, S or D waiting,
+    Z ended, ... ('' when it is gone)."""
+    try:
+        with open(f'/proc/{pid}/stat') as stat:
+            return stat.read().rsplit(')', 1)[1].split()[0]
+    except (OSError, IndexError):
+        return ''
+
+
+def until_waiting(proc: subprocess.Popen, limit_s: float) -> bool:
+    """Wait until the main thread of every process under ``proc`` (bubblewrap's own aside)
+    sits waiting, in two looks in a row: a program idle in its spin, as a person at a
+    terminal sees it before pressing Ctrl+C.  Whether a signal lands in the spin's wait or
+    between two of its rounds then depends on the program, not on how busy the machine is.
+
+    :param limit_s: how long to wait at most (:class:`Patience`): a program that never waits
+        (a loop) is signalled all the same.
+    :return: True when it sat waiting, False when it had its limit (or ended).
+    """
+    patience, calm = Patience(proc.pid, limit_s), 0
+    while calm < 2:
+        if proc.poll() is not None or patience.exhausted():
+            return False
+        pids = [pid for pid in tree_pids(proc.pid) if _name(pid) != 'bwrap']
+        calm = calm + 1 if pids and all(_state(pid) in ('S', 'D') for pid in pids) else 0
+        time.sleep(POLL_S)
+    return True
+
+
 def interrupt(proc: subprocess.Popen, sig: int = signal.SIGINT) -> None:
     """Press Ctrl+C for ``proc``: send ``sig`` to its process group, as a terminal does.
 

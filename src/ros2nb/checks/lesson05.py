@@ -28,7 +28,7 @@ from std_msgs.msg import Float32
 
 from .. import course
 from ..errors import CheckFailed, Ros2nbError
-from ..processes import interrupt, kill_process_group, wait_patiently
+from ..processes import interrupt, kill_process_group, until_waiting, wait_patiently
 from ..terminal.colcon import build_cause, venv_tool
 from ..terminal.files import saved_parts
 from ..terminal.pkg_templates import SETUP_CFG, render_setup_py
@@ -199,8 +199,10 @@ def _ros2_run(judge: Judge, ws: Path, env: dict[str, str], executable: str,
 
 
 def _stop(procs: list[Any]) -> list[Optional[int]]:
-    """Ctrl+C for each process; their exit codes (None: one had to be killed)."""
+    """Ctrl+C for each process, once it sits idle in its spin; their exit codes (None: one
+    had to be killed)."""
     for proc in procs:
+        until_waiting(proc, EXIT_AFTER_CTRL_C_S)
         interrupt(proc)
     codes = [wait_patiently(proc, EXIT_AFTER_CTRL_C_S) for proc in procs]
     for proc, code in zip(procs, codes):
