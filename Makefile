@@ -63,32 +63,32 @@ lab: $(STAMP) bytecode graph-tool
 lab-instructor: $(STAMP) bytecode graph-tool
 	$(VENV)/bin/ros2nb-lab --instructor
 
-# Unit tests of ros2nb, the notebook checks, then nbval over both notebook folders.
-# Grading runs learners' code in bubblewrap sandboxes (Debian's bubblewrap package).
+# The Debian tools some tests and grading use: installed by make when it runs as root; else it
+# says the one apt line, and what goes without them (their tests skip, saying why).
+# $(call from_debian,COMMANDS,PACKAGES,WITHOUT): installs PACKAGES when a command is missing.
+have_all = for command in $(1); do command -v $$command >/dev/null || exit 1; done
+define from_debian
+	@( $(call have_all,$(1)) ) || [ "$$(id -u)" != 0 ] || apt-get install -y -q $(2) >/dev/null 2>&1 \
+	  || { apt-get update -q >/dev/null 2>&1 && apt-get install -y -q $(2) >/dev/null 2>&1; } || true
+	@( $(call have_all,$(1)) ) || echo "$(firstword $(2)) is not installed (sudo apt-get install $(2)): $(3)"
+endef
+
+# Grading runs learners' code in bubblewrap sandboxes.
 sandbox-tool:
-	@command -v bwrap >/dev/null || [ "$$(id -u)" != 0 ] || apt-get install -y -q bubblewrap >/dev/null 2>&1 \
-	  || { apt-get update -q >/dev/null 2>&1 && apt-get install -y -q bubblewrap >/dev/null 2>&1; } || true
-	@command -v bwrap >/dev/null || echo "bubblewrap is not installed (sudo apt-get install bubblewrap): grading refuses to run and its tests skip."
+	$(call from_debian,bwrap,bubblewrap,grading refuses to run and its tests skip.)
 
 # Browser tests (Playwright) drive Debian's chromium; Playwright's own download is unreachable.
 browser-tool:
-	@command -v chromium >/dev/null || [ "$$(id -u)" != 0 ] || apt-get install -y -q chromium >/dev/null 2>&1 \
-	  || { apt-get update -q >/dev/null 2>&1 && apt-get install -y -q chromium >/dev/null 2>&1; } || true
-	@command -v chromium >/dev/null || echo "chromium is not installed (sudo apt-get install chromium): the browser tests skip."
+	$(call from_debian,chromium,chromium,the browser tests skip.)
 
-# Notebook 06 draws the ROS graph with Graphviz's dot layout (as rqt_graph does): Debian's graphviz.
+# Notebook 06 draws the ROS graph with Graphviz's dot layout (as rqt_graph does).
 graph-tool:
-	@command -v dot >/dev/null || [ "$$(id -u)" != 0 ] || apt-get install -y -q graphviz >/dev/null 2>&1 \
-	  || { apt-get update -q >/dev/null 2>&1 && apt-get install -y -q graphviz >/dev/null 2>&1; } || true
-	@command -v dot >/dev/null || echo "graphviz is not installed (sudo apt-get install graphviz): notebook 06 lists the graph as text instead of drawing it."
+	$(call from_debian,dot,graphviz,notebook 06 lists the graph as text instead of drawing it.)
 
-# The image test (tests/test_image.py) builds the course's image with Debian's podman and runc
-# on a base debootstrap makes: installed here when make runs as root, else the test skips.
+# The image test (tests/test_image.py) builds the course's image with podman and runc on a base
+# debootstrap makes.
 image-tool:
-	@command -v podman >/dev/null && command -v runc >/dev/null && command -v debootstrap >/dev/null \
-	  || [ "$$(id -u)" != 0 ] || apt-get install -y -q podman runc debootstrap >/dev/null 2>&1 \
-	  || { apt-get update -q >/dev/null 2>&1 && apt-get install -y -q podman runc debootstrap >/dev/null 2>&1; } || true
-	@command -v podman >/dev/null || echo "podman is not installed (sudo apt-get install podman runc debootstrap): the image test skips."
+	$(call from_debian,podman runc debootstrap,podman runc debootstrap,the image test skips.)
 
 # The fast lane (docs/developing.md): ruff over the course's Python, then the tests that need
 # only Python (no ROS process, kernel, sandbox, browser, image or hub: tests/conftest.py's
@@ -139,10 +139,11 @@ clean:
 
 # The course as an image (environment/Containerfile), with podman or else docker:
 # `make image` (IMAGE=ros2-course, BASE=a Debian 12 or Ubuntu 24.04 image, PULL=never for a
-# base that is only local).
+# base that is only local, IMAGE_ARGS=--no-cache or any other option of the engine's build).
 IMAGE   ?= ros2-course
 BASE    ?= docker.io/library/debian:bookworm
 PULL    ?= missing
+IMAGE_ARGS ?=
 # This machine's certificate authorities, handed to the build as a secret (behind a proxy
 # that re-signs HTTPS, pip needs them); an empty file when there are none.
 HOST_CA ?= $(firstword $(wildcard /etc/ssl/certs/ca-certificates.crt) /dev/null)
@@ -155,7 +156,7 @@ image:
 	@engine=$$(command -v podman || command -v docker) || { echo "Neither podman nor docker is installed: sudo apt install podman (Debian, Ubuntu), then make image again."; exit 1; }; \
 	  cache=; if [ "$$(basename $$engine)" = podman ] && [ -d "$(UV_CACHE_DIR)" ]; then \
 	    cache="--volume $(UV_CACHE_DIR):$(IMAGE_UV_CACHE):O"; fi; \
-	  $$engine build --network host --pull=$(PULL) --build-arg BASE=$(BASE) $$cache \
+	  $$engine build --network host --pull=$(PULL) --build-arg BASE=$(BASE) $$cache $(IMAGE_ARGS) \
 	    --secret id=host-ca,src=$(HOST_CA) -f environment/Containerfile -t $(IMAGE) .
 
 # ---- Classroom server: JupyterHub on this machine (docs/classroom-server.md) --------------

@@ -19,7 +19,9 @@ import sys
 import tempfile
 import threading
 import time
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Iterator
 
 import pytest
 
@@ -112,8 +114,22 @@ def grader_tmp():
         shutil.rmtree(folder, ignore_errors=True)
 
 
+@dataclass(frozen=True)
+class Graded:
+    """The sample class graded once, and what the grading could have touched."""
+
+    out: Path  #: the grading/ folder ros2nb-grade wrote
+    done: subprocess.CompletedProcess  #: ros2nb-grade's exit code and output
+    repository: dict[str, str]  #: the repository's fingerprint before grading
+    decoy_bytes: bytes  #: a gradebook outside the grading folder, before grading
+    decoy: Path  #: that gradebook
+    home_file: Path  #: a file a hostile learner tries to write into the real home
+    forged: Path  #: a file a process left behind would write after grading
+    left: list[str]  #: processes of the class still there after grading
+
+
 @pytest.fixture(scope='module')
-def graded(tmp_path_factory):
+def graded(tmp_path_factory) -> Iterator[Graded]:
     root = tmp_path_factory.mktemp('grading')
     out = root / 'grading'
     decoy = root / 'elsewhere' / 'gradebook.db'
@@ -132,13 +148,12 @@ def graded(tmp_path_factory):
             env=dict(os.environ, TMPDIR=str(tmp)))
     (root / 'disk-peak').write_text(str(peak[0]))
     print(f'graded {len(EXPECTED)} learners in {time.monotonic() - started:.0f} s')
-    left = survivors()
-    yield out, done, before, decoy, home_file, forged, left
+    yield Graded(out, done, *before, decoy, home_file, forged, survivors())
     home_file.unlink(missing_ok=True)
 
 
 def test_grading_exits_0(graded):
-    _, done, *_ = graded
+    done = graded.done
     assert done.returncode == 0, done.stdout + done.stderr
     assert re.search(r'\[\d+/\d+ notebooks, \d+/\d+ learners; .* so far, about .* left\]',
                      done.stdout), done.stdout  # progress, with an estimate
@@ -148,13 +163,13 @@ def test_the_grader_copies_stay_within_the_caps(graded):
     """A learner whose every notebook fills the 1 GiB workspace: each judge's snapshot of
     it is on a capped tmpfs, freed once judged, never in the grader's TMPDIR on the host
     (before, each stayed there until the learner's last notebook was judged: 2 GiB here)."""
-    out, *_ = graded
+    out = graded.out
     peak = int((out.parent / 'disk-peak').read_text())
     assert peak < HOME_BYTES // 2, f'the grader\'s TMPDIR grew by {peak >> 20} MiB while grading'
 
 
 def test_every_score_and_csv_row(graded):
-    out, *_ = graded
+    out = graded.out
     with open(out / 'grades.csv', newline='') as stream:
         rows = list(csv.DictReader(stream))
     assert len(rows) == len(EXPECTED) * (len(NOTEBOOKS) + 1)
@@ -195,7 +210,7 @@ def test_a_fault_in_any_host_stage_is_one_learners_note(graded):
     ends with exit 0 and every other score stands (test_every_score_and_csv_row); each of
     them gets a note naming the fault (test_feedback_and_notes_say_what_happened), and a
     page that could not be made keeps its score."""
-    out, done, *_ = graded
+    out, done = graded.out, graded.done
     assert done.returncode == 0, done.stdout + done.stderr
     notes = json.loads((out / 'notes.json').read_text())['learners']
     for learner in ('plant-read', *(f'x-{stage}' for stage in STAGES[1:])):
@@ -206,7 +221,7 @@ def test_a_fault_in_any_host_stage_is_one_learners_note(graded):
 def test_names_are_data(graded):
     """A folder name that is not UTF-8 and one that is a formula: graded, and written as
     plain text (the CSV cell a value, never a formula)."""
-    out, *_ = graded
+    out = graded.out
     text = (out / 'grades.csv').read_text(encoding='utf-8')
     assert 'Zo\\xeb-cp1252,' in text
     assert '\n"\'=HYPERLINK(""example.invalid"",""open me"")",' in text
@@ -221,7 +236,7 @@ def shown(page: Path) -> str:
 
 @pytest.mark.parametrize('learner', sorted(EXPECTED))
 def test_feedback_and_notes_say_what_happened(graded, learner):
-    out, *_ = graded
+    out = graded.out
     case = EXPECTED[learner]
     notes = json.loads((out / 'notes.json').read_text())['learners'][as_text(learner)]
     for notebook in NOTEBOOKS:
@@ -242,7 +257,7 @@ def test_feedback_and_notes_say_what_happened(graded, learner):
 
 
 def test_learners_content_is_text_in_the_feedback(graded):
-    out, *_ = graded
+    out = graded.out
     for page in (out / 'feedback').rglob('*.html'):
         text = page.read_text()
         assert not re.search(r'<script[^>]*>[^<]*pwned', text), page  # no learner script runs
@@ -252,20 +267,19 @@ def test_learners_content_is_text_in_the_feedback(graded):
 
 
 def test_nothing_escaped(graded):
-    out, done, (repository, decoy_bytes), decoy, home_file, forged, left = graded
-    assert left == [], f'processes of the class outlived grading: {left}'
-    time.sleep(3)  # a process left behind would now overwrite these
-    assert not forged.exists()
-    assert fingerprint(ROOT) == repository  # the course, byte for byte, ignored files too
-    assert decoy.read_bytes() == decoy_bytes
-    assert not home_file.exists()
+    out = graded.out
+    assert graded.left == [], f'processes of the class outlived grading: {graded.left}'
+    assert not graded.forged.exists()
+    assert fingerprint(ROOT) == graded.repository  # the course, byte for byte, ignored too
+    assert graded.decoy.read_bytes() == graded.decoy_bytes
+    assert not graded.home_file.exists()
     with open(out / 'grades.csv') as stream:
         assert 'forged' not in stream.read()
 
 
 def test_the_gradebook_holds_only_what_nbgrader_scored(graded):
     """A notebook cannot forge manual scores: none are set, and nbgrader's export agrees."""
-    out, *_ = graded
+    out = graded.out
     course = out / 'nbgrader'
     export = out / 'export.csv'
     done = subprocess.run([sys.executable, '-m', 'nbgrader', 'export',
@@ -286,7 +300,7 @@ def test_the_gradebook_holds_only_what_nbgrader_scored(graded):
 
 def test_links_are_never_followed(graded):
     """Links in the submissions folder are named, never graded as their targets."""
-    out, done, *_ = graded
+    out, done = graded.out, graded.done
     notes = json.loads((out / 'notes.json').read_text())
     assert any(line.startswith('"links-to-the-solutions": a link') for line in notes['not graded'])
     assert '"links-to-the-solutions": a link' in done.stdout
@@ -296,7 +310,7 @@ def test_links_are_never_followed(graded):
 
 def test_feedback_pages_forbid_scripts_and_show_learners_html_as_text(graded):
     """Every page carries the CSP; the raw cell's fake score box is text, not a box."""
-    out, *_ = graded
+    out = graded.out
     for page in (out / 'feedback').rglob('*.html'):
         text = page.read_text()
         assert "Content-Security-Policy\" content=\"default-src 'none'" in text, page
@@ -325,7 +339,7 @@ def test_no_learner_script_runs_in_a_browser(graded, page, tmp_path):
 
     A planted page (the same payloads, unsanitised) shows the check sees a script that runs.
     """
-    out, *_ = graded
+    out = graded.out
     planted = tmp_path / 'planted.html'
     planted.write_text(f'<html><head><title>planted</title></head><body><img src="x" '
                        f"onerror=\"document.title='{PWNED}';window.pwned=1\"></body></html>")
@@ -343,7 +357,7 @@ def test_no_learner_script_runs_in_a_browser(graded, page, tmp_path):
 def test_the_class_report_in_a_browser(graded, page, tmp_path):
     """grading/report.html in chromium: it loads nothing, runs nothing, draws the plot of
     scores, and its tables hold every learner and the checks' counts the grades imply."""
-    out, *_ = graded
+    out = graded.out
     title, flag, left = _opened(page, out / 'report.html')
     assert (title, flag, left) == ('The class at a glance', None, [])
     assert page.evaluate("document.getElementById('spread').naturalWidth") > 300  # drawn

@@ -13,6 +13,7 @@ from . import course, domains, qos
 from .errors import (CheckFailed, ColconBuildError, DomainsExhaustedError, FileProtectedError,
                      LearnerCodeError, PkgCreateError, Ros2nbError, UsageError)
 from .kernel import add, install, shutdown, spin, start, stop
+from .on_first_use import loader
 from .runtime import current_runtime
 from .runtime.rates import callback_groups, timer_runs
 from .terminal.background import NodeProcess, ros2_start, stop_all
@@ -33,18 +34,7 @@ _ON_FIRST_USE = {'checks': 'checks', 'Recording': 'terminal.bag', 'bag_info': 't
                  'bag_play': 'terminal.bag', 'bag_record': 'terminal.bag'}
 
 
-def __getattr__(name: str):
-    if name not in _ON_FIRST_USE:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    import importlib
-    module = importlib.import_module(f'{__name__}.{_ON_FIRST_USE[name]}')
-    value = module if name == 'checks' else getattr(module, name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted({*globals(), *_ON_FIRST_USE})
+__getattr__, __dir__ = loader(globals(), _ON_FIRST_USE)
 
 
 def load_ipython_extension(ipython) -> None:

@@ -20,6 +20,7 @@ One module per lesson (``lesson00`` ... ``lesson10``) on a small shared vocabula
 """
 
 from ..errors import CheckFailed
+from ..on_first_use import loader
 
 #: Each lesson's checks, by the module that holds them.  A module loads on first use of one
 #: of its names (PEP 562): a notebook's kernel and its judge load their own lesson's
@@ -43,17 +44,6 @@ LESSONS = {
 _MODULE_OF = {name: module for module, names in LESSONS.items() for name in names}
 
 
-def __getattr__(name: str):
-    if name not in _MODULE_OF:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    import importlib
-    value = getattr(importlib.import_module(f'{__name__}.{_MODULE_OF[name]}'), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted({*globals(), *_MODULE_OF})
-
+__getattr__, __dir__ = loader(globals(), _MODULE_OF)
 
 __all__ = ['CheckFailed', *sorted(_MODULE_OF)]

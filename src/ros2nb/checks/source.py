@@ -118,15 +118,6 @@ def made_by(module: ast.Module, function: Optional[ast.AST], node: ast.expr,
     return None
 
 
-def called_name(node: Optional[ast.expr]) -> Optional[str]:
-    """The name a call calls: ``X`` for ``X(...)`` and ``m.X(...)``; None for anything else."""
-    if not isinstance(node, ast.Call):
-        return None
-    func = node.func
-    return func.id if isinstance(func, ast.Name) else (
-        func.attr if isinstance(func, ast.Attribute) else None)
-
-
 class ClassSource:
     """One class of the learner's file, as the judge reads it (text only)."""
 
@@ -201,11 +192,6 @@ class ClassSource:
         """Values ``__init__`` assigns to ``self.<attribute>``, in order."""
         return _assigned(self.method('__init__'), f'self.{attribute}')
 
-    def assigned_anywhere(self, attribute: str) -> bool:
-        """True when any method of the class assigns ``self.<attribute>``."""
-        return any(_assigned(f, f'self.{attribute}') for f in self.cls.body
-                   if isinstance(f, ast.FunctionDef))
-
     def attribute(self, attribute: str, depth: int = 0) -> Any:
         """The constant ``__init__`` last assigns to ``self.<attribute>``, or UNKNOWN."""
         found = self.assignments(attribute)
@@ -238,13 +224,6 @@ class ClassSource:
                 found.append(_method_name(node.args[position] if len(node.args) > position
                                           else given.get('callback')))
         return found
-
-    def reaches_call(self, method: str, attrs: frozenset[str] | set[str] | str) -> bool:
-        """True when ``method`` calls ``something.A(...)`` for an ``A`` in ``attrs``, itself or
-        through ``self.m()`` calls of the class."""
-        attrs = {attrs} if isinstance(attrs, str) else set(attrs)
-        return self._reaches(method, lambda node: isinstance(node, ast.Call) and isinstance(
-            node.func, ast.Attribute) and node.func.attr in attrs)
 
     def reaches_assignment(self, method: str, attribute: str) -> bool:
         """True when ``method`` assigns ``self.<attribute>`` (``=``, ``+=``, ``setattr``),

@@ -24,11 +24,10 @@ from rosgraph_msgs.msg import Clock
 
 from .. import domains
 from ..errors import SHUT_DOWN_MESSAGE, Ros2nbError
-from ..processes import child_pids
 from .callers import use_cheaper_caller_lookup
 from .clock import SimulatedClock
 from .logs import LogLines
-from .nodes import NodeKeeping, destroy_stray_nodes, drop_qos_warnings, logs_elsewhere
+from .nodes import NodeKeeping, destroy_stray_nodes, drop_qos_warnings
 from .spinning import Spinning
 
 #: Hidden name of the kernel's own node (names starting with ``_`` are hidden
@@ -118,17 +117,6 @@ class Runtime(LogLines, Spinning, NodeKeeping, SimulatedClock):
         """:raises Ros2nbError: when ROS 2 was shut down under ros2nb."""
         if not self.alive:
             raise Ros2nbError(SHUT_DOWN_MESSAGE)
-
-    def lines_made(self, logger: str) -> Optional[int]:
-        """How many /rosout lines of ``logger`` this process made, every one taken by now; None
-        when some may still be on their way: from a program this process started, or from a
-        node of another ROS context.  A judge then knows how many to wait for (notebook 10).
-        """
-        if not self.alive or child_pids(os.getpid()):
-            return None
-        with self.exclusive():
-            self.drain()  # takes every line this runtime's own nodes made
-        return None if logs_elsewhere(self.context, logger) else self.log_counts.get(logger, 0)
 
     def participant_prefix(self) -> Optional[bytes]:
         """This process's DDS participant: the first 12 bytes of its endpoints' GIDs."""

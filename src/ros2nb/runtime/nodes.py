@@ -180,14 +180,3 @@ def destroy_stray_nodes(context: rclpy.context.Context) -> None:
         if getattr(candidate, '_context', None) is context:
             with contextlib.suppress(Exception):  # already destroyed, or half-built
                 candidate.destroy_node()
-
-
-def logs_elsewhere(context: rclpy.context.Context, logger: str) -> bool:
-    """True when a node of another context in this process logs as ``logger``: its /rosout
-    lines reach ``context``'s subscriptions over DDS, later, not at the next drain."""
-    for candidate in _live_nodes():
-        if getattr(candidate, '_context', None) is not context:
-            with contextlib.suppress(Exception):  # a half-built node has no logger yet
-                if candidate.get_logger().name == logger:
-                    return True
-    return False

@@ -5,13 +5,11 @@ the learner writes, ``%%part``), ``colcon`` (``colcon build``, ``source``), ``pk
 (``ros2 pkg create``), ``run`` (``ros2 run`` and Ctrl+C), ``topic`` and ``echo`` (``ros2
 node``/``ros2 topic``), ``param`` (``ros2 param``).  The real command is used wherever it exists
 (colcon always; ``ros2`` when it is on PATH); elsewhere these print what it prints.  This
-``__init__`` imports nothing, so that ``ros2nb.course`` can use the file verbs without ROS.
+``__init__`` imports nothing of ROS, so that ``ros2nb.course`` can use the file verbs without it.
 """
 
 
-def __getattr__(name: str):
-    """``ros2nb.terminal.bag`` (notebook 10) loads on first use, with rosbags (PEP 562)."""
-    if name != 'bag':
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    import importlib
-    return importlib.import_module(f'{__name__}.bag')
+from ..on_first_use import loader
+
+#: ``ros2nb.terminal.bag`` (notebook 10) loads on first use, with rosbags.
+__getattr__, __dir__ = loader(globals(), {'bag': 'bag'})

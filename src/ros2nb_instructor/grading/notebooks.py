@@ -36,11 +36,6 @@ def _grade_id(cell: Any) -> Optional[str]:
     return grade_id if isinstance(grade_id, str) and grade_id else None
 
 
-def graded_ids(release: nbformat.NotebookNode) -> list[str]:
-    """The grade ids of the course's graded cells, in notebook order."""
-    return [_grade_id(c) for c in release.cells if nbgrader(c).get('grade') and _grade_id(c)]
-
-
 def _by_grade_id(nb: nbformat.NotebookNode) -> dict[str, Any]:
     return {_grade_id(c): c for c in nb.cells if _grade_id(c)}
 

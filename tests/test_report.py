@@ -1,0 +1,71 @@
+"""The class report (``grading/report.html``) from grades and results, without grading a class.
+
+The sample class (tests/test_grading.py) shows the report of a real grading in a browser; here
+its pure logic: what each table counts, and that a learner's text stays text.
+"""
+
+from __future__ import annotations
+
+import html
+import re
+from pathlib import Path
+
+from ros2nb_instructor.grading.report import write_report
+from ros2nb_instructor.grading.submissions import Learner
+
+NOTEBOOKS = ['03-write-the-publisher', '04-write-the-subscriber']
+FAILURE = 'TemperatureSensor() never calls super().__init__'
+
+
+def class_of_three() -> tuple[list[Learner], list[list[str]]]:
+    """Three learners: one complete, one who failed the same check as another, one who handed
+    in 03 only and named a folder like a script."""
+    ada, bo = Learner('ada', 'ada'), Learner('bo', 'bo')
+    mallory = Learner('<script>alert(1)</script>', 'mallory')
+    for learner in (ada, bo, mallory):
+        learner.files['03-write-the-publisher'] = Path('03.ipynb')
+        learner.results['03-write-the-publisher'] = {'constructor': {'passed': True}}
+    for learner in (ada, bo):
+        learner.files['04-write-the-subscriber'] = Path('04.ipynb')
+    ada.results['04-write-the-subscriber'] = {'callback': {'passed': True}}
+    bo.results['04-write-the-subscriber'] = {'callback': {'passed': False, 'message': FAILURE}}
+    mallory.results['03-write-the-publisher']['callback'] = {
+        'passed': False, 'message': FAILURE}
+    mallory.note('_folder', '<b>bold</b> claims')
+    rows = [['ada', NOTEBOOKS[0], '6', '6'], ['ada', NOTEBOOKS[1], '4', '4'],
+            ['ada', 'TOTAL', '10', '10'],
+            ['bo', NOTEBOOKS[0], '6', '6'], ['bo', NOTEBOOKS[1], '1', '4'],
+            ['bo', 'TOTAL', '7', '10'],
+            [mallory.shown, NOTEBOOKS[0], '3', '6'], [mallory.shown, 'TOTAL', '3', '10']]
+    return [ada, bo, mallory], rows
+
+
+def table(page: str, name: str) -> str:
+    return re.search(rf'<table id="{name}">.*?</table>', page, re.S).group(0)
+
+
+def test_the_report_counts_what_the_class_did(tmp_path):
+    learners, rows = class_of_three()
+    page = write_report(tmp_path, learners, NOTEBOOKS, rows, ['eve/extra.zip: not unpacked'])
+    text = page.read_text()
+    checks = table(text, 'checks')
+    assert re.search(r'<td>03</td><td>constructor</td><td class="n">3</td><td class="n">3</td>',
+                     checks), checks
+    assert '<tr><td>04</td><td>callback</td><td class="n">1</td><td class="n">2</td>' in checks
+    assert '<tr class="low"><td>03</td><td>callback</td><td class="n">0</td>' in checks  # fewer
+    # than half passed: marked
+    failures = table(text, 'failures')
+    assert f'<td class="n">2</td><td>callback</td><td>{html.escape(FAILURE)}</td>' in failures
+    learners_table = table(text, 'learners')
+    assert '<td class="n none">–</td>' in learners_table  # 04 not handed in
+    assert '10 of 10' in learners_table and '7 of 10' in learners_table
+    assert 'eve/extra.zip: not unpacked' in text
+    assert 'src="data:image/png;base64,' in text
+
+
+def test_a_learners_text_stays_text(tmp_path):
+    learners, rows = class_of_three()
+    text = write_report(tmp_path, learners, NOTEBOOKS, rows, []).read_text()
+    assert '<script>alert(1)</script>' not in text and '<b>bold</b>' not in text
+    assert '&lt;script&gt;alert(1)&lt;/script&gt;' in text
+    assert "script-src 'none'" in text or 'default-src' in text  # the page runs nothing
