@@ -35,24 +35,21 @@ def main() -> int:
     hours = parser.parse_args().hours
     from judging import judging_env
     from ros2nb import checks, course
-    from ros2nb.checks.base import bind_judge
-    from ros2nb.checks.dispatch import captured
+    from ros2nb.judge.interface import captured
     from ros2nb.judge.session import Session
     print('| hour | wall s | judge CPU-s | machine busy CPU-s | verdict |')
     print('|---|---|---|---|---|')
     with tempfile.TemporaryDirectory() as tmp, judging_env(Path(tmp)) as workspace:
         course.catch_up(4)  # the workspace as notebook 03 leaves it
         session = Session(workspace)
-        bind_judge(session)
         try:
             for hour in range(1, hours + 1):
                 wall, judge, busy = time.monotonic(), own_cpu_s(), busy_cpu_s()
-                outcome = captured(checks.check_sensor_hour)
+                outcome = captured(lambda: checks.run_check('check_sensor_hour', session))
                 print(f'| {hour} | {time.monotonic() - wall:.2f} | {own_cpu_s() - judge:.2f} '
                       f'| {busy_cpu_s() - busy:.2f} | '
                       f'{"passed" if outcome["passed"] else outcome.get("message", "")[:60]} |')
         finally:
-            bind_judge(None)
             session.close()
     return 0
 

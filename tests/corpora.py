@@ -180,7 +180,6 @@ def grade_learner(learner: Learner, root: Path, *, knows_nothing: bool = False
     :raises AssertionError: when the judge printed no result (its output in the message).
     """
     from ros2nb import domains
-    from ros2nb.checks.dispatch import IN_JUDGE_ENV
     from ros2nb.course import GRADING_ENV
     from ros2nb.processes import kill_process_group
     from ros2nb.terminal.workspace import WORKSPACE_ENV
@@ -191,7 +190,7 @@ def grade_learner(learner: Learner, root: Path, *, knows_nothing: bool = False
     (given / 'source.ipynb').write_text(NOTEBOOKS[learner.notebook].read_text())
     (given / 'submission.ipynb').write_text(json.dumps(nb))
     env = {k: v for k, v in os.environ.items() if k != domains.DOMAIN_ENV}
-    env.update({IN_JUDGE_ENV: '1', WORKSPACE_ENV: str(ws), GRADING_ENV: '1'})
+    env.update({WORKSPACE_ENV: str(ws), GRADING_ENV: '1'})
     command = [sys.executable, str(ROOT / 'tests' / 'judge_apart.py'),
                *(['--knows-nothing'] if knows_nothing else []),
                str(given / 'source.ipynb'), str(given / 'submission.ipynb')]

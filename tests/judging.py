@@ -1,7 +1,8 @@
 """The checks' tests run their judge in the test process: one way to set that up.
 
 :func:`judge_session` gives a judge :class:`Session` on a fresh workspace caught up to a
-notebook, bound as the current judge, and puts everything back afterwards.
+notebook and puts everything back afterwards; :func:`run_check` runs a check's body with it,
+as the judge process does.
 """
 
 from __future__ import annotations
@@ -10,13 +11,11 @@ import os
 import re
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Iterator
+from typing import Callable, Iterator, Union
 
 import nbformat
 
-from ros2nb import course
-from ros2nb.checks.base import bind_judge
-from ros2nb.checks.dispatch import IN_JUDGE_ENV
+from ros2nb import checks, course
 from ros2nb.judge.session import Session
 from ros2nb.terminal import workspace as ws_module
 
@@ -24,33 +23,38 @@ from ros2nb.terminal import workspace as ws_module
 @contextmanager
 def judging_env(root: Path) -> Iterator[Path]:
     """This process as a judge on the workspace ``root/ws``; everything put back afterwards."""
-    saved = {k: os.environ.get(k) for k in ('ROS2NB_WORKSPACE', IN_JUDGE_ENV)}
+    saved = os.environ.get('ROS2NB_WORKSPACE')
     os.environ['ROS2NB_WORKSPACE'] = str(root / 'ws')
-    os.environ[IN_JUDGE_ENV] = '1'
     ws_module._current = None
     try:
         yield root / 'ws'
     finally:
-        for key, value in saved.items():
-            if value is None:
-                os.environ.pop(key, None)
-            else:
-                os.environ[key] = value
+        if saved is None:
+            os.environ.pop('ROS2NB_WORKSPACE', None)
+        else:
+            os.environ['ROS2NB_WORKSPACE'] = saved
         ws_module._current = None
 
 
 @contextmanager
 def judge_session(root: Path, notebook: int) -> Iterator[Session]:
-    """A judge session (this process is the judge) on ``root/ws``, caught up to ``notebook``."""
+    """A judge session (this process is the judge) on ``root/ws``, caught up to ``notebook``:
+    a check's body runs with it through :func:`run_check`."""
     with judging_env(root) as ws:
         course.catch_up(notebook)
         session = Session(ws)
-        bind_judge(session)
         try:
             yield session
         finally:
-            bind_judge(None)
             session.close()
+
+
+def run_check(session: Session, check: Union[str, Callable[..., None]], *args: object,
+              **kwargs: object) -> None:
+    """Run ``check`` (its name, or the notebook's function of it) with ``session`` as its
+    judge, as ``python -m ros2nb.judge`` does."""
+    checks.run_check(check if isinstance(check, str) else check.__name__, session,
+                     *args, **kwargs)
 
 
 #: A forging learner's module code that finds the subject's request loop from the learner's import

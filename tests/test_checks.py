@@ -18,10 +18,10 @@ from pathlib import Path
 import pytest
 
 from ros2nb import checks, course
-from ros2nb.checks.dispatch import IN_JUDGE_ENV
 from ros2nb.errors import CheckFailed, LearnerCodeError
 from ros2nb.judge.subjects import SubjectHung
 
+from judging import run_check
 from waiting import wait_for
 
 pytestmark = [pytest.mark.judge, pytest.mark.timeout(300)]
@@ -68,9 +68,9 @@ def restore(session, relative: str) -> None:
     alone(session)
 
 
-def fails(check, pattern: str) -> str:
+def fails(session, check, pattern: str) -> str:
     with pytest.raises(CheckFailed) as caught:
-        check()
+        run_check(session, check)
     message = str(caught.value)
     MESSAGES.append(message)
     assert re.search(pattern, message), message
@@ -82,7 +82,7 @@ def test_reference_nodes_pass(session, capsys):
     for check in (checks.check_sensor_constructor, checks.check_sensor_callback,
                   checks.check_sensor_main, checks.check_monitor_constructor,
                   checks.check_monitor_callback, checks.check_monitor_main):
-        check()
+        run_check(session, check)
     out = capsys.readouterr().out
     assert out.count('Check passed:') == 6
 
@@ -173,7 +173,7 @@ def test_learner_error_shows_their_traceback(session):
     mutated(session, PUB, 'self.publisher_.publish(msg)', 'self.publisher_.publish(mgs)')
     try:
         with pytest.raises(LearnerCodeError) as caught:
-            checks.check_sensor_callback()
+            run_check(session, checks.check_sensor_callback)
     finally:
         restore(session, PUB)
     shown = caught.value._render_traceback_()
@@ -228,7 +228,7 @@ MISTAKES = [(PUB, *m) for m in SENSOR_MISTAKES] + [(SUB, *m) for m in MONITOR_MI
 def test_a_mistake_gets_one_line(session, file, label, old, new, check, pattern):
     mutated(session, file, old, new)
     try:
-        fails(check, pattern)
+        fails(session, check, pattern)
     finally:
         restore(session, file)
 
@@ -242,8 +242,9 @@ def test_a_part_run_out_of_order_is_named_by_the_check(session):
     (session.workspace / PUB).write_text(part3)
     session.drop(('file', PUB))
     try:
-        fails(checks.check_sensor_constructor, r'temperature_publisher.py is missing parts 1, 2: '
-                                               r'run the %%part cells for them')
+        fails(session, checks.check_sensor_constructor,
+              r'temperature_publisher.py is missing parts 1, 2: '
+              r'run the %%part cells for them')
     finally:
         record.unlink()
         restore(session, PUB)
@@ -273,7 +274,7 @@ def test_a_shutdown_from_outside_that_the_spin_missed_still_ends_it(session):
     honest learner was told their main() did not stop."""
     mutated(session, SUB, *RACED_SHUTDOWN)
     try:
-        checks.check_monitor_main()
+        run_check(session, checks.check_monitor_main)
     finally:
         restore(session, SUB)
 
@@ -332,22 +333,24 @@ PUBLISHER_ENTRY = "'temperature_publisher = sensor_simulator.temperature_publish
 SUBSCRIBER_ENTRY = "'temperature_subscriber = sensor_simulator.temperature_subscriber:main'"
 
 
-def test_entry_point_checks(package_files):
+def test_entry_point_checks(session, package_files):
     _, _, entries = package_files
     entries('# YOUR CODE HERE', 'raise NotImplementedError()')
-    fails(checks.check_entry_points, r'setup.py still holds the placeholder')
+    fails(session, checks.check_entry_points, r'setup.py still holds the placeholder')
     entries()
-    fails(checks.check_entry_points, r'ros2 run sensor_simulator temperature_publisher: No '
-                                     r'executable found: console_scripts has no entry named '
-                                     r'temperature_publisher')
+    fails(session, checks.check_entry_points,
+          r'ros2 run sensor_simulator temperature_publisher: No '
+          r'executable found: console_scripts has no entry named '
+          r'temperature_publisher')
     entries(PUBLISHER_ENTRY, SUBSCRIBER_ENTRY + ',')  # no comma after the first
-    fails(checks.check_entry_points, r'is two entries run together: end each string in the '
-                                     r'console_scripts list with a comma')
+    fails(session, checks.check_entry_points,
+          r'is two entries run together: end each string in the '
+          r'console_scripts list with a comma')
     entries("'temperature_publisher = sensor_simulator/temperature_publisher.py:main',")
-    fails(checks.check_entry_points, r'is not written NAME = package.module:function: the '
+    fails(session, checks.check_entry_points, r'is not written NAME = package.module:function: the '
                                      r'module is written with dots')
     entries("'temperature_publisher = sensor_simulator.publisher:main',", SUBSCRIBER_ENTRY + ',')
-    fails(checks.check_entry_points, r'did not start main\(\) of '
+    fails(session, checks.check_entry_points, r'did not start main\(\) of '
                                      r'sensor_simulator.temperature_publisher: .*'
                                      r'temperature_publisher = sensor_simulator.publisher:main: '
                                      r'it should start main\(\) in '
@@ -358,25 +361,28 @@ def test_setup_cfg_checks(session, package_files, capsys):
     setup_cfg, generated_cfg, entries = package_files
     entries(PUBLISHER_ENTRY + ',', SUBSCRIBER_ENTRY + ',')
     setup_cfg.write_text(generated_cfg.replace('$base/lib/sensor_simulator', '$base/bin'))
-    fails(checks.check_setup_cfg, r'\[develop\] script_dir is \$base/bin; ros2 run looks in '
-                                  r'\$base/lib/sensor_simulator')
+    fails(session, checks.check_setup_cfg,
+          r'\[develop\] script_dir is \$base/bin; ros2 run looks in '
+          r'\$base/lib/sensor_simulator')
     setup_cfg.write_text(generated_cfg.replace('=$base/lib/sensor_simulator',
                                                '=$base/lib/sensor_simulator/'))
-    checks.check_setup_cfg()  # a trailing slash: the same folder, ros2 run finds them
+    # a trailing slash: the same folder, ros2 run finds them
+    run_check(session, checks.check_setup_cfg)
     setup_cfg.write_text(generated_cfg.replace('script_dir', 'script-dir'))  # older template
-    fails(checks.check_setup_cfg, r'^setup.cfg spells script-dir with a dash: setuptools reads it '
-                                  r'with a deprecation warning .* a coming release refuses it, as '
-                                  r'78\.0\.0 did until 78\.0\.2 took that back .*: write '
-                                  r'script_dir\.$')
+    fails(session, checks.check_setup_cfg,
+          r'^setup.cfg spells script-dir with a dash: setuptools reads it '
+          r'with a deprecation warning .* a coming release refuses it, as '
+          r'78\.0\.0 did until 78\.0\.2 took that back .*: write '
+          r'script_dir\.$')
     setup_cfg.unlink()
-    fails(checks.check_setup_cfg, r'setup.cfg is missing')
+    fails(session, checks.check_setup_cfg, r'setup.cfg is missing')
     setup_cfg.write_text(generated_cfg)
     # The grader's stand-ins take the place of the nodes: a broken node costs nothing here.
     (session.workspace / PUB).write_text('raise SystemExit("broken")\n')
     capsys.readouterr()
-    checks.check_entry_points()
-    checks.check_setup_cfg()
-    checks.check_package_runs()
+    run_check(session, checks.check_entry_points)
+    run_check(session, checks.check_setup_cfg)
+    run_check(session, checks.check_package_runs)
     assert capsys.readouterr().out.count('Check passed:') == 3
 
 
@@ -391,7 +397,6 @@ def test_a_check_from_the_kernel_runs_in_a_judge_process(tmp_path, monkeypatch, 
     """The kernel's path: a judge process of its own, on a domain of its own."""
     import ros2nb
     from ros2nb.terminal import workspace as ws_module
-    monkeypatch.delenv(IN_JUDGE_ENV, raising=False)
     monkeypatch.setenv('ROS2NB_WORKSPACE', str(tmp_path / 'ws'))
     monkeypatch.setattr(ws_module, '_current', None)
     ros2nb.course.catch_up(5)
@@ -474,9 +479,10 @@ def test_links_out_of_the_workspace_are_never_followed(session, tmp_path):
     (session.workspace / PUB).unlink()
     (session.workspace / PUB).symlink_to(outside)
     try:
-        fails(checks.check_sensor_constructor, r'temperature_publisher.py is a link to .*, '
-                                               r'outside your workspace: the grader reads your '
-                                               r'files in the workspace only')
+        fails(session, checks.check_sensor_constructor,
+              r'temperature_publisher.py is a link to .*, '
+              r'outside your workspace: the grader reads your '
+              r'files in the workspace only')
     finally:
         (session.workspace / PUB).unlink()
         restore(session, PUB)
@@ -486,7 +492,7 @@ def test_links_out_of_the_workspace_are_never_followed(session, tmp_path):
     link.symlink_to(secret)
     try:
         with contextlib.suppress(CheckFailed):  # the build is what counts here, not its entries
-            checks.check_entry_points()
+            run_check(session, checks.check_entry_points)
         copies = list(session.scratch.glob(f'build-*/src/{course.PACKAGE}/notes.txt'))
         assert copies and all(c.is_symlink() for c in copies), \
             [c.read_text() for c in copies if not c.is_symlink()]

@@ -15,7 +15,7 @@ pytestmark = [pytest.mark.judge,
               pytest.mark.skipif(sys.version_info < (3, 11),
                                  reason='bags need Python 3.11 or newer (rosbags needs apsw)')]
 
-from ros2nb.checks.base import AnswerRef  # noqa: E402
+from ros2nb.judge.interface import AnswerRef  # noqa: E402
 from ros2nb.errors import CheckFailed  # noqa: E402
 from ros2nb.judge.session import Session  # noqa: E402
 
@@ -32,7 +32,7 @@ def judge(session: Session, name: str, answer: str, context: str = CONTEXT) -> N
     """Run the check of ``name`` on the answer's source, in a subject of this judge."""
     ref = AnswerRef(name, (context, answer))
     try:
-        CHECKS[name](ref)
+        ros2nb.checks.run_check(CHECKS[name].__name__, session, ref)
     finally:
         session.drop(('cells', ref.sources))  # one subject at a time
 

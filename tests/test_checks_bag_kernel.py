@@ -7,7 +7,6 @@ a bag written the lesson's way opens with readers the course does not own, and b
 the bag verbs gets one line.
 """
 
-import os
 import re
 import sys
 
@@ -19,8 +18,6 @@ pytestmark = [pytest.mark.ros,
                                  reason='bags need Python 3.11 or newer (rosbags needs apsw)')]
 
 import ros2nb  # noqa: E402
-from ros2nb.checks.base import bind_judge  # noqa: E402
-from ros2nb.checks.dispatch import IN_JUDGE_ENV  # noqa: E402
 from ros2nb.errors import CheckFailed, Ros2nbError, UsageError  # noqa: E402
 from ros2nb.terminal.workspace import WORKSPACE_ENV  # noqa: E402
 
@@ -33,8 +30,6 @@ from judging import answer_cells  # noqa: E402
 def kernel(tmp_path_factory):
     """A workspace caught up to notebook 10 (its sensor and monitor), and ROS up in this
     process on simulated time, as the lesson's kernel has them; no judge."""
-    assert IN_JUDGE_ENV not in os.environ
-    bind_judge(None)
     with pytest.MonkeyPatch.context() as patch:
         patch.setenv(WORKSPACE_ENV, str(tmp_path_factory.mktemp('checks10') / 'ws'))
         ros2nb.course.catch_up(10)

@@ -14,12 +14,12 @@ with one line; the honest twin of each is the reference, which passes (tests/tes
 import pytest
 
 from ros2nb import checks, course
-from ros2nb.checks.base import AnswerRef
+from ros2nb.judge.interface import AnswerRef
 
 from grading_samples import FORGED_TIMER, MAIN_GUARD, REWRITING_READER, TIMER_LINE
 from nodes import name_without_endpoints
 from waiting import wait_for
-from judging import FIND_SUBJECT
+from judging import FIND_SUBJECT, run_check
 from test_checks import PUB, SUB, fails, mutated, restore
 
 pytestmark = [pytest.mark.judge, pytest.mark.timeout(300)]
@@ -51,8 +51,9 @@ if _SUBJECT is not None:
 def test_a_sensor_without_a_timer_whose_subject_reports_one(session):
     mutated(session, PUB, (TIMER_LINE, MAIN_GUARD), ('', FORGED_TIMER + MAIN_GUARD))
     try:
-        fails(checks.check_sensor_constructor, r'TemperatureSensor has no timer')
-        checks.check_sensor_callback()  # part 4 is the reference's: it deserves its points
+        fails(session, checks.check_sensor_constructor, r'TemperatureSensor has no timer')
+        # part 4 is the reference's: it deserves its points
+        run_check(session, checks.check_sensor_callback)
     finally:
         restore(session, PUB)
 
@@ -62,10 +63,12 @@ def test_a_callback_that_does_nothing_while_its_subject_publishes(session):
             ('    def publish_temperature(self):\n        return\n\n    def unused(self):\n',
              FORGED_CALLBACK + MAIN_GUARD))
     try:
-        checks.check_sensor_constructor()  # part 3 is the reference's: it deserves its point
-        fails(checks.check_sensor_callback, r'publish_temperature ran but nothing arrived on '
-                                            r'/temperature')
-        fails(checks.check_sensor_hour, r'No reading arrived on /temperature')
+        # part 3 is the reference's: it deserves its point
+        run_check(session, checks.check_sensor_constructor)
+        fails(session, checks.check_sensor_callback,
+              r'publish_temperature ran but nothing arrived on '
+              r'/temperature')
+        fails(session, checks.check_sensor_hour, r'No reading arrived on /temperature')
     finally:
         restore(session, PUB)
 
@@ -86,10 +89,10 @@ def test_a_start_value_reported_by_a_property(session):
         'msg.data = self.walk',
         "info(f'Publishing: {self.walk:.2f}C')"))
     try:
-        fails(checks.check_sensor_constructor,
+        fails(session, checks.check_sensor_constructor,
               r'The first reading is 2[45]\.\d\d °C: the walk starts at|'
               r"property 'temperature' of 'TemperatureSensor' object has no setter")
-        fails(checks.check_sensor_callback, r'The first reading is 2[45]\.\d\d °C|'
+        fails(session, checks.check_sensor_callback, r'The first reading is 2[45]\.\d\d °C|'
                                             r"property 'temperature' of 'TemperatureSensor' "
                                             r'object has no setter')
     finally:
@@ -115,7 +118,7 @@ def test_a_main_that_never_starts_ros(session):
                      'the graph listing a temperature_sensor that owns no endpoint',
                      seen=observer.node.get_node_names_and_namespaces)
             assert not observer.has_node(course.SENSOR_NODE)
-            fails(checks.check_sensor_main, r'never started its node temperature_sensor')
+            fails(session, checks.check_sensor_main, r'never started its node temperature_sensor')
     finally:
         restore(session, PUB)
 
@@ -146,8 +149,9 @@ def test_a_monitor_callback_that_does_nothing_while_another_method_logs(session)
              '    def unused(self, msg):\n',
              FORGED_SUBSCRIPTION + MAIN_GUARD))
     try:
-        checks.check_monitor_constructor()  # part 3 is the reference's: it deserves its points
-        fails(checks.check_monitor_callback, r'the monitor logged nothing: log one line')
+        # part 3 is the reference's: it deserves its points
+        run_check(session, checks.check_monitor_constructor)
+        fails(session, checks.check_monitor_callback, r'the monitor logged nothing: log one line')
     finally:
         restore(session, SUB)
 
@@ -156,7 +160,7 @@ def test_a_package_reader_that_rewrites_the_package_xml(session):
     xml = session.workspace / course.PACKAGE_XML_FILE
     saved = xml.read_text()
     try:
-        fails(lambda: checks.check_dependencies(AnswerRef('package_dependencies',
+        fails(session, lambda: checks.check_dependencies(AnswerRef('package_dependencies',
                                                           (REWRITING_READER,))),
               r"For graded_reader/package.xml you returned \['ament_python', 'geometry_msgs', "
               r"'rclpy', 'sensor_msgs'\], but it declares \['geometry_msgs', 'rclpy', "

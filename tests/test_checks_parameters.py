@@ -16,6 +16,8 @@ import pytest
 from ros2nb import checks, course
 from ros2nb.errors import CheckFailed
 
+from judging import run_check
+
 pytestmark = [pytest.mark.judge, pytest.mark.timeout(300)]
 
 SOLUTION = os.path.join(os.path.dirname(__file__), '..', 'solutions', '08-parameters.ipynb')
@@ -42,8 +44,8 @@ def write_monitor(session, text: str) -> None:
 
 def test_the_solution_passes_both_checks(session, capsys):
     write_monitor(session, REFERENCE)
-    checks.check_monitor_parameters()
-    checks.check_threshold_callback()
+    run_check(session, checks.check_monitor_parameters)
+    run_check(session, checks.check_threshold_callback)
     out = capsys.readouterr().out
     assert out.count('Check passed:') == 2, out
 
@@ -142,7 +144,7 @@ def test_a_forgotten_registration_costs_its_own_part_only(session, capsys):
     write_monitor(session, REFERENCE.replace(
         '        self.add_on_set_parameters_callback(self.on_set_thresholds)\n', '', 1))
     capsys.readouterr()
-    checks.check_threshold_callback()
+    run_check(session, checks.check_threshold_callback)
     assert 'Check passed: on_set_thresholds accepts valid thresholds' in capsys.readouterr().out
 
 
@@ -152,7 +154,7 @@ def test_a_mistake_gets_one_line(session, check, label, old, new, pattern):
     assert old in REFERENCE, old
     write_monitor(session, REFERENCE.replace(old, new, 1))
     with pytest.raises(CheckFailed) as caught:
-        check()
+        run_check(session, check)
     message = str(caught.value).splitlines()[0] if type(caught.value) is not CheckFailed \
         else str(caught.value)
     assert re.search(pattern, message), message

@@ -14,8 +14,7 @@ import re
 import pytest
 
 from ros2nb import checks
-from ros2nb.checks.base import AnswerRef, bind_judge
-from ros2nb.checks.dispatch import IN_JUDGE_ENV
+from ros2nb.judge.interface import AnswerRef
 from ros2nb.errors import CheckFailed
 from ros2nb.judge.session import Session
 
@@ -30,27 +29,19 @@ LEARNER = os.path.join(HERE, '..', 'notebooks', '09-qos.ipynb')
 
 CONTEXT, ANSWERS = answer_cells(SOLUTION)
 UNTOUCHED = answer_cells(LEARNER)[1]  # the learner's copy: '# YOUR CODE HERE', NotImplementedError
-CHECKS = {'newest_only_profile': checks.check_newest_only,
-          'sensor_subscription_profile': checks.check_sensor_subscription,
-          'latched_thresholds_profile': checks.check_latched_thresholds}
+CHECKS = {'newest_only_profile': 'check_newest_only',
+          'sensor_subscription_profile': 'check_sensor_subscription',
+          'latched_thresholds_profile': 'check_latched_thresholds'}
 
 
 @pytest.fixture(scope='module')
 def session(tmp_path_factory):
     """A judge session (this process is the judge) with a workspace of its own."""
     root = tmp_path_factory.mktemp('checks09')
-    saved = os.environ.get(IN_JUDGE_ENV)
-    os.environ[IN_JUDGE_ENV] = '1'
     (root / 'ws').mkdir()
     session = Session(root / 'ws')
-    bind_judge(session)
     yield session
-    bind_judge(None)
     session.close()
-    if saved is None:
-        os.environ.pop(IN_JUDGE_ENV, None)
-    else:
-        os.environ[IN_JUDGE_ENV] = saved
 
 
 def run_check(session, path: str, name: str, answer: str) -> None:
@@ -58,11 +49,11 @@ def run_check(session, path: str, name: str, answer: str) -> None:
     if path == 'kernel':
         namespace: dict = {}
         exec(CONTEXT + '\n' + answer, namespace)
-        CHECKS[name](namespace[name])
+        getattr(checks, CHECKS[name])(namespace[name])
     else:
         ref = AnswerRef(name, (CONTEXT, answer))
         try:
-            CHECKS[name](ref)
+            checks.run_check(CHECKS[name], session, ref)
         finally:
             session.drop(('cells', ref.sources))  # one subject at a time
 

@@ -12,7 +12,7 @@ import pytest
 
 from ros2nb import checks, course
 from ros2nb.errors import CheckFailed
-from judging import FIND_SUBJECT
+from judging import FIND_SUBJECT, run_check
 
 pytestmark = [pytest.mark.judge, pytest.mark.timeout(300)]
 #: The judge session's workspace is caught up to notebook 07 (tests/conftest.py: session).
@@ -45,7 +45,7 @@ def passes_with(session, capsys, relative: str, old: str, new: str, check) -> No
     """``check`` passes on the course's file with ``old`` written as ``new``."""
     mutated(session, relative, old, new)
     try:
-        check()
+        run_check(session, check)
     finally:
         restore(session, relative)
     assert 'Check passed:' in capsys.readouterr().out
@@ -60,7 +60,7 @@ def fails_forged(session, relative: str, old: str, new: str, forge: str, check,
     path.write_text(path.read_text() + forge)
     try:
         with pytest.raises(CheckFailed, match=pattern):
-            check()
+            run_check(session, check)
     finally:
         restore(session, relative)
 
@@ -69,7 +69,7 @@ def test_reference_files_pass(session, capsys):
     for check in (checks.check_fan_controller, checks.check_fan_main,
                   checks.check_counting_monitor, checks.check_responsive_worker,
                   checks.check_room_arguments, checks.check_plot_callback):
-        check()
+        run_check(session, check)
     out = capsys.readouterr().out
     assert out.count('Check passed:') == 6, out
     assert 'a heartbeat came while slow_work was busy, on a MultiThreadedExecutor' in out
@@ -174,7 +174,7 @@ def test_a_mistake_gets_one_line(session, label, file, old, new, check, pattern)
     mutated(session, file, old, new)
     try:
         with pytest.raises(CheckFailed) as caught:
-            check()
+            run_check(session, check)
     finally:
         restore(session, file)
     message = str(caught.value)
@@ -208,7 +208,8 @@ def test_a_node_of_the_same_name_in_another_program_hides_nothing(session):
         assert decoy.stdout.readline().strip() == 'up'
         observer = session.observer
         wait_for(lambda: observer.has_node(course.PLOT_NODE), 'the decoy node in the graph')
-        checks.check_plot_callback()  # the learner's node is alive in its subject after it
+        # the learner's node is alive in its subject after it
+        run_check(session, checks.check_plot_callback)
         by_process = observer._endpoints_by_process(course.PLOT_NODE, '/')
         assert len(by_process) == 2, by_process
         per_node = {('subscription', topic, kind) for topic, kinds in
@@ -395,7 +396,7 @@ def test_a_reply_of_no_known_shape_fails_that_check_alone(session, monkeypatch):
     """A check that meets a reply it cannot read raises an error of its own (KeyError here);
     before, that ended the judge and every check of the notebook went with it. Now it fails
     that check with one line, and the notebook's other checks are graded."""
-    from ros2nb.checks.dispatch import captured
+    from ros2nb.judge.interface import captured
     from ros2nb.judge.subjects import SubjectProcess
 
     request = SubjectProcess.request
@@ -407,8 +408,8 @@ def test_a_reply_of_no_known_shape_fails_that_check_alone(session, monkeypatch):
     monkeypatch.setattr(SubjectProcess, 'request', nonsense)
     session.drop(('file', PLOT))
     with pytest.raises(KeyError):  # what ended the judge
-        checks.check_plot_callback()
-    outcome = captured(checks.check_plot_callback)
+        run_check(session, checks.check_plot_callback)
+    outcome = captured(lambda: run_check(session, checks.check_plot_callback))
     assert outcome['passed'] is False and '\n' not in outcome['message']
     assert outcome['message'].startswith('The grader could not finish this check (KeyError'), \
         outcome

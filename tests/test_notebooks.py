@@ -83,14 +83,17 @@ def test_the_points_the_notebook_states_are_the_points_it_gives(path):
 
 @pytest.mark.parametrize('path', SOLUTIONS, ids=lambda p: p.name)
 def test_the_judge_can_run_every_graded_cell(path):
-    """Graded cells hold only ros2nb.checks calls, which the judge runs outside the kernel."""
+    """Graded cells hold only ros2nb.checks calls, each a registered check the judge looks up
+    by name (ros2nb.checks.run_check) and runs outside the kernel."""
     from ros2nb import checks
-    from ros2nb.judge import grading as judge
+    from ros2nb.checks.base import CHECKS
+    from ros2nb.judge import graded_cells
     for cell in load(path)['cells']:
         if nbgrader(cell).get('grade'):
-            calls = judge.graded_calls(text(cell))
+            calls = graded_cells.graded_calls(text(cell))
             assert calls, (path.name, nbgrader(cell)['grade_id'])
-            assert all(callable(getattr(checks, name, None)) for name, _, _ in calls)
+            assert all(callable(getattr(checks, name, None)) and name in CHECKS
+                       for name, _, _ in calls), calls
 
 
 NODE_CALLS = ('create_publisher(', 'create_timer(', 'create_subscription(', '.publish(')

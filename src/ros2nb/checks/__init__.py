@@ -14,12 +14,20 @@ from your kernel.  Checks of a function or class you defined in a cell (notebook
 call it right here in the kernel; the grader runs those from the source of your answer cell.
 
 One module per lesson (``lesson00`` ... ``lesson10``) on a small shared vocabulary:
-``base`` (a check's parts and the judge it asks), ``dispatch`` (kernel to judge and back),
+``base`` (a check's registration and parts), ``dispatch`` (kernel to judge and back),
 ``verdicts``, ``answers`` (answer cells), ``nodes`` (a node from a file), ``mains``
-(``main()`` and Ctrl+C).  A new lesson adds a module and its names here.
+(``main()`` and Ctrl+C).  A new lesson adds a module and its names here.  Each check
+registers itself by its own name (:func:`.base.judged`, :func:`.base.direct`); the judge
+runs one with :func:`run_check`.
 """
 
+from __future__ import annotations
+
+import sys
+from typing import Any, Optional
+
 from ..errors import CheckFailed
+from ..judge.interface import Judge
 from ..on_first_use import loader
 
 #: Each lesson's checks, by the module that holds them.  A module loads on first use of one
@@ -45,5 +53,25 @@ _MODULE_OF = {name: module for module, names in LESSONS.items() for name in name
 
 
 __getattr__, __dir__ = loader(globals(), _MODULE_OF)
+
+
+def run_check(name: str, judge: Optional[Judge], *args: Any, **kwargs: Any) -> None:
+    """Run the body of the check ``name`` once, with ``judge``, and print its passed line.
+
+    The judge's one way into the checks (:mod:`ros2nb.judge`): its lesson's module loads on
+    first use, and the body registered under ``name`` runs with the judge's session.
+
+    :param name: e.g. ``'check_sensor_constructor'``.
+    :param args: the call's arguments after the judge (the learner's answer cells as
+        :class:`~ros2nb.judge.interface.AnswerRef`).
+    :raises ValueError: for a name no lesson registers (a mistake of the course's).
+    :raises CheckFailed: (or :class:`~ros2nb.errors.LearnerCodeError`) with the verdict.
+    """
+    from .base import CHECKS, run_body
+    if name in _MODULE_OF:
+        getattr(sys.modules[__name__], name)  # loads its lesson's module, which registers it
+    if name not in CHECKS:
+        raise ValueError(f'no check is named {name!r}')
+    run_body(CHECKS[name], judge, *args, **kwargs)
 
 __all__ = ['CheckFailed', *sorted(_MODULE_OF)]

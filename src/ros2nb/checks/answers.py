@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import CheckFailed
-from .base import AnswerRef, current_judge, learner_error
+from ..judge.interface import AnswerRef, Judge, learner_error
 
 
 def defined_verdict(reply: dict, name: str) -> None:
@@ -23,9 +23,13 @@ def defined_verdict(reply: dict, name: str) -> None:
                           '(and run the cell) without renaming it.')
 
 
-def answer_results(ref: AnswerRef, inputs: list[list[Any]]) -> list[dict]:
-    """Call the learner's function ``ref`` (from their answer cell) in a subject."""
-    subject = current_judge().answer_subject(ref)
+def answer_results(judge: Judge, ref: AnswerRef, inputs: list[list[Any]]) -> list[dict]:
+    """Call the learner's function ``ref`` (from their answer cell) in a subject of ``judge``'s.
+
+    :param inputs: one list of arguments per call.
+    :return: one output per call (:func:`decoded` reads it).
+    """
+    subject = judge.answer_subject(ref)
     reply = subject.request('call', name=ref.name, inputs=inputs)
     defined_verdict(reply, ref.name)
     return reply['outputs']

@@ -18,8 +18,8 @@ from typing import Any, Iterator, Optional
 
 from .. import course
 from ..terminal import bag
-from .base import current_judge
-from .dispatch import in_judge
+
+from ..judge.interface import Judge
 
 #: Topics of the recording: the readings, and /rosout where the monitor's statuses go.
 TEMPERATURE, ROSOUT = '/' + course.TOPIC, course.ROSOUT_TOPIC
@@ -38,10 +38,11 @@ def check_readings_c(seed: Optional[int] = None) -> list[float]:
 
 
 @contextlib.contextmanager
-def fresh_path(name: str) -> Iterator[Path]:
-    """A bag folder that does not exist yet, in the judge's scratch folder or a temporary
-    one; removed with what the learner's function put beside it once the check is done."""
-    parent = str(current_judge().scratch) if in_judge() else None
+def fresh_path(judge: Optional[Judge], name: str) -> Iterator[Path]:
+    """A bag folder that does not exist yet, in the judge's scratch folder (None: the kernel's
+    temporary one); removed with what the learner's function put beside it once the check
+    is done."""
+    parent = str(judge.scratch) if judge is not None else None
     folder = Path(tempfile.mkdtemp(prefix='ros2nb-bag-', dir=parent))
     try:
         yield folder / name
@@ -50,18 +51,18 @@ def fresh_path(name: str) -> Iterator[Path]:
 
 
 @contextlib.contextmanager
-def read_back(path: Path) -> Iterator[Path]:
+def read_back(judge: Optional[Judge], path: Path) -> Iterator[Path]:
     """The bag the learner's function wrote at ``path``, to read: in the judge, its own copy
     (links refused), taken once the function is done."""
-    if not in_judge():
+    if judge is None:
         yield path
         return
-    with current_judge().taken_back(path) as copy:
+    with judge.taken_back(path) as copy:
         yield copy
 
 
 @contextlib.contextmanager
-def check_bag(name: str, readings: list[float]) -> Iterator[Path]:
+def check_bag(judge: Optional[Judge], name: str, readings: list[float]) -> Iterator[Path]:
     """The check's own bag of ``readings``, as a folder ``name`` the learner's function may
     read; removed once the check is done.
 
@@ -69,22 +70,22 @@ def check_bag(name: str, readings: list[float]) -> Iterator[Path]:
     a copy over (:meth:`ros2nb.judge.Session.hand_over`): it never writes to a path in the
     folder subjects may write, where the learner's code could have put a link.
     """
-    if not in_judge():
-        with fresh_path(name) as path:
-            writecheck_bag(path, readings)
+    if judge is None:
+        with fresh_path(None, name) as path:
+            write_check_bag(path, readings)
             yield path
         return
     with tempfile.TemporaryDirectory(prefix='ros2nb-bag-') as private:
-        writecheck_bag(Path(private) / name, readings)
+        write_check_bag(Path(private) / name, readings)
         files = {f'{name}/{f.name}': f.read_bytes() for f in (Path(private) / name).iterdir()}
-    folder = current_judge().hand_over('ros2nb-bag-', files)
+    folder = judge.hand_over('ros2nb-bag-', files)
     try:
         yield folder / name
     finally:
         shutil.rmtree(folder, ignore_errors=True)
 
 
-def writecheck_bag(path: Path, readings: list[float]) -> None:
+def write_check_bag(path: Path, readings: list[float]) -> None:
     """A bag of the check's own: ``readings`` on /temperature 1 s apart, and a /rosout line."""
     store = bag.typestore()
     float32 = store.types[course.MESSAGE_TYPE]

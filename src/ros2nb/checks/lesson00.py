@@ -7,14 +7,15 @@ the ROS graph.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Optional
 
 import rclpy
 from rclpy.node import Node
 
 from ..endpoints import node_endpoints
 from ..errors import CheckFailed
-from .base import AnswerRef, call_learner, current_judge, learner_error, passed
+from ..judge.interface import AnswerRef, Judge, learner_error
+from .base import call_learner, direct
 from .verdicts import endpoint_verdict
 
 
@@ -25,7 +26,9 @@ def require_ros() -> None:
                           'run ros2nb.shutdown(); ros2nb.start() and this cell again.')
 
 
-def check_endpoint(node_class: Any, kind: str, topic: str, type_name: str) -> None:
+@direct
+def check_endpoint(judge: Optional[Judge], node_class: Any, kind: str, topic: str,
+                   type_name: str) -> str:
     """Check that a node class makes a publisher or subscription on ``topic`` with ``type_name``.
 
     In the kernel the node is created, inspected and destroyed again (ROS must be up);
@@ -39,12 +42,12 @@ def check_endpoint(node_class: Any, kind: str, topic: str, type_name: str) -> No
     :param type_name: e.g. ``'std_msgs/msg/String'``.
     :raises CheckFailed: naming what the node has instead.
     """
-    if isinstance(node_class, AnswerRef):
-        name, found = _answer_node_endpoints(node_class)
+    if isinstance(node_class, AnswerRef) and judge is not None:
+        name, found = _answer_node_endpoints(judge, node_class)
     else:
         name, found = _kernel_node_endpoints(node_class)
     endpoint_verdict(name, found, kind, topic, type_name)
-    passed(f'{name} has a {kind} on {topic} [{type_name}].')
+    return f'{name} has a {kind} on {topic} [{type_name}].'
 
 
 def _kernel_node_endpoints(node_class: Any) -> tuple[str, list]:
@@ -59,8 +62,7 @@ def _kernel_node_endpoints(node_class: Any) -> tuple[str, list]:
         node.destroy_node()
 
 
-def _answer_node_endpoints(ref: AnswerRef) -> tuple[str, list]:
-    judge = current_judge()
+def _answer_node_endpoints(judge: Judge, ref: AnswerRef) -> tuple[str, list]:
     subject = judge.answer_subject(ref)
     reply = subject.request('new_node', cls=ref.name, stand_ins=[], seed=None)
     if reply.get('no_class'):

@@ -7,14 +7,16 @@ judge calls it from the learner's answer cell in a subject (:mod:`.answers`).
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import Any, Optional
 
 from ..errors import CheckFailed
 from .answers import answer_results, decoded, type_name_of
-from .base import AnswerRef, call_learner, current_judge, passed
+from ..judge.interface import AnswerRef, Judge
+from .base import call_learner, direct
 
 
-def check_expanded_path(make_path: Any, *, ends_with: str) -> None:
+@direct
+def check_expanded_path(judge: Optional[Judge], make_path: Any, *, ends_with: str) -> str:
     """Check the path a function returns is absolute, inside home and ends with ``ends_with``.
 
     Introduced in ``01-create-a-workspace.ipynb``.
@@ -23,9 +25,9 @@ def check_expanded_path(make_path: Any, *, ends_with: str) -> None:
     :param ends_with: how the path must end, e.g. ``'Documents/ROS2_and_RL_Tutorials'``.
     :raises CheckFailed: e.g. for the tutorial's ``/Documents/...`` (no ``~``).
     """
-    if isinstance(make_path, AnswerRef):  # the learner's home: their subject's
-        path = decoded(answer_results(make_path, [[]])[0], f'{make_path.name}()')
-        home = Path(current_judge().subject_env()['HOME'])
+    if isinstance(make_path, AnswerRef) and judge is not None:  # their subject's home
+        path = decoded(answer_results(judge, make_path, [[]])[0], f'{make_path.name}()')
+        home = Path(judge.subject_env()['HOME'])
     else:
         path, home = call_learner(make_path), Path.home()
     if not isinstance(path, Path):
@@ -39,4 +41,4 @@ def check_expanded_path(make_path: Any, *, ends_with: str) -> None:
                           'starts with "/" starts at the root of the disk.')
     if not str(path).endswith(ends_with):
         raise CheckFailed(f'{path} should end with {ends_with}.')
-    passed(f'{path} is inside your home folder.')
+    return f'{path} is inside your home folder.'

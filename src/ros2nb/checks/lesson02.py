@@ -16,7 +16,8 @@ from .. import course
 from ..errors import CheckFailed, Ros2nbError
 from ..terminal.workspace import current_workspace
 from .answers import answer_results, decoded, type_name_of
-from .base import AnswerRef, call_learner, current_judge, passed
+from ..judge.interface import AnswerRef, Judge
+from .base import call_learner, direct
 
 
 def package_dependencies(package_xml: Path) -> list[str]:
@@ -61,7 +62,9 @@ _EXTRA_PACKAGE_XML = '''<?xml version="1.0"?>
 '''
 
 
-def check_dependencies(reader: Any, package_xml: Optional[Path] = None) -> None:
+@direct
+def check_dependencies(judge: Optional[Judge], reader: Any,
+                       package_xml: Optional[Path] = None) -> str:
     """Check a learner's package.xml reader against catkin_pkg, ROS's own reader.
 
     Introduced in ``02-create-a-package.ipynb``.
@@ -76,15 +79,16 @@ def check_dependencies(reader: Any, package_xml: Optional[Path] = None) -> None:
         raise CheckFailed(f'{files[0]} does not exist: run the pkg_create cell above first.')
     # What each file declares, read before the learner's reader runs: it may write them.
     wanted = [package_dependencies(files[0])]
-    if isinstance(reader, AnswerRef):
+    in_judge = isinstance(reader, AnswerRef) and judge is not None
+    if in_judge:
         # The grader's own file: what it declares comes from its text, never from the copy
         # the learner's code can reach.
-        folder = current_judge().hand_over('ros2nb-package-', {
+        folder = judge.hand_over('ros2nb-package-', {
             'graded_reader/package.xml': _EXTRA_PACKAGE_XML.encode()})
         files.append(folder / 'graded_reader' / 'package.xml')
         wanted.append(_depends(parse_package_string(_EXTRA_PACKAGE_XML)))
-    if isinstance(reader, AnswerRef):
-        outputs = answer_results(reader, [[{'path': str(f)}] for f in files])
+    if in_judge:
+        outputs = answer_results(judge, reader, [[{'path': str(f)}] for f in files])
         results = [decoded(o, f'{reader.name}(package_xml)') for o in outputs]
     else:
         results = [call_learner(reader, f) for f in files]
@@ -101,4 +105,4 @@ def check_dependencies(reader: Any, package_xml: Optional[Path] = None) -> None:
             raise CheckFailed(f'For {file.parent.name}/package.xml you returned {got}, but it '
                               f'declares {want}: read the text of each <depend> element, in '
                               'order, without spaces around it (test_depend is not a depend).')
-    passed(f'package.xml depends on {", ".join(wanted[0])}.')
+    return f'package.xml depends on {", ".join(wanted[0])}.'

@@ -20,9 +20,10 @@ from std_msgs.msg import Float32
 
 from .. import course
 from ..errors import CheckFailed
-from .base import ARRIVAL_TIMEOUT_S, Judge, judged, learner_error, passed
+from ..judge.interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
+from .base import direct, judged
 from .mains import run_main
-from .nodes import caught_up, new_node
+from .file_nodes import lines_logged, new_node
 from .source import ClassSource
 from .verdicts import endpoint_verdict, node_name_verdict
 
@@ -77,7 +78,7 @@ def _make_sensor(judge: Judge, stand_ins: tuple[str, ...], seed: int) -> SensorR
     subject, info = new_node(judge, course.PUBLISHER_FILE, course.SENSOR_CLASS,
                              stand_ins=stand_ins, seed=seed)
     found = observer.endpoints(info['name'], info['namespace'], info['endpoints'])
-    return SensorRun(subject, info, found, caught_up(judge, info, mark, info['started_lines']))
+    return SensorRun(subject, info, found, lines_logged(judge, info, mark, info['started_lines']))
 
 
 def _run(judge: Judge, sensor: SensorRun, seconds: float, *, step_s: float, seed: int,
@@ -235,7 +236,9 @@ def _samples_verdict(samples: list[float], *, seconds: float,
                               f'°C{tutorial}: clamp every new reading into [{low}, {high}].')
 
 
-def check_publisher_samples(samples: list[float], *, seconds: float) -> None:
+@direct
+def check_publisher_samples(judge: Optional[Judge], samples: list[float], *,
+                            seconds: float) -> str:
     """Check a recorded run of the sensor: one reading per second, walk and clamp respected.
 
     Introduced in ``03-write-the-publisher.ipynb``.
@@ -245,9 +248,9 @@ def check_publisher_samples(samples: list[float], *, seconds: float) -> None:
     :raises CheckFailed: naming the first rule broken.
     """
     _samples_verdict(samples, seconds=seconds)
-    passed(f'{len(samples)} readings, one every {course.PUBLISH_PERIOD_S} s, steps within '
-           f'±{course.MAX_STEP_C} °C, all inside [{course.MIN_TEMPERATURE_C}, '
-           f'{course.MAX_TEMPERATURE_C}] °C.')
+    return (f'{len(samples)} readings, one every {course.PUBLISH_PERIOD_S} s, steps within '
+            f'±{course.MAX_STEP_C} °C, all inside [{course.MIN_TEMPERATURE_C}, '
+            f'{course.MAX_TEMPERATURE_C}] °C.')
 
 
 # ------------------------------------------------------------------ part 3: the constructor
@@ -280,7 +283,8 @@ def _sensor_constructor(judge: Judge) -> str:
             f'{course.START_TEMPERATURE_C} °C.')
 
 
-def check_sensor_constructor() -> None:
+@judged
+def check_sensor_constructor(judge: Judge) -> str:
     """Check part 3 of ``temperature_publisher.py``: the sensor's ``__init__``.
 
     Creates your ``TemperatureSensor`` (with the course's ``publish_temperature``, so that
@@ -292,7 +296,7 @@ def check_sensor_constructor() -> None:
 
     :raises CheckFailed: naming what was seen and what was expected.
     """
-    judged('check_sensor_constructor', _sensor_constructor)
+    return _sensor_constructor(judge)
 
 
 # ------------------------------------------------------------------ part 4: the callback
@@ -338,7 +342,8 @@ def _sensor_callback(judge: Judge) -> str:
             f'inside [{course.MIN_TEMPERATURE_C}, {course.MAX_TEMPERATURE_C}] °C, each logged.')
 
 
-def check_sensor_callback() -> None:
+@judged
+def check_sensor_callback(judge: Judge) -> str:
     """Check part 4 of ``temperature_publisher.py``: the timer callback.
 
     Runs your sensor for 20 s of the grader's clock and watches ``/temperature`` over ROS:
@@ -351,7 +356,7 @@ def check_sensor_callback() -> None:
 
     :raises CheckFailed: naming what was seen and what was expected.
     """
-    judged('check_sensor_callback', _sensor_callback)
+    return _sensor_callback(judge)
 
 
 def _sensor_hour(judge: Judge) -> str:
@@ -364,17 +369,19 @@ def _sensor_hour(judge: Judge) -> str:
             f'{course.MAX_TEMPERATURE_C}] °C.')
 
 
-def check_sensor_hour() -> None:
+@judged
+def check_sensor_hour(judge: Judge) -> str:
     """Hidden test of notebook 03: your sensor over one hour of the grader's clock (3600 readings).
 
     Introduced in ``03-write-the-publisher.ipynb``.
 
     :raises CheckFailed: naming the first rule broken.
     """
-    judged('check_sensor_hour', _sensor_hour)
+    return _sensor_hour(judge)
 
 
-def check_sensor_main() -> None:
+@judged
+def check_sensor_main(judge: Judge) -> str:
     """Check part 5 of ``temperature_publisher.py``: ``main()`` and Ctrl+C.
 
     Runs your ``main()`` as ``ros2 run`` does, presses Ctrl+C once its node spins (it
@@ -385,5 +392,5 @@ def check_sensor_main() -> None:
 
     :raises CheckFailed: with the process's last line.
     """
-    judged('check_sensor_main', run_main, relative=course.PUBLISHER_FILE,
-           node_name=course.SENSOR_NODE, node_class=course.SENSOR_CLASS)
+    return run_main(judge, relative=course.PUBLISHER_FILE, node_name=course.SENSOR_NODE,
+                    node_class=course.SENSOR_CLASS)

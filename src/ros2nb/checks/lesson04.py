@@ -14,16 +14,18 @@ from typing import Any
 
 from .. import course
 from ..errors import CheckFailed
-from .base import Judge, judged
+from ..judge.interface import Judge
+from .base import judged
 from .mains import run_main
-from .nodes import feed, new_node, reach, started_log_verdict
+from .file_nodes import feed, new_node, reach, started_log_verdict
 from .verdicts import endpoint_verdict, node_name_verdict
 
 #: Readings the monitor callback check sends: both boundaries and their neighbours (°C).
 BOUNDARY_READINGS_C = (19.99, 20.0, 23.0, 26.0, 26.01, 18.5, 27.5)
 
 
-def check_monitor_main() -> None:
+@judged
+def check_monitor_main(judge: Judge) -> str:
     """Check part 5 of ``temperature_subscriber.py``: ``main()`` and Ctrl+C.
 
     As :func:`check_sensor_main`, for the monitor.
@@ -32,8 +34,8 @@ def check_monitor_main() -> None:
 
     :raises CheckFailed: with the process's last line.
     """
-    judged('check_monitor_main', run_main, relative=course.SUBSCRIBER_FILE,
-           node_name=course.MONITOR_NODE, node_class=course.MONITOR_CLASS)
+    return run_main(judge, relative=course.SUBSCRIBER_FILE, node_name=course.MONITOR_NODE,
+                    node_class=course.MONITOR_CLASS)
 
 
 # ------------------------------------------------------------------ the monitor
@@ -91,7 +93,8 @@ def _monitor_constructor(judge: Judge) -> str:
             'grader\'s readings.')
 
 
-def check_monitor_constructor() -> None:
+@judged
+def check_monitor_constructor(judge: Judge) -> str:
     """Check part 3 of ``temperature_subscriber.py``: the monitor's ``__init__``.
 
     Creates your ``TemperatureMonitor`` (with the course's ``temperature_callback``, so that
@@ -102,7 +105,7 @@ def check_monitor_constructor() -> None:
 
     :raises CheckFailed: naming your value and the expected one.
     """
-    judged('check_monitor_constructor', _monitor_constructor)
+    return _monitor_constructor(judge)
 
 
 def _own_or_course_constructor(judge: Judge, readings: list[float]) -> list[list[str]]:
@@ -152,7 +155,8 @@ def _monitor_callback(judge: Judge) -> str:
             f'including {course.LOW_BELOW_C} and {course.HIGH_ABOVE_C} °C (both Normal).')
 
 
-def check_monitor_callback() -> None:
+@judged
+def check_monitor_callback(judge: Judge) -> str:
     """Check part 4 of ``temperature_subscriber.py``: the callback and its statuses.
 
     The judge publishes readings around both thresholds (19.99, 20.0, 26.0, 26.01 °C and
@@ -163,7 +167,7 @@ def check_monitor_callback() -> None:
 
     :raises CheckFailed: naming the reading, what your monitor said and the rule.
     """
-    judged('check_monitor_callback', _monitor_callback)
+    return _monitor_callback(judge)
 
 
 def _monitor_readings(judge: Judge) -> str:
@@ -175,7 +179,8 @@ def _monitor_readings(judge: Judge) -> str:
     return f'the right status and the reading in one line for each of {len(readings)} readings.'
 
 
-def check_monitor_readings() -> None:
+@judged
+def check_monitor_readings(judge: Judge) -> str:
     """Hidden test of notebook 04: 34 readings from the grader's own publisher.
 
     Random readings over the whole range and the boundaries; every one must give one line
@@ -185,4 +190,4 @@ def check_monitor_readings() -> None:
 
     :raises CheckFailed: naming the first reading handled wrongly.
     """
-    judged('check_monitor_readings', _monitor_readings)
+    return _monitor_readings(judge)

@@ -33,7 +33,8 @@ from ..terminal.colcon import build_cause, venv_tool
 from ..terminal.files import saved_parts
 from ..terminal.pkg_templates import SETUP_CFG, render_setup_py
 from ..terminal.run import find_executable
-from .base import ARRIVAL_TIMEOUT_S, Judge, judged
+from ..judge.interface import ARRIVAL_TIMEOUT_S, Judge
+from .base import judged
 from .mains import EXIT_AFTER_CTRL_C_S, last_line
 from .package_stand_ins import EXECUTABLES
 from .source import TEXT
@@ -291,7 +292,8 @@ def _entry_points(judge: Judge) -> str:
             f'{course.SUBSCRIBER_EXECUTABLE} from your console_scripts.')
 
 
-def check_entry_points() -> None:
+@judged
+def check_entry_points(judge: Judge) -> str:
     """Check the ``console_scripts`` entry points in ``setup.py`` (notebook 05).
 
     Builds a copy of your package with colcon (the grader's stand-in nodes take the place
@@ -303,7 +305,7 @@ def check_entry_points() -> None:
 
     :raises CheckFailed: naming the executable that did not start, or the build's cause.
     """
-    judged('check_entry_points', _entry_points)
+    return _entry_points(judge)
 
 
 def _setup_cfg_cause(judge: Judge) -> Optional[str]:
@@ -355,7 +357,8 @@ def _setup_cfg(judge: Judge) -> str:
             'finds them.')
 
 
-def check_setup_cfg() -> None:
+@judged
+def check_setup_cfg(judge: Judge) -> str:
     """Check ``setup.cfg``: executables go to ``lib/sensor_simulator``, where ros2 run looks.
 
     Builds your package (with the course's setup.py when yours is at fault, so that only
@@ -365,7 +368,7 @@ def check_setup_cfg() -> None:
 
     :raises CheckFailed: naming the setting and the expected value.
     """
-    judged('check_setup_cfg', _setup_cfg)
+    return _setup_cfg(judge)
 
 
 def _package_runs(judge: Judge) -> str:
@@ -375,7 +378,8 @@ def _package_runs(judge: Judge) -> str:
     return 'ros2 run starts both entry points; they talk over /temperature and stop on Ctrl+C.'
 
 
-def check_package_runs() -> None:
+@judged
+def check_package_runs(judge: Judge) -> str:
     """Hidden test of notebook 05: the built package runs with ``ros2 run``.
 
     Builds your package (with the grader's stand-in nodes), starts both executables the
@@ -386,4 +390,4 @@ def check_package_runs() -> None:
 
     :raises CheckFailed: with the CLI's error or what went wrong.
     """
-    judged('check_package_runs', _package_runs)
+    return _package_runs(judge)

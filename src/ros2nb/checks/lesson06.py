@@ -18,9 +18,10 @@ from std_msgs.msg import Bool
 from .. import course
 from ..errors import CheckFailed
 from ..explain.settings import ros_arguments_mistake
-from .base import ARRIVAL_TIMEOUT_S, Judge, judged, learner_error
+from ..judge.interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
+from .base import judged
 from .mains import run_main
-from .nodes import announced, caught_up, feed, new_node, reach
+from .file_nodes import announced, feed, lines_logged, new_node, reach
 from .verdicts import endpoint_verdict, node_name_verdict
 
 #: Readings the fan check sends (°C): both sides of the High threshold.
@@ -90,7 +91,8 @@ def _slow_callback_verdict(fastest_s: float) -> None:
                           'too (section 4): publish the command at once, without waiting.')
 
 
-def check_fan_controller() -> None:
+@judged
+def check_fan_controller(judge: Judge) -> str:
     """Check part 2 of ``fan_controller.py``: the third node, added without touching the others.
 
     The judge creates your ``FanController``, reads its subscription and publisher from the
@@ -101,10 +103,11 @@ def check_fan_controller() -> None:
 
     :raises CheckFailed: naming the reading and the command your node published.
     """
-    judged('check_fan_controller', _fan_controller)
+    return _fan_controller(judge)
 
 
-def check_fan_main() -> None:
+@judged
+def check_fan_main(judge: Judge) -> str:
     """Check part 3 of ``fan_controller.py``: ``main()`` runs it as a process of its own.
 
     As :func:`check_sensor_main`: the file is started as a program, gets Ctrl+C once its
@@ -114,8 +117,8 @@ def check_fan_main() -> None:
 
     :raises CheckFailed: with the process's last line.
     """
-    judged('check_fan_main', run_main, relative=course.FAN_FILE, node_name=course.FAN_NODE,
-           part=3, node_class=course.FAN_CLASS)
+    return run_main(judge, relative=course.FAN_FILE, node_name=course.FAN_NODE, part=3,
+                    node_class=course.FAN_CLASS)
 
 
 # ------------------------------------------------------------------ scalability
@@ -130,7 +133,7 @@ def _counting_monitor(judge: Judge) -> str:
                           'pass the name it is given on to super().__init__(name).')
     found = observer.endpoints(info['name'], info['namespace'], info['endpoints'])
     endpoint_verdict(name, found, 'subscription', '/' + course.TOPIC, course.MESSAGE_TYPE)
-    caught_up(judge, info, mark, info['started_lines'])
+    lines_logged(judge, info, mark, info['started_lines'])
     reach(judge, subject, name)
     counts = info
     for index in range(1, COUNTED_READINGS + 1):
@@ -152,7 +155,8 @@ def _counting_monitor(judge: Judge) -> str:
             f'{COUNTED_READINGS} of {COUNTED_READINGS} readings, as its lines on /rosout say.')
 
 
-def check_counting_monitor() -> None:
+@judged
+def check_counting_monitor(judge: Judge) -> str:
     """Check part 2 of ``promises.py``: a monitor that only counts, named as it is told.
 
     Creates ``CountingMonitor('monitor_7')``, checks its name and subscription in the ROS
@@ -162,7 +166,7 @@ def check_counting_monitor() -> None:
 
     :raises CheckFailed: naming the name or count found and the one expected.
     """
-    judged('check_counting_monitor', _counting_monitor)
+    return _counting_monitor(judge)
 
 
 # ------------------------------------------------------------------ concurrency
@@ -246,7 +250,8 @@ def _responsive_worker(judge: Judge) -> str:
                       f'watched): {_worker_cause(reply)}.')
 
 
-def check_responsive_worker() -> None:
+@judged
+def check_responsive_worker(judge: Judge) -> str:
     """Check part 4 of ``promises.py``: a slow callback no longer holds up the heartbeat.
 
     Calls your ``responsive_worker()`` for its node and executor and spins them on the wall
@@ -258,7 +263,7 @@ def check_responsive_worker() -> None:
 
     :raises CheckFailed: naming the cause.
     """
-    judged('check_responsive_worker', _responsive_worker)
+    return _responsive_worker(judge)
 
 
 # ------------------------------------------------------------------ reusability
@@ -310,7 +315,8 @@ def _rooms(judge: Judge) -> str:
             f'/ROOM/{course.TOPIC}, as the ROS graph shows.')
 
 
-def check_room_arguments() -> None:
+@judged
+def check_room_arguments(judge: Judge) -> str:
     """Check part 5 of ``promises.py``: the arguments that make one package serve two rooms.
 
     Calls ``room_arguments('kitchen')`` and ``room_arguments('attic')``, starts a sensor and
@@ -321,4 +327,4 @@ def check_room_arguments() -> None:
 
     :raises CheckFailed: naming the node or topic the graph shows and the one expected.
     """
-    judged('check_room_arguments', _rooms)
+    return _rooms(judge)

@@ -16,8 +16,9 @@ from typing import Optional
 
 from .. import course
 from ..errors import CheckFailed
-from .base import Judge, judged
-from .nodes import caught_up, feed, new_node, reach
+from ..judge.interface import Judge
+from .base import judged
+from .file_nodes import feed, lines_logged, new_node, reach
 from .source import ClassSource
 from .verdicts import endpoint_verdict, node_name_verdict
 
@@ -46,7 +47,7 @@ def _plot_callback(judge: Judge) -> str:
     node_name_verdict(info, course.PLOT_NODE)
     found = observer.endpoints(info['name'], info['namespace'], info['endpoints'])
     endpoint_verdict(info['name'], found, 'subscription', '/' + course.TOPIC, course.MESSAGE_TYPE)
-    caught_up(judge, info, mark, info['started_lines'])
+    lines_logged(judge, info, mark, info['started_lines'])
     reach(judge, subject, info['name'])
     counts = info
     for number, value in enumerate(PLOT_READINGS_C, start=1):
@@ -95,7 +96,8 @@ def _unplotted_cause(judge: Judge) -> str:
             '(redraw() plots the newest point and logs it).')
 
 
-def check_plot_callback() -> None:
+@judged
+def check_plot_callback(judge: Judge) -> str:
     """Check part 2 of ``live_plot.py``: the callback that feeds the live plot.
 
     The judge publishes 4 readings one second of its clock apart to your ``PlotFeeder`` and
@@ -106,4 +108,4 @@ def check_plot_callback() -> None:
 
     :raises CheckFailed: naming what was plotted and what should have been.
     """
-    judged('check_plot_callback', _plot_callback)
+    return _plot_callback(judge)

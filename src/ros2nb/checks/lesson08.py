@@ -22,8 +22,9 @@ from rclpy.parameter_client import AsyncParameterClient
 from .. import course
 from ..errors import CheckFailed
 from ..runtime.services import call_until_answered
-from .base import ARRIVAL_TIMEOUT_S, Judge, judged, learner_error
-from .nodes import caught_up, feed, new_node, reach
+from ..judge.interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
+from .base import judged
+from .file_nodes import feed, lines_logged, new_node, reach
 
 #: The on-set callback the learner writes (part 4); the constructor registers it.
 CALLBACK = 'on_set_thresholds'
@@ -59,7 +60,7 @@ class _Monitor:
         self.judge, self.observer, self.stand_ins = judge, judge.observer, stand_ins
         self.name = self.info['name']
         self.full = self.info['namespace'].rstrip('/') + '/' + self.name
-        caught_up(judge, self.info, mark, self.info['started_lines'])
+        lines_logged(judge, self.info, mark, self.info['started_lines'])
         reach(judge, self.subject, self.name)
         self.counts = self.info
         self.subject.request('serve')
@@ -227,7 +228,8 @@ def _monitor_parameters(judge: Judge) -> str:
             f'{course.MAX_TEMPERATURE_C}] °C; setting them changes the statuses it logs.')
 
 
-def check_monitor_parameters() -> None:
+@judged
+def check_monitor_parameters(judge: Judge) -> str:
     """Check part 3 of notebook 08: the monitor declares its two thresholds as parameters.
 
     Creates your ``TemperatureMonitor`` (with the course's on-set callback, so that only your
@@ -240,7 +242,7 @@ def check_monitor_parameters() -> None:
 
     :raises CheckFailed: naming the parameter and what its declaration lacks.
     """
-    judged('check_monitor_parameters', _monitor_parameters)
+    return _monitor_parameters(judge)
 
 
 #: (name, value, must succeed, the reading that shows the thresholds in force afterwards) in
@@ -337,7 +339,8 @@ def _threshold_steps(node: _Monitor) -> str:
             f'{course.LOW_PARAMETER} at or above {course.HIGH_PARAMETER}; the statuses follow.')
 
 
-def check_threshold_callback() -> None:
+@judged
+def check_threshold_callback(judge: Judge) -> str:
     """Check part 4 of notebook 08: the on-set callback refuses inverted thresholds.
 
     Sets the thresholds of your running monitor through its ``set_parameters`` service, as
@@ -349,4 +352,4 @@ def check_threshold_callback() -> None:
 
     :raises CheckFailed: naming the change and what the node answered.
     """
-    judged('check_threshold_callback', _threshold_callback)
+    return _threshold_callback(judge)

@@ -13,7 +13,7 @@ a late joiner of the judge's receives from it.  Either way the same rules decide
 from __future__ import annotations
 
 import secrets
-from typing import Any
+from typing import Any, Optional
 
 from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy,
                        qos_profile_sensor_data)
@@ -23,7 +23,8 @@ from .. import qos
 from ..explain.settings import zero_depth_refused
 from ..errors import CheckFailed
 from .answers import defined_verdict, type_name_of
-from .base import ARRIVAL_TIMEOUT_S, AnswerRef, call_learner, current_judge, learner_error, passed
+from ..judge.interface import ARRIVAL_TIMEOUT_S, AnswerRef, Judge, learner_error
+from .base import call_learner, direct
 
 #: The burst of part 1 and what a display of the newest reading must be left with.
 BURST = 30
@@ -61,8 +62,8 @@ class _Endpoint:
     """An endpoint with the learner's profile, made in a subject on a topic of the judge's,
     and the judge's view of it."""
 
-    def __init__(self, ref: AnswerRef, kind: str, numbers: tuple[int, ...] = ()) -> None:
-        judge = current_judge()
+    def __init__(self, judge: Judge, ref: AnswerRef, kind: str,
+                 numbers: tuple[int, ...] = ()) -> None:
         judge.drop_all()  # nothing of the learner's left to publish on a trial's topic
         self.judge, self.observer = judge, judge.observer
         self.topic = f'/ros2nb_qos_trial_{secrets.token_hex(4)}'
@@ -105,10 +106,10 @@ class _Endpoint:
         self.judge.drop_all()
 
 
-def _judged_burst(ref: AnswerRef) -> qos.Deliveries:
+def _judged_burst(judge: Judge, ref: AnswerRef) -> qos.Deliveries:
     """The burst of part 1, from the judge's publisher to a subscription with the learner's
     profile that takes nothing until the whole burst was acknowledged."""
-    endpoint = _Endpoint(ref, 'subscription')
+    endpoint = _Endpoint(judge, ref, 'subscription')
     node = endpoint.observer.node
     publisher = node.create_publisher(Int32, endpoint.topic, QoSProfile(depth=BURST))
     out = qos.Deliveries()
@@ -130,10 +131,10 @@ def _judged_burst(ref: AnswerRef) -> qos.Deliveries:
     return out
 
 
-def _judged_pair(ref: AnswerRef) -> tuple[qos.Deliveries, QoSProfile]:
+def _judged_pair(judge: Judge, ref: AnswerRef) -> tuple[qos.Deliveries, QoSProfile]:
     """Part 2: does the judge's sensor publisher match a subscription with the learner's
     profile?  rclpy decides from both profiles as discovery reports them."""
-    endpoint = _Endpoint(ref, 'subscription')
+    endpoint = _Endpoint(judge, ref, 'subscription')
     node = endpoint.observer.node
     publisher = node.create_publisher(Int32, endpoint.topic, SENSOR_QOS)
     out = qos.Deliveries()
@@ -150,14 +151,14 @@ def _judged_pair(ref: AnswerRef) -> tuple[qos.Deliveries, QoSProfile]:
     return out, endpoint.profile
 
 
-def _judged_late_joiner(ref: AnswerRef) -> tuple[qos.Deliveries, QoSProfile]:
+def _judged_late_joiner(judge: Judge, ref: AnswerRef) -> tuple[qos.Deliveries, QoSProfile]:
     """Part 3: a publisher with the learner's profile publishes 20 numbers; then the judge's
     subscription joins, with that profile as discovery reports it (keeping all it is sent),
     and the judge counts what it got once the publisher says everything was acknowledged."""
     # Numbers only the judge knows, so that what the joiner gets is what this publisher
     # kept: anything else on the topic (a thread of the answer cell's) is seen as such.
     sent = tuple(secrets.randbelow(2**31 - 1) for _ in range(LATCHED_SENT))
-    endpoint = _Endpoint(ref, 'publisher', numbers=sent)
+    endpoint = _Endpoint(judge, ref, 'publisher', numbers=sent)
     profile = endpoint.profile
     joiner = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=profile.reliability,
                         durability=profile.durability, deadline=profile.deadline,
@@ -196,9 +197,9 @@ def _take_all(subscription: Any) -> list[int]:
 
 
 # ------------------------------------------------------------------ the three parts
-def _newest_only(make_profile: Any) -> str:
-    if isinstance(make_profile, AnswerRef):
-        got = _judged_burst(make_profile)
+def _newest_only(judge: Optional[Judge], make_profile: Any) -> str:
+    if isinstance(make_profile, AnswerRef) and judge is not None:
+        got = _judged_burst(judge, make_profile)
         shown = 'your profile'
         keeps_all = None
     else:
@@ -221,7 +222,8 @@ def _newest_only(make_profile: Any) -> str:
                       'keeps that many; a display of the newest reading keeps depth=1.')
 
 
-def check_newest_only(make_profile: Any) -> None:
+@direct
+def check_newest_only(judge: Optional[Judge], make_profile: Any) -> str:
     """Check part 1 of notebook 09: a subscription profile that keeps only the newest reading.
 
     A reliable publisher sends a burst of 30 numbers (0 to 29) before the subscription's
@@ -232,12 +234,12 @@ def check_newest_only(make_profile: Any) -> None:
     :param make_profile: your function returning the profile (no parentheses).
     :raises CheckFailed: naming what the subscription got instead.
     """
-    passed(_newest_only(make_profile))
+    return _newest_only(judge, make_profile)
 
 
-def _latched(make_profile: Any) -> str:
-    if isinstance(make_profile, AnswerRef):
-        got, profile = _judged_late_joiner(make_profile)
+def _latched(judge: Optional[Judge], make_profile: Any) -> str:
+    if isinstance(make_profile, AnswerRef) and judge is not None:
+        got, profile = _judged_late_joiner(judge, make_profile)
     else:
         profile = learner_profile(make_profile)
         got = qos.late_joiner(profile, count=LATCHED_SENT)
@@ -263,7 +265,8 @@ def _latched(make_profile: Any) -> str:
                       f'last {LATCHED_KEPT} {_span(LATCHED)}: depth={LATCHED_KEPT}.')
 
 
-def check_latched_thresholds(make_profile: Any) -> None:
+@direct
+def check_latched_thresholds(judge: Optional[Judge], make_profile: Any) -> str:
     """Check part 3 of notebook 09: a "latched" profile that late joiners still hear.
 
     A publisher with your profile publishes 20 numbers with nobody listening; then a
@@ -274,12 +277,12 @@ def check_latched_thresholds(make_profile: Any) -> None:
     :param make_profile: your function returning the profile (no parentheses).
     :raises CheckFailed: naming what the late joiner got instead.
     """
-    passed(_latched(make_profile))
+    return _latched(judge, make_profile)
 
 
-def _sensor_subscription(make_profile: Any) -> str:
-    if isinstance(make_profile, AnswerRef):
-        got, profile = _judged_pair(make_profile)
+def _sensor_subscription(judge: Optional[Judge], make_profile: Any) -> str:
+    if isinstance(make_profile, AnswerRef) and judge is not None:
+        got, profile = _judged_pair(judge, make_profile)
     else:
         profile = learner_profile(make_profile)
         got = qos.pair(SENSOR_QOS, profile, count=READINGS)
@@ -292,7 +295,8 @@ def _sensor_subscription(make_profile: Any) -> str:
             'no incompatible-QoS event.')
 
 
-def check_sensor_subscription(make_profile: Any) -> None:
+@direct
+def check_sensor_subscription(judge: Optional[Judge], make_profile: Any) -> str:
     """Check part 2 of notebook 09: a subscription profile the best-effort sensor can serve.
 
     A publisher with rclpy's sensor-data preset (best effort, keep last 5, volatile) meets a
@@ -304,4 +308,4 @@ def check_sensor_subscription(make_profile: Any) -> None:
     :param make_profile: your function returning the profile (no parentheses).
     :raises CheckFailed: with the one-line reason when the pair is incompatible.
     """
-    passed(_sensor_subscription(make_profile))
+    return _sensor_subscription(judge, make_profile)

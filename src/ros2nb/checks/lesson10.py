@@ -31,8 +31,8 @@ from ..terminal import bag
 from .answers import decoded, defined_verdict
 from .bags import (CHECK_LOGGER, ROSOUT, TEMPERATURE, check_bag, check_readings_c, fresh_path,
                    bag_messages, read_back)
-from .base import AnswerRef, call_learner, current_judge, learner_error, passed
-from .dispatch import in_judge
+from ..judge.interface import AnswerRef, Judge, learner_error
+from .base import call_learner, direct
 
 #: The monitor's log line, as notebook 04 writes it.
 STATUS_LINE = re.compile(r'Temperature: (-?[\d.]+)C - Status: (\w+)')
@@ -78,12 +78,12 @@ class Witness:
 
 
 @contextlib.contextmanager
-def _witnessing() -> Iterator[Witness]:
+def _witnessing(judge: Optional[Judge]) -> Iterator[Witness]:
     """Hear /temperature and /rosout while the block runs: the judge's node (stamped with
     its clock), or in the kernel subscriptions of the check's own (the kernel's clock)."""
     seen = Witness()
-    if in_judge():
-        observer = current_judge().observer
+    if judge is not None:
+        observer = judge.observer
         heard = observer.watch(TEMPERATURE, Float32, lambda m: float(m.data))
         first, mark = len(heard), len(observer.logs)
         try:
@@ -110,18 +110,15 @@ def _witnessing() -> Iterator[Witness]:
 
 
 # ------------------------------------------------------------------ calling the learner
-def _catch_up_workspace() -> Optional[Any]:
-    """The judge's workspace with the course's nodes where the learner's are missing (what
-    ``catch_up(10)`` promises a notebook run on its own); None in the kernel."""
-    return current_judge().caught_up(course.STEPS[10]) if in_judge() else None
-
-
-def _call(function: Any, label: str, *args: Any, spin_s: float = 0.0) -> Any:
+def _call(judge: Optional[Judge], function: Any, label: str, *args: Any,
+          spin_s: float = 0.0) -> Any:
     """Call the learner's function (in the kernel, or from source in a subject whose nodes
-    run on the judge's clock for up to ``spin_s`` simulated seconds)."""
-    if isinstance(function, AnswerRef):
-        judge = current_judge()
-        subject = judge.answer_subject(function, workspace=_catch_up_workspace())
+    run on the judge's clock for up to ``spin_s`` simulated seconds, in the judge's
+    workspace with the course's nodes where the learner's are missing, as ``catch_up(10)``
+    promises a notebook run on its own)."""
+    if isinstance(function, AnswerRef) and judge is not None:
+        subject = judge.answer_subject(function,
+                                       workspace=judge.answers_workspace(course.STEPS[10]))
         encoded = [{'path': str(a)} if isinstance(a, Path) else a for a in args]
         reply = judge.clock.drive(subject, 'call', name=function.name, inputs=[encoded],
                                   step_s=STEP_S, limit_s=spin_s + SPARE_S, what=label)
@@ -177,20 +174,21 @@ def _bag_verdict(path: Path, label: str) -> dict[str, int]:
     return {t: v['message_count'] for t, v in topics.items()}
 
 
-def _recording(record_hour: Any) -> str:
+def _recording(judge: Optional[Judge], record_hour: Any) -> str:
     label = f'{record_hour.__name__}(bag_path)'
-    with fresh_path('hour') as path:
-        with _witnessing() as seen:
-            _call(record_hour, label, path, spin_s=course.RECORD_S)
+    with fresh_path(judge, 'hour') as path:
+        with _witnessing(judge) as seen:
+            _call(judge, record_hour, label, path, spin_s=course.RECORD_S)
         if not path.is_dir():
             _bag_verdict(path, label)  # the line for "no bag at all"
-        with read_back(path) as copy:
+        with read_back(judge, path) as copy:
             verdict = _recording_verdict(copy, label, seen)
-    _seed_verdict(record_hour, label, [value for _t, value in seen.readings])
+    _seed_verdict(judge, record_hour, label, [value for _t, value in seen.readings])
     return verdict
 
 
-def _seed_verdict(record_hour: Any, label: str, hour: list[float]) -> None:
+def _seed_verdict(judge: Optional[Judge], record_hour: Any, label: str,
+                  hour: list[float]) -> None:
     """The hour must be the one ``random.seed(SEED)`` gives (the same on every run): its
     first readings are what the notebook's sensor publishes right after that seed, as the
     check hears it.  Without the notebook's names (SEED, pub) there is nothing to compare."""
@@ -203,8 +201,8 @@ def _seed_verdict(record_hour: Any, label: str, hour: list[float]) -> None:
         exec(SEEDED, names)  # noqa: S102 - the course's own lines, in a copy of the names
         probe = names['_ros2nb_seeded_sensor']
     try:
-        with _witnessing() as seen:
-            _call(probe, 'the seeded sensor', spin_s=SEEDED_S)
+        with _witnessing(judge) as seen:
+            _call(judge, probe, 'the seeded sensor', spin_s=SEEDED_S)
     except CheckFailed:
         return  # the notebook's names are not what the course gave: no comparison
     seeded = [value for _t, value in seen.readings]
@@ -279,7 +277,8 @@ def _statuses_follow_readings(said: list[tuple[int, float, str]],
                           f'{len(heard)} readings: one per reading, from one monitor.')
 
 
-def check_recording(record_hour: Any) -> None:
+@direct
+def check_recording(judge: Optional[Judge], record_hour: Any) -> str:
     """Check part 1 of notebook 10: one simulated hour recorded into an MCAP bag.
 
     Calls your function with a folder that does not exist yet and listens meanwhile to
@@ -292,15 +291,15 @@ def check_recording(record_hour: Any) -> None:
     :param record_hour: your function (no parentheses).
     :raises CheckFailed: naming what the bag lacks.
     """
-    passed(_recording(record_hour))
+    return _recording(judge, record_hour)
 
 
 # ------------------------------------------------------------------ part 2: the replay
-def _replay(replay: Any) -> str:
+def _replay(judge: Optional[Judge], replay: Any) -> str:
     readings = check_readings_c()
-    with check_bag('sixty', readings) as path:
-        with _witnessing() as seen:
-            _call(replay, f'{replay.__name__}(bag_path, rate)', path, CHECK_RATE,
+    with check_bag(judge, 'sixty', readings) as path:
+        with _witnessing(judge) as seen:
+            _call(judge, replay, f'{replay.__name__}(bag_path, rate)', path, CHECK_RATE,
                   spin_s=len(readings) * course.PUBLISH_PERIOD_S)
     return _replay_verdict(readings, seen, f'{replay.__name__}(bag_path, rate)')
 
@@ -329,7 +328,8 @@ def _replay_verdict(readings: list[float], seen: Witness, label: str) -> str:
             f'logged the status each calls for, as it heard it.')
 
 
-def check_replay(replay: Any) -> None:
+@direct
+def check_replay(judge: Optional[Judge], replay: Any) -> str:
     """Check part 2 of notebook 10: a bag replayed into the monitor gives its statuses again.
 
     Writes a bag of 60 readings of its own, calls ``replay(bag_path, rate)`` and listens
@@ -341,18 +341,19 @@ def check_replay(replay: Any) -> None:
     :param replay: your function (no parentheses).
     :raises CheckFailed: naming what the replay delivered instead.
     """
-    passed(_replay(replay))
+    return _replay(judge, replay)
 
 
 # ------------------------------------------------------------------ part 3: reading a bag
-def _readings(read_temperatures: Any) -> str:
+def _readings(judge: Optional[Judge], read_temperatures: Any) -> str:
     readings = check_readings_c()
-    with check_bag('sixty', readings) as path:
-        return _readings_in(path, read_temperatures, readings)
+    with check_bag(judge, 'sixty', readings) as path:
+        return _readings_in(judge, path, read_temperatures, readings)
 
 
-def _readings_in(path: Path, read_temperatures: Any, readings: list[float]) -> str:
-    got = _call(read_temperatures, f'{read_temperatures.__name__}(bag_path)', path)
+def _readings_in(judge: Optional[Judge], path: Path, read_temperatures: Any,
+                 readings: list[float]) -> str:
+    got = _call(judge, read_temperatures, f'{read_temperatures.__name__}(bag_path)', path)
     name = f'{getattr(read_temperatures, "__name__", "your function")}()'
     if not (isinstance(got, (list, tuple)) and len(got) == 2
             and all(isinstance(side, (list, tuple)) for side in got)):
@@ -376,7 +377,8 @@ def _readings_in(path: Path, read_temperatures: Any, readings: list[float]) -> s
     return f'{name} returns the {sent} readings of the bag, with their times from 0 s.'
 
 
-def check_readings(read_temperatures: Callable[..., Any]) -> None:
+@direct
+def check_readings(judge: Optional[Judge], read_temperatures: Callable[..., Any]) -> str:
     """Check part 3 of notebook 10: a bag's readings read back with rosbags.
 
     Writes a bag of 60 readings of its own, one second apart (and one ``/rosout`` line),
@@ -388,4 +390,4 @@ def check_readings(read_temperatures: Callable[..., Any]) -> None:
     :param read_temperatures: your function (no parentheses).
     :raises CheckFailed: naming what your function returned instead.
     """
-    passed(_readings(read_temperatures))
+    return _readings(judge, read_temperatures)

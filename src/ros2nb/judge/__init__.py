@@ -11,15 +11,18 @@ checks, hooks, exceptions) changes it.  While grading, every subject also runs i
 sandbox of its own (the grader passes the sandbox command in ``ROS2NB_SUBJECT_PREFIX``)
 and cannot see, signal or trace the judge.
 
-Modules: ``observer`` (its own ROS node), ``subjects`` (the processes that run the
-learner's code), ``session`` (what the checks get as their judge), ``grading`` (a whole
-notebook's graded cells), ``flags`` (code that reaches in, for the instructor),
-``__main__`` (the command line).  It imports the checks it
-runs; the checks never import it (the kernel starts it by name).
+Modules: ``interface`` (what a check may ask of the judge, and the one JSON line of its
+outcome: the checks depend on it, never on the rest), ``observer`` (its own ROS node),
+``clock`` (its simulated time), ``subjects`` (the processes that run the learner's code),
+``session`` (what the checks get as their judge), ``graded_cells`` (a whole notebook's
+graded cells), ``flags`` (code that reaches in, for the instructor), ``__main__`` (the
+command line).  Only ``__main__`` and ``graded_cells`` reach into the checks, to run a
+check's body by name (:func:`ros2nb.checks.run_check`); the kernel starts the judge by name.
 
 Command line (``python -m ros2nb.judge``):
 
-- ``check NAME KWARGS_JSON``: run ``ros2nb.checks.NAME(**kwargs)``; print one JSON line.
+- ``check NAME``: run the body of the check ``ros2nb.checks.NAME`` with the judge's session;
+  print one JSON line.
 - ``grade SOURCE.ipynb SUBMISSION.ipynb``: run every graded cell of the course's source
   notebook (hidden tests included) against the learner's submission and workspace; print
   one JSON object, ``{"results": {grade_id: result}, "flags": [...]}`` (the flags, for the

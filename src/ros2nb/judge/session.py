@@ -1,7 +1,7 @@
 """One judge process's session: its observer, its subjects, its builds, its scratch folder.
 
 Part of the judge (:mod:`ros2nb.judge`).  The checks get the session as their judge
-(:class:`ros2nb.checks.base.Judge`) and ask it for subjects, programs and the observer.
+(:class:`ros2nb.judge.interface.Judge`) and ask it for subjects, programs and the observer.
 """
 
 from __future__ import annotations
@@ -23,14 +23,14 @@ from rclpy.qos import QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Bool, Float32
 
 from .. import course
-from ..checks.base import AnswerRef, learner_error
-from ..checks.nodes import parts_verdict
 from ..errors import CheckFailed
 from ..processes import kill_process_group, wait_patiently
 from ..runtime.clock import JUDGE_TOPICS_ENV
 from ..subject.forked import fork_program
+from ..terminal.files import parts_verdict
 from ..terminal.workspace import WORKSPACE_ENV
 from .clock import JudgeClock
+from .interface import AnswerRef, learner_error
 from .observer import Observer
 from .subjects import (Output, SubjectHung, SubjectProcess, home_and_tmp, subject_env,
                        subject_prefix, subjects_folder)
@@ -43,7 +43,7 @@ SET_ENV_AND_EXEC = ('import json, os, sys; env = json.loads(sys.argv[1]); '
 
 
 #: The course's reference node files (the judge's to read; a subject sees only the copies
-#: :meth:`Session.caught_up` hands it).
+#: :meth:`Session.answers_workspace` hands it).
 reference_files = resources.files('ros2nb.reference')
 #: Most bytes :meth:`Session.taken_back` copies out of one folder (an hour's bag is < 1 MiB).
 MAX_TAKEN_BACK_BYTES = 64 << 20
@@ -159,7 +159,7 @@ class Session:
 
         return self.subject(('cells', ref.sources, str(workspace)), load, workspace)
 
-    def caught_up(self, steps: tuple[str, ...]) -> Path:
+    def answers_workspace(self, steps: tuple[str, ...]) -> Path:
         """The workspace a notebook's answers run in: the learner's, or, when a node file the
         notebook relies on (``steps``, as :data:`ros2nb.course.STEPS` names them) is missing
         because the notebook was handed in alone, a copy with the course's reference node in

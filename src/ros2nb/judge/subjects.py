@@ -21,7 +21,6 @@ from pathlib import Path
 from typing import Any, Optional
 
 from .. import domains
-from ..checks.dispatch import IN_JUDGE_ENV
 from ..errors import CheckFailed
 from ..processes import Patience, kill_process_group, stop_process_group
 from ..runtime.clock import JUDGE_CLOCK_ENV
@@ -75,7 +74,7 @@ def subject_env(extra: Optional[dict[str, str]] = None) -> dict[str, str]:
     folders) and its ``TMPDIR`` is its ``tmp/``.
     """
     env = {k: v for k, v in os.environ.items()
-           if k not in (IN_JUDGE_ENV, SUBJECT_PREFIX_ENV, SUBJECTS_FOLDER_ENV)}
+           if k not in (SUBJECT_PREFIX_ENV, SUBJECTS_FOLDER_ENV)}
     folder, own_home = subjects_folder(), os.environ.get('HOME', '')
     if folder is not None:
         home, tmp = home_and_tmp(folder)

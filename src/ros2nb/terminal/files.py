@@ -16,7 +16,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import Iterator, Optional
 
-from ..errors import FileProtectedError, Ros2nbError, UsageError
+from ..errors import CheckFailed, FileProtectedError, Ros2nbError, UsageError
 from .workspace import PathLike, current_workspace, shown, workspace_file
 
 #: Where ros2nb records what it wrote, so it never overwrites a file you edited.
@@ -160,6 +160,21 @@ def missing_parts(workspace: Path, relative: str) -> list[int]:
     Introduced in ``03-write-the-publisher.ipynb`` (checks name a part run out of order).
     """
     return _gaps(saved_parts(workspace, relative) or set())
+
+
+def parts_verdict(workspace: Path, relative: str) -> None:
+    """Raise CheckFailed naming the ``%%part`` cells of ``relative`` never run, if any.
+
+    What a check says first when the learner's file does not load or lacks a class: a part
+    never run explains it best.  Introduced in ``03-write-the-publisher.ipynb``.
+    """
+    gaps = missing_parts(workspace, relative)
+    if gaps:
+        many = len(gaps) > 1
+        raise CheckFailed(f'{Path(relative).name} is missing part{"s" if many else ""} '
+                          f'{", ".join(map(str, gaps))}: run the %%part cell{"s" if many else ""} '
+                          f'for {"them" if many else "it"} (parts go into the file in number '
+                          'order), then this check again.')
 
 
 def _gaps(saved: set[int]) -> list[int]:

@@ -66,7 +66,7 @@ def judge_notebook(scratch: Scratch, notebook: str, submitted: nbformat.Notebook
         part.mkdir(parents=True)
     argv = [sys.executable, '-m', 'ros2nb.judge', 'grade', str(source),
             str(given / 'submission.ipynb')]
-    env = sandbox_env(own / 'home', ROS2NB_WORKSPACE=str(workspace), ROS2NB_JUDGE='1',
+    env = sandbox_env(own / 'home', ROS2NB_WORKSPACE=str(workspace),
                       TMPDIR=str(own / 'tmp'), **{SUBJECTS_FOLDER_ENV: str(subjects)})
     limits = sandbox.Limits(wall_s=JUDGE_TIMEOUT_S)
     if settings.sandboxed:

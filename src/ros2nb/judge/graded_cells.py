@@ -11,8 +11,7 @@ import ast
 from typing import Any, Optional
 
 from .. import checks, nbmeta
-from ..checks.base import AnswerRef
-from ..checks.dispatch import captured
+from .interface import AnswerRef, Judge, captured
 
 
 def _is_check_call(node: ast.AST) -> Optional[str]:
@@ -66,7 +65,7 @@ def _defined_names(source: str) -> set[str]:
     return names
 
 
-def grade(source: dict, submission: dict) -> dict[str, dict]:
+def grade(source: dict, submission: dict, judge: Judge) -> dict[str, dict]:
     """Run every graded cell of ``source`` (the course's notebook, hidden tests included).
 
     Names in a graded call (``LoudListener``) are the learner's: the judge passes an
@@ -76,6 +75,7 @@ def grade(source: dict, submission: dict) -> dict[str, dict]:
     :param source: the course's source notebook (nbformat JSON).
     :param submission: the learner's notebook (nbformat JSON); only its answer cells
         (nbgrader ``solution: true``) are used.
+    :param judge: the session every check's body runs with (:func:`ros2nb.checks.run_check`).
     :return: ``{grade_id: result}`` with ``passed``, ``lines``, ``type``, ``message``.
     """
     context = [nbmeta.text(c) for c in nbmeta.cells(source) if nbmeta.CONTEXT_TAG in
@@ -91,10 +91,9 @@ def grade(source: dict, submission: dict) -> dict[str, dict]:
             continue
         results[meta['grade_id']] = result = {'passed': True, 'lines': []}
         for name, args, keywords in graded_calls(nbmeta.text(cell)):
-            function = getattr(checks, name)
             values = [_value(a, names) for a in args]
             options = {k.arg: _value(k.value, names) for k in keywords}
-            outcome = captured(lambda: function(*values, **options))
+            outcome = captured(lambda: checks.run_check(name, judge, *values, **options))
             result['lines'] += outcome.pop('lines')
             if not outcome['passed']:
                 result.update(outcome)

@@ -10,21 +10,10 @@ from typing import Any, Optional
 
 from .. import course
 from ..errors import CheckFailed
-from ..terminal.files import missing_parts
+from ..terminal.files import parts_verdict
 from std_msgs.msg import Float32
 
-from .base import ARRIVAL_TIMEOUT_S, Judge, learner_error
-
-
-def parts_verdict(workspace: Path, relative: str) -> None:
-    """Raise CheckFailed naming the ``%%part`` cells of ``relative`` never run, if any."""
-    gaps = missing_parts(workspace, relative)
-    if gaps:
-        many = len(gaps) > 1
-        raise CheckFailed(f'{Path(relative).name} is missing part{"s" if many else ""} '
-                          f'{", ".join(map(str, gaps))}: run the %%part cell{"s" if many else ""} '
-                          f'for {"them" if many else "it"} (parts go into the file in number '
-                          'order), then this check again.')
+from ..judge.interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
 
 
 def new_node(judge: Judge, relative: str, cls: str, *, stand_ins: tuple[str, ...] = (),
@@ -53,17 +42,17 @@ def new_node(judge: Judge, relative: str, cls: str, *, stand_ins: tuple[str, ...
     if not reply['ok']:
         shown = ', '.join(repr(a) for a in args)
         raise learner_error(f'{cls}({shown})', reply['error'])
-    caught_up(judge, reply, mark, reply['started_lines'])
+    lines_logged(judge, reply, mark, reply['started_lines'])
     return subject, reply
 
 
 def started_log_verdict(judge: Judge, info: dict, mark: int, cls: str) -> None:
-    if info['started_lines'] == 0 or not caught_up(judge, info, mark, info['started_lines']):
+    if info['started_lines'] == 0 or not lines_logged(judge, info, mark, info['started_lines']):
         raise CheckFailed(f'{cls} logged nothing when it started: log a line such as '
                           f"'{cls[:11]} {cls[11:]} Node Started' with the node's logger.")
 
 
-def caught_up(judge: Judge, info: dict, mark: int, lines: int) -> list[str]:
+def lines_logged(judge: Judge, info: dict, mark: int, lines: int) -> list[str]:
     """Wait until the judge has ``lines`` log lines of the node after ``mark``; return them."""
     observer = judge.observer
     observer.wait_until(lambda: len(observer.lines_of(info['name'], mark)) >= lines,
@@ -116,4 +105,4 @@ def feed(judge: Judge, subject: Any, info: dict, value: float, counts: dict,
                             context=f' for {value} °C')
     if not reply['ok']:
         raise CheckFailed(f'The reading {value} °C never reached {never}')
-    return reply, caught_up(judge, info, mark, reply['logged'] - counts['logged'])
+    return reply, lines_logged(judge, info, mark, reply['logged'] - counts['logged'])
