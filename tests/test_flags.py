@@ -43,7 +43,8 @@ def test_flagged_exactly_when_the_code_reaches_in(learner: Learner, tmp_path):
     ("open('/proc/1/cmdline')", '/proc'),
     ('from rclpy.publisher import Publisher\nPublisher.publish = print', 'Publisher.publish'),
     ('import rclpy\nsetattr(rclpy, "spin", print)', 'an attribute of rclpy'),
-    ('from ros2nb.runtime import clock', "ros2nb.runtime.clock (ros2nb's internals)"),
+    ('from ros2nb.runtime import simulated_clock',
+     "ros2nb.runtime.simulated_clock (ros2nb's internals)"),
     ('import ros2nb\nros2nb.current_runtime()', 'ros2nb.current_runtime'),
     ('import ctypes', 'ctypes'),
 ])

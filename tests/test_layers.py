@@ -179,20 +179,76 @@ def test_no_module_or_function_is_too_long():
     assert too_long == []
 
 
+def folder_problems(text: str, sources: dict[str, tuple[str, bool]]) -> list[str]:
+    """One line per folder of the tree without its section in the document ("### `pkg`" with
+    "Runs in" and "Trusts"), per module its folder's section does not name, and per section
+    or name of the document that is not in the tree."""
+    sections = dict(re.findall(r'^### `([\w.]+)`\n(.*?)(?=^#)', text + '\n#', re.M | re.S))
+    packages = sorted(name for name, (_, is_package) in sources.items() if is_package)
+    found = [f'{name} is a section of docs/architecture.md but no folder of src/'
+             for name in sorted(sections) if name not in packages]
+    for package in packages:
+        section = sections.get(package)
+        if section is None:
+            found.append(f'{package} has no section in docs/architecture.md: add "### `{package}`"')
+            continue
+        found += [f'the section of {package} does not say "{what}"'
+                  for what in ('**Runs in:**', '**Trusts:**') if what not in section]
+        named = set(re.findall(r'`([\w.]+)`', section))
+        found += [f'{name} is not named in the section of {package}' for name in sorted(sources)
+                  if name.rpartition('.')[0] == package and not sources[name][1]
+                  and name not in named]
+    return found
+
+
 def test_the_architecture_document_matches_the_tree():
-    """Every module and layer appears in docs/architecture.md (a package for its modules),
-    and the document names no module that is not in the tree."""
+    """Every folder has its section (where it runs, whom it trusts) naming each of its
+    modules; every layer appears; and the document names no module that is not in the tree."""
     text = ARCHITECTURE.read_text()
+    sources = tree_sources()
     named = set(re.findall(r'`((?:ros2nb|ros2nb_instructor)(?:\.\w+)*)`', text))
-    modules = set(tree_sources())
-    packages = {name for name, (_, is_package) in tree_sources().items() if is_package}
+    modules = set(sources)
     layered = {prefix for layer in LAYERS for prefix in layer}
-    missing = sorted(name for name in modules | layered
-                     if name not in named and not any(name.startswith(p + '.') and p in named
-                                                      and p in packages for p in named))
+    missing = sorted(name for name in layered if name not in named)
     unknown = sorted(name for name in named if name not in modules | layered
-                     and name.rpartition('.')[0] not in modules)  # a module's function is fine
-    assert (missing, unknown) == ([], [])
+                     and not _attribute_of_a_module(name, sources))
+    assert (folder_problems(text, sources), missing, unknown) == ([], [], [])
+
+
+def _attribute_of_a_module(name: str, sources: dict[str, tuple[str, bool]]) -> bool:
+    """``ros2nb.checks.source.TEXT``: a name its module defines at its top level."""
+    module, _, attribute = name.rpartition('.')
+    if module not in sources:
+        return False
+    tree = ast.parse(sources[module][0])
+    defined = {getattr(node, 'name', None) for node in tree.body}
+    defined |= {target.id for node in tree.body if isinstance(node, (ast.Assign, ast.AnnAssign))
+                for target in (node.targets if isinstance(node, ast.Assign) else [node.target])
+                if isinstance(target, ast.Name)}
+    defined |= {alias.asname or alias.name for node in tree.body
+                if isinstance(node, ast.ImportFrom) for alias in node.names}
+    return attribute in defined
+
+
+def test_a_module_left_out_of_the_document_is_named():
+    """The check itself can fail: a new module, and a folder without its section."""
+    sources = {'pkg': ('', True), 'pkg.old': ('', False), 'pkg.new': ('', False),
+               'pkg.sub': ('', True), 'pkg.sub.mod': ('', False)}
+    text = ('### `pkg`\n- **Runs in:** here.\n- **Trusts:** nothing.\n- **Modules:** '
+            '`pkg.old`.\n\n### `gone`\n- **Runs in:** nowhere.\n')
+    assert folder_problems(text, sources) == [
+        'gone is a section of docs/architecture.md but no folder of src/',
+        'pkg.new is not named in the section of pkg',
+        'pkg.sub has no section in docs/architecture.md: add "### `pkg.sub`"']
+
+
+def test_no_two_modules_share_a_name():
+    """A module's file name says what it is, once in src/ (``python -m`` needs __main__)."""
+    seen: dict[str, list[str]] = {}
+    for path in sorted(SRC.rglob('*.py')):
+        if path.stem not in ('__init__', '__main__'):
+            seen.setdefault(path.stem, []).append(str(path.relative_to(SRC)))
+    assert {stem: paths for stem, paths in seen.items() if len(paths) > 1} == {}
 
 
 def test_every_module_imports():

@@ -42,7 +42,7 @@ def test_import_does_nothing():
 
 def test_a_subject_does_not_load_the_checks_or_rosbags():
     """A judge starts hundreds of subjects in a class; checks and rosbags cost each 0.35 CPU-s."""
-    probe = ('import sys, ros2nb.subject.process, ros2nb; '
+    probe = ('import sys, ros2nb.subject.commands, ros2nb; '
              'loaded = [m in sys.modules for m in ("ros2nb.checks", "rosbags")]; '
              'print(*loaded, ros2nb.checks.check_recording.__name__, ros2nb.bag_info.__name__, '
              'ros2nb.terminal.bag.__name__, "checks" in dir(ros2nb), "bag_play" in dir(ros2nb))')

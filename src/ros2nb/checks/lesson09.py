@@ -20,7 +20,7 @@ from rclpy.qos import (DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityP
 from std_msgs.msg import Int32
 
 from .. import qos
-from ..explain.settings import zero_depth_refused
+from ..explain.ros_settings import zero_depth_refused
 from ..errors import CheckFailed
 from .answers import defined_verdict, type_name_of
 from ..judge.interface import ARRIVAL_TIMEOUT_S, AnswerRef, Judge, learner_error

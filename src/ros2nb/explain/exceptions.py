@@ -24,7 +24,7 @@ from .bag_reading import bag_reading_mistake
 from .frames import frames_of, is_library_file, learner_entry, learner_frame, raised_in
 from .plain_python import python_mistake
 from .plots import plot_in_callback
-from .settings import qos_setting, settings_mistake
+from .ros_settings import qos_setting, settings_mistake
 
 
 def learner_line(exc: BaseException) -> str:

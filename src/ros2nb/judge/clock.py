@@ -2,7 +2,7 @@
 
 Part of the judge (:mod:`ros2nb.judge`).  The judge publishes ``/clock`` from its own node;
 the learner's nodes in a subject run on it (their runtime follows it, see
-:class:`ros2nb.runtime.clock.JudgeTime`), and everything the judge's node hears is stamped
+:class:`ros2nb.subject.judge_time.JudgeTime`), and everything the judge's node hears is stamped
 with it (:attr:`ros2nb.judge.observer.Observer.now_ns`).  How far each step goes, and how
 far the clock goes at all, is the judge's choice; a subject only says, after each step,
 that it has run what became due, how much it published and logged meanwhile (so that the
@@ -21,7 +21,7 @@ from rosgraph_msgs.msg import Clock
 from .interface import ARRIVAL_TIMEOUT_S, learner_error
 from ..errors import CheckFailed
 from ..processes import Patience, kill_process_group
-from ..runtime.clock import JUDGE_CLOCK_QOS
+from ..subject.judge_time import JUDGE_CLOCK_QOS
 from ..runtime.core import QUIET_PUBLISHER
 from .observer import Observer
 from .subjects import REPLY_TIMEOUT_S, SubjectProcess

@@ -25,7 +25,7 @@ from std_msgs.msg import Bool, Float32
 from .. import course
 from ..errors import CheckFailed
 from ..processes import kill_process_group, wait_patiently
-from ..runtime.clock import JUDGE_TOPICS_ENV
+from ..subject.judge_time import JUDGE_TOPICS_ENV
 from ..subject.forked import fork_program
 from ..terminal.files import parts_verdict
 from ..terminal.workspace import WORKSPACE_ENV

@@ -23,7 +23,7 @@ from typing import Any, Optional
 from .. import domains
 from ..errors import CheckFailed
 from ..processes import Patience, kill_process_group, stop_process_group
-from ..runtime.clock import JUDGE_CLOCK_ENV
+from ..subject.judge_time import JUDGE_CLOCK_ENV
 from ..subject.forked import fork_subject, has_server
 
 #: JSON list put in front of every subject's command (the grader's sandbox).
@@ -108,7 +108,7 @@ class Output:
 
 
 def _well_formed_ack(line: bytes) -> Optional[dict]:
-    """An acknowledgement as :class:`~ros2nb.runtime.clock.JudgeTime` writes it, or None."""
+    """An acknowledgement as :class:`~ros2nb.subject.judge_time.JudgeTime` writes it, or None."""
     try:
         ack = json.loads(line)
     except ValueError:

@@ -25,7 +25,7 @@ from rosgraph_msgs.msg import Clock
 from .. import domains
 from ..errors import SHUT_DOWN_MESSAGE, Ros2nbError
 from .callers import use_cheaper_caller_lookup
-from .clock import SimulatedClock
+from .simulated_clock import SimulatedClock
 from .logs import LogLines
 from .nodes import NodeKeeping, destroy_stray_nodes, drop_qos_warnings
 from .spinning import Spinning

@@ -1,7 +1,7 @@
 """``python -m ros2nb.subject IN_FD OUT_FD``: the process that runs the learner's code for a judge.
 
 Started by the judge (:mod:`ros2nb.judge.subjects`), sandboxed while grading.  The first
-command loads the learner's code (:func:`ros2nb.subject.process.load`) before the command
+command loads the learner's code (:func:`ros2nb.subject.commands.load`) before the command
 loop exists; the loop answers the rest.
 """
 
@@ -13,13 +13,13 @@ import sys
 
 from ..explain.plots import guard_pyplot
 from ..processes import end_this_process
-from ..runtime.clock import JudgeTime
-from .process import LOADERS, PROTOCOL_ERROR, load, serve
+from . import judge_time
+from .commands import LOADERS, PROTOCOL_ERROR, load, serve
 
 
 def main(argv: list[str]) -> int:
     """Entry point: ``python -m ros2nb.subject IN_FD OUT_FD``."""
-    JudgeTime.claim()  # the judge's pipe: this process's alone, never a child's
+    judge_time.install()  # the judge's pipe and time: this process's alone, never a child's
     guard_pyplot()  # plt.pause / plt.show in a callback: the learner's one line
     if len(argv) != 2:
         print('Usage: python -m ros2nb.subject IN_FD OUT_FD (started by ros2nb.judge).',

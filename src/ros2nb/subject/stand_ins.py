@@ -3,7 +3,7 @@
 Introduced in ``03-write-the-publisher.ipynb``.  A check grades one part of a node: the
 constructor, or the callback, or ``main()``.  So that a mistake in one part costs only
 that part's points, the judge may run the learner's class with another part replaced by
-the one here (``new_node(..., stand_ins=[...])``, :mod:`ros2nb.subject.process`), or
+the one here (``new_node(..., stand_ins=[...])``, :mod:`ros2nb.subject.commands`), or
 ``main()`` with a whole stand-in node (:mod:`ros2nb.subject.program`).  A stand-in never
 counts for the learner: it only makes room for their own part to be seen.
 

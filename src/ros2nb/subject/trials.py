@@ -1,6 +1,6 @@
 """The subject's commands for notebooks 06 and 09: the learner's worker, rooms and QoS endpoints.
 
-Part of :mod:`ros2nb.subject` (a mixin of :class:`ros2nb.subject.process.Subject`).  Each
+Part of :mod:`ros2nb.subject` (a mixin of :class:`ros2nb.subject.commands.Subject`).  Each
 command makes something of the learner's run (their executor spinning their Worker, nodes
 started with their arguments, an endpoint with their profile); the judge watches it over ROS
 itself.  A reply names the parts only so that the judge can say why what it saw went wrong.
@@ -20,7 +20,7 @@ from std_msgs.msg import Float32, Int32
 
 from ..endpoints import node_endpoints
 from ..explain.exceptions import describe_error
-from ..explain.settings import zero_depth_refused
+from ..explain.ros_settings import zero_depth_refused
 from ..runtime.rates import callback_groups
 from .replies import encode
 

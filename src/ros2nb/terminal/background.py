@@ -17,7 +17,7 @@ import threading
 from typing import Optional
 
 from ..errors import UsageError
-from ..explain.settings import output_mistake
+from ..explain.ros_settings import output_mistake
 from ..processes import stop_process_group, wait_for_work
 from .colcon import source_workspace
 from .run import _command, node_process_env

@@ -22,7 +22,7 @@ from ament_index_python.packages import PackageNotFoundError, get_package_prefix
 
 from .. import domains, runtime
 from ..errors import Ros2nbError, UsageError
-from ..explain.settings import output_mistake
+from ..explain.ros_settings import output_mistake
 from ..processes import STOP_GRACE_S, Patience, signal_group, stop_process_group
 from .colcon import source_workspace
 from .workspace import PathLike, workspace_or_current

@@ -7,7 +7,7 @@ The judge (:mod:`ros2nb.judge`) starts this process, sends it commands as JSON l
 file descriptor IN and reads one JSON reply per command on OUT.  The first command loads
 the learner's code (their file imported, or their answer cells run), before anything of the
 command loop exists; then their nodes run here on the judge's clock (the runtime follows the
-judge's ``/clock``, :mod:`ros2nb.runtime.clock`), with the course's stand-ins in place of
+judge's ``/clock``, :mod:`ros2nb.subject.judge_time`), with the course's stand-ins in place of
 the parts a check does not grade (:mod:`.stand_ins`).  The judge watches the nodes over ROS
 itself; a reply only tells it how long to wait, or which mistake to name.
 """
@@ -30,7 +30,7 @@ from ..endpoints import node_endpoints
 from ..errors import Ros2nbError
 from ..explain.exceptions import describe_error
 from ..runtime import Runtime, enable_field_checks
-from ..runtime.clock import JudgeTime
+from .judge_time import JudgeTime
 from .replies import decode_argument, encode
 from .stand_ins import with_stand_ins
 from .trials import Trials
@@ -147,7 +147,7 @@ class Subject(Trials):
                            if isinstance(v, type) and issubclass(v, Node) and v is not Node)
             return {'ok': False, 'no_class': True, 'classes': found}
         node_class = with_stand_ins(node_class, stand_ins)
-        rt.catch_up_with_judge()
+        rt.take_judge_time()
         if seed is not None:
             random.seed(seed)
         self.received, self.failure = 0, None
