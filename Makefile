@@ -21,7 +21,7 @@ export PIP_DISABLE_PIP_VERSION_CHECK := 1
 # (an institution's, whose CA the machine trusts), uv's own roots refuse PyPI.
 export UV_SYSTEM_CERTS := 1
 # numpy's OpenBLAS starts a thread per CPU that spins at import; every process with ROS imports
-# numpy (rclpy's message types), and none of them does linear algebra: 0.05-0.1 CPU-s each.
+# numpy (rclpy's message types), and none of them does linear algebra (docs/decisions.md).
 export OPENBLAS_NUM_THREADS := 1
 
 .PHONY: image image-tool lab lab-instructor check test setup bytecode sandbox-tool browser-tool graph-tool grading-course solutions learner-notebooks bench grade clean
@@ -45,8 +45,8 @@ $(STAMP): environment/requirements.txt environment/installer.txt pyproject.toml
 
 # The course's own Python compiled once, here: where PYTHONDONTWRITEBYTECODE is set (as on
 # our machines) every process that imports ros2nb (kernels, judges, subjects: hundreds in
-# make test) would compile it again, 0.1 CPU-s each.  Python checks each file's source time
-# and size, so a stale one is compiled again in memory, never used.
+# make test) would compile it again (docs/decisions.md).  Python checks each file's source
+# time and size, so a stale one is compiled again in memory, never used.
 bytecode: $(STAMP)
 	@$(PY) -m compileall -q src tests benchmarks conftest.py >/dev/null
 
@@ -111,8 +111,7 @@ test: check $(STAMP) bytecode sandbox-tool browser-tool graph-tool image-tool gr
 # The nbgrader course of the current solutions (generate_assignment, kept per version of the
 # solutions in .cache/grading-courses/), made before the tests start. Otherwise the first test
 # that grades makes it, at make test's busiest moment and as the first step of the sample
-# class, tests/'s longest chain: in a fresh clone beside two CPU burners, that class's grader
-# ran 226 s before its first learner started (alone, 10 s), and the class took 799 s.
+# class, tests/'s longest chain, which then waits for it (docs/decisions.md).
 grading-course: $(STAMP) bytecode
 	@$(PY) -c 'from ros2nb_instructor.grading.gradebook import kept_course; kept_course()'
 

@@ -73,8 +73,9 @@ MISTAKE_IDS = [f'{m[0]}: {m[1]}' for m in MISTAKES]
 #: Simulated seconds a mistake of ``record_hour`` records, unless the mistake is the length
 #: itself: ``course.RECORD_S`` and the notebook's ``HOUR_S`` are both set to it for that test.
 #: Which line a mistake gets does not depend on how long the recording runs, and the full
-#: hour of the sensor and the monitor cost each mistake about 3 CPU-s in the kernel and 7 in
-#: the judge and its subject.  ``test_the_solutions_pass`` records the full hour, both ways.
+#: hour of the sensor and the monitor would cost each mistake an hour in the kernel and
+#: another in the judge and its subject (docs/decisions.md).  ``test_the_solutions_pass``
+#: records the full hour, both ways.
 SHORT_RECORD_S = 120
 #: The grading context's line that sets the hour (the course's own length).
 HOUR_LINE = f'HOUR_S = {int(course.RECORD_S)}\n'

@@ -49,7 +49,7 @@ def chromium() -> Iterator:
 
 @pytest.fixture(scope='module')
 def module_chromium():
-    """One headless chromium for a test module's pages (a launch costs about 5 CPU-s);
+    """One headless chromium for a test module's pages (a launch is costly: docs/decisions.md);
     skips the tests where there is no browser."""
     why = problem()
     if why:

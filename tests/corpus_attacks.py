@@ -62,9 +62,9 @@ for _argument in sys.argv:
             os.chmod(os.path.join(_bin, _name), 0o755)
 ''')]
 
-#: Module code that finds the subject's request loop from the learner's import, as the
-#: attacks of 123efa2's sample class did, and answers every question with a right answer's
-#: numbers.  The subject now loads the learner's code before the loop exists.
+#: Module code that finds the subject's request loop from the learner's import and answers
+#: every question with a right answer's numbers.  It needs a loop that already exists when
+#: the learner's code is imported; the subject loads that code before the loop exists.
 FORGE_REPLIES = '''
 import sys as _sys
 _frame = _sys._getframe()

@@ -404,8 +404,8 @@ MAIN_GUARD = "\nif __name__ == '__main__':"
 
 #: A callback that waits for a flag only another callback could set: with one thread
 #: spinning, it waits for ever. (The hangs wait rather than compute: a hung cell keeps its
-#: sandbox for the whole cell limit, and a loop burning a CPU for those two minutes took a
-#: third of the sample class's CPU time from the learners graded beside it.)
+#: sandbox for the whole cell limit, and a loop burning a CPU for those two minutes takes
+#: CPU time from the learners graded beside it: docs/decisions.md.)
 HANG_IN_CALLBACK = '''
 import time
 from rclpy.node import Node

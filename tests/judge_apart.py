@@ -9,8 +9,8 @@ finds nothing: no point may depend on reading the learner's code.
 The corpora's tests (``corpora.py``) start it rather than judging in the test process: a judge
 steps its subject's clock one simulated second at a time, each step a turn of each process,
 and in pytest-xdist's worker the judge shared the worker's scheduling group (its session) with
-every other worker: beside two CPU burners started from the same shell, one hour of notebook
-03 took its test 80 s instead of 5.
+every other worker, and beside CPU burners started from the same shell one hour of notebook
+03 took its test many times as long (docs/decisions.md).
 """
 
 from __future__ import annotations

@@ -14,11 +14,11 @@
 # Each result gives the step's wall seconds and the CPU seconds of all its processes
 # (tests/run_counted.py).
 #
-# Every step runs at the same priority (NBVAL_NICE=0).  Steps 2 and 3 once ran at nice 5, so
-# that the grading of the sample class (step 1's longest chain) went first; since the class is
-# scored as each learner ends, tests/ is CPU-bound across all its workers, not held up by one
-# chain, and a lower priority only gave other programs on the machine a larger share of the
-# two cores (beside two CPU burners, nice weighs steps 2 and 3 at a third of a burner each).
+# Every step runs at the same priority (NBVAL_NICE=0).  The sample class (step 1's longest
+# chain) is scored as each learner ends, so tests/ is CPU-bound across all its workers, not
+# held up by one chain: a lower priority for steps 2 and 3 would not let the class go first,
+# it would only give other programs on the machine a larger share of the two cores (at nice 5
+# a step weighs a third of a CPU burner at nice 0).
 # Usage: tests/run_steps.sh PYTHON WORKERS
 set -u
 python=$1 workers=$2

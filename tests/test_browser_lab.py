@@ -165,8 +165,8 @@ def test_a_finished_notebook_runs_to_the_end_with_its_check_passing(lab):
 
 def test_interrupt_stops_a_spin_with_one_line(lab):
     """Stop ends a spin that would run for 10**7 s, with one line. How fast (the target is
-    under a second) is ``make bench BENCH_ARGS='--only interrupt'``'s to measure: asserted
-    here, 1.0 s failed at 1.10 s beside two CPU burners."""
+    under a second) is ``make bench BENCH_ARGS='--only interrupt'``'s to measure: a browser
+    beside CPU burners cannot promise a second (docs/decisions.md)."""
     page, shots, _ = lab
     index = page.locator('.jp-Notebook .jp-CodeCell').count()  # the new cell's, at the end
     page.locator('.jp-Notebook .jp-Cell').last.click()

@@ -4,11 +4,11 @@ As tests/test_checks.py: this process is the judge, the learner's code runs in r
 processes and the verdicts come from the judge's own ROS node. Each learner below is the
 course's reference with one piece of work left out and, at import, code that walks up the
 stack to the subject's request loop and rewrites its replies (or does the missing work
-itself inside them, or rewrites the files the judge reads). Against the judge of 31f397c,
-which believed the subject's replies, every check below passed (notebook 03: no timer 6/6,
-a callback doing nothing 6/6, a property's start value 3/6, a main() that never starts ROS
-6/6; notebook 04: a callback doing nothing 5/5; notebook 02's reader 1/1). Now each fails
-with one line; the honest twin of each is the reference, which passes (tests/test_checks.py).
+itself inside them, or rewrites the files the judge reads). Against a judge that believed
+the subject's replies, every check below passed (notebook 03: no timer 6/6, a callback doing
+nothing 6/6, a property's start value 3/6, a main() that never starts ROS 6/6; notebook 04:
+a callback doing nothing 5/5; notebook 02's reader 1/1). Here each fails with one line; the
+honest twin of each is the reference, which passes (tests/test_checks.py).
 """
 
 import pytest

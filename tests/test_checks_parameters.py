@@ -67,7 +67,7 @@ DECLARATION_MISTAKES = [
      "        self.get_parameter('high_above_c')\n"
      "        self.declare_parameter('high_above_c', HIGH_ABOVE_C,",
      r'TemperatureMonitor\(\) reads the parameter high_above_c before it declares it'),
-    # told at once (it waited 60 s and blamed a busy machine)
+    # told at once, not after a long wait blamed on a busy machine
     ('no parameter services', "super().__init__('temperature_monitor')",
      "super().__init__('temperature_monitor', start_parameter_services=False)",
      r'TemperatureMonitor has no parameter services \(was it made with '

@@ -217,9 +217,8 @@ def test_a_new_node_joins_the_graph_of_a_running_process_without_waiting_3_s():
     """Every process of the course announces itself every second (the course's Fast DDS
     profile, ros2nb.domains.DISCOVERY_PROFILE), so a node a check starts appears in its
     judge's graph within about a second. With Fast DDS's default of 3 s, a newcomer whose first
-    exchange with the judge was lost waited for the judge's next announcement: in five runs
-    of eight starts on an idle machine, the slowest took 2.6-3.0 s every time
-    (benchmarks/discovery.py measures both)."""
+    exchange with the judge was lost waits for the judge's next announcement, up to 3 s
+    (benchmarks/discovery.py measures both: docs/decisions.md)."""
     from nodes import join_times
 
     from ros2nb.judge.observer import Observer

@@ -1,7 +1,7 @@
 """A subject or program forked from the fork server is the process a started one is.
 
 A judge forks its unsandboxed subjects and the learner's main() from a server that has
-imported ROS (``ros2nb.subject.forked``), 0.2-0.3 CPU-s less each.  What the learner's code can
+imported ROS (``ros2nb.subject.forked``), sparing each the imports.  What the learner's code can
 see of its process must not change with it: environment, working folder, ``sys.path``, its own
 session, standard streams, and rclpy's field checks, which generated message modules read
 from the environment once, when the server imported them (the judge's own environment, here

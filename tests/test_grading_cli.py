@@ -128,7 +128,7 @@ def test_a_scoring_process_that_ended_is_started_again(tmp_path):
     """nbgrader scores a class batch by batch in one process (gradebook.Scoring); one that
     ended between two batches (killed, crashed) is started again for the next batch, whose
     learner is scored all the same (without the new start, that batch was lost: 0 points)."""
-    # Here, not at the top: nbgrader's package imports its server extensions (1 CPU-s), and
+    # Here, not at the top: nbgrader's package imports its server extensions (costly), and
     # every pytest-xdist worker imports each test file while it collects.
     from nbgrader.api import Gradebook
     from ros2nb_instructor.grading.gradebook import Scoring, set_up_course
@@ -164,7 +164,7 @@ def _runs(pid: str, *words: bytes) -> bool:
 def test_a_grading_waits_for_the_course_another_is_making(locked, tmp_path, monkeypatch):
     """The nbgrader course is made once per version of the solutions (``kept_course``): a
     grading that asks while another is making it waits for that one.  Without the lock the
-    second made it again (nbgrader's generate_assignment: about 10 CPU-s).  generate_assignment
+    second made it again (nbgrader's generate_assignment, seconds of CPU).  generate_assignment
     is played by a stand-in that holds until the test lets it finish."""
     from ros2nb_instructor.grading import gradebook
     monkeypatch.setattr(gradebook, 'SET_UP_CACHE', tmp_path)

@@ -82,7 +82,7 @@ def test_results_are_read_without_following_a_link(tmp_path, host):
 @pytest.mark.skipif(os.geteuid() != 0, reason='a size-capped scratch needs root (the grader is)')
 def test_a_learners_home_holds_a_bounded_total(scratch):
     """Files each under the size limit still stop at the home's total: the learner's own
-    disk is full, nobody else's (before, one learner wrote 3 GB in 24 s)."""
+    disk is full, nobody else's (a learner's loop can write gigabytes in seconds)."""
     chunk = b'x' * (64 << 20)
     with pytest.raises(OSError, match='No space left'):
         for number in range(HOME_BYTES // len(chunk) + 2):

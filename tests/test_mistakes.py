@@ -407,8 +407,8 @@ def test_a_long_simulated_spin_interrupted_is_one_line_not_its_log_lines(ros):
 
 def test_a_callback_left_due_by_the_stop_button_adds_no_line_after_it(ros):
     # The Stop button lands after a step of /clock made two timers due and before the second
-    # ran. Run later, by the thread that spins between cells, its line (0.3 s later) came
-    # after "Interrupted ..." in the same cell (a learner's Lab showed it). The first timer
+    # ran. Run later, by the thread that spins between cells, its line would come after
+    # "Interrupted ..." in the same cell (a learner's Lab showed it). The first timer
     # presses Stop itself, so the interrupt lands there however busy the machine is.
     ros.run("import os, signal, time\n"
             "class Sensor(Node):\n    def __init__(self):\n        super().__init__('slow')\n"
@@ -456,8 +456,8 @@ def test_a_qos_setting_of_the_wrong_type_in_09(ros, profile, fragments):
 
 
 def test_plt_pause_in_a_plot_callback_is_one_line_not_a_minute_of_copies(ros):
-    """07: plt.pause in the callback held every message up for its interval (the live cell
-    took 78 s instead of 1.3 s) and drew a copy each time; now the node stops at the first
+    """07: plt.pause in the callback holds every message up for its interval (a live cell of
+    a second runs for a minute) and draws a copy each time; the node stops at the first
     message with one line at the learner's line."""
     ros.run('import matplotlib.pyplot as plt\n'
             'class Pausing(Node):\n'

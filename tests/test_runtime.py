@@ -41,7 +41,8 @@ def test_import_does_nothing():
 
 
 def test_a_subject_does_not_load_the_checks_or_rosbags():
-    """A judge starts hundreds of subjects in a class; checks and rosbags cost each 0.35 CPU-s."""
+    """A judge starts hundreds of subjects in a class; checks and rosbags would cost each one
+    half its start (docs/decisions.md)."""
     probe = ('import sys, ros2nb.subject.commands, ros2nb; '
              'loaded = [m in sys.modules for m in ("ros2nb.checks", "rosbags")]; '
              'print(*loaded, ros2nb.checks.check_recording.__name__, ros2nb.bag_info.__name__, '
@@ -73,7 +74,7 @@ def test_start_is_idempotent_and_keeps_the_clock(ros):
     monitor = ros2nb.add(Monitor())
     ros2nb.add(Sensor())
     started = time.monotonic()
-    ros2nb.spin(30)  # the old start() switched to the wall clock: this took 30 s
+    ros2nb.spin(30)  # on the wall clock (a start() that switched to it) this would be 30 s
     assert time.monotonic() - started < 29  # 30 simulated s, not 30 real ones
     assert len(monitor.received) == 30
 

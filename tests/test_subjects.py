@@ -92,8 +92,8 @@ while True:
 
 def test_a_program_the_scheduler_starves_is_working_not_waiting():
     """A program that stands ready on the run queue while others hold the CPU is not waiting
-    for ever. Beside two CPU burners and a test run, a learner's main() was measured at 0.07 s
-    of CPU and 8.7 s queued in its first 10 s, and was told it never started its node.
+    for ever. Beside CPU burners and a test run, a learner's main() stood queued for most of
+    its first seconds, and was told it never started its node (docs/decisions.md).
     Here a program of the lowest scheduling class shares one CPU with a burner."""
     cpu = min(os.sched_getaffinity(0))
     burner = subprocess.Popen([sys.executable, '-c', 'import os\nos.sched_setaffinity(0, {%d})\n'
@@ -188,8 +188,8 @@ CUT = 6
 def test_a_busy_watcher_does_not_make_a_waiting_program_look_busy():
     """Only the watched tree's threads count. A judge that grades in the test process has
     executor and Fast DDS threads at work beside its watch; counted too, they stood ready in
-    every look, and a main() that never starts ROS was given ten times its limit (124 s
-    instead of 20 beside two CPU burners). Here the watcher's own thread computes without
+    every look, and a main() that never starts ROS was given ten times its limit beside CPU
+    burners (docs/decisions.md). Here the watcher's own thread computes without
     the GIL while the program it watches sleeps for an hour."""
     done = run_to_end([sys.executable, '-c', WATCHER, str(LIMIT_S), str(CUT)], 'the watcher')
     verdict, _, waited = done.stdout.strip().rpartition(' ')
@@ -214,8 +214,8 @@ def test_the_judges_node_waits_only_for_what_it_hears():
     """The judge's executor waits once or twice per step of its clock, thousands of times
     per check, and each wait walks every entity of its node. rclpy's default QoS event
     handlers (two per publisher and per subscription, /parameter_events included) made eight
-    of them here, only to warn of a QoS mismatch: a simulated hour cost the judge 2.1 CPU-s
-    with them, 1.5 without."""
+    of them here, only to warn of a QoS mismatch, in every wait of a simulated hour
+    (docs/decisions.md)."""
     from std_msgs.msg import Float32
     from ros2nb.judge.clock import JudgeClock
     watching = observer.Observer()

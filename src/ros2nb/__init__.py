@@ -29,7 +29,7 @@ from .terminal.workspace import create_workspace, current_workspace, tree
 
 
 #: Loaded on first use (PEP 562): a process that only runs nodes, such as a judge's subject,
-#: never pays for the notebooks' checks or for rosbags (0.35 CPU-s of a subject's 0.7 start).
+#: never pays for importing the notebooks' checks or rosbags (docs/decisions.md).
 _ON_FIRST_USE = {'checks': 'checks', 'Recording': 'terminal.bag', 'bag_info': 'terminal.bag',
                  'bag_play': 'terminal.bag', 'bag_record': 'terminal.bag'}
 

@@ -18,7 +18,8 @@ sticky bit, like ``/tmp``.
 Every process of the course finds its peers with the course's Fast DDS profile
 (:data:`DISCOVERY_PROFILE`, put into the environment by :func:`use_discovery_profile`, which
 :func:`domain_id` and the runtime call before ROS comes up): a new node appears in the graph
-of the processes already running within about a second, not after 2-3 s.  No ROS import here.
+of the processes already running within about a second, not at Fast DDS's default
+announcement every 3 s.  No ROS import here.
 """
 
 from __future__ import annotations

@@ -69,8 +69,8 @@ def kill_process_group(proc: subprocess.Popen) -> Optional[int]:
     later; return the exit code.
 
     Not SIGKILL at once: a ROS process killed so leaves its Fast DDS shared-memory ports
-    behind, and the next participants on that domain took seconds more to be discovered
-    (2-6 s instead of 0.3 s, measured); rclpy ends on SIGTERM in a fraction of that.
+    behind, and the next participants on that domain take seconds more to be discovered
+    (docs/decisions.md); rclpy ends on SIGTERM in a fraction of that.
     """
     return stop_process_group(proc, signals=((signal.SIGTERM, KILL_GRACE_S),
                                              (signal.SIGKILL, TERM_GRACE_S)))

@@ -12,9 +12,9 @@ from .. import course
 #: the context down from a thread of its own, and the KeyboardInterrupt reaches the spin a
 #: moment later; a callback, or the spin's next wait, that runs in between fails on the invalid
 #: context (RCLError, a RuntimeError), as ros2cli also finds (ros2/ros2cli#854).  The stand-ins,
-#: busy five times a second, met it in 13 of 240 runs of check_package_runs (ten at once beside
-#: two CPU burners), and the learner lost the point; with this clause, in none of 240.  (A
-#: learner's main() that meets it is run again with the course's stand-in node: mains.run_main.)
+#: busy five times a second, meet it on a busy machine, and the learner would lose the point
+#: to rclpy; with this clause they do not (docs/decisions.md).  (A learner's main() that
+#: meets it is run again with the course's stand-in node: mains.run_main.)
 RCLPY_SHUTDOWN_RACE = '''\
     except RuntimeError:  # Ctrl+C shut rclpy down while it worked: rclpy's race, not a fault
         if rclpy.ok():

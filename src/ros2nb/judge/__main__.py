@@ -35,8 +35,8 @@ def main(argv: list[str]) -> int:
         if argv[0] == 'check':
             result: Any = captured(lambda: checks.run_check(argv[1], session))
         else:
-            # Only grading flags code (the flags parse cells with IPython: 40 ms of imports
-            # that every check of a learner's kernel would pay).
+            # Only grading flags code (the flags parse cells with IPython, whose imports
+            # every check of a learner's kernel would pay).
             from .flags import notebook_flags
             source, submission = (json.loads(Path(p).read_text()) for p in argv[1:])
             result = {'results': grade(source, submission, session),

@@ -32,10 +32,9 @@ from ..runtime.services import call_until_answered
 
 
 #: Longest wait of the judge's spin thread for work (s); None: until work comes, or
-#: :meth:`Observer.close` wakes it.  rclpy's ``spin_once`` could only end at its timeout (at
-#: 0.05 s an idle judge took 1.1 % of a core), and a wait with a timeout costs rclpy a timer
-#: of its own: without one, the spin thread spends 0.8-0.9 CPU-s on a simulated hour of
-#: notebook 03 instead of 0.9-1.0.
+#: :meth:`Observer.close` wakes it.  rclpy's ``spin_once`` could only end at its timeout, so
+#: an idle judge kept waking for nothing, and a wait with a timeout costs rclpy a timer of its
+#: own, which the spin thread pays for in every wait of a simulated hour (docs/decisions.md).
 SPIN_WAIT_S: Optional[float] = None
 #: Bytes of an endpoint's gid that name its participant (the DDS GUID prefix): one per
 #: process that brought ROS up.

@@ -154,7 +154,7 @@ class SubjectProcess:
                         acks_from_subject)}, text=True, stdin=subprocess.DEVNULL,
                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True,
                     pass_fds=(to_subject, from_subject, acks_from_subject))
-            else:  # forked from a process that has imported ROS (0.17 CPU-s less each)
+            else:  # forked from a process that has imported ROS: no imports of its own
                 self.proc = fork_subject((to_subject, from_subject, acks_from_subject),
                                          str(workspace), environment, JUDGE_CLOCK_ENV)
         finally:

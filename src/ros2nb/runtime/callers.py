@@ -4,8 +4,8 @@ Part of :class:`ros2nb.runtime.Runtime`.  rclpy's logger puts the caller's funct
 and line in every ``/rosout`` message (and keys ``once=``/``throttle_duration_sec=`` on
 them).  To find the caller it asks :func:`inspect.getframeinfo` for every frame it walks,
 which also reads a line of source from disk, and resolves each file name with
-:func:`os.path.realpath`: 1.3 ms per log line, and a quarter of the CPU time of notebook
-10's ``record_hour`` (a simulated hour, 7200 log lines: 12.0 CPU-s, 9.1 with this).  The same
+:func:`os.path.realpath`, for every log line, and notebook 10's ``record_hour`` logs 7200
+in a simulated hour (what that cost: docs/decisions.md).  The same
 caller is found here from each frame's own file name (what ``getframeinfo`` returns for
 it, without its look at the disk) and each file's real path remembered (only used to skip
 rclpy's own frames, whose files do not move).  The messages are unchanged:

@@ -50,9 +50,8 @@ def node_serving_nothing(name: str, **kwargs: Any) -> Node:
 
     Nor does its ``/parameter_events`` publisher (every rclpy node has one) keep rclpy's
     default QoS event handlers: two more entities in each wait, only to warn of a QoS that
-    does not match.  The judge's node waited with eight such handlers; without them (and
-    with quiet subscriptions and ``/clock``) a simulated hour of notebook 03 costs the judge
-    1.5 CPU-s instead of 2.1.
+    does not match.  The judge's node waited with eight such handlers it never needed, in
+    each of the thousands of waits of a simulated hour (what they cost: docs/decisions.md).
 
     :param name: the node's name.
     :param kwargs: passed on to :class:`rclpy.node.Node` (e.g. ``context``, ``enable_rosout``).

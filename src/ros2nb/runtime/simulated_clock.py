@@ -151,10 +151,10 @@ class SimulatedClock:
                 node.set_parameters([Parameter('use_sim_time', Parameter.Type.BOOL, sim)])
             if sim and self.judge_time is not None:
                 self.judge_time.deafen(node)
-            # rclpy's own endpoints without their QoS warnings: a kernel's simulated hour of a
-            # sensor and a monitor costs 1.6 CPU-s instead of 2.0 (a judge's subject of
-            # notebook 10, whose nodes have no time source, 4.1 instead of 4.2); the learner's
-            # own publishers and subscriptions keep theirs (notebook 09).
+            # rclpy's own endpoints without their QoS warnings, which could only ever warn of
+            # another program's endpoint and add entities to every wait of a simulated hour
+            # (docs/decisions.md); the learner's own publishers and subscriptions keep theirs
+            # (notebook 09).
             drop_qos_warnings(node, rclpys_own_entities(node))
             (self._on_sim.add if sim else self._on_sim.discard)(name)
             changed.append(node)

@@ -26,8 +26,8 @@ from .stop_button import StopButton
 
 #: Longest wait of the background thread for work (s).  A pause (every spin, add, stop)
 #: wakes the wait at once (:meth:`Spinning._wanted_elsewhere`), so this only bounds a wake
-#: that never came.  An idle kernel wakes this often: at 0.02 s (rclpy's own timed wait can
-#: only end at its timeout) each idle kernel took 2.9 % of a CPU, 0.16 % now (``make bench``).
+#: that never came.  An idle kernel wakes this often (rclpy's own timed wait can only end at
+#: its timeout), so a short bound keeps every idle kernel busy for nothing (docs/decisions.md).
 BACKGROUND_WAIT_S = 0.5
 #: Callbacks one idle-wait may run before ros2nb calls it a loop that never ends (a burst
 #: of a few thousand messages to many subscriptions stays well below).

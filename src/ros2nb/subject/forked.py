@@ -4,8 +4,8 @@ Part of the subjects (:mod:`ros2nb.subject`); the judge (:mod:`ros2nb.judge`) st
 subjects and the learner's programs here when it runs them without a sandbox command.
 
 A subject spends most of its CPU time starting: Python, ``rclpy`` (with PyYAML and the
-message types) and ``ros2nb`` take about 0.3 CPU-s to import and start, of a short
-subject's 0.35-0.45 CPU-s, where ``make test`` starts hundreds.  A fork server
+message types) and ``ros2nb`` take most of a short subject's CPU time to import and start
+(docs/decisions.md), and ``make test`` starts hundreds.  A fork server
 (:mod:`ros2nb.subject.fork_server`) holds those imports and forks each child from there:
 the child is then the process ``python -m ros2nb.subject`` (or ``python -m
 ros2nb.subject.program``) would be (its own session, working folder, environment,

@@ -83,8 +83,8 @@ PATIENCE_S = 10.0
 def kill(cgroups: list[Path]) -> None:
     """SIGKILL every process in the cgroups, again until none is left.
 
-    The kernel takes a zombie out of ``cgroup.procs`` (Linux 4.4, commit 2e91fa7f "cgroup:
-    keep zombies associated with their original cgroups"), so our own unreaped child does
+    The kernel takes a zombie out of ``cgroup.procs`` (Linux 4.4, the commit "cgroup: keep
+    zombies associated with their original cgroups"), so our own unreaped child does
     not keep this waiting.  Whatever a process forks meanwhile is born in the same cgroup
     and is killed in the next round.  Gives up silently after :data:`PATIENCE_S`
     (:func:`remove` raises then).

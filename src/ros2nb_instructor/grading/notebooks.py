@@ -183,7 +183,7 @@ def drop_large_attachments(nb: nbformat.NotebookNode) -> list[str]:
 
 #: Most characters of one markdown cell of the learner's shown in the feedback, and of all
 #: of a notebook's: nbconvert's markdown rendering can take time quadratic in a cell's
-#: length (400 kB of ``[x](`` took minutes), and it runs on the host for the whole class.
+#: length (docs/decisions.md), and it runs on the host for the whole class.
 MAX_MARKDOWN_CELL = 20_000
 MAX_MARKDOWN_TOTAL = 100_000
 #: Most characters of a code cell of the learner's shown in the feedback (what is graded

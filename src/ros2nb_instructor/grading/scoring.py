@@ -6,9 +6,9 @@ learners').  Each line on its standard input is one batch: a JSON list of the id
 leaves out (every learner not in the batch); it answers each with a line ``{"ok": BOOL}``
 once scored, and ends at the end of its input.  nbgrader's own converters do the work its
 ``autograde`` and ``generate_feedback`` commands do, one after the other, as nbgrader's API
-(the Formgrader's) runs them.  One process serves the whole class: nbgrader starts once
-(about 1.5 CPU-s: its imports, its templates), and a batch then costs about 0.1 CPU-s and
-0.2 CPU-s per notebook, so learners are scored as soon as each is done.  Autograde only
+(the Formgrader's) runs them.  One process serves the whole class: nbgrader's start (its
+imports, its templates) is paid once, and a batch then costs a fraction of it
+(docs/decisions.md), so learners are scored as soon as each is done.  Autograde only
 scores: every notebook was run in a sandbox and judged before, so its Execute and
 ClearOutput steps are off.
 """

@@ -131,8 +131,9 @@ def _not_for_the_judge(workspace: Path):
 
 
 #: What the ROS 2 wheels' bootstrapper (a ``.pth`` file of the venv) sets before it runs a
-#: new Python process again, once, from the start (20 ms of CPU each): the libraries' path,
-#: and the mark that it was done.  The grader's own process has both.
+#: new Python process again, once, from the start: the libraries' path, and the mark that it
+#: was done.  The grader's own process has both; handed on, they spare each sandboxed runner
+#: and judge that second start (docs/decisions.md).
 ROS_WHEELS_ENV = ('LD_LIBRARY_PATH', '_ROS_WHEELS_BOOTSTRAP_COMPLETE')
 
 
