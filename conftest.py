@@ -67,16 +67,16 @@ def pytest_runtest_call(item):
 
 
 #: Test files that take longest, started first so that pytest-xdist's workers finish together
-#: (scheduling only: no test depends on it).  Seconds of one worker, idle, each file alone
-#: (benchmarks/test_profile.py): 195, 145, 142, 107, 106, 69, 66, 63, 47, 38, 35, 24, 24, 16.
-#: Files that mostly wait (a hub, a message that never comes, an image build) go early too:
-#: beside the CPU-bound work they cost nothing, while at the end they left the CPUs idle.
+#: (scheduling only: no test depends on it); ``benchmarks/test_profile.py`` measures each
+#: file alone.  Files that mostly wait (a hub, a message that never comes, an image build) go
+#: early too: beside the CPU-bound work they cost nothing, while at the end they left the CPUs
+#: idle.
 #: make test passes --no-loadscope-reorder: xdist otherwise sorts files by their number of
 #: tests, whatever this order says.
-LONGEST_FIRST = ('test_grading.py', 'test_jupyterhub.py', 'test_checks_forged.py',
-                 'test_image.py', 'test_corpus_wrong_03_06.py', 'test_corpus_honest_06_10.py',
-                 'test_checks.py', 'test_corpus_honest_03_05.py', 'test_lessons_06_07.py',
-                 'test_corpora.py', 'test_corpus_wrong_07_10.py', 'test_checks_parameters.py',
+LONGEST_FIRST = ('test_grading.py', 'test_corpus_honest.py', 'test_corpus_wrong.py',
+                 'test_jupyterhub.py', 'test_checks_forged.py', 'test_image.py',
+                 'test_checks.py', 'test_lessons_06_07.py', 'test_corpora.py',
+                 'test_checks_parameters.py',
                  'test_checks_qos.py', 'test_checks_bag_judge.py', 'test_isolation.py',
                  'test_sandbox.py', 'test_grading_cli.py', 'test_checks_bag_kernel.py',
                  'test_runtime.py', 'test_workspace.py', 'test_subjects.py')

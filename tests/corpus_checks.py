@@ -1,5 +1,5 @@
-"""What the corpora's tests assert, one function per corpus (the test files are split by
-notebooks so that pytest-xdist, which keeps a file on one worker, spreads the grading).
+"""What the corpora's tests assert, one function per corpus, one test file per meaning
+(``test_corpus_honest.py``, ``test_corpus_wrong.py``, ``test_corpora.py`` for the attacks).
 
 - An honest learner (``corpus_honest.py``) gets full marks, and gets them with the judge's
   reader of their text replaced by one that knows nothing: no point depends on reading the
@@ -19,11 +19,6 @@ from corpora import Learner, expected_score, grade_learner, score
 def failed(results: dict) -> dict[str, str]:
     """grade id -> message, of the parts that failed."""
     return {gid: r.get('message', '') for gid, r in results.items() if not r['passed']}
-
-
-def within(corpus: list[Learner], first: str, last: str) -> list[Learner]:
-    """The learners of notebooks ``first`` to ``last`` (e.g. ``'03'``, ``'05'``)."""
-    return [learner for learner in corpus if first <= learner.notebook <= last]
 
 
 def full_marks_without_the_text_reader(learner: Learner, root: Path) -> None:

@@ -1,7 +1,7 @@
 """Attacks beside their twins, and the text reader that only words failures.
 
-The honest and wrong corpora are graded in ``test_corpus_honest_*.py`` and
-``test_corpus_wrong_*.py`` (see ``corpus_checks.py``).  Each attack (``corpus_attacks.py``)
+The honest and wrong corpora are graded in ``test_corpus_honest.py`` and
+``test_corpus_wrong.py`` (see ``corpus_checks.py``).  Each attack (``corpus_attacks.py``)
 scores what its honest twin scores, except those the wire cannot tell from honest code, which
 the judge flags for the instructor instead (``tests/test_flags.py``).
 
