@@ -35,7 +35,7 @@ def main() -> int:
     hours = parser.parse_args().hours
     from judging import judging_env
     from ros2nb import checks, course
-    from ros2nb.judge.interface import captured
+    from ros2nb.judge_interface import captured
     from ros2nb.judge.session import Session
     print('| hour | wall s | judge CPU-s | machine busy CPU-s | verdict |')
     print('|---|---|---|---|---|')

@@ -15,7 +15,7 @@ pytestmark = [pytest.mark.judge,
               pytest.mark.skipif(sys.version_info < (3, 11),
                                  reason='bags need Python 3.11 or newer (rosbags needs apsw)')]
 
-from ros2nb.judge.interface import AnswerRef  # noqa: E402
+from ros2nb.judge_interface import AnswerRef  # noqa: E402
 from ros2nb.errors import CheckFailed  # noqa: E402
 from ros2nb.judge.session import Session  # noqa: E402
 

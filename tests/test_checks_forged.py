@@ -14,7 +14,7 @@ honest twin of each is the reference, which passes (tests/test_checks.py).
 import pytest
 
 from ros2nb import checks, course
-from ros2nb.judge.interface import AnswerRef
+from ros2nb.judge_interface import AnswerRef
 
 from grading_samples import FORGED_TIMER, MAIN_GUARD, REWRITING_READER, TIMER_LINE
 from nodes import name_without_endpoints

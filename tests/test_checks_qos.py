@@ -14,7 +14,7 @@ import re
 import pytest
 
 from ros2nb import checks
-from ros2nb.judge.interface import AnswerRef
+from ros2nb.judge_interface import AnswerRef
 from ros2nb.errors import CheckFailed
 from ros2nb.judge.session import Session
 

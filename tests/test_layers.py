@@ -31,7 +31,7 @@ LAYERS: list[tuple[str, ...]] = [
     ('ros2nb.runtime', 'ros2nb.qos'),
     ('ros2nb.terminal',),
     ('ros2nb.kernel',),
-    ('ros2nb.judge.interface',),
+    ('ros2nb.judge_interface',),
     ('ros2nb.checks',),
     ('ros2nb.subject',),
     ('ros2nb.judge',),

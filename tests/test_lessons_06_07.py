@@ -396,7 +396,7 @@ def test_a_reply_of_no_known_shape_fails_that_check_alone(session, monkeypatch):
     """A check that meets a reply it cannot read raises an error of its own (KeyError here);
     before, that ended the judge and every check of the notebook went with it. Now it fails
     that check with one line, and the notebook's other checks are graded."""
-    from ros2nb.judge.interface import captured
+    from ros2nb.judge_interface import captured
     from ros2nb.judge.subjects import SubjectProcess
 
     request = SubjectProcess.request

@@ -27,7 +27,7 @@ import sys
 from typing import Any, Optional
 
 from ..errors import CheckFailed
-from ..judge.interface import Judge
+from ..judge_interface import Judge
 from ..on_first_use import loader
 
 #: Each lesson's checks, by the module that holds them.  A module loads on first use of one
@@ -63,7 +63,7 @@ def run_check(name: str, judge: Optional[Judge], *args: Any, **kwargs: Any) -> N
 
     :param name: e.g. ``'check_sensor_constructor'``.
     :param args: the call's arguments after the judge (the learner's answer cells as
-        :class:`~ros2nb.judge.interface.AnswerRef`).
+        :class:`~ros2nb.judge_interface.AnswerRef`).
     :raises ValueError: for a name no lesson registers (a mistake of the course's).
     :raises CheckFailed: (or :class:`~ros2nb.errors.LearnerCodeError`) with the verdict.
     """

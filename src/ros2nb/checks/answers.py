@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import CheckFailed
-from ..judge.interface import AnswerRef, Judge, learner_error
+from ..judge_interface import AnswerRef, Judge, learner_error
 
 
 def defined_verdict(reply: dict, name: str) -> None:

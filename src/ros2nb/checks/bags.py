@@ -19,7 +19,7 @@ from typing import Any, Iterator, Optional
 from .. import course
 from ..terminal import bag
 
-from ..judge.interface import Judge
+from ..judge_interface import Judge
 
 #: Topics of the recording: the readings, and /rosout where the monitor's statuses go.
 TEMPERATURE, ROSOUT = '/' + course.TOPIC, course.ROSOUT_TOPIC

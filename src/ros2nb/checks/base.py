@@ -1,7 +1,7 @@
 """What every check is made of: its registration, its one line, and a call of the learner's.
 
 Part of :mod:`ros2nb.checks`.  A check's body takes the judge that runs it
-(:class:`~ros2nb.judge.interface.Judge`, None in the kernel) and the learner's things, and
+(:class:`~ros2nb.judge_interface.Judge`, None in the kernel) and the learner's things, and
 returns the ``Check passed`` sentence or raises :class:`CheckFailed` with one line.  One of
 two decorators registers it under its own name (:data:`CHECKS`) and makes the function the
 notebook calls:
@@ -9,7 +9,7 @@ notebook calls:
 - :func:`judged`: the body runs only in a judge; the notebook's call asks a judge process
   to run it (:func:`~ros2nb.checks.dispatch.ask_judge`) and shows its verdict;
 - :func:`direct`: the body runs where it is called; in the kernel on the learner's objects
-  (no judge), in the judge on their answer cells (:class:`~ros2nb.judge.interface.AnswerRef`).
+  (no judge), in the judge on their answer cells (:class:`~ros2nb.judge_interface.AnswerRef`).
 
 The judge looks a body up by name (:func:`ros2nb.checks.run_check`) and runs it with its
 session, once: no check is called twice or dispatched again.
@@ -24,7 +24,7 @@ from typing import Any, Callable, Optional
 
 from ..errors import CheckFailed, Ros2nbError
 from ..explain.exceptions import describe_error
-from ..judge.interface import Judge, learner_error
+from ..judge_interface import Judge, learner_error
 from .dispatch import ask_judge
 
 #: A check's body: ``body(judge, *learner_things) -> the passed sentence``.

@@ -3,7 +3,7 @@
 Part of :mod:`ros2nb.checks`; runs in the kernel.  :func:`ask_judge` starts ``python -m
 ros2nb.judge check NAME`` (the judge is named, never imported), which runs the check's
 registered body once and prints its outcome as one JSON line
-(:func:`ros2nb.judge.interface.captured`); :func:`~ros2nb.judge.interface.show_result` turns
+(:func:`ros2nb.judge_interface.captured`); :func:`~ros2nb.judge_interface.show_result` turns
 it back into the printed lines or the raised failure.
 """
 
@@ -16,7 +16,7 @@ import sys
 
 from .. import domains
 from ..errors import CheckFailed, Ros2nbError
-from ..judge.interface import show_result
+from ..judge_interface import show_result
 from ..processes import LOOK_S, Patience, kill_process_group
 from ..terminal.workspace import WORKSPACE_ENV, current_workspace
 

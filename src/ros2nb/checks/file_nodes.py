@@ -13,7 +13,7 @@ from ..errors import CheckFailed
 from ..terminal.files import parts_verdict
 from std_msgs.msg import Float32
 
-from ..judge.interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
+from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
 
 
 def new_node(judge: Judge, relative: str, cls: str, *, stand_ins: tuple[str, ...] = (),

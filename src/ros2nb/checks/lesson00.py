@@ -14,7 +14,7 @@ from rclpy.node import Node
 
 from ..endpoints import node_endpoints
 from ..errors import CheckFailed
-from ..judge.interface import AnswerRef, Judge, learner_error
+from ..judge_interface import AnswerRef, Judge, learner_error
 from .base import call_learner, direct
 from .verdicts import endpoint_verdict
 

@@ -11,7 +11,7 @@ from typing import Any, Optional
 
 from ..errors import CheckFailed
 from .answers import answer_results, decoded, type_name_of
-from ..judge.interface import AnswerRef, Judge
+from ..judge_interface import AnswerRef, Judge
 from .base import call_learner, direct
 
 

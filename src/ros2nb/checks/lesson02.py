@@ -16,7 +16,7 @@ from .. import course
 from ..errors import CheckFailed, Ros2nbError
 from ..terminal.workspace import current_workspace
 from .answers import answer_results, decoded, type_name_of
-from ..judge.interface import AnswerRef, Judge
+from ..judge_interface import AnswerRef, Judge
 from .base import call_learner, direct
 
 

@@ -20,7 +20,7 @@ from std_msgs.msg import Float32
 
 from .. import course
 from ..errors import CheckFailed
-from ..judge.interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
+from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
 from .base import direct, judged
 from .mains import run_main
 from .file_nodes import lines_logged, new_node

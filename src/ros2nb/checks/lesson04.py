@@ -14,7 +14,7 @@ from typing import Any
 
 from .. import course
 from ..errors import CheckFailed
-from ..judge.interface import Judge
+from ..judge_interface import Judge
 from .base import judged
 from .mains import run_main
 from .file_nodes import feed, new_node, reach, started_log_verdict

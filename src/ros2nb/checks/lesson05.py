@@ -33,7 +33,7 @@ from ..terminal.colcon import build_cause, venv_tool
 from ..terminal.files import saved_parts
 from ..terminal.pkg_templates import SETUP_CFG, render_setup_py
 from ..terminal.run import find_executable
-from ..judge.interface import ARRIVAL_TIMEOUT_S, Judge
+from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge
 from .base import judged
 from .mains import EXIT_AFTER_CTRL_C_S, last_line
 from .package_stand_ins import EXECUTABLES

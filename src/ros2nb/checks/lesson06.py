@@ -18,7 +18,7 @@ from std_msgs.msg import Bool
 from .. import course
 from ..errors import CheckFailed
 from ..explain.ros_settings import ros_arguments_mistake
-from ..judge.interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
+from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
 from .base import judged
 from .mains import run_main
 from .file_nodes import announced, feed, lines_logged, new_node, reach

@@ -16,7 +16,7 @@ from typing import Optional
 
 from .. import course
 from ..errors import CheckFailed
-from ..judge.interface import Judge
+from ..judge_interface import Judge
 from .base import judged
 from .file_nodes import feed, lines_logged, new_node, reach
 from .source import ClassSource

@@ -22,7 +22,7 @@ from rclpy.parameter_client import AsyncParameterClient
 from .. import course
 from ..errors import CheckFailed
 from ..runtime.services import call_until_answered
-from ..judge.interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
+from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
 from .base import judged
 from .file_nodes import feed, lines_logged, new_node, reach
 

@@ -23,7 +23,7 @@ from .. import qos
 from ..explain.ros_settings import zero_depth_refused
 from ..errors import CheckFailed
 from .answers import defined_verdict, type_name_of
-from ..judge.interface import ARRIVAL_TIMEOUT_S, AnswerRef, Judge, learner_error
+from ..judge_interface import ARRIVAL_TIMEOUT_S, AnswerRef, Judge, learner_error
 from .base import call_learner, direct
 
 #: The burst of part 1 and what a display of the newest reading must be left with.

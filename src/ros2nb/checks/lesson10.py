@@ -31,7 +31,7 @@ from ..terminal import bag
 from .answers import decoded, defined_verdict
 from .bags import (CHECK_LOGGER, ROSOUT, TEMPERATURE, check_bag, check_readings_c, fresh_path,
                    bag_messages, read_back)
-from ..judge.interface import AnswerRef, Judge, learner_error
+from ..judge_interface import AnswerRef, Judge, learner_error
 from .base import call_learner, direct
 
 #: The monitor's log line, as notebook 04 writes it.

@@ -20,7 +20,7 @@ from typing import Any, Optional
 
 from ..errors import CheckFailed
 from ..processes import interrupt, kill_process_group, until_waiting, wait_patiently
-from ..judge.interface import Judge
+from ..judge_interface import Judge
 from .source import TEXT
 
 #: Seconds a node process gets to exit after Ctrl+C (which comes once its node spins).

@@ -64,7 +64,7 @@ def describe_error(error: BaseException) -> dict:
     (their own frames, :func:`learner_traceback`) and ``where`` (:func:`learner_line`).
 
     What a check makes of an error in the learner's code, in a subject or in the kernel
-    (``ros2nb.judge.interface.learner_error``); introduced in ``03-write-the-publisher.ipynb``.
+    (``ros2nb.judge_interface.learner_error``); introduced in ``03-write-the-publisher.ipynb``.
     """
     try:
         explanation = explain_exception(error)

@@ -11,13 +11,15 @@ checks, hooks, exceptions) changes it.  While grading, every subject also runs i
 sandbox of its own (the grader passes the sandbox command in ``ROS2NB_SUBJECT_PREFIX``)
 and cannot see, signal or trace the judge.
 
-Modules: ``interface`` (what a check may ask of the judge, and the one JSON line of its
-outcome: the checks depend on it, never on the rest), ``observer`` (its own ROS node),
+Modules: ``observer`` (its own ROS node),
 ``clock`` (its simulated time), ``subjects`` (the processes that run the learner's code),
 ``session`` (what the checks get as their judge), ``graded_cells`` (a whole notebook's
 graded cells), ``flags`` (code that reaches in, for the instructor), ``__main__`` (the
-command line).  Only ``__main__`` and ``graded_cells`` reach into the checks, to run a
-check's body by name (:func:`ros2nb.checks.run_check`); the kernel starts the judge by name.
+command line).  The checks depend only on the judge's small interface
+(:mod:`ros2nb.judge_interface`, which the session implements), never on this package; only
+``__main__`` and ``graded_cells`` reach into the checks, to run a check's body by name
+(:func:`ros2nb.checks.run_check`), and ``flags`` reads the learner's text through them.  The
+kernel starts the judge by name.
 
 Command line (``python -m ros2nb.judge``):
 

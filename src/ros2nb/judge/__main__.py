@@ -17,7 +17,7 @@ from ..processes import end_this_process
 from ..subject.forked import serve_from_here
 from ..terminal.workspace import default_workspace
 from .graded_cells import grade
-from .interface import captured
+from ..judge_interface import captured
 from .session import Session
 from .subjects import subject_prefix
 

@@ -18,7 +18,7 @@ from typing import Any, Optional
 
 from rosgraph_msgs.msg import Clock
 
-from .interface import ARRIVAL_TIMEOUT_S, learner_error
+from ..judge_interface import ARRIVAL_TIMEOUT_S, learner_error
 from ..errors import CheckFailed
 from ..processes import Patience, kill_process_group
 from ..subject.judge_time import JUDGE_CLOCK_QOS

@@ -11,7 +11,7 @@ import ast
 from typing import Any, Optional
 
 from .. import checks, nbmeta
-from .interface import AnswerRef, Judge, captured
+from ..judge_interface import AnswerRef, Judge, captured
 
 
 def _is_check_call(node: ast.AST) -> Optional[str]:

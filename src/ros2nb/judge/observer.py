@@ -24,7 +24,7 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 from rclpy.signals import SignalHandlerOptions
 
 from .. import domains
-from .interface import ARRIVAL_TIMEOUT_S
+from ..judge_interface import ARRIVAL_TIMEOUT_S
 from ..errors import CheckFailed
 from ..processes import Patience, wait_for_work
 from ..runtime import QUIET_SUBSCRIPTION, node_serving_nothing

@@ -1,7 +1,7 @@
 """One judge process's session: its observer, its subjects, its builds, its scratch folder.
 
 Part of the judge (:mod:`ros2nb.judge`).  The checks get the session as their judge
-(:class:`ros2nb.judge.interface.Judge`) and ask it for subjects, programs and the observer.
+(:class:`ros2nb.judge_interface.Judge`) and ask it for subjects, programs and the observer.
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ from ..subject.forked import fork_program
 from ..terminal.files import parts_verdict
 from ..terminal.workspace import WORKSPACE_ENV
 from .clock import JudgeClock
-from .interface import AnswerRef, learner_error
+from ..judge_interface import AnswerRef, learner_error
 from .observer import Observer
 from .subjects import (Output, SubjectHung, SubjectProcess, home_and_tmp, subject_env,
                        subject_prefix, subjects_folder)

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, ContextManager, Optional, Protocol
 
-from ..errors import CheckFailed, LearnerCodeError, Ros2nbError
+from .errors import CheckFailed, LearnerCodeError, Ros2nbError
 
 #: Seconds the judge waits for what a subject published to arrive over ROS, and for ROS
 #: discovery to show a subject's node; the wait ends as soon as it is there, so a long
