@@ -68,9 +68,10 @@ def restore(session, relative: str) -> None:
     alone(session)
 
 
-def fails(session, check, pattern: str) -> str:
+def fails(session, check, pattern: str, *args) -> str:
+    """Run ``check(*args)`` with ``session`` as its judge; its one line must match ``pattern``."""
     with pytest.raises(CheckFailed) as caught:
-        run_check(session, check)
+        run_check(session, check, *args)
     message = str(caught.value)
     MESSAGES.append(message)
     assert re.search(pattern, message), message
