@@ -24,7 +24,7 @@ export UV_SYSTEM_CERTS := 1
 # numpy (rclpy's message types), and none of them does linear algebra (docs/decisions.md).
 export OPENBLAS_NUM_THREADS := 1
 
-.PHONY: image image-tool lab lab-instructor check test setup bytecode sandbox-tool browser-tool graph-tool grading-course solutions learner-notebooks bench grade clean
+.PHONY: image image-tool lab lab-instructor check test setup bytecode sandbox-tool browser-tool graph-tool grading-course solutions learner-notebooks bench grade clean docs
 
 setup: $(STAMP)
 
@@ -98,14 +98,14 @@ check: $(STAMP) bytecode
 	@$(PY) -m pytest --lane check -q
 
 # Everything: the fast lane first (a lint error or a broken rule stops here, in a minute),
-# then three steps, always all three (tests/run_steps.sh): the slow lane of tests/ with
+# the website (make docs, which its browser test opens), then three steps, always all three (tests/run_steps.sh): the slow lane of tests/ with
 # pytest-xdist, and nbval over solutions/ and notebooks/ alongside it; one failure never
 # hides the others, the results come together at the end, and make fails if any step failed.
 # Six workers: much of a slow test's time is a judge and its subject waiting on each other
 # step by step, and fewer left the cores idle between steps (docs/decisions.md).
 TEST_WORKERS ?= 6
 
-test: check $(STAMP) bytecode sandbox-tool browser-tool graph-tool image-tool grading-course
+test: check $(STAMP) bytecode sandbox-tool browser-tool graph-tool image-tool grading-course docs
 	@tests/run_steps.sh $(PY) $(TEST_WORKERS)
 
 # The nbgrader course of the current solutions (generate_assignment, kept per version of the
@@ -114,6 +114,16 @@ test: check $(STAMP) bytecode sandbox-tool browser-tool graph-tool image-tool gr
 # class, tests/'s longest chain, which then waits for it (docs/decisions.md).
 grading-course: $(STAMP) bytecode
 	@$(PY) -c 'from ros2nb_instructor.grading.gradebook import kept_course; kept_course()'
+
+# The course's website (docs/site/build.py): the lessons as the learner sees them (from the
+# stored outputs of solutions/, each answer an exercise with its hint, never its solution),
+# the guides and the reference, in docs/_build/html; offline, nothing executed, every Sphinx
+# warning an error and every link checked.  make test builds it for tests/test_docs_site.py.
+# SOLUTIONS=1: the instructor's site, with the solutions, in docs/_build/instructor/html.
+# DOCS_HUB_URL=https://hub.example.org/hub/user-redirect/lab/tree/notebooks/{notebook}:
+# each lesson also links to itself on that JupyterHub.
+docs: $(STAMP)
+	@$(PY) docs/site/build.py $(if $(SOLUTIONS),--solutions --out docs/_build/instructor)
 
 # Re-run solutions/ in place so their stored outputs are fresh (then make learner-notebooks).
 solutions: $(STAMP)
