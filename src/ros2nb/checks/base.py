@@ -56,9 +56,12 @@ def _register(body: Body, judged: bool, call: Callable[..., None]) -> Callable[.
     CHECKS[name] = Check(name, body, judged)
     functools.update_wrapper(call, body)
     del call.__wrapped__  # type: ignore[attr-defined]
-    parameters = list(inspect.signature(body).parameters.values())[1:]  # no judge
+    # What the notebook calls: the body's parameters without the judge, and no return value.
+    parameters = list(inspect.signature(body).parameters.values())[1:]
     call.__signature__ = inspect.Signature(  # type: ignore[attr-defined]
         parameters, return_annotation=None)
+    call.__annotations__ = {**{name: hint for name, hint in body.__annotations__.items()
+                               if name not in ('judge', 'return')}, 'return': 'None'}
     return call
 
 
