@@ -24,7 +24,9 @@ import subprocess
 import sys
 import time
 import urllib.request
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import nbformat
 import pytest
@@ -70,6 +72,20 @@ def answers(url: str) -> bool:
         return False
 
 
+@dataclass(frozen=True)
+class Lab:
+    """What the ``lab`` fixture hands a test.
+
+    :ivar page: Playwright's page, on notebook 01 in the learner's lab.
+    :ivar shots: where the test's screenshots go.
+    :ivar work: the learner's work folder (``ROS2NB_WORK``).
+    """
+
+    page: Any
+    shots: Path
+    work: Path
+
+
 @pytest.fixture(scope='module')
 def lab(tmp_path_factory):
     """A learner's lab (``ros2nb-lab``) on a free port with a token, and a page on notebook 01."""
@@ -107,7 +123,7 @@ def lab(tmp_path_factory):
             code_cells = sum(c.cell_type == 'code' for c in nbformat.read(work / NOTEBOOK, 4).cells)
             wait_for(lambda: page.evaluate(NOTEBOOK_READY, code_cells), 'the notebook shown',
                      seen=lambda: page.content()[-800:])
-            yield page, shots, work
+            yield Lab(page, shots, work)
             context.close()
     finally:
         os.killpg(server.pid, signal.SIGTERM)
@@ -130,7 +146,7 @@ def prompts(page) -> list[str]:
 
 
 def test_no_instructor_tool_and_no_news_popup(lab):
-    page, shots, work = lab
+    page, shots, work = lab.page, lab.shots, lab.work
     labels = page.eval_on_selector_all('.lm-MenuBar-itemLabel',
                                        'els => els.map(e => e.textContent)')
     assert {'File', 'Run', 'Kernel'} <= set(labels), labels  # the menu bar is there, and read
@@ -148,7 +164,7 @@ def test_no_instructor_tool_and_no_news_popup(lab):
 
 
 def test_a_finished_notebook_runs_to_the_end_with_its_check_passing(lab):
-    page, shots, _ = lab
+    page, shots = lab.page, lab.shots
     menu(page, 'Edit', 'Clear Outputs of All Cells')
     wait_for(lambda: all(p in ('[ ]:', '') for p in prompts(page)), 'outputs cleared',
              seen=lambda: prompts(page))
@@ -167,7 +183,7 @@ def test_interrupt_stops_a_spin_with_one_line(lab):
     """Stop ends a spin that would run for 10**7 s, with one line. How fast (the target is
     under a second) is ``make bench BENCH_ARGS='--only interrupt'``'s to measure: a browser
     beside CPU burners cannot promise a second (docs/decisions.md)."""
-    page, shots, _ = lab
+    page, shots = lab.page, lab.shots
     index = page.locator('.jp-Notebook .jp-CodeCell').count()  # the new cell's, at the end
     page.locator('.jp-Notebook .jp-Cell').last.click()
     page.keyboard.press('Escape')

@@ -13,7 +13,9 @@ import re
 import shutil
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 import pytest
 
@@ -305,6 +307,20 @@ def test_a_program_the_judge_runs_is_given_work_not_wall_time(session, tmp_path)
     assert 2 <= time.monotonic() - began < 60
 
 
+@dataclass(frozen=True)
+class PackageFiles:
+    """What ``package_files`` hands a test.
+
+    :ivar setup_cfg: the workspace's setup.cfg.
+    :ivar generated_cfg: its text as pkg_create wrote it.
+    :ivar entries: writes setup.py as pkg_create wrote it, with the given console_scripts lines.
+    """
+
+    setup_cfg: Path
+    generated_cfg: str
+    entries: Callable[..., None]
+
+
 @pytest.fixture
 def package_files(session):
     """setup.py and setup.cfg as pkg_create wrote them, and a writer of console_scripts lines;
@@ -323,7 +339,7 @@ def package_files(session):
             f'            {line}\n' for line in lines) + '        ],\n'))
 
     try:
-        yield setup_cfg, generated_cfg, entries
+        yield PackageFiles(setup_cfg, generated_cfg, entries)
     finally:
         setup_py.write_text(generated_py)
         setup_cfg.write_text(generated_cfg)
@@ -335,7 +351,7 @@ SUBSCRIBER_ENTRY = "'temperature_subscriber = sensor_simulator.temperature_subsc
 
 
 def test_entry_point_checks(session, package_files):
-    _, _, entries = package_files
+    entries = package_files.entries
     entries('# YOUR CODE HERE', 'raise NotImplementedError()')
     fails(session, checks.check_entry_points, r'setup.py still holds the placeholder')
     entries()
@@ -359,7 +375,8 @@ def test_entry_point_checks(session, package_files):
 
 
 def test_setup_cfg_checks(session, package_files, capsys):
-    setup_cfg, generated_cfg, entries = package_files
+    setup_cfg, generated_cfg, entries = (package_files.setup_cfg, package_files.generated_cfg,
+                                         package_files.entries)
     entries(PUBLISHER_ENTRY + ',', SUBSCRIBER_ENTRY + ',')
     setup_cfg.write_text(generated_cfg.replace('$base/lib/sensor_simulator', '$base/bin'))
     fails(session, checks.check_setup_cfg,
