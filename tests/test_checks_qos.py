@@ -82,6 +82,11 @@ MISTAKES = [
      'history=HistoryPolicy.KEEP_ALL',
      r'got all 30: KEEP_ALL \(or a depth of 30 or more\) keeps every message; use KEEP_LAST '
      r'with depth=1\.'),
+    ('newest_only_profile', 'best effort', 'depth=1)',
+     'depth=1, reliability=ReliabilityPolicy.BEST_EFFORT)',
+     r"^Your subscription is BEST_EFFORT, (KEEP_LAST \(1\), )?VOLATILE: the display's "
+     r'subscription is reliable, as the task says \(the default\): leave reliability out, or '
+     r'give ReliabilityPolicy\.RELIABLE\.$'),
     ('newest_only_profile', 'transient local', 'depth=1)',
      'depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)',
      r'never matched the reliable, volatile publisher: rclpy says: Volatile publisher and '

@@ -106,9 +106,10 @@ class _Endpoint:
         self.judge.drop_all()
 
 
-def _judged_burst(judge: Judge, ref: AnswerRef) -> qos.Deliveries:
+def _judged_burst(judge: Judge, ref: AnswerRef) -> tuple[qos.Deliveries, QoSProfile]:
     """The burst of part 1, from the judge's publisher to a subscription with the learner's
-    profile that takes nothing until the whole burst was acknowledged."""
+    profile that takes nothing until the whole burst was acknowledged; and that subscription's
+    profile as discovery reports it."""
     endpoint = _Endpoint(judge, ref, 'subscription')
     node = endpoint.observer.node
     publisher = node.create_publisher(Int32, endpoint.topic, QoSProfile(depth=BURST))
@@ -128,7 +129,7 @@ def _judged_burst(judge: Judge, ref: AnswerRef) -> qos.Deliveries:
     finally:
         node.destroy_publisher(publisher)
         endpoint.close()
-    return out
+    return out, endpoint.profile
 
 
 def _judged_pair(judge: Judge, ref: AnswerRef) -> tuple[qos.Deliveries, QoSProfile]:
@@ -199,7 +200,7 @@ def _take_all(subscription: Any) -> list[int]:
 # ------------------------------------------------------------------ the three parts
 def _newest_only(judge: Optional[Judge], make_profile: Any) -> str:
     if isinstance(make_profile, AnswerRef) and judge is not None:
-        got = _judged_burst(judge, make_profile)
+        got, profile = _judged_burst(judge, make_profile)
         shown = 'your profile'
         keeps_all = None
     else:
@@ -210,6 +211,12 @@ def _newest_only(judge: Optional[Judge], make_profile: Any) -> str:
     if not got.matched:
         raise CheckFailed(f'Your subscription ({shown}) never matched the reliable, volatile '
                           f'publisher: {got.explanation or "they never matched."}')
+    # The task says reliable; what a best-effort subscription keeps of a burst varies from run
+    # to run, so its policy decides, as discovery reports it (the same in every run).
+    if profile.reliability != ReliabilityPolicy.RELIABLE:
+        raise CheckFailed(f'Your subscription is {qos.describe(profile)}: the display\'s '
+                          'subscription is reliable, as the task says (the default): leave '
+                          'reliability out, or give ReliabilityPolicy.RELIABLE.')
     if got.received == NEWEST:
         return (f'after a burst of {BURST}, a subscription with {shown} is left with '
                 f'{NEWEST}: the newest reading only.')
