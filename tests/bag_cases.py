@@ -52,6 +52,9 @@ MISTAKES = [
      "    ros2nb.bag_play(bag_path, rate=rate, topics=['/temperature'])\n"
      '    ros2nb.add(sub.TemperatureMonitor())\n',
      r'^temperature_monitor logged no status during the replay'),
+    ('replay', 'monitor never stopped', 'ros2nb.stop()', 'pass',
+     r'^replay\(bag_path, rate\) returned with /?temperature_monitor still running: end it with '
+     r'ros2nb\.stop\(\), as the task says, so that it stops the nodes it added\.$'),
     ('read_temperatures', 'absolute times', '(stamp - first) / 1e9', 'stamp / 1e9',
      r'^read_temperatures\(\) returned times \[1\.0, 2\.0, 3\.0\]\.\.\.; expected seconds since '
      r'the first reading'),

@@ -43,6 +43,10 @@ WRONG = [
         "ros2nb.bag_play(bag_path, rate=rate, topics=['/temperature'])",
         'ros2nb.bag_play(bag_path, rate=rate)')]},
         loses=('replay',)),
+    Learner('10 a replay that never stops the monitor', '10', {'replay': [(
+        "ros2nb.bag_play(bag_path, rate=rate, topics=['/temperature'])\n    ros2nb.stop()",
+        "ros2nb.bag_play(bag_path, rate=rate, topics=['/temperature'])")]},
+        loses=('replay',)),
 ]
 
 

@@ -31,7 +31,7 @@ from ..terminal import bag
 from .answers import decoded, defined_verdict
 from .bags import (CHECK_LOGGER, ROSOUT, TEMPERATURE, check_bag, check_readings_c, fresh_path,
                    bag_messages, read_back)
-from ..judge_interface import AnswerRef, Judge, learner_error
+from ..judge_interface import ARRIVAL_TIMEOUT_S, AnswerRef, Judge, learner_error
 from .base import call_learner, direct
 
 #: The monitor's log line, as notebook 04 writes it.
@@ -111,11 +111,16 @@ def _witnessing(judge: Optional[Judge]) -> Iterator[Witness]:
 
 # ------------------------------------------------------------------ calling the learner
 def _call(judge: Optional[Judge], function: Any, label: str, *args: Any,
-          spin_s: float = 0.0) -> Any:
+          spin_s: float = 0.0, stops: Optional[str] = None) -> Any:
     """Call the learner's function (in the kernel, or from source in a subject whose nodes
     run on the judge's clock for up to ``spin_s`` simulated seconds, in the judge's
     workspace with the course's nodes where the learner's are missing, as ``catch_up(10)``
-    promises a notebook run on its own)."""
+    promises a notebook run on its own).
+
+    :param stops: a node the function must have stopped by the time it returns (the judge
+        waits for it to leave the ROS graph; the kernel looks at its own nodes).
+    :raises CheckFailed: when it raised, or left ``stops`` running.
+    """
     if isinstance(function, AnswerRef) and judge is not None:
         subject = judge.answer_subject(function,
                                        workspace=judge.answers_workspace(course.STEPS[10]))
@@ -126,12 +131,28 @@ def _call(judge: Optional[Judge], function: Any, label: str, *args: Any,
         output = reply['outputs'][0]
         if 'error' in output:
             raise learner_error(label, output['error'])
+        observer = judge.observer
+        left = stops is not None and not observer.wait_until(
+            lambda: not observer.has_node(stops), ARRIVAL_TIMEOUT_S)
         judge.drop_all()  # its nodes leave the graph: what they said is heard by now
+        if left:
+            raise CheckFailed(_LEFT_RUNNING.format(label=label, node=stops))
         return _plain(output['result'])
     if spin_s:  # the function runs nodes: none of an earlier cell's may run beside them
         _no_nodes_left(label)
     with contextlib.redirect_stdout(io.StringIO()):  # the verdict is the check's line alone
-        return call_learner(function, *args)
+        result = call_learner(function, *args)
+    rt = current_runtime()
+    if stops is not None and rt is not None and rt.nodes:
+        left = ', '.join(sorted(rt.nodes))
+        rt.stop()  # the next check's call must start with no node of this one
+        raise CheckFailed(_LEFT_RUNNING.format(label=label, node=left))
+    return result
+
+
+#: The line for a function that left a node it should have stopped.
+_LEFT_RUNNING = ('{label} returned with {node} still running: end it with ros2nb.stop(), as '
+                 'the task says, so that it stops the nodes it added.')
 
 
 def _no_nodes_left(label: str) -> None:
@@ -300,7 +321,7 @@ def _replay(judge: Optional[Judge], replay: Any) -> str:
     with check_bag(judge, 'sixty', readings) as path:
         with _witnessing(judge) as seen:
             _call(judge, replay, f'{replay.__name__}(bag_path, rate)', path, CHECK_RATE,
-                  spin_s=len(readings) * course.PUBLISH_PERIOD_S)
+                  spin_s=len(readings) * course.PUBLISH_PERIOD_S, stops=course.MONITOR_NODE)
     return _replay_verdict(readings, seen, f'{replay.__name__}(bag_path, rate)')
 
 
