@@ -16,13 +16,8 @@ from __future__ import annotations
 import contextlib
 import io
 import math
-import re
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Iterator, Optional
-
-from rcl_interfaces.msg import Log
-from std_msgs.msg import Float32
+from typing import Any, Callable, Optional
 
 from .. import course
 from ..errors import CheckFailed
@@ -33,9 +28,8 @@ from .bags import (CHECK_LOGGER, ROSOUT, TEMPERATURE, check_bag, check_readings_
                    bag_messages, read_back)
 from ..judge_interface import ARRIVAL_TIMEOUT_S, AnswerRef, Judge, learner_error
 from .base import call_learner, direct
+from .witness import STATUS_LINE, Witness, witnessing
 
-#: The monitor's log line, as notebook 04 writes it.
-STATUS_LINE = re.compile(r'Temperature: (-?[\d.]+)C - Status: (\w+)')
 #: Rate the check replays at (simulated s per wall s): fast, and below what play reaches.
 CHECK_RATE = 100.0
 #: Steps of the judge's clock while the learner's function records or replays (s).
@@ -52,61 +46,6 @@ def _ros2nb_seeded_sensor():
     ros2nb.spin({SEEDED_S}, show_logs=False)
     ros2nb.stop()
 '''
-
-
-# ------------------------------------------------------------------ what the check hears
-@dataclass
-class Witness:
-    """What the check's own ROS hears while the learner's function runs: each reading on
-    /temperature and each /rosout line, with the time it arrived (ns of simulated time).
-
-    :ivar readings: ``(t_ns, °C)`` in order of arrival.
-    :ivar lines: ``(t_ns, logger, text)`` in order of arrival.
-    """
-
-    readings: list[tuple[int, float]] = field(default_factory=list)
-    lines: list[tuple[int, str, str]] = field(default_factory=list)
-
-    def statuses(self) -> list[tuple[int, float, str]]:
-        """``(t_ns, reading, status)`` of every status line of the monitor."""
-        found = []
-        for t_ns, name, text in self.lines:
-            match = STATUS_LINE.fullmatch(text) if name == course.MONITOR_NODE else None
-            if match:
-                found.append((t_ns, float(match.group(1)), match.group(2)))
-        return found
-
-
-@contextlib.contextmanager
-def _witnessing(judge: Optional[Judge]) -> Iterator[Witness]:
-    """Hear /temperature and /rosout while the block runs: the judge's node (stamped with
-    its clock), or in the kernel subscriptions of the check's own (the kernel's clock)."""
-    seen = Witness()
-    if judge is not None:
-        observer = judge.observer
-        heard = observer.watch(TEMPERATURE, Float32, lambda m: float(m.data))
-        first, mark = len(heard), len(observer.logs)
-        try:
-            yield seen
-        finally:
-            seen.readings = [(h.t_ns, h.value) for h in heard[first:]]
-            seen.lines = [(line.t_ns, line.name, line.text) for line in observer.logs[mark:]]
-        return
-    rt = current_runtime()
-    with rt.exclusive():
-        made = [rt.node.create_subscription(
-                    Float32, TEMPERATURE,
-                    lambda m: seen.readings.append((rt.sim_now_ns, float(m.data))), bag.KEEP_ALL),
-                rt.node.create_subscription(
-                    Log, ROSOUT, lambda m: seen.lines.append((rt.sim_now_ns, m.name, m.msg)),
-                    bag.KEEP_ALL)]
-    try:
-        yield seen
-    finally:
-        with rt.exclusive():
-            rt.drain()
-            for subscription in made:
-                rt.node.destroy_subscription(subscription)
 
 
 # ------------------------------------------------------------------ calling the learner
@@ -198,7 +137,7 @@ def _bag_verdict(path: Path, label: str) -> dict[str, int]:
 def _recording(judge: Optional[Judge], record_hour: Any) -> str:
     label = f'{record_hour.__name__}(bag_path)'
     with fresh_path(judge, 'hour') as path:
-        with _witnessing(judge) as seen:
+        with witnessing(judge) as seen:
             _call(judge, record_hour, label, path, spin_s=course.RECORD_S)
         if not path.is_dir():
             _bag_verdict(path, label)  # the line for "no bag at all"
@@ -222,7 +161,7 @@ def _seed_verdict(judge: Optional[Judge], record_hour: Any, label: str,
         exec(SEEDED, names)  # noqa: S102 - the course's own lines, in a copy of the names
         probe = names['_ros2nb_seeded_sensor']
     try:
-        with _witnessing(judge) as seen:
+        with witnessing(judge) as seen:
             _call(judge, probe, 'the seeded sensor', spin_s=SEEDED_S)
     except CheckFailed:
         return  # the notebook's names are not what the course gave: no comparison
@@ -319,7 +258,7 @@ def check_recording(judge: Optional[Judge], record_hour: Any) -> str:
 def _replay(judge: Optional[Judge], replay: Any) -> str:
     readings = check_readings_c()
     with check_bag(judge, 'sixty', readings) as path:
-        with _witnessing(judge) as seen:
+        with witnessing(judge) as seen:
             _call(judge, replay, f'{replay.__name__}(bag_path, rate)', path, CHECK_RATE,
                   spin_s=len(readings) * course.PUBLISH_PERIOD_S, stops=course.MONITOR_NODE)
     return _replay_verdict(readings, seen, f'{replay.__name__}(bag_path, rate)')
