@@ -174,10 +174,11 @@ limit, cut = float(sys.argv[1]), float(sys.argv[2])
 sleeper = subprocess.Popen([sys.executable, '-c', 'import time\\nprint("asleep", flush=True)\\n'
                             'time.sleep(3600)'], stdout=subprocess.PIPE, text=True)
 sleeper.stdout.readline()  # its start is work (a busy machine queues it): watch it asleep
-patience, began = Patience(sleeper.pid, limit), time.monotonic()
+began = time.monotonic()
+patience = Patience(sleeper.pid, limit, started=began)  # one start for both: no rounding
 while not (gave_up := patience.exhausted()) and time.monotonic() - began < cut * limit:
     time.sleep(0.1)
-print('gave up' if gave_up else 'still waiting', round(time.monotonic() - began, 1))
+print('gave up' if gave_up else 'still waiting', time.monotonic() - began)
 sleeper.kill()
 """
 #: Where the watcher stops waiting for Patience itself (times the limit): the failure
