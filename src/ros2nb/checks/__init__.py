@@ -67,11 +67,11 @@ def run_check(name: str, judge: Optional[Judge], *args: Any, **kwargs: Any) -> N
     :raises ValueError: for a name no lesson registers (a mistake of the course's).
     :raises CheckFailed: (or :class:`~ros2nb.errors.LearnerCodeError`) with the verdict.
     """
-    from .base import CHECKS, run_body
+    from .base import CHECKS, passed
     if name in _MODULE_OF:
         getattr(sys.modules[__name__], name)  # loads its lesson's module, which registers it
     if name not in CHECKS:
         raise ValueError(f'no check is named {name!r}')
-    run_body(CHECKS[name], judge, *args, **kwargs)
+    passed(CHECKS[name](judge, *args, **kwargs))
 
 __all__ = ['CheckFailed', *sorted(_MODULE_OF)]

@@ -19,41 +19,26 @@ from __future__ import annotations
 
 import functools
 import inspect
-from dataclasses import dataclass
-from typing import Any, Callable, Optional
+from typing import Any, Callable
 
 from ..errors import CheckFailed, Ros2nbError
 from ..explain.exceptions import describe_error
-from ..judge_interface import Judge, learner_error
+from ..judge_interface import learner_error
 from .dispatch import ask_judge
 
 #: A check's body: ``body(judge, *learner_things) -> the passed sentence``.
 Body = Callable[..., str]
 
 
-@dataclass(frozen=True)
-class Check:
-    """A registered check.
-
-    :ivar name: the notebook's name for it, e.g. ``'check_sensor_constructor'``.
-    :ivar body: what decides, given the judge (None in the kernel) and the call's arguments.
-    :ivar judged: True when the body runs only in a judge.
-    """
-
-    name: str
-    body: Body
-    judged: bool
+#: The body of every check of the lessons loaded so far, by the check's name.
+CHECKS: dict[str, Body] = {}
 
 
-#: Every check of the lessons loaded so far, by name.
-CHECKS: dict[str, Check] = {}
-
-
-def _register(body: Body, judged: bool, call: Callable[..., None]) -> Callable[..., None]:
+def _register(body: Body, call: Callable[..., None]) -> Callable[..., None]:
     name = body.__name__
     if name in CHECKS:
         raise RuntimeError(f'two checks are named {name}')  # a mistake of the course's
-    CHECKS[name] = Check(name, body, judged)
+    CHECKS[name] = body
     functools.update_wrapper(call, body)
     del call.__wrapped__  # type: ignore[attr-defined]
     # What the notebook calls: the body's parameters without the judge, and no return value.
@@ -71,7 +56,7 @@ def judged(body: Body) -> Callable[[], None]:
     def call() -> None:
         ask_judge(body.__name__)
 
-    return _register(body, True, call)
+    return _register(body, call)
 
 
 def direct(body: Body) -> Callable[..., None]:
@@ -80,15 +65,7 @@ def direct(body: Body) -> Callable[..., None]:
     def call(*args: Any, **kwargs: Any) -> None:
         passed(body(None, *args, **kwargs))
 
-    return _register(body, False, call)
-
-
-def run_body(check: Check, judge: Optional[Judge], *args: Any, **kwargs: Any) -> None:
-    """Run a registered check's body with ``judge`` and print its ``Check passed`` line.
-
-    :raises CheckFailed: (or :class:`LearnerCodeError`) with the check's verdict.
-    """
-    passed(check.body(judge, *args, **kwargs))
+    return _register(body, call)
 
 
 def passed(message: str) -> None:
