@@ -164,7 +164,8 @@ MISTAKES = [
                                  r'call self.redraw\(\) once per message'),
     ('plot: the message, not its data', PLOT, 'self.temps_c.append(msg.data)',
      'self.temps_c.append(msg)', checks.check_plot_callback,
-     r'unsupported format string passed to Float32'),
+     r'temperature_callback raised for 21\.5 °C: a Float32 message is not its value: use its '
+     r'field \(data\), e\.g\. msg\.data\.'),
 ]
 
 
@@ -413,3 +414,83 @@ def test_a_reply_of_no_known_shape_fails_that_check_alone(session, monkeypatch):
     assert outcome['passed'] is False and '\n' not in outcome['message']
     assert outcome['message'].startswith('The grader could not finish this check (KeyError'), \
         outcome
+
+
+#: The Worker's slow callback logs the heartbeat's line itself, between its own two lines, on a
+#: SingleThreadedExecutor: the lines say "heartbeat during slow work", yet no heartbeat ran.
+LOGGED_HEARTBEAT = ('        time.sleep(SLOW_WORK_S)   # stands for a long computation\n', '''\
+        time.sleep(SLOW_WORK_S / 2)
+        self.get_logger().info('heartbeat')
+        time.sleep(SLOW_WORK_S / 2)
+''')
+SINGLE_THREADED = '''    from rclpy.executors import SingleThreadedExecutor
+    return Worker('responsive_worker'), SingleThreadedExecutor()
+'''
+
+
+def test_a_heartbeat_the_slow_callback_logs_itself(session):
+    """Before, the judge read the worker's lines on /rosout and this worker passed (its
+    honest twin, the same without the logged line, failed); now the course's callbacks on
+    the Worker's timers tell the judge when each ran, and no heartbeat ran during slow_work."""
+    text = course.reference_source(Path(PROMISES).name)
+    for old, new in (LOGGED_HEARTBEAT, (RESPONSIVE, SINGLE_THREADED)):
+        assert old in text, old
+        text = text.replace(old, new)
+    (session.workspace / PROMISES).write_text(text)
+    session.drop(('file', PROMISES))
+    try:
+        with pytest.raises(CheckFailed, match=r'No heartbeat came while slow_work was busy '
+                                              r'\(\d+ runs of slow_work watched\): a '
+                                              r'SingleThreadedExecutor runs one callback'):
+            run_check(session, checks.check_responsive_worker)
+    finally:
+        restore(session, PROMISES)
+
+
+RIGHT_PLOT = '''        self.times_s.append(self.get_clock().now().nanoseconds / 1e9)
+        self.temps_c.append(msg.data)
+        self.redraw()
+'''
+#: The plot's callback logs redraw()'s line for each reading, with the node's time and the
+#: reading, and neither keeps them nor calls redraw(): the lines say "plotted", nothing was.
+LOGGED_POINT = '''        self.logged = getattr(self, 'logged', 0) + 1
+        self.get_logger().info(f'Plotted {msg.data:.2f} °C at '
+                               f'{self.get_clock().now().nanoseconds / 1e9:.3f} s, '
+                               f'point {self.logged}')
+'''
+
+
+def test_a_point_the_callback_logs_itself(session):
+    """Before, the judge read redraw()'s lines on /rosout and this callback passed (its
+    honest twin, a callback that does nothing, failed); now the course's redraw() tells the
+    judge what it drew, and it never drew."""
+    fails_forged(session, PLOT, RIGHT_PLOT, LOGGED_POINT, '', checks.check_plot_callback,
+                 r'For the reading 21\.5 °C nothing was plotted')
+
+
+#: The callback publishes on the judge's witness topic what the course's redraw() would have
+#: told it, with a token of its own making.
+WITNESS_FORGED = '''        import json
+        from std_msgs.msg import String
+        if not hasattr(self, 'forger'):
+            self.forger = self.create_publisher(String, '/ros2nb/witness', 10)
+            self.points = []
+        self.points.append(self.get_clock().now().nanoseconds / 1e9)
+        self.forger.publish(String(data=json.dumps({
+            'token': 'guessed', 'event': 'drawn', 'times_s': self.points,
+            'temps_c': [21.5, 26.25, 19.75, 23.0][:len(self.points)]})))
+'''
+
+
+def test_a_witness_message_without_the_token_counts_for_nothing(session, capsys, monkeypatch):
+    """Only messages with the token the judge drew for this check run count: one the
+    learner's code publishes on the witness topic itself is not taken for the course's.
+    With every message taken whatever its token, the same callback passes."""
+    fails_forged(session, PLOT, RIGHT_PLOT, WITNESS_FORGED, '', checks.check_plot_callback,
+                 r'For the reading 21\.5 °C nothing was plotted')
+    from ros2nb.checks import lesson07, witnessed
+    monkeypatch.setattr(lesson07, 'told', lambda heard, start, token: [
+        fact for fact in witnessed.told(heard, start, 'guessed')])
+    # the subject counts only what the course's redraw() told: wait for one message each
+    monkeypatch.setattr(lesson07, '_shown', lambda counts: None)
+    passes_with(session, capsys, PLOT, RIGHT_PLOT, WITNESS_FORGED, checks.check_plot_callback)

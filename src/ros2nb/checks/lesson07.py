@@ -1,85 +1,112 @@
 """Checks of notebook 07, a live plot: the subscription callback that feeds the plot.
 
 Part of :mod:`ros2nb.checks`.  The judge creates the learner's ``PlotFeeder`` (from
-``live_plot.py``) in a subject, moves its own clock on between readings it publishes from
-its own node, and reads what the node says on ``/rosout``: its ``redraw()`` (part 1, given)
-logs each point it plots, with its time and its reading.  So the judge hears, for every
-reading it sent, whether a point was plotted, with which time and value.  The file, read
-as text, only picks the words of a failure the judge has seen.
+``live_plot.py``) in a subject, with the course's own ``redraw()`` in place of the given one
+(part 1): it tells the judge every point it drew (:mod:`.witnessed`).  The judge moves its own
+clock on between readings it publishes from its own node, so it knows, for every reading it
+sent, whether the plot was redrawn, and with which times and values.  A line the node logs
+decides nothing (any code can print one); the file, read as text, only picks the words of a
+failure the judge has seen.
 """
 
 from __future__ import annotations
 
 import math
-import re
 from typing import Optional
 
 from .. import course
 from ..errors import CheckFailed
-from ..judge_interface import Judge
+from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge
 from .base import judged
-from .file_nodes import feed, lines_logged, new_node, reach
+from .file_nodes import feed, new_node, reach
 from .source import ClassSource
 from .verdicts import endpoint_verdict, node_name_verdict
+from .witnessed import WITNESS_TOPIC, new_token, told, told_to
 
 #: Readings the check publishes (°C), one simulated second apart; exact in Float32.
 PLOT_READINGS_C = (21.5, 26.25, 19.75, 23.0)
 #: Simulated seconds of the judge's clock between two readings.
 READING_GAP_S = 1.0
-#: The line ``redraw()`` logs for each point (part 1 of live_plot.py).
-PLOTTED = re.compile(r'Plotted (-?[\d.]+) °C at (-?[\d.]+) s, point (\d+)')
+#: How close a drawn reading must be to the one sent (°C): Float32 keeps about 7 digits.
+READING_TOLERANCE_C = 0.006
 
 
-def _plotted(lines: list[str]) -> list[tuple[float, float, int]]:
-    """(reading, time, number) of each point a list of log lines says was plotted."""
-    found = []
-    for line in lines:
-        match = PLOTTED.fullmatch(line)
-        if match:
-            found.append((float(match.group(1)), float(match.group(2)), int(match.group(3))))
-    return found
+def _shown(counts: dict) -> Optional[int]:
+    """How many messages a subject's counts say the course's redraw() told, or None when
+    they say nothing usable: how long to wait for them, never what passes."""
+    told = counts.get('shown')
+    return told if isinstance(told, int) and not isinstance(told, bool) else None
+
+
+def _drawn(judge: Judge, subject, info: dict, value: float, counts: dict, token: str
+           ) -> tuple[dict, list[dict]]:
+    """Feed one reading and return the subject's counts after it and what the course's
+    redraw() drew meanwhile (each redraw: its ``times_s`` and ``temps_c``)."""
+    heard = told_to(judge)
+    mark, before = len(heard), _shown(counts)
+    counts, _lines = feed(judge, subject, info, value, counts, 'temperature_callback.')
+    after = _shown(counts)
+    # as many redraws as the subject says it told (none: no wait; it says nothing: one)
+    expected = 1 if before is None or after is None else after - before
+    judge.observer.wait_until(lambda: len(told(heard, mark, token)) >= expected,
+                              ARRIVAL_TIMEOUT_S)
+    return counts, [fact for fact in told(heard, mark, token) if fact['event'] == 'drawn']
 
 
 def _plot_callback(judge: Judge) -> str:
     observer = judge.observer
-    mark = len(observer.logs)
+    token = new_token()
+    told_to(judge)  # the judge's subscription exists before the subject looks for it
     subject, info = new_node(judge, course.LIVE_PLOT_FILE, course.PLOT_CLASS)
     node_name_verdict(info, course.PLOT_NODE)
     found = observer.endpoints(info['name'], info['namespace'], info['endpoints'])
     endpoint_verdict(info['name'], found, 'subscription', '/' + course.TOPIC, course.MESSAGE_TYPE)
-    lines_logged(judge, info, mark, info['started_lines'])
+    shown = subject.request('plot_shown', topic=WITNESS_TOPIC, token=token,
+                            seconds=ARRIVAL_TIMEOUT_S, timeout=ARRIVAL_TIMEOUT_S + 30)
+    if not shown['ok']:
+        raise CheckFailed("The plot's witness never reached the grader: is the machine very "
+                          'busy? Run this check again.')
     reach(judge, subject, info['name'])
-    counts = info
-    for number, value in enumerate(PLOT_READINGS_C, start=1):
+    counts = {**info, 'shown': shown.get('shown')}
+    sent: list[tuple[float, float]] = []
+    for value in PLOT_READINGS_C:
         judge.clock.drive(subject, 'run', seconds=READING_GAP_S, step_s=READING_GAP_S,
                           limit_s=READING_GAP_S, what=course.PLOT_CLASS)
-        sent_s = judge.clock.now_s
-        counts, lines = feed(judge, subject, info, value, counts, 'temperature_callback.')
-        _point_verdict(judge, value, sent_s, number, _plotted(lines))
+        sent.append((judge.clock.now_s, value))
+        counts, drawn = _drawn(judge, subject, info, value, counts, token)
+        _point_verdict(judge, sent, drawn)
     return (f'each of {len(PLOT_READINGS_C)} readings was plotted once, at the time it arrived '
             'on the node\'s clock (the grader\'s simulated time), with its value.')
 
 
-def _point_verdict(judge: Judge, value: float, sent_s: float, number: int,
-                   points: list[tuple[float, float, int]]) -> None:
-    """One point per reading: this reading, at the time it arrived, the next in the plot."""
-    if not points:
+def _point_verdict(judge: Judge, sent: list[tuple[float, float]], drawn: list[dict]) -> None:
+    """One redraw per reading, drawing every reading sent so far: its value, at the time
+    it arrived (``sent``: the judge's ``(time, reading)`` of each)."""
+    sent_s, value = sent[-1]
+    number = len(sent)
+    if not drawn:
         raise CheckFailed(f'For the reading {value} °C nothing was plotted: '
                           f'{_unplotted_cause(judge)}')
-    if len(points) > 1:
-        raise CheckFailed(f'For the reading {value} °C the plot was redrawn {len(points)} times: '
+    if len(drawn) > 1:
+        raise CheckFailed(f'For the reading {value} °C the plot was redrawn {len(drawn)} times: '
                           'call self.redraw() once per message, after appending.')
-    reading, time_s, count = points[0]
-    if count != number:
-        raise CheckFailed(f'After {number} readings the plot holds {count} points: append one '
-                          'time and one reading per message, no more.')
-    if not math.isclose(reading, value, abs_tol=0.006):
-        raise CheckFailed(f'For the reading {value} °C the plot shows {reading} °C: append '
-                          'msg.data, the number the message carries.')
-    if not math.isclose(time_s, sent_s, abs_tol=1e-3):
-        raise CheckFailed(f'A reading that arrived at {sent_s:g} s of simulated time was plotted '
-                          f'at {time_s:g} s: use the node\'s clock in seconds, '
-                          'self.get_clock().now().nanoseconds / 1e9 (it follows simulated time).')
+    times_s, temps_c = drawn[0].get('times_s') or [], drawn[0].get('temps_c') or []
+    if len(temps_c) != number:
+        raise CheckFailed(f'After {number} readings the plot holds {len(temps_c)} points: append '
+                          'one time and one reading per message, no more.')
+    for (at_s, reading), time_s, temp_c in zip(sent, times_s, temps_c):
+        if temp_c is None or not math.isclose(temp_c, reading, abs_tol=READING_TOLERANCE_C):
+            raise CheckFailed(f'For the reading {reading} °C the plot shows '
+                              f'{"something that is no number" if temp_c is None else temp_c} '
+                              '°C: append msg.data, the number the message carries.')
+        if time_s is None or not math.isclose(time_s, at_s, abs_tol=1e-3):
+            raise CheckFailed(f'A reading that arrived at {at_s:g} s of simulated time was '
+                              f'plotted at {time_s if time_s is None else format(time_s, "g")} '
+                              "s: use the node's clock in seconds, self.get_clock().now()"
+                              '.nanoseconds / 1e9 (it follows simulated time).')
+    if len(times_s) != number:
+        raise CheckFailed(f'After {number} readings the plot holds {len(times_s)} times: append '
+                          'one time and one reading per message, no more.')
 
 
 def _unplotted_cause(judge: Judge) -> str:
@@ -93,16 +120,17 @@ def _unplotted_cause(judge: Judge) -> str:
             if not source.reaches_change('temperature_callback', attribute):
                 return f'append {what} to self.{attribute} in temperature_callback.'
     return ('append the time and the reading, then call self.redraw() once per message '
-            '(redraw() plots the newest point and logs it).')
+            '(redraw() draws every point so far).')
 
 
 @judged
 def check_plot_callback(judge: Judge) -> str:
     """Check part 2 of ``live_plot.py``: the callback that feeds the live plot.
 
-    The judge publishes 4 readings one second of its clock apart to your ``PlotFeeder`` and
-    listens to what it plots (``redraw()`` logs each point on ``/rosout``): every reading
-    plotted once, with its value and the node's simulated time when it arrived.
+    The judge publishes 4 readings one second of its clock apart to your ``PlotFeeder``, whose
+    ``redraw()`` is the course's own (as given in part 1), telling the grader every point it
+    draws: every reading plotted once, with its value and the node's simulated time when it
+    arrived.
 
     Introduced in ``07-live-plot.ipynb``.
 

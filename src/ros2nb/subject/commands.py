@@ -174,8 +174,9 @@ class Subject(Trials):
     def _counts(self) -> dict:
         rt = self._runtime()
         logged = rt.log_counts.get(self.node.get_logger().name, 0) if self.node else 0
+        shown = self._plot_shown.told if self._plot_shown is not None else None
         return {'received': self.received, 'logged': logged, 'failure': self.failure,
-                'published': JudgeTime.published()}
+                'published': JudgeTime.published(), 'shown': shown}
 
     def counts(self) -> dict:
         return {'ok': True, **self._counts()}
@@ -248,6 +249,7 @@ def serve(commands: Any, replies: Any, namespace: dict[str, Any]) -> None:
         'set_attribute': subject.set_attribute, 'wait_matched': subject.wait_matched,
         'wait_received': subject.wait_received, 'counts': subject.counts,
         'serve': subject.serve, 'worker': subject.worker, 'worker_stop': subject.worker_stop,
+        'plot_shown': subject.plot_shown,
         'room_nodes': subject.room_nodes, 'wait_publishers': subject.wait_publishers,
         'qos_endpoint': subject.qos_endpoint, 'qos_take': subject.qos_take,
         'qos_acked': subject.qos_acked,

@@ -1,9 +1,12 @@
-"""The subject's commands for notebooks 06 and 09: the learner's worker, rooms and QoS endpoints.
+"""The subject's commands for notebooks 06, 07 and 09: the learner's worker, rooms, plot and
+QoS endpoints.
 
 Part of :mod:`ros2nb.subject` (a mixin of :class:`ros2nb.subject.commands.Subject`).  Each
 command makes something of the learner's run (their executor spinning their Worker, nodes
 started with their arguments, an endpoint with their profile); the judge watches it over ROS
-itself.  A reply names the parts only so that the judge can say why what it saw went wrong.
+itself, and where the learner's code drives code the course gave them, the course's own
+version of it tells the judge what happened (:mod:`.shown`).  A reply names the parts only so
+that the judge can say why what it saw went wrong.
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ from ..explain.exceptions import describe_error
 from ..explain.ros_settings import zero_depth_refused
 from ..runtime.rates import callback_groups
 from .replies import encode
+from .shown import Shown, plot_redraw, worker_callbacks
 
 #: The node that makes an endpoint with the learner's QoS profile (notebook 09).
 QOS_NODE = 'qos_answer'
@@ -35,16 +39,24 @@ class Trials:
 
     namespace: dict[str, Any]
     rooms: list[Node]
-    _spun: Optional[tuple[Node, Executor, threading.Thread, threading.Event, list]]
+    node: Optional[Node]
+    _spun: Optional[tuple[Node, Executor, threading.Thread, threading.Event, list, Shown]]
     _qos: Optional[tuple[Node, Any, list[int]]]
+    _plot_shown: Optional[Shown] = None
 
     def _runtime(self) -> Any:  # provided by Subject
         raise NotImplementedError
 
     # ------------------------------------------------------------ notebook 06
-    def worker(self, name: str) -> dict:
-        """Call the learner's ``name()`` for ``(node, executor)`` and spin them on the wall
-        clock in a thread until :meth:`worker_stop`; the judge listens to their lines."""
+    def worker(self, name: str, topic: str, token: str, work_s: float, seconds: float) -> dict:
+        """Call the learner's ``name()`` for ``(node, executor)``, put the course's callbacks
+        (:func:`.shown.worker_callbacks`, telling ``topic`` with ``token``) on the Worker's two
+        timers, in the callback groups the learner chose, and spin the learner's executor on the
+        wall clock in a thread until :meth:`worker_stop`; the judge watches ``topic``.
+
+        :param work_s: how long the course's slow callback works (s, wall clock).
+        :param seconds: how long to wait, at most, for the judge's subscription to match.
+        """
         function = self.namespace.get(name)
         if not callable(function):
             return {'ok': False, 'undefined': True}
@@ -57,6 +69,18 @@ class Trials:
                 and isinstance(made[1], Executor)):
             return {'ok': False, 'returned': encode(made)}
         node, executor = made
+        described = {'name': node.get_name(), 'executor': type(executor).__name__,
+                     'threads': getattr(executor, '_num_threads', None),
+                     'groups': callback_groups(node)}
+        timers = sorted(node.timers, key=lambda timer: timer.timer_period_ns)
+        if len(timers) < 2:
+            return {'ok': False, 'timers': len(timers), **described}
+        shown = Shown(topic, token)
+        if not shown.reaches_judge(seconds):
+            shown.close()
+            return {'ok': False, 'unmatched': True, **described}
+        # the slowest timer is slow_work's, the quickest heartbeat's (part 3: 0.5 s, 0.1 s)
+        timers[-1].callback, timers[0].callback = worker_callbacks(shown, work_s)
         executor.add_node(node)
         stop, failures = threading.Event(), []
 
@@ -64,29 +88,41 @@ class Trials:
             while not stop.is_set():
                 try:
                     executor.spin_once(timeout_sec=SPIN_ROUND_S)
-                except BaseException as error:  # the learner's callback may raise anything
+                except BaseException as error:  # the learner's executor may raise anything
                     failures.append({'callback': f'{type(node).__name__} callback',
                                      **describe_error(error)})
                     return
 
         thread = threading.Thread(target=spin, name='ros2nb-subject-worker', daemon=True)
-        self._spun = (node, executor, thread, stop, failures)
+        self._spun = (node, executor, thread, stop, failures, shown)
         thread.start()
-        return {'ok': True, 'name': node.get_name(), 'executor': type(executor).__name__,
-                'threads': getattr(executor, '_num_threads', None),
-                'groups': callback_groups(node)}
+        return {'ok': True, **described}
 
     def worker_stop(self) -> dict:
         """Stop spinning the learner's worker; the first failure of its callbacks, if any."""
         if self._spun is None:
             return {'ok': True, 'failure': None}
-        node, executor, thread, stop, failures = self._spun
+        node, executor, thread, stop, failures, shown = self._spun
         self._spun = None
         stop.set()
         thread.join()
         executor.shutdown(timeout_sec=5)
         node.destroy_node()
+        shown.close()
         return {'ok': True, 'failure': failures[0] if failures else None}
+
+    # ------------------------------------------------------------ notebook 07
+    def plot_shown(self, topic: str, token: str, seconds: float) -> dict:
+        """Put the course's ``redraw()`` (:func:`.shown.plot_redraw`, telling ``topic`` with
+        ``token``) in place of the given one on the class of the node made last, and wait (at
+        most ``seconds``) for the judge's subscription on ``topic`` to match."""
+        if self.node is None:
+            return {'ok': False}
+        if self._plot_shown is not None:
+            self._plot_shown.close()
+        self._plot_shown = shown = Shown(topic, token)
+        type(self.node).redraw = plot_redraw(shown)  # type: ignore[attr-defined]
+        return {'ok': shown.reaches_judge(seconds), 'shown': shown.told}
 
     def room_nodes(self, arguments: list) -> dict:
         """A stand-in sensor and monitor, each started with ``arguments`` (as ``--ros-args``)."""
