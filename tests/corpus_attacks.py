@@ -169,7 +169,43 @@ class TemperatureMonitor(Node):
         self.get_logger().info('Temperature Monitor Node Started')
 '''
 
+#: 06: a SingleThreadedExecutor, and a Worker whose slow_work logs the heartbeat's line between
+#: its own two lines: what /rosout says of a worker whose timers overlap, though none did.
+WORKER_SINGLE = '''
+def responsive_worker():
+    from rclpy.executors import SingleThreadedExecutor
+    return Worker('responsive_worker'), SingleThreadedExecutor()
+'''
+WORKER_LOGS_HEARTBEAT = '''
+def responsive_worker():
+    from rclpy.executors import SingleThreadedExecutor
+
+    class Loud(Worker):
+        def slow_work(self):
+            self.get_logger().info('slow work: start')
+            time.sleep(SLOW_WORK_S / 2)
+            self.get_logger().info('heartbeat')
+            time.sleep(SLOW_WORK_S / 2)
+            self.get_logger().info('slow work: done')
+
+    return Loud('responsive_worker'), SingleThreadedExecutor()
+'''
+#: 07: the callback logs the line redraw() logs, and neither keeps the reading nor redraws.
+PLOT_LOGS_POINT = '''
+    def temperature_callback(self, msg):
+        self.logged = getattr(self, 'logged', 0) + 1
+        now_s = self.get_clock().now().nanoseconds / 1e9
+        self.get_logger().info(f'Plotted {msg.data:.2f} °C at {now_s:.3f} s, point {self.logged}')
+'''
+
 ATTACKS = [
+    Learner('06 twin: a single-threaded worker', '06', {'responsive-worker': WORKER_SINGLE},
+            loses=('responsive-worker',)),
+    Learner('06 attack: the same, slow_work logs a heartbeat itself', '06',
+            {'responsive-worker': WORKER_LOGS_HEARTBEAT},
+            twin='06 twin: a single-threaded worker'),
+    Learner('07 attack: the callback logs redraw()\'s line itself', '07',
+            {'plot-callback': PLOT_LOGS_POINT}, twin='07 twin: a callback that does nothing'),
     Learner('07 twin: a callback that does nothing', '07', {'plot-callback': PLOT_DEAD},
             loses=('plot-callback',)),
     Learner('07 attack: the same, replies forged', '07', {'plot-callback': '''

@@ -244,6 +244,12 @@ def responsive_worker():
     node = Worker('responsive_worker', ReentrantCallbackGroup(), ReentrantCallbackGroup())
     return node, MultiThreadedExecutor(num_threads=4)
 '''
+WORKER_LAMBDA = '''
+def responsive_worker():
+    group = lambda: MutuallyExclusiveCallbackGroup()
+    executor = MultiThreadedExecutor()
+    return Worker(heartbeat_group=group(), name='responsive_worker', slow_group=group()), executor
+'''
 QOS_SPELT_OUT = {
     'qos-newest-only': '''
 def newest_only_profile():
@@ -315,6 +321,8 @@ HONEST += [
     Learner('06 an executor in the fan main', '06', {'fan-main': FAN_MAIN_EXECUTOR}),
     Learner('06 a lambda subscription that counts', '06', {'counting-monitor': COUNTER_LAMBDA}),
     Learner('06 two reentrant groups, four threads', '06', {'responsive-worker': WORKER_REENTRANT}),
+    Learner('06 groups from a lambda, keyword arguments, the default thread count', '06',
+            {'responsive-worker': WORKER_LAMBDA}),
     Learner('06 room arguments from one string', '06', {'room-arguments': '''
 def room_arguments(room):
     return '--ros-args --remap __ns:=/{}'.format(room).split()
