@@ -54,6 +54,7 @@ class Shown:
         self.told += 1
 
     def close(self) -> None:
+        """Destroy the course's node (and with it its publisher)."""
         self.node.destroy_node()
 
 
