@@ -18,14 +18,25 @@ from .. import course
 from ..errors import CheckFailed
 from ..judge_interface import Judge
 from .base import judged
+from .drawn import chooser
 from .file_nodes import feed, lines_logged, new_node, reach
 from .source import ClassSource
 from .verdicts import endpoint_verdict, node_name_verdict
 
-#: Readings the check publishes (°C), one simulated second apart; exact in Float32.
+#: Readings the check publishes (°C); exact in Float32.
 PLOT_READINGS_C = (21.5, 26.25, 19.75, 23.0)
-#: Simulated seconds of the judge's clock between two readings.
+#: Steps of the judge's clock between two readings (s).
 READING_GAP_S = 1.0
+#: Whole seconds of the judge's clock before the first reading, and between two readings,
+#: drawn for each run (a point's time is then no table's: the first never comes at 1 s).
+FIRST_GAP_S, NEXT_GAP_S = (2, 9), (1, 4)
+
+
+def _gaps_s(judge: Judge) -> list[int]:
+    """Simulated seconds before each reading, drawn for this run (:mod:`.drawn`)."""
+    source = chooser(judge, '07 reading times')
+    return [source.randint(*(FIRST_GAP_S if k == 0 else NEXT_GAP_S))
+            for k in range(len(PLOT_READINGS_C))]
 #: The line ``redraw()`` logs for each point (part 1 of live_plot.py).
 PLOTTED = re.compile(r'Plotted (-?[\d.]+) °C at (-?[\d.]+) s, point (\d+)')
 
@@ -50,9 +61,9 @@ def _plot_callback(judge: Judge) -> str:
     lines_logged(judge, info, mark, info['started_lines'])
     reach(judge, subject, info['name'])
     counts = info
-    for number, value in enumerate(PLOT_READINGS_C, start=1):
-        judge.clock.drive(subject, 'run', seconds=READING_GAP_S, step_s=READING_GAP_S,
-                          limit_s=READING_GAP_S, what=course.PLOT_CLASS)
+    for number, (value, gap_s) in enumerate(zip(PLOT_READINGS_C, _gaps_s(judge)), start=1):
+        judge.clock.drive(subject, 'run', seconds=gap_s, step_s=READING_GAP_S,
+                          limit_s=gap_s, what=course.PLOT_CLASS)
         sent_s = judge.clock.now_s
         counts, lines = feed(judge, subject, info, value, counts, 'temperature_callback.')
         _point_verdict(judge, value, sent_s, number, _plotted(lines))
@@ -100,9 +111,9 @@ def _unplotted_cause(judge: Judge) -> str:
 def check_plot_callback(judge: Judge) -> str:
     """Check part 2 of ``live_plot.py``: the callback that feeds the live plot.
 
-    The judge publishes 4 readings one second of its clock apart to your ``PlotFeeder`` and
-    listens to what it plots (``redraw()`` logs each point on ``/rosout``): every reading
-    plotted once, with its value and the node's simulated time when it arrived.
+    The judge publishes 4 readings to your ``PlotFeeder``, at times of its clock drawn for
+    this run, and listens to what it plots (``redraw()`` logs each point on ``/rosout``):
+    every reading plotted once, with its value and the node's simulated time when it arrived.
 
     Introduced in ``07-live-plot.ipynb``.
 

@@ -18,6 +18,7 @@ from typing import NamedTuple, Optional
 
 import nbformat
 
+from ros2nb.checks.drawn import SEED_OPTION
 from ros2nb.judge.subjects import SUBJECTS_FOLDER_ENV, home_and_tmp
 
 from ..paths import ROOT, SOLUTIONS
@@ -66,6 +67,8 @@ def judge_notebook(scratch: Scratch, notebook: str, submitted: nbformat.Notebook
         part.mkdir(parents=True)
     argv = [sys.executable, '-m', 'ros2nb.judge', 'grade', str(source),
             str(given / 'submission.ipynb')]
+    if settings.seed is not None:  # on the command line: the judge's subjects, each with
+        argv += [SEED_OPTION, str(settings.seed)]  # a PID namespace of its own, never see it
     env = sandbox_env(own / 'home', ROS2NB_WORKSPACE=str(workspace),
                       TMPDIR=str(own / 'tmp'), **{SUBJECTS_FOLDER_ENV: str(subjects)})
     limits = sandbox.Limits(wall_s=JUDGE_TIMEOUT_S)
