@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 import sys
 from pathlib import Path
-from typing import Any
+from typing import Any, Optional
 
 from .. import checks
 from ..checks.drawn import SEED_OPTION, parse_seed
@@ -25,19 +25,30 @@ from .session import Session
 from .subjects import subject_prefix
 
 
-def main(argv: list[str]) -> int:
-    """Run one check, or grade one notebook; print the outcome as one JSON line."""
+USAGE = f'Usage: python -m ros2nb.judge check NAME | grade SOURCE SUBMISSION [{SEED_OPTION} N]'
+
+
+def arguments(argv: list[str]) -> tuple[list[str], Optional[int]]:
+    """The command (``check NAME`` or ``grade SOURCE SUBMISSION``) and the grader's seed of
+    the drawn inputs (None: the judge draws one).  Only ``grade`` takes a seed: a check in
+    the lab is asked for by the learner's kernel, which must not choose its inputs.
+
+    :raises Ros2nbError: with the usage, or with what is wrong with the seed.
+    """
     seed = None
     if argv[:1] == ['grade'] and len(argv) == 5 and argv[3] == SEED_OPTION:
-        try:
-            seed = parse_seed(argv[4])
-        except Ros2nbError as problem:
-            print(problem, file=sys.stderr)
-            return 2
-        argv = argv[:3]
+        argv, seed = argv[:3], parse_seed(argv[4])
     if (argv[:1], len(argv)) not in ((['check'], 2), (['grade'], 3)):
-        print(f'Usage: python -m ros2nb.judge check NAME | grade SOURCE SUBMISSION '
-              f'[{SEED_OPTION} N]', file=sys.stderr)
+        raise Ros2nbError(USAGE)
+    return argv, seed
+
+
+def main(argv: list[str]) -> int:
+    """Run one check, or grade one notebook; print the outcome as one JSON line."""
+    try:
+        argv, seed = arguments(argv)
+    except Ros2nbError as problem:
+        print(problem, file=sys.stderr)
         return 2
     if not subject_prefix():  # subjects not sandboxed: forked from here, before ROS starts
         serve_from_here()
