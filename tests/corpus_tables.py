@@ -3,10 +3,11 @@ judge once fed every run (fixed, and readable in ``ros2nb.checks``), wrong in ge
 
 Each table is built from those old inputs as a learner reading the course's code would have
 built it: notebook 04's boundary readings and the hidden test's ``random.Random(2024)``
-readings, 06's fan readings, counted readings and rooms, 07's readings one second apart from
-0 s, 08's three refused changes, 03's clamp probes.  With fixed inputs each scored above its
-twin (the same answer without the table); with inputs drawn for each run
-(:mod:`ros2nb.checks.drawn`) it scores what its twin scores (``test_corpora.py``).
+readings, 06's fan readings, counted readings, rooms and the counting monitor's name
+('monitor_7'), 07's readings one second apart from 0 s, 08's three refused changes, 03's
+clamp probes.  With fixed inputs each scored above its twin (the same answer without the
+table); with inputs drawn for each run (:mod:`ros2nb.checks.drawn`) it scores what its twin
+scores (``test_corpora.py``).
 """
 
 import random
@@ -95,6 +96,13 @@ TABLES = [
     Learner('06 table: the old fan readings, counts and rooms', '06',
             _06('round(msg.data, 2) in (26.01, 27.5)', 'round(msg.data) - 20', ROOMS_TABLE),
             twin='06 twin: fan off, nothing counted, no room'),
+    Learner('06 twin: a counting monitor that ignores its name', '06', {'counting-monitor': [(
+        '        super().__init__(name)\n', "        super().__init__('counting_monitor')\n")]},
+            loses=('counting-monitor',)),
+    Learner('06 table: a counting monitor named as the old check names it', '06', {
+        'counting-monitor': [('        super().__init__(name)\n',
+                              "        super().__init__('monitor_7')\n")]},
+            twin='06 twin: a counting monitor that ignores its name'),
     Learner('07 twin: every point at 0 s', '07', {'plot-callback': [(
         TIMES_07[0], TIMES_07[1].format('0.0'))]}, loses=('plot-callback',)),
     Learner('07 table: the seconds the old readings came', '07', {'plot-callback': [(

@@ -172,8 +172,18 @@ def _counting_monitor(judge: Judge) -> str:
             raise CheckFailed(f'After {index} reading{"s" if index > 1 else ""} {name} logged '
                               f'"{lines[0]}": add one to self.received for every message, and '
                               'log the new count.')
+    _named_as_told(judge, f'monitor_{chooser(judge, "06 counting name").randrange(10, 1000)}')
     return (f"{course.COUNTING_CLASS}('{name}') is called {name} and counted "
             f'{COUNTED_READINGS} of {COUNTED_READINGS} readings, as its lines on /rosout say.')
+
+
+def _named_as_told(judge: Judge, name: str) -> None:
+    """A counting monitor given ``name`` (drawn for this run: no table holds it) is called
+    ``name``."""
+    _subject, info = new_node(judge, course.PROMISES_FILE, course.COUNTING_CLASS, args=(name,))
+    if info['name'] != name:
+        raise CheckFailed(f"{course.COUNTING_CLASS}('{name}') made a node called {info['name']}: "
+                          'pass the name it is given on to super().__init__(name).')
 
 
 @judged
@@ -182,7 +192,7 @@ def check_counting_monitor(judge: Judge) -> str:
 
     Creates ``CountingMonitor('monitor_7')``, checks its name and subscription in the ROS
     graph, publishes 5 readings (drawn for this run) and reads on ``/rosout`` the count it
-    logs for each: 1 to 5.
+    logs for each: 1 to 5; then checks the name of one made with a name drawn for this run.
 
     Introduced in ``06-five-promises.ipynb``.
 
