@@ -7,6 +7,7 @@ subject reports about the learner's objects.
 """
 
 from corpora import Learner
+from corpus_tables import TABLES
 
 #: 03: no timer; every step of the course's runtime (found among the garbage collector's
 #: objects) publishes the walk.  On the wire, one reading per simulated second, as a timer's.
@@ -279,3 +280,6 @@ def record_hour(bag_path):
     statuses.destroy_node()
 '''}, twin='10 twin: record_hour records nothing'),
 ]
+
+#: Lookup tables of the judge's old fixed inputs, beside their honest-wrong twins.
+ATTACKS += TABLES

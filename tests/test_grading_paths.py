@@ -219,7 +219,8 @@ def test_a_learners_build_scripts_never_run_in_the_judge(scratch, monkeypatch):
     learner's ran beside the judge, in sight of its processes (and their stdout, where the
     verdict goes). The environment they give is the learner's nodes' own, set inside their
     sandbox: before, its PATH chose the program that sandboxes them, which then ran beside
-    the judge."""
+    the judge. The judge grades with a seed of drawn inputs on its command line, which no
+    process of the learner's sees."""
     monkeypatch.setenv('ROS2NB_WORKSPACE', str(scratch.workspace))
     monkeypatch.setattr(ws_module, '_current', None)
     course.catch_up(8)  # the package as notebook 05 leaves it (06 and 07 add no step)
@@ -232,7 +233,8 @@ def test_a_learners_build_scripts_never_run_in_the_judge(scratch, monkeypatch):
         '    data_files=[\n', f"    data_files=[\n        ('share/{course.PACKAGE}/hook', "
                              "['planted.sh']),\n", 1))
     submitted = nbformat.read(SOLUTION[NB05], as_version=4)
-    results, problem, _flags = judge_notebook(scratch, NB05, submitted, Settings(120, 600, True),
+    results, problem, _flags = judge_notebook(scratch, NB05, submitted,
+                                             Settings(120, 600, True, seed=8675309),
                                              scratch.snapshot(NB05))
     assert problem is None and results and all(r.get('passed') for r in results.values()), \
         results

@@ -85,7 +85,7 @@ MISTAKES = [
      checks.check_fan_controller, r'no publisher on /fan_command \(it has: /fan_comand'),
     ('fan: a callback that sleeps', FAN, '        self.publisher_.publish(command)\n',
      "        __import__('time').sleep(1.0)\n        self.publisher_.publish(command)\n",
-     checks.check_fan_controller, r'took 0\.5 s or more to answer each of 6 readings: '
+     checks.check_fan_controller, r'took 0\.5 s or more to answer each of 10 readings: '
                                   r'temperature_callback waits \(a time\.sleep\?\)'),
     # Busy programs of its own keep its threads waiting for a CPU: still its own slowness.
     ('fan: a callback that sleeps beside busy programs of its own', FAN,
@@ -95,7 +95,7 @@ MISTAKES = [
      "            self.busy = [subprocess.Popen([sys.executable, '-c', 'while True: pass'])\n"
      "                         for _ in range(4)]\n"
      "        __import__('time').sleep(1.0)\n        self.publisher_.publish(command)\n",
-     checks.check_fan_controller, r'took 0\.5 s or more to answer each of 6 readings: '
+     checks.check_fan_controller, r'took 0\.5 s or more to answer each of 10 readings: '
                                   r'temperature_callback waits \(a time\.sleep\?\)'),
     ('fan: node name', FAN, "super().__init__('fan_controller')", "super().__init__('fan')",
      checks.check_fan_controller, r'The node is called fan; name it fan_controller'),

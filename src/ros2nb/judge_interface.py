@@ -50,6 +50,7 @@ class Judge(Protocol):
     observer: Any  #: the judge's own ROS node: graph, messages, logs, stamped by its clock
     clock: Any  #: the judge's clock (:class:`ros2nb.judge.clock.JudgeClock`)
     probe_publisher: Any  #: the judge's Float32 publisher on /temperature
+    seed: int  #: the seed of this run's drawn inputs (:func:`ros2nb.checks.drawn.chooser`)
 
     def file_subject(self, relative: str) -> Any: ...
     def answer_subject(self, ref: AnswerRef, workspace: Optional[Path] = None) -> Any: ...

@@ -30,7 +30,8 @@ CHECK_LOGGER = 'bag_check'
 
 def check_readings_c(seed: Optional[int] = None) -> list[float]:
     """Readings for a bag of the check's own: a walk through all three statuses, two
-    decimals, new each time (``seed`` makes them repeat)."""
+    decimals, new each time (``seed``, drawn for the run by :func:`.drawn.chooser`, makes
+    them repeat)."""
     chooser = random.Random(seed)
     phase = chooser.uniform(0, 2 * math.pi)
     return [round(22.0 + 6.5 * math.sin(k / 7.0 + phase) + chooser.uniform(-0.2, 0.2), 2)

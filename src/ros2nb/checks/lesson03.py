@@ -22,6 +22,7 @@ from .. import course
 from ..errors import CheckFailed
 from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
 from .base import direct, judged
+from .drawn import clamp_probes_c, sensor_seed
 from .mains import run_main
 from .file_nodes import lines_logged, new_node
 from .source import ClassSource
@@ -37,10 +38,6 @@ CONSTRUCTOR_RUN_S, CALLBACK_RUN_S, CLAMP_RUN_S, HOUR_S = 6, 20, 40, 3600
 #: Steps of the judge's clock (s): four to a period, so a timer of another period shows; the
 #: hour in steps of one period.
 FINE_STEP_S, HOUR_STEP_S = 0.25, 1.0
-#: Seeds of ``random`` for the sensor checks (a clamp-less walk crosses both limits).
-SENSOR_SEED, CEILING_SEED, FLOOR_SEED = 7, 2, 1
-#: Where the clamp probes start the walk (°C): just inside the limits.
-CLAMP_PROBES_C = (course.MAX_TEMPERATURE_C - 0.05, course.MIN_TEMPERATURE_C + 0.05)
 TOPIC = '/' + course.TOPIC
 
 
@@ -259,7 +256,7 @@ def _attempt(judge: Judge, stand_ins: tuple[str, ...]) -> tuple[Optional[SensorR
     """A constructor run with ``stand_ins``, and what part 3 got wrong in it (None: nothing)."""
     try:
         run = _sensor_run(judge, stand_ins, CONSTRUCTOR_RUN_S, step_s=FINE_STEP_S,
-                          seed=SENSOR_SEED)
+                          seed=sensor_seed(judge, '03 sensor constructor'))
     except CheckFailed as problem:
         return None, problem
     return run, _constructor_problem(judge, run, CONSTRUCTOR_RUN_S)
@@ -330,9 +327,11 @@ def _callback_problem(run: SensorRun, seconds: float) -> None:
 
 
 def _sensor_callback(judge: Judge) -> str:
-    run = _callback_run(judge, CALLBACK_RUN_S, FINE_STEP_S, SENSOR_SEED)
+    run = _callback_run(judge, CALLBACK_RUN_S, FINE_STEP_S,
+                        sensor_seed(judge, '03 sensor callback'))
     _callback_problem(run, CALLBACK_RUN_S)
-    for start_c, seed in zip(CLAMP_PROBES_C, (CEILING_SEED, FLOOR_SEED)):
+    for number, start_c in enumerate(clamp_probes_c(judge)):
+        seed = sensor_seed(judge, f'03 clamp probe {number}', start_c, CLAMP_RUN_S)
         probe = _run(judge, run, CLAMP_RUN_S, step_s=HOUR_STEP_S, seed=seed, start_c=start_c)
         if probe.problem is not None:
             raise probe.problem
@@ -348,8 +347,9 @@ def check_sensor_callback(judge: Judge) -> str:
 
     Runs your sensor for 20 s of the grader's clock and watches ``/temperature`` over ROS:
     one reading per second, the first within 0.5 °C of 22.0, steps of at most ±0.5 °C, one
-    log line showing each reading; then starts the walk just inside each limit and checks
-    that the clamp holds it in [18.0, 28.0] °C.  When your constructor is at fault, the
+    log line showing each reading; then starts the walk just inside each limit (at places and
+    with seeds drawn for this run, then at 27.95 and 18.05 °C) and checks that the clamp holds
+    it in [18.0, 28.0] °C.  When your constructor is at fault, the
     course's stands in for it, so that only your callback counts.
 
     Introduced in ``03-write-the-publisher.ipynb``.
@@ -360,7 +360,8 @@ def check_sensor_callback(judge: Judge) -> str:
 
 
 def _sensor_hour(judge: Judge) -> str:
-    run = _callback_run(judge, HOUR_S, HOUR_STEP_S, SENSOR_SEED + 1)
+    run = _callback_run(judge, HOUR_S, HOUR_STEP_S,
+                        sensor_seed(judge, '03 sensor hour', course.START_TEMPERATURE_C, HOUR_S))
     if run.problem is not None:
         raise run.problem
     _samples_verdict(run.values, seconds=HOUR_S)

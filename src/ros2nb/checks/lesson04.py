@@ -8,7 +8,6 @@ the place of another (:mod:`ros2nb.subject.stand_ins`).
 
 from __future__ import annotations
 
-import random
 import re
 from typing import Any
 
@@ -16,12 +15,29 @@ from .. import course
 from ..errors import CheckFailed
 from ..judge_interface import Judge
 from .base import judged
+from .drawn import chooser
 from .mains import run_main
 from .file_nodes import feed, new_node, reach, started_log_verdict
 from .verdicts import endpoint_verdict, node_name_verdict
 
 #: Readings the monitor callback check sends: both boundaries and their neighbours (°C).
 BOUNDARY_READINGS_C = (19.99, 20.0, 23.0, 26.0, 26.01, 18.5, 27.5)
+#: Where readings are drawn (°C, two decimals): each status's band, kept off the boundaries.
+STATUS_BANDS_C = {'Low': (17.0, course.LOW_BELOW_C - 0.02),
+                  'Normal': (course.LOW_BELOW_C + 0.01, course.HIGH_ABOVE_C - 0.01),
+                  'High': (course.HIGH_ABOVE_C + 0.02, 29.0)}
+#: Readings drawn in each band for the callback's check, and for the hidden test.
+CALLBACK_DRAWN_PER_STATUS, HIDDEN_DRAWN_PER_STATUS = 2, 10
+
+
+def drawn_readings_c(judge: Any, purpose: str, per_status: int) -> list[float]:
+    """``per_status`` readings of each status (two decimals, °C), drawn for this run
+    (:mod:`.drawn`), in a drawn order: no table of the course's readings holds them."""
+    source = chooser(judge, purpose)
+    readings = [round(source.uniform(*STATUS_BANDS_C[status]), 2)
+                for status in STATUS_BANDS_C for _ in range(per_status)]
+    source.shuffle(readings)
+    return readings
 
 
 @judged
@@ -149,9 +165,11 @@ def _statuses_verdict(readings: tuple[float, ...] | list[float], lines: list[lis
 
 
 def _monitor_callback(judge: Judge) -> str:
-    lines = _own_or_course_constructor(judge, list(BOUNDARY_READINGS_C))
-    _statuses_verdict(BOUNDARY_READINGS_C, lines, with_value=True)
-    return (f'one line with the right status for each of {len(BOUNDARY_READINGS_C)} readings, '
+    readings = [*BOUNDARY_READINGS_C,
+                *drawn_readings_c(judge, '04 monitor callback', CALLBACK_DRAWN_PER_STATUS)]
+    lines = _own_or_course_constructor(judge, readings)
+    _statuses_verdict(readings, lines, with_value=True)
+    return (f'one line with the right status for each of {len(readings)} readings, '
             f'including {course.LOW_BELOW_C} and {course.HIGH_ABOVE_C} °C (both Normal).')
 
 
@@ -160,8 +178,9 @@ def check_monitor_callback(judge: Judge) -> str:
     """Check part 4 of ``temperature_subscriber.py``: the callback and its statuses.
 
     The judge publishes readings around both thresholds (19.99, 20.0, 26.0, 26.01 °C and
-    more) to your monitor over ROS and reads its log lines from ``/rosout``: exactly one
-    line per message, with the reading (two decimals), naming High, Low or Normal correctly.
+    more, and two of each status drawn for this run) to your monitor over ROS and reads its
+    log lines from ``/rosout``: exactly one line per message, with the reading (two
+    decimals), naming High, Low or Normal correctly.
 
     Introduced in ``04-write-the-subscriber.ipynb``.
 
@@ -171,8 +190,7 @@ def check_monitor_callback(judge: Judge) -> str:
 
 
 def _monitor_readings(judge: Judge) -> str:
-    chooser = random.Random(2024)
-    readings = [round(chooser.uniform(17.0, 29.0), 2) for _ in range(30)]
+    readings = drawn_readings_c(judge, '04 monitor readings', HIDDEN_DRAWN_PER_STATUS)
     readings += [course.LOW_BELOW_C, course.HIGH_ABOVE_C, 19.995, 26.005]
     lines = _own_or_course_constructor(judge, readings)
     _statuses_verdict(readings, lines, with_value=True)
@@ -183,8 +201,8 @@ def _monitor_readings(judge: Judge) -> str:
 def check_monitor_readings(judge: Judge) -> str:
     """Hidden test of notebook 04: 34 readings from the grader's own publisher.
 
-    Random readings over the whole range and the boundaries; every one must give one line
-    with the reading (two decimals) and the right status.
+    Readings drawn for this run, ten of each status, and the boundaries; every one must give
+    one line with the reading (two decimals) and the right status.
 
     Introduced in ``04-write-the-subscriber.ipynb``.
 

@@ -15,7 +15,6 @@ import ast
 import configparser
 import json
 import os
-import random
 import re
 import shutil
 import sys
@@ -35,6 +34,7 @@ from ..terminal.pkg_templates import SETUP_CFG, render_setup_py
 from ..terminal.run import find_executable
 from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge
 from .base import judged
+from .drawn import chooser
 from .mains import EXIT_AFTER_CTRL_C_S, last_line
 from .package_stand_ins import EXECUTABLES
 from .source import TEXT
@@ -220,7 +220,7 @@ def _runs(judge: Judge, ws: Path) -> Optional[str]:
     env = _sourced(judge, ws)
     observer = judge.observer
     readings = observer.watch('/' + course.TOPIC, Float32, lambda m: float(m.data))
-    given = round(random.uniform(19.0, 25.0), 3)
+    given = round(chooser(judge, '05 package runs').uniform(19.0, 25.0), 3)
     heard = f'heard {given:.3f}'
     first, mark = len(readings), len(observer.logs)
     procs: list[Any] = []

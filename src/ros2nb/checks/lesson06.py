@@ -22,18 +22,36 @@ from ..errors import CheckFailed
 from ..explain.ros_settings import ros_arguments_mistake
 from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
 from .base import judged
+from .drawn import chooser
 from .mains import run_main
 from .file_nodes import announced, feed, lines_logged, new_node, reach
 from .verdicts import endpoint_verdict, node_name_verdict
 from .witnessed import WITNESS_TOPIC, events, new_token, told_to
 
-#: Readings the fan check sends (°C): both sides of the High threshold.
+#: Readings the fan check sends (°C): both sides of the High threshold; then drawn ones.
 FAN_READINGS_C = (22.0, 26.0, 26.01, 27.5, 25.99, 19.0)
+#: Readings drawn for each run (°C, two decimals): two High, two not, away from the threshold.
+FAN_DRAWN_BANDS_C = ((course.HIGH_ABOVE_C + 0.02, 29.0), (course.HIGH_ABOVE_C + 0.02, 29.0),
+                     (17.0, course.LOW_BELOW_C - 0.02),
+                     (course.LOW_BELOW_C + 0.01, course.HIGH_ABOVE_C - 0.02))
 #: A fan controller slower than this (s, the judge's own watch) for every one of its readings
 #: waits in its callback: honest ones answer in milliseconds, even on a busy machine.
 SLOW_CALLBACK_S = 0.5
-#: Readings the counting monitor check sends.
+#: Readings the counting monitor check sends, their values drawn for each run (°C).
 COUNTED_READINGS = 5
+COUNTED_RANGE_C = (17.0, 29.0)
+#: Rooms the reusability check runs, then one drawn for each run from these words (and a
+#: number): no table of rooms holds it.
+DRAWN_ROOM_WORDS = ('cellar', 'garage', 'hall', 'landing', 'loft', 'office', 'pantry', 'porch',
+                    'study', 'workshop')
+
+
+def _fan_readings(judge: Judge) -> list[float]:
+    """The fan check's readings: :data:`FAN_READINGS_C`, then ones drawn for this run."""
+    source = chooser(judge, '06 fan readings')
+    drawn = [round(source.uniform(*band), 2) for band in FAN_DRAWN_BANDS_C]
+    source.shuffle(drawn)
+    return [*FAN_READINGS_C, *drawn]
 
 
 # ------------------------------------------------------------------ modularity
@@ -55,7 +73,8 @@ def _fan_controller(judge: Judge) -> str:
     counts = info
     fan_topic = '/' + course.FAN_TOPIC
     answered_s = []  # per reading: from the judge's publishing it to its command arriving
-    for value in FAN_READINGS_C:
+    readings = _fan_readings(judge)
+    for value in readings:
         before, sent_before = len(commands), announced(counts, fan_topic)
         started = time.monotonic()
         counts, _lines = feed(judge, subject, info, value, counts,
@@ -78,18 +97,18 @@ def _fan_controller(judge: Judge) -> str:
             raise CheckFailed(f'For {value} °C the fan controller published {bool(said[0])}; it '
                               f'should be {want}: the fan is on only when the reading is High, '
                               f'strictly above HIGH_ABOVE_C = {course.HIGH_ABOVE_C} °C.')
-    _slow_callback_verdict(min(answered_s))
+    _slow_callback_verdict(min(answered_s), len(readings))
     return (f'{info["name"]} hears /{course.TOPIC} and publishes one command on '
-            f'/{course.FAN_TOPIC} per reading, True only when High ({len(FAN_READINGS_C)} '
+            f'/{course.FAN_TOPIC} per reading, True only when High ({len(readings)} '
             'readings).')
 
 
-def _slow_callback_verdict(fastest_s: float) -> None:
+def _slow_callback_verdict(fastest_s: float, readings: int) -> None:
     """A callback that waits (``time.sleep``, a loop, a blocking call) holds up every other
     callback of its node: notebook 06 says to answer each reading at once."""
     if fastest_s >= SLOW_CALLBACK_S:
         raise CheckFailed(f'The fan controller took {SLOW_CALLBACK_S:g} s or more to answer each '
-                          f'of {len(FAN_READINGS_C)} readings: temperature_callback waits (a '
+                          f'of {readings} readings: temperature_callback waits (a '
                           'time.sleep?), and meanwhile every other callback of its node waits '
                           'too (section 4): publish the command at once, without waiting.')
 
@@ -99,8 +118,8 @@ def check_fan_controller(judge: Judge) -> str:
     """Check part 2 of ``fan_controller.py``: the third node, added without touching the others.
 
     The judge creates your ``FanController``, reads its subscription and publisher from the
-    ROS graph, publishes readings on both sides of 26 °C from its own publisher and reads
-    every command on ``/fan_command``.
+    ROS graph, publishes readings on both sides of 26 °C from its own publisher (some drawn
+    for this run) and reads every command on ``/fan_command``.
 
     Introduced in ``06-five-promises.ipynb``.
 
@@ -139,8 +158,10 @@ def _counting_monitor(judge: Judge) -> str:
     lines_logged(judge, info, mark, info['started_lines'])
     reach(judge, subject, name)
     counts = info
+    source = chooser(judge, '06 counted readings')
     for index in range(1, COUNTED_READINGS + 1):
-        counts, lines = feed(judge, subject, info, 20.0 + index, counts,
+        value = round(source.uniform(*COUNTED_RANGE_C), 2)
+        counts, lines = feed(judge, subject, info, value, counts,
                              "its callback: is it the subscription's callback?")
         numbers = [int(n) for line in lines for n in re.findall(r'(?<![\d.])\d+(?![\d.])', line)]
         if not lines:
@@ -154,8 +175,18 @@ def _counting_monitor(judge: Judge) -> str:
             raise CheckFailed(f'After {index} reading{"s" if index > 1 else ""} {name} logged '
                               f'"{lines[0]}": add one to self.received for every message, and '
                               'log the new count.')
+    _named_as_told(judge, f'monitor_{chooser(judge, "06 counting name").randrange(10, 1000)}')
     return (f"{course.COUNTING_CLASS}('{name}') is called {name} and counted "
             f'{COUNTED_READINGS} of {COUNTED_READINGS} readings, as its lines on /rosout say.')
+
+
+def _named_as_told(judge: Judge, name: str) -> None:
+    """A counting monitor given ``name`` (drawn for this run: no table holds it) is called
+    ``name``."""
+    _subject, info = new_node(judge, course.PROMISES_FILE, course.COUNTING_CLASS, args=(name,))
+    if info['name'] != name:
+        raise CheckFailed(f"{course.COUNTING_CLASS}('{name}') made a node called {info['name']}: "
+                          'pass the name it is given on to super().__init__(name).')
 
 
 @judged
@@ -163,7 +194,8 @@ def check_counting_monitor(judge: Judge) -> str:
     """Check part 2 of ``promises.py``: a monitor that only counts, named as it is told.
 
     Creates ``CountingMonitor('monitor_7')``, checks its name and subscription in the ROS
-    graph, publishes 5 readings and reads on ``/rosout`` the count it logs for each: 1 to 5.
+    graph, publishes 5 readings (drawn for this run) and reads on ``/rosout`` the count it
+    logs for each: 1 to 5; then checks the name of one made with a name drawn for this run.
 
     Introduced in ``06-five-promises.ipynb``.
 
@@ -311,10 +343,16 @@ def _room_arguments_of(subject, room: str) -> list[str]:
     return arguments
 
 
+def _drawn_room(judge: Judge) -> str:
+    """A room for this run (:mod:`.drawn`), e.g. ``study_42``: a name no table holds."""
+    source = chooser(judge, '06 room')
+    return f'{source.choice(DRAWN_ROOM_WORDS)}_{source.randrange(10, 100)}'
+
+
 def _rooms(judge: Judge) -> str:
     subject = judge.file_subject(course.PROMISES_FILE)
     seen: dict[str, str] = {}
-    for room in course.ROOMS:
+    for room in (*course.ROOMS, _drawn_room(judge)):
         arguments = _room_arguments_of(subject, room)
         reply = subject.request('room_nodes', arguments=arguments)
         if not reply['ok']:
@@ -335,7 +373,8 @@ def _rooms(judge: Judge) -> str:
             if full in seen:
                 raise CheckFailed(f'Both rooms run a node {full}: use the room you are given.')
             seen[full] = room
-    return (f'the same two nodes run as {", ".join(sorted(seen))}, each room on its own '
+    shown = sorted(full for full, room in seen.items() if room in course.ROOMS)
+    return (f'the same two nodes run as {", ".join(shown)}, each room on its own '
             f'/ROOM/{course.TOPIC}, as the ROS graph shows.')
 
 
@@ -343,7 +382,8 @@ def _rooms(judge: Judge) -> str:
 def check_room_arguments(judge: Judge) -> str:
     """Check part 5 of ``promises.py``: the arguments that make one package serve two rooms.
 
-    Calls ``room_arguments('kitchen')`` and ``room_arguments('attic')``, starts a sensor and
+    Calls ``room_arguments('kitchen')``, ``room_arguments('attic')`` and the same for a room
+    drawn for this run (e.g. ``'study_42'``), starts a sensor and
     a monitor node with each list (as ``ros2 run ... --ros-args ...`` would) and reads the
     ROS graph: each room's nodes in their own namespace, talking on their own topic.
 

@@ -18,17 +18,28 @@ from .. import course
 from ..errors import CheckFailed
 from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge
 from .base import judged
+from .drawn import chooser
 from .file_nodes import feed, new_node, reach
 from .source import ClassSource
 from .verdicts import endpoint_verdict, node_name_verdict
 from .witnessed import WITNESS_TOPIC, new_token, told, told_to
 
-#: Readings the check publishes (°C), one simulated second apart; exact in Float32.
+#: Readings the check publishes (°C); exact in Float32.
 PLOT_READINGS_C = (21.5, 26.25, 19.75, 23.0)
-#: Simulated seconds of the judge's clock between two readings.
+#: Steps of the judge's clock between two readings (s).
 READING_GAP_S = 1.0
 #: How close a drawn reading must be to the one sent (°C): Float32 keeps about 7 digits.
 READING_TOLERANCE_C = 0.006
+#: Whole seconds of the judge's clock before the first reading, and between two readings,
+#: drawn for each run (a point's time is then no table's: the first never comes at 1 s).
+FIRST_GAP_S, NEXT_GAP_S = (2, 9), (1, 4)
+
+
+def _gaps_s(judge: Judge) -> list[int]:
+    """Simulated seconds before each reading, drawn for this run (:mod:`.drawn`)."""
+    source = chooser(judge, '07 reading times')
+    return [source.randint(*(FIRST_GAP_S if k == 0 else NEXT_GAP_S))
+            for k in range(len(PLOT_READINGS_C))]
 
 
 def _shown(counts: dict) -> Optional[int]:
@@ -69,9 +80,9 @@ def _plot_callback(judge: Judge) -> str:
     reach(judge, subject, info['name'])
     counts = {**info, 'shown': shown.get('shown')}
     sent: list[tuple[float, float]] = []
-    for value in PLOT_READINGS_C:
-        judge.clock.drive(subject, 'run', seconds=READING_GAP_S, step_s=READING_GAP_S,
-                          limit_s=READING_GAP_S, what=course.PLOT_CLASS)
+    for value, gap_s in zip(PLOT_READINGS_C, _gaps_s(judge)):
+        judge.clock.drive(subject, 'run', seconds=gap_s, step_s=READING_GAP_S,
+                          limit_s=gap_s, what=course.PLOT_CLASS)
         sent.append((judge.clock.now_s, value))
         counts, drawn = _drawn(judge, subject, info, value, counts, token)
         _point_verdict(judge, sent, drawn)
@@ -127,10 +138,10 @@ def _unplotted_cause(judge: Judge) -> str:
 def check_plot_callback(judge: Judge) -> str:
     """Check part 2 of ``live_plot.py``: the callback that feeds the live plot.
 
-    The judge publishes 4 readings one second of its clock apart to your ``PlotFeeder``, whose
-    ``redraw()`` is the course's own (as given in part 1), telling the grader every point it
-    draws: every reading plotted once, with its value and the node's simulated time when it
-    arrived.
+    The judge publishes 4 readings to your ``PlotFeeder``, at times of its clock drawn for
+    this run; its ``redraw()`` is the course's own (as given in part 1), telling the grader
+    every point it draws: every reading plotted once, with its value and the node's simulated
+    time when it arrived.
 
     Introduced in ``07-live-plot.ipynb``.
 

@@ -24,6 +24,7 @@ from ..errors import CheckFailed
 from ..runtime.services import call_until_answered
 from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
 from .base import judged
+from .drawn import chooser
 from .file_nodes import feed, lines_logged, new_node, reach
 
 #: The on-set callback the learner writes (part 4); the constructor registers it.
@@ -252,6 +253,26 @@ STEPS = ((course.HIGH_PARAMETER, 25.0, True, 25.5), (course.LOW_PARAMETER, 25.5,
          (course.HIGH_PARAMETER, 20.5, False, 24.0))
 
 
+
+
+def _drawn_steps(judge: Judge) -> list[tuple[str, float, bool, float]]:
+    """Four changes drawn for this run (:mod:`.drawn`), made after :data:`STEPS` (which leave
+    high at 25.0 and low at 21.0): low and high moved to valid values, then a low at or
+    above the new high and a high at or below the new low, each refused; every reading lies
+    where only the thresholds in force give the status the check expects."""
+    source = chooser(judge, '08 threshold changes')
+    low = round(source.choice((source.uniform(18.5, 20.5), source.uniform(21.5, 23.0))), 2)
+    high = round(source.choice((source.uniform(max(low + 1.0, 22.0), 24.5),
+                                source.uniform(25.5, 27.5))), 2)
+    too_low = round(source.uniform(course.MIN_TEMPERATURE_C, low), 2)
+    too_high = round(source.uniform(high, course.MAX_TEMPERATURE_C), 2)
+    between = round((low + high) / 2, 2)
+    return [(course.LOW_PARAMETER, low, True, round((low + 21.0) / 2, 2)),
+            (course.HIGH_PARAMETER, high, True, round((high + 25.0) / 2, 2)),
+            (course.LOW_PARAMETER, too_high, False, between),
+            (course.HIGH_PARAMETER, too_low, False, between)]
+
+
 def _refusal_hint(name: str) -> str:
     if name == course.HIGH_PARAMETER:
         return (f'your callback gets only the parameters being set: compare with the current '
@@ -301,9 +322,11 @@ def _never_registered(judge: Judge) -> bool:
 
 
 def _threshold_steps(node: _Monitor) -> str:
-    """Part 4 on ``node``: each change of :data:`STEPS`, its answer and the statuses after."""
+    """Part 4 on ``node``: each change of :data:`STEPS` and of :func:`_drawn_steps`, its
+    answer and the statuses after."""
     current = dict(course.THRESHOLD_DEFAULTS_C)
-    for name, value, valid, reading in STEPS:
+    steps = [*STEPS, *_drawn_steps(node.judge)]
+    for name, value, valid, reading in steps:
         other = course.LOW_PARAMETER if name == course.HIGH_PARAMETER else course.HIGH_PARAMETER
         result = node.set(name, value)
         if result is None or not hasattr(result, 'successful'):
@@ -335,7 +358,7 @@ def _threshold_steps(node: _Monitor) -> str:
                           f'{[current[course.HIGH_PARAMETER], current[course.LOW_PARAMETER]]}: '
                           'do not change parameters inside the callback.')
     return (f'{CALLBACK} accepts valid thresholds and refuses, with a reason, '
-            f'{len([s for s in STEPS if not s[2]])} changes that would put '
+            f'{len([s for s in steps if not s[2]])} changes that would put '
             f'{course.LOW_PARAMETER} at or above {course.HIGH_PARAMETER}; the statuses follow.')
 
 
@@ -345,8 +368,9 @@ def check_threshold_callback(judge: Judge) -> str:
 
     Sets the thresholds of your running monitor through its ``set_parameters`` service, as
     ``ros2 param set`` does: valid pairs must be accepted, and every change that leaves
-    ``low_below_c`` at or above ``high_above_c`` refused with a reason; after each change the
-    statuses the monitor logs for the grader's readings follow the thresholds in force.
+    ``low_below_c`` at or above ``high_above_c`` refused with a reason (five changes, two of
+    them drawn for this run); after each change the statuses the monitor logs for the
+    grader's readings follow the thresholds in force.
 
     Introduced in ``08-parameters.ipynb``.
 

@@ -28,6 +28,7 @@ from .bags import (CHECK_LOGGER, ROSOUT, TEMPERATURE, check_bag, check_readings_
                    bag_messages, read_back)
 from ..judge_interface import ARRIVAL_TIMEOUT_S, AnswerRef, Judge, learner_error
 from .base import call_learner, direct
+from .drawn import chooser
 from .witness import STATUS_LINE, Witness, witnessing
 
 #: Rate the check replays at (simulated s per wall s): fast, and below what play reaches.
@@ -256,7 +257,7 @@ def check_recording(judge: Optional[Judge], record_hour: Any) -> str:
 
 # ------------------------------------------------------------------ part 2: the replay
 def _replay(judge: Optional[Judge], replay: Any) -> str:
-    readings = check_readings_c()
+    readings = check_readings_c(chooser(judge, '10 replay').getrandbits(32))
     with check_bag(judge, 'sixty', readings) as path:
         with witnessing(judge) as seen:
             _call(judge, replay, f'{replay.__name__}(bag_path, rate)', path, CHECK_RATE,
@@ -306,7 +307,7 @@ def check_replay(judge: Optional[Judge], replay: Any) -> str:
 
 # ------------------------------------------------------------------ part 3: reading a bag
 def _readings(judge: Optional[Judge], read_temperatures: Any) -> str:
-    readings = check_readings_c()
+    readings = check_readings_c(chooser(judge, '10 readings').getrandbits(32))
     with check_bag(judge, 'sixty', readings) as path:
         return _readings_in(judge, path, read_temperatures, readings)
 

@@ -1,8 +1,9 @@
-"""``python -m ros2nb.judge check NAME`` or ``grade SOURCE SUBMISSION``.
+"""``python -m ros2nb.judge check NAME`` or ``grade SOURCE SUBMISSION [--seed N]``.
 
 The judge's command line (see :mod:`ros2nb.judge`): it opens a :class:`Session`, runs the
 body of each check asked for with it (:func:`ros2nb.checks.run_check`) and prints one JSON
-line with the outcome.
+line with the outcome.  A check draws its inputs from a seed the judge draws itself; only
+the grader gives one (``--seed``, :mod:`ros2nb.checks.drawn`), the learner's kernel never.
 """
 
 from __future__ import annotations
@@ -10,9 +11,11 @@ from __future__ import annotations
 import json
 import sys
 from pathlib import Path
-from typing import Any
+from typing import Any, Optional
 
 from .. import checks
+from ..checks.drawn import SEED_OPTION, parse_seed
+from ..errors import Ros2nbError
 from ..processes import end_this_process
 from ..subject.forked import serve_from_here
 from ..terminal.workspace import default_workspace
@@ -22,15 +25,34 @@ from .session import Session
 from .subjects import subject_prefix
 
 
+USAGE = f'Usage: python -m ros2nb.judge check NAME | grade SOURCE SUBMISSION [{SEED_OPTION} N]'
+
+
+def arguments(argv: list[str]) -> tuple[list[str], Optional[int]]:
+    """The command (``check NAME`` or ``grade SOURCE SUBMISSION``) and the grader's seed of
+    the drawn inputs (None: the judge draws one).  Only ``grade`` takes a seed: a check in
+    the lab is asked for by the learner's kernel, which must not choose its inputs.
+
+    :raises Ros2nbError: with the usage, or with what is wrong with the seed.
+    """
+    seed = None
+    if argv[:1] == ['grade'] and len(argv) == 5 and argv[3] == SEED_OPTION:
+        argv, seed = argv[:3], parse_seed(argv[4])
+    if (argv[:1], len(argv)) not in ((['check'], 2), (['grade'], 3)):
+        raise Ros2nbError(USAGE)
+    return argv, seed
+
+
 def main(argv: list[str]) -> int:
     """Run one check, or grade one notebook; print the outcome as one JSON line."""
-    if (argv[:1], len(argv)) not in ((['check'], 2), (['grade'], 3)):
-        print('Usage: python -m ros2nb.judge check NAME | grade SOURCE SUBMISSION',
-              file=sys.stderr)
+    try:
+        argv, seed = arguments(argv)
+    except Ros2nbError as problem:
+        print(problem, file=sys.stderr)
         return 2
     if not subject_prefix():  # subjects not sandboxed: forked from here, before ROS starts
         serve_from_here()
-    session = Session(default_workspace())
+    session = Session(default_workspace(), seed)
     try:
         if argv[0] == 'check':
             result: Any = captured(lambda: checks.run_check(argv[1], session))

@@ -23,6 +23,7 @@ from rclpy.qos import QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Bool, Float32
 
 from .. import course
+from ..checks.drawn import new_seed
 from ..errors import CheckFailed
 from ..processes import kill_process_group, wait_patiently
 from ..subject.judge_time import JUDGE_TOPICS_ENV
@@ -52,8 +53,11 @@ MAX_TAKEN_BACK_BYTES = 64 << 20
 class Session:
     """Everything one judge process shares between checks: observer, subjects, builds."""
 
-    def __init__(self, workspace: Path) -> None:
+    def __init__(self, workspace: Path, seed: Optional[int] = None) -> None:
         self.workspace = workspace
+        #: the seed of this run's drawn inputs (:mod:`ros2nb.checks.drawn`): a grading run's,
+        #: or a fresh one, drawn here, after the subjects' fork server started.
+        self.seed = new_seed() if seed is None else seed
         shared = subjects_folder()
         self.scratch = Path(tempfile.mkdtemp(prefix='ros2nb-judge-',
                                              dir=home_and_tmp(shared)[1] if shared else None))

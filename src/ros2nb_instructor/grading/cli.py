@@ -41,6 +41,9 @@ import zipfile
 from pathlib import Path
 from typing import Optional
 
+from ros2nb.checks.drawn import SEED_OPTION, new_seed, parse_seed
+from ros2nb.errors import Ros2nbError
+
 from ..paths import ROOT
 from . import sandbox
 from .gradebook import Scoring, collect_zip, set_up_course, write_results
@@ -62,7 +65,18 @@ def _options(argv: Optional[list[str]]) -> argparse.Namespace:
                         help='replace an earlier grading/ (and any manual grades in it)')
     parser.add_argument('--no-sandbox', action='store_true',
                         help='grade without a sandbox: only for work you trust')
+    parser.add_argument(SEED_OPTION, type=_seed, default=None,
+                        help='the seed of the judges\' drawn inputs, to grade again with the '
+                             'inputs of an earlier grading (its notes.json); new by default')
     return parser.parse_args(argv)
+
+
+def _seed(text: str) -> int:
+    """``--seed``'s value (:func:`ros2nb.checks.drawn.parse_seed`), as argparse wants it."""
+    try:
+        return parse_seed(text)
+    except Ros2nbError as problem:
+        raise argparse.ArgumentTypeError(str(problem)) from None
 
 
 def _refusal(submissions: Path, out: Path, args: argparse.Namespace) -> Optional[str]:
@@ -172,11 +186,12 @@ def _score(scoring: Scoring, learners: list[Learner], batch: set[str]) -> None:
 
 
 def _report(out: Path, learners: list[Learner], rows: list[list[str]],
-            refused: list[str]) -> None:
-    """notes.json, and one line per learner: their total and what happened."""
+            refused: list[str], seed: int) -> None:
+    """notes.json (with the seed that grades again with the same inputs: ``--seed``), and
+    one line per learner: their total and what happened."""
     (out / 'notes.json').write_text(json.dumps(
-        {'learners': {learner.shown: learner.notes for learner in learners}, 'not graded': refused},
-        indent=1, sort_keys=True, ensure_ascii=False) + '\n')
+        {'learners': {learner.shown: learner.notes for learner in learners}, 'not graded': refused,
+         'seed': seed}, indent=1, sort_keys=True, ensure_ascii=False) + '\n')
     totals = {row[0]: f'{row[2]}/{row[3]}' for row in rows if row[1] == 'TOTAL'}
     for learner in learners:
         notes = '; '.join(f'{k}: {v}' for k, v in sorted(learner.notes.items()))
@@ -232,10 +247,11 @@ def _grade(args: argparse.Namespace, submissions: Path, out: Path, started: floa
     if not learners:
         print(f'{submissions} has no learner folders (<learner>/NN-title.ipynb).')
         return 2
-    settings = Settings(args.cell_timeout, args.notebook_timeout, not args.no_sandbox)
+    seed = new_seed() if args.seed is None else args.seed  # one for the class: notes.json
+    settings = Settings(args.cell_timeout, args.notebook_timeout, not args.no_sandbox, seed)
     _grade_all(course, learners, notebooks, settings, args.jobs)
     rows = write_results(course, out, learners, notebooks)
-    _report(out, learners, rows, refused)
+    _report(out, learners, rows, refused, seed)
     try:
         write_report(out, learners, notebooks, rows, refused)
     except Exception as error:  # noqa: BLE001 - the grades stand without the overview

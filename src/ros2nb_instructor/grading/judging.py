@@ -18,6 +18,7 @@ from typing import NamedTuple, Optional
 
 import nbformat
 
+from ros2nb.checks.drawn import SEED_OPTION
 from ros2nb.judge.subjects import SUBJECTS_FOLDER_ENV, home_and_tmp
 
 from ..paths import ROOT, SOLUTIONS
@@ -64,8 +65,7 @@ def judge_notebook(scratch: Scratch, notebook: str, submitted: nbformat.Notebook
     own, subjects = folder / 'judge', folder / 'subjects'
     for part in (own / 'home', own / 'tmp', *home_and_tmp(subjects)):
         part.mkdir(parents=True)
-    argv = [sys.executable, '-m', 'ros2nb.judge', 'grade', str(source),
-            str(given / 'submission.ipynb')]
+    argv = judge_argv(source, given / 'submission.ipynb', settings)
     env = sandbox_env(own / 'home', ROS2NB_WORKSPACE=str(workspace),
                       TMPDIR=str(own / 'tmp'), **{SUBJECTS_FOLDER_ENV: str(subjects)})
     limits = sandbox.Limits(wall_s=JUDGE_TIMEOUT_S)
@@ -96,6 +96,14 @@ def judge_notebook(scratch: Scratch, notebook: str, submitted: nbformat.Notebook
     if timed_out:
         return Verdict({}, f'checking it took longer than {JUDGE_TIMEOUT_S} s')
     return _read_verdict(out, err, code)
+
+
+def judge_argv(source: Path, submission: Path, settings: Settings) -> list[str]:
+    """The judge's command for one notebook, with the grading's seed of the drawn inputs
+    (:mod:`ros2nb.checks.drawn`) when it has one: on the command line, which the judge's
+    subjects (each with a PID namespace of its own) never see."""
+    argv = [sys.executable, '-m', 'ros2nb.judge', 'grade', str(source), str(submission)]
+    return argv + ([SEED_OPTION, str(settings.seed)] if settings.seed is not None else [])
 
 
 def _read_verdict(out: str, err: Optional[str], code: int) -> Verdict:

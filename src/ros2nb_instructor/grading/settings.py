@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass
+from typing import Optional
 
 #: Seconds one cell may run before its kernel is interrupted (the next cell still runs).
 CELL_TIMEOUT_S = 120
@@ -20,8 +21,10 @@ JOBS = (os.cpu_count() or 1) + 1
 
 @dataclass(frozen=True)
 class Settings:
-    """How to grade: the limits and whether to sandbox."""
+    """How to grade: the limits, whether to sandbox, and the seed of the judges' drawn inputs
+    (:mod:`ros2nb.checks.drawn`; None: each judge draws its own)."""
 
     cell_timeout: int
     notebook_timeout: int
     sandboxed: bool
+    seed: Optional[int] = None
