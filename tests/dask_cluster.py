@@ -69,15 +69,17 @@ def _stop(process: subprocess.Popen) -> None:
 
 
 @contextlib.contextmanager
-def local_cluster(folder: Path, workers: int = 2) -> Iterator[LocalCluster]:
-    """``dask scheduler`` on 127.0.0.1 (a free port) and ``workers`` workers, all connected."""
+def local_cluster(folder: Path, workers: int = 2,
+                  env: Optional[dict] = None) -> Iterator[LocalCluster]:
+    """``dask scheduler`` on 127.0.0.1 (a free port, its environment ``env``) and ``workers``
+    workers, all connected."""
     folder.mkdir(parents=True, exist_ok=True)
     info = folder / 'scheduler.json'
     log = open(folder / 'scheduler.log', 'w')
     scheduler = subprocess.Popen(
         [DASK, 'scheduler', '--host', '127.0.0.1', '--port', '0', '--no-dashboard',
          '--scheduler-file', str(info)], stdout=log, stderr=subprocess.STDOUT,
-        start_new_session=True)
+        start_new_session=True, env=env or os.environ.copy())
     log.close()
     cluster = None
     try:
@@ -93,3 +95,39 @@ def local_cluster(folder: Path, workers: int = 2) -> Iterator[LocalCluster]:
         for worker in (cluster.workers if cluster else []):
             _stop(worker)
         _stop(scheduler)
+
+
+def _executing(dask_worker) -> list:
+    """Run on a worker: the keys of the tasks it runs now."""
+    return [task.key for task in dask_worker.state.executing]
+
+
+def kill_when_grading(address: str, name: str, learner: str = '', alone: bool = False) -> dict:
+    """SIGKILL the process of the worker named ``name`` once it runs a learner's task (whose
+    key holds ``learner``) and that learner's sandbox has started (a child process): it holds
+    the learner mid-grading.  With ``alone``, only once that task is all the worker holds
+    (a task queued on a worker that dies is counted as killed there too).  Return its
+    address, pid and the keys it ran."""
+    import cloudpickle
+    from distributed import Client
+    from ros2nb.processes import child_pids
+
+    cloudpickle.register_pickle_by_value(sys.modules[__name__])  # workers lack tests/ on sys.path
+    with Client(address, set_as_default=False, timeout=60) as client:
+        def holding():
+            workers = client.scheduler_info(n_workers=-1)['workers']
+            worker = next((a for a, w in workers.items() if w.get('name') == name), None)
+            if worker is None:
+                return None
+            keys = client.run(_executing, workers=[worker]).get(worker)
+            if not keys or not any(learner in str(key) for key in keys):
+                return None
+            if alone and len(client.processing(workers=[worker]).get(worker, ())) > 1:
+                return None
+            pid = client.run(os.getpid, workers=[worker])[worker]
+            return child_pids(pid) and {'worker': worker, 'pid': pid, 'keys': keys}
+
+        held = wait_for(holding, f'worker {name} grading {learner or "a learner"}',
+                        interval=0.2)
+        os.kill(held['pid'], signal.SIGKILL)
+        return held

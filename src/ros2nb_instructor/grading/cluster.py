@@ -1,4 +1,4 @@
-"""Grading a class on a Dask cluster (``make grade SCHEDULER=tcp://host:8786``): one task per learner.
+"""Grading a class on a Dask cluster (``make grade SCHEDULER=tcp://host:8786``): a task a learner.
 
 Runs on the instructor's host.  Each learner is one task of a Dask scheduler, graded on a
 worker where the course is installed by :func:`.cluster_task.grade_job` (the local grading's
@@ -77,12 +77,14 @@ class Cluster:
         print(f'grading on the Dask scheduler at {address}: {len(self._accepted)} worker(s) of '
               f'course version {self.version}', flush=True)
 
-    def _check_new_workers(self) -> None:
-        """Check the workers not seen before; print one line for each one refused."""
+    def _check_new_workers(self) -> bool:
+        """Check the workers not seen before; print one line for each one refused.  True
+        when one was accepted."""
         workers = set(self.client.scheduler_info(n_workers=-1)['workers'])
         new = sorted(workers - self._accepted - set(self.refused))
         if not new:
-            return
+            return False
+        before = len(self._accepted)
         answers = self.client.run(accept, self.version, self.settings.sandboxed, workers=new,
                                   on_error='return')
         for worker in new:
@@ -94,6 +96,7 @@ class Cluster:
             else:
                 self.refused[worker] = why
                 print(f'worker {worker} refused, no learner runs there: {why}', flush=True)
+        return len(self._accepted) > before
 
     def graded(self, course: Path, learners: list[Learner], notebooks: list[str]
                ) -> Iterator[list[tuple[Learner, Optional[BaseException]]]]:
@@ -104,22 +107,38 @@ class Cluster:
         and has their notes and the judge's results, as a local grading leaves them.
         """
         release = course / 'release' / ASSIGNMENT
-        run = uuid.uuid4().hex[:8]
         futures = {}
         # Most notebooks first (a higher priority), so the longest learner does not start last.
-        for number, learner in enumerate(sorted(learners, key=lambda lr: -len(lr.files))):
+        for learner in sorted(learners, key=lambda lr: -len(lr.files)):
             job = Job(learner.id, {n: _handed_in(p) for n, p in learner.files.items()},
                       {n: (release / f'{n}.ipynb').read_text() for n in learner.files},
                       tuple(notebooks), self.settings, self.version)
-            future = self.client.submit(
-                grade_job, job, key=f'ros2nb-learner-{run}-{number}', pure=False,
-                resources={resource_name(self.version): 1}, priority=len(learner.files))
-            futures[future] = learner
+            futures[self._submit(job)] = (learner, job)
         try:
             yield from self._gathered(course, futures)
         finally:
             for future in futures:
                 future.cancel()
+
+    def _submit(self, job: Job):
+        """``job`` as a task only a checked worker runs (it needs their resource)."""
+        # The key names the learner (an nbgrader id) for the dashboard, and is new each time.
+        return self.client.submit(
+            grade_job, job, key=f'ros2nb-learner-{uuid.uuid4().hex[:12]}-{job.id}', pure=False,
+            resources={resource_name(self.version): 1}, priority=len(job.files))
+
+    def _resubmit_unrunnable(self, futures: dict, pending: set) -> None:
+        """Submit again the tasks no worker could take when they were placed (every checked
+        worker had gone); a worker checked since does not make the scheduler look at them.
+        They never ran, so nobody is graded twice."""
+        stuck = set(self.client.run_on_scheduler(_unrunnable_keys))
+        for future in [f for f in pending if f.key in stuck]:
+            learner, job = futures.pop(future)
+            pending.discard(future)
+            future.cancel()
+            again = self._submit(job)
+            futures[again] = (learner, job)
+            pending.add(again)
 
     def _gathered(self, course: Path, futures: dict) -> Iterator[list]:
         """The learners of ``futures`` in batches as their tasks end, each taken once."""
@@ -130,22 +149,23 @@ class Cluster:
                 with self.client.as_current():
                     wait(list(pending), timeout=LOOK_S, return_when='FIRST_COMPLETED')
             except TimeoutError:
-                self._check_new_workers()
+                if self._check_new_workers():
+                    self._resubmit_unrunnable(futures, pending)
                 continue
             batch = []
             for future in [f for f in pending if f.done()]:
                 pending.discard(future)
-                learner = futures[future]
+                learner = futures[future][0]
                 if learner.id in taken:  # one result per learner, whatever ran twice
                     continue
                 taken.add(learner.id)
                 try:
-                    _file(course, learner, future.result())
+                    graded = future.result()
+                    _file(course, learner, graded)
+                    self.graded_by[learner.id] = graded.worker
                     error = None
                 except Exception as failed:  # noqa: BLE001 - that learner's, in a note
                     error = failed
-                else:
-                    self.graded_by[learner.id] = future.result().worker
                 future.release()
                 batch.append((learner, error))
             yield batch
@@ -153,6 +173,11 @@ class Cluster:
     def close(self) -> None:
         """Disconnect from the scheduler (the scheduler and its workers go on)."""
         self.client.close()
+
+
+def _unrunnable_keys(dask_scheduler) -> list:
+    """Run on the scheduler: the keys of the tasks no worker can run now."""
+    return [task.key for task in dask_scheduler.unrunnable]
 
 
 def _handed_in(path: Path) -> Optional[bytes]:
