@@ -27,7 +27,11 @@ time; grading <= 10 s per notebook for a complete learner.
    cell ends (target: under 1 s).
 
 6. Only when asked (``--only class``): a whole class of ``--learners`` complete learners
-   graded at once (``tools/grade.py``'s default jobs), minutes in all and seconds per notebook.
+   graded at once (``ros2nb-grade``'s default jobs), minutes in all and seconds per notebook;
+   then the same class through a local Dask scheduler and two workers (``dask worker
+   --nworkers 1 --nthreads 1``, ``--scheduler``), with the CPU seconds of each (every process
+   each run started, the scheduler and workers included): their difference per learner is
+   what the engine costs.  Two workers on two cores show that cost, not a speed-up.
 
 Usage: ``make bench`` or
 ``python benchmarks/bench.py [--reps N] [--only sim|first|grading|idle|interrupt]``;
@@ -37,8 +41,10 @@ Usage: ``make bench`` or
 from __future__ import annotations
 
 import argparse
+import contextlib
 import csv
 import json
+import resource
 import shutil
 import statistics
 import subprocess
@@ -52,6 +58,8 @@ PEERS = Path(__file__).resolve().parent / 'peers.py'
 SIMULATED_S = 3600
 #: The instructor's grading command, as the course's venv installs it.
 GRADE = str(Path(sys.executable).with_name('ros2nb-grade'))
+sys.path.insert(0, str(ROOT / 'tests'))
+from dask_cluster import local_cluster  # noqa: E402 - the tests' cluster: Dask's own CLI
 
 
 def peer(what: str, key: str = 'seconds') -> float:
@@ -90,10 +98,18 @@ def grading_seconds_per_notebook(folder: str) -> float:
     return elapsed / len(notebooks)
 
 
-def grade_class(learners: int) -> tuple[float, int, str]:
-    """Grade ``learners`` learners who each handed in the complete notebooks.
+def _children_cpu() -> float:
+    """CPU seconds of every process this one started and waited for (and theirs)."""
+    used = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return used.ru_utime + used.ru_stime
 
-    :return: seconds in all, notebooks graded, and how many scored full marks (``k of n``).
+
+def grade_class(learners: int, workers: int = 0) -> tuple[float, float, int, str]:
+    """Grade ``learners`` learners who each handed in the complete notebooks: on this machine,
+    or (``workers`` > 0) through a Dask scheduler and that many one-thread workers on loopback.
+
+    :return: wall seconds in all (the cluster's start and stop included), CPU seconds of
+        every process started, notebooks graded, and how many scored full marks (``k of n``).
     """
     notebooks = sorted((ROOT / 'solutions').glob('*.ipynb'))
     with tempfile.TemporaryDirectory(prefix='ros2nb-bench-') as tmp:
@@ -102,14 +118,17 @@ def grade_class(learners: int) -> tuple[float, int, str]:
             learner.mkdir(parents=True)
             for notebook in notebooks:
                 shutil.copy2(notebook, learner / notebook.name)
-        started = time.perf_counter()
-        subprocess.run([GRADE, str(Path(tmp) / 'class'), '--out', str(Path(tmp) / 'grading')],
-                       capture_output=True, timeout=7200)
-        elapsed = time.perf_counter() - started
+        argv = [GRADE, str(Path(tmp) / 'class'), '--out', str(Path(tmp) / 'grading')]
+        cpu, started = _children_cpu(), time.perf_counter()
+        with (local_cluster(Path(tmp) / 'cluster', workers) if workers
+              else contextlib.nullcontext()) as cluster:
+            subprocess.run(argv + (['--scheduler', cluster.address] if cluster else []),
+                           capture_output=True, timeout=7200)
+        elapsed, cpu = time.perf_counter() - started, _children_cpu() - cpu
         with open(Path(tmp) / 'grading' / 'grades.csv', newline='') as stream:
             totals = [r for r in csv.DictReader(stream) if r['notebook'] == 'TOTAL']
     full = sum(1 for r in totals if float(r['score']) == float(r['max_score']))
-    return elapsed, learners * len(notebooks), f'{full} of {learners}'
+    return elapsed, cpu, learners * len(notebooks), f'{full} of {learners}'
 
 
 def interleaved(measures: dict[str, callable], reps: int) -> dict[str, list[float]]:
@@ -184,10 +203,16 @@ def main() -> None:
                   stopped['kernel'],
                   'target < 1 s (a timed test would fail on a busy machine)'))
     if args.only == 'class':
-        elapsed, count, full = grade_class(args.learners)
-        print(f'| a class of {args.learners} complete learners | {elapsed:.0f} | | 1 | '
-              f'{elapsed / 60:.1f} min, {elapsed / count:.1f} s per notebook; {full} '
-              'with the highest total |')
+        runs = {}
+        for label, workers in (('here', 0), ('Dask, 2 workers', 2)):
+            elapsed, cpu, count, full = runs[label] = grade_class(args.learners, workers)
+            print(f'| a class of {args.learners} complete learners, {label} | {elapsed:.0f} | '
+                  f'| 1 | {elapsed / 60:.1f} min, {elapsed / count:.1f} s per notebook, '
+                  f'{cpu:.0f} CPU-s; {full} with the highest total |')
+        (wall_here, cpu_here, *_), (wall_dask, cpu_dask, *_) = runs.values()
+        print(f'| Dask\'s overhead per learner, CPU-s (wall s) | '
+              f'{(cpu_dask - cpu_here) / args.learners:.2f} | | 1 | '
+              f'{(wall_dask - wall_here) / args.learners:.2f} s of wall time per learner |')
 
 
 if __name__ == '__main__':

@@ -102,15 +102,28 @@ def _executing(dask_worker) -> list:
     return [task.key for task in dask_worker.state.executing]
 
 
+def in_a_sandbox(pid: int) -> bool:
+    """True when a process below ``pid`` is a bubblewrap sandbox (a learner's notebook or
+    judge running: the worker holds that learner mid-grading)."""
+    from ros2nb.processes import child_pids
+
+    below = list(child_pids(pid))
+    while below:
+        child = below.pop()
+        with contextlib.suppress(OSError):
+            if Path(f'/proc/{child}/cmdline').read_bytes().startswith(b'bwrap'):
+                return True
+        below += child_pids(child)
+    return False
+
+
 def kill_when_grading(address: str, name: str, learner: str = '', alone: bool = False) -> dict:
     """SIGKILL the process of the worker named ``name`` once it runs a learner's task (whose
-    key holds ``learner``) and that learner's sandbox has started (a child process): it holds
-    the learner mid-grading.  With ``alone``, only once that task is all the worker holds
-    (a task queued on a worker that dies is counted as killed there too).  Return its
-    address, pid and the keys it ran."""
+    key holds ``learner``) and a sandbox of that learner's runs (:func:`in_a_sandbox`).  With
+    ``alone``, only once that task is all the worker holds (a task queued on a worker that
+    dies is counted as killed there too).  Return its address, pid and the keys it ran."""
     import cloudpickle
     from distributed import Client
-    from ros2nb.processes import child_pids
 
     cloudpickle.register_pickle_by_value(sys.modules[__name__])  # workers lack tests/ on sys.path
     with Client(address, set_as_default=False, timeout=60) as client:
@@ -125,7 +138,7 @@ def kill_when_grading(address: str, name: str, learner: str = '', alone: bool = 
             if alone and len(client.processing(workers=[worker]).get(worker, ())) > 1:
                 return None
             pid = client.run(os.getpid, workers=[worker])[worker]
-            return child_pids(pid) and {'worker': worker, 'pid': pid, 'keys': keys}
+            return in_a_sandbox(pid) and {'worker': worker, 'pid': pid, 'keys': keys}
 
         held = wait_for(holding, f'worker {name} grading {learner or "a learner"}',
                         interval=0.2)

@@ -15,6 +15,7 @@ tasks again elsewhere, and each learner's result is taken once, from the one tas
 from __future__ import annotations
 
 import os
+import time
 import uuid
 from pathlib import Path
 from typing import Iterator, Optional
@@ -143,14 +144,16 @@ class Cluster:
     def _gathered(self, course: Path, futures: dict) -> Iterator[list]:
         """The learners of ``futures`` in batches as their tasks end, each taken once."""
         from distributed import wait
-        pending, taken = set(futures), set()
+        pending, taken, looked = set(futures), set(), time.monotonic()
         while pending:
+            if time.monotonic() - looked >= LOOK_S:  # also while results keep coming
+                looked = time.monotonic()
+                if self._check_new_workers():
+                    self._resubmit_unrunnable(futures, pending)
             try:
                 with self.client.as_current():
                     wait(list(pending), timeout=LOOK_S, return_when='FIRST_COMPLETED')
             except TimeoutError:
-                if self._check_new_workers():
-                    self._resubmit_unrunnable(futures, pending)
                 continue
             batch = []
             for future in [f for f in pending if f.done()]:
