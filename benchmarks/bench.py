@@ -27,7 +27,11 @@ time; grading <= 10 s per notebook for a complete learner.
    cell ends (target: under 1 s).
 
 6. Only when asked (``--only class``): a whole class of ``--learners`` complete learners
-   graded at once (``tools/grade.py``'s default jobs), minutes in all and seconds per notebook.
+   graded at once (``ros2nb-grade``'s default jobs), minutes in all and seconds per notebook;
+   then the same class through a local Dask scheduler and two workers (``dask worker
+   --nworkers 1 --nthreads 1``, ``--scheduler``), with the CPU seconds of each (every process
+   each run started, the scheduler and workers included): their difference per learner is
+   what the engine costs.  Two workers on two cores show that cost, not a speed-up.
 
 Usage: ``make bench`` or
 ``python benchmarks/bench.py [--reps N] [--only sim|first|grading|idle|interrupt]``;
@@ -37,8 +41,10 @@ Usage: ``make bench`` or
 from __future__ import annotations
 
 import argparse
+import contextlib
 import csv
 import json
+import os
 import shutil
 import statistics
 import subprocess
@@ -46,12 +52,15 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Iterator
 
 ROOT = Path(__file__).resolve().parent.parent
 PEERS = Path(__file__).resolve().parent / 'peers.py'
 SIMULATED_S = 3600
 #: The instructor's grading command, as the course's venv installs it.
 GRADE = str(Path(sys.executable).with_name('ros2nb-grade'))
+sys.path.insert(0, str(ROOT / 'tests'))
+from dask_cluster import local_cluster  # noqa: E402 - the tests' cluster: Dask's own CLI
 
 
 def peer(what: str, key: str = 'seconds') -> float:
@@ -90,10 +99,39 @@ def grading_seconds_per_notebook(folder: str) -> float:
     return elapsed / len(notebooks)
 
 
-def grade_class(learners: int) -> tuple[float, int, str]:
-    """Grade ``learners`` learners who each handed in the complete notebooks.
+#: cgroup v1's CPU accounting: a group's processes and all they start are counted, the
+#: sandboxes too (they make groups of their own for pids and memory only).
+CPUACCT = Path('/sys/fs/cgroup/cpuacct')
 
-    :return: seconds in all, notebooks graded, and how many scored full marks (``k of n``).
+
+@contextlib.contextmanager
+def cpu_counted() -> Iterator[list[float]]:
+    """This process (and whatever it starts meanwhile) in a cpuacct group of its own; once
+    the block ends, ``[seconds]`` holds their CPU seconds, or nan where no group can be made
+    (rusage would miss the sandboxes: their processes are never waited for by ours)."""
+    counted = [float('nan')]
+    group = CPUACCT / f'ros2nb-bench-{os.getpid()}'
+    try:
+        group.mkdir()
+        (group / 'cgroup.procs').write_text(str(os.getpid()))
+    except OSError:
+        yield counted
+        return
+    try:
+        yield counted
+    finally:
+        counted[0] = int((group / 'cpuacct.usage').read_text()) / 1e9
+        (CPUACCT / 'cgroup.procs').write_text(str(os.getpid()))
+        with contextlib.suppress(OSError):
+            group.rmdir()
+
+
+def grade_class(learners: int, workers: int = 0) -> tuple[float, float, int, str]:
+    """Grade ``learners`` learners who each handed in the complete notebooks: on this machine,
+    or (``workers`` > 0) through a Dask scheduler and that many one-thread workers on loopback.
+
+    :return: wall seconds in all (the cluster's start and stop included), CPU seconds of
+        every process started, notebooks graded, and how many scored full marks (``k of n``).
     """
     notebooks = sorted((ROOT / 'solutions').glob('*.ipynb'))
     with tempfile.TemporaryDirectory(prefix='ros2nb-bench-') as tmp:
@@ -102,14 +140,17 @@ def grade_class(learners: int) -> tuple[float, int, str]:
             learner.mkdir(parents=True)
             for notebook in notebooks:
                 shutil.copy2(notebook, learner / notebook.name)
+        argv = [GRADE, str(Path(tmp) / 'class'), '--out', str(Path(tmp) / 'grading')]
         started = time.perf_counter()
-        subprocess.run([GRADE, str(Path(tmp) / 'class'), '--out', str(Path(tmp) / 'grading')],
-                       capture_output=True, timeout=7200)
+        with cpu_counted() as cpu, (local_cluster(Path(tmp) / 'cluster', workers) if workers
+                                    else contextlib.nullcontext()) as cluster:
+            subprocess.run(argv + (['--scheduler', cluster.address] if cluster else []),
+                           capture_output=True, timeout=7200)
         elapsed = time.perf_counter() - started
         with open(Path(tmp) / 'grading' / 'grades.csv', newline='') as stream:
             totals = [r for r in csv.DictReader(stream) if r['notebook'] == 'TOTAL']
     full = sum(1 for r in totals if float(r['score']) == float(r['max_score']))
-    return elapsed, learners * len(notebooks), f'{full} of {learners}'
+    return elapsed, cpu[0], learners * len(notebooks), f'{full} of {learners}'
 
 
 def interleaved(measures: dict[str, callable], reps: int) -> dict[str, list[float]]:
@@ -184,10 +225,16 @@ def main() -> None:
                   stopped['kernel'],
                   'target < 1 s (a timed test would fail on a busy machine)'))
     if args.only == 'class':
-        elapsed, count, full = grade_class(args.learners)
-        print(f'| a class of {args.learners} complete learners | {elapsed:.0f} | | 1 | '
-              f'{elapsed / 60:.1f} min, {elapsed / count:.1f} s per notebook; {full} '
-              'with the highest total |')
+        runs = {}
+        for label, workers in (('here', 0), ('Dask, 2 workers', 2)):
+            elapsed, cpu, count, full = runs[label] = grade_class(args.learners, workers)
+            print(f'| a class of {args.learners} complete learners, {label} | {elapsed:.0f} | '
+                  f'| 1 | {elapsed / 60:.1f} min, {elapsed / count:.1f} s per notebook, '
+                  f'{cpu:.0f} CPU-s; {full} with the highest total |')
+        (wall_here, cpu_here, *_), (wall_dask, cpu_dask, *_) = runs.values()
+        print(f'| Dask\'s overhead per learner, CPU-s (wall s) | '
+              f'{(cpu_dask - cpu_here) / args.learners:.2f} | | 1 | '
+              f'{(wall_dask - wall_here) / args.learners:.2f} s of wall time per learner |')
 
 
 if __name__ == '__main__':

@@ -16,6 +16,10 @@ nothing by itself.  Per notebook, three steps, none of which the notebook can re
 3. The judge's results become the outputs of the graded cells of the executed notebook,
    which nbgrader then scores (without executing anything) and turns into feedback.
 
+With ``--scheduler tcp://HOST:8786`` (``SCHEDULER=...``) each learner is one task of that
+Dask scheduler, graded the same way on a worker where the course is installed
+(:mod:`.cluster`); nbgrader scores here, and ``grading/`` ends as it does on one machine.
+
 Without a sandbox (no bubblewrap, no user namespaces) grading refuses to start; with
 ``--no-sandbox`` (``NO_SANDBOX=1``) it grades trusted work unsandboxed.
 
@@ -39,7 +43,7 @@ import threading
 import time
 import zipfile
 from pathlib import Path
-from typing import Optional
+from typing import TYPE_CHECKING, Optional
 
 from ros2nb.checks.drawn import SEED_OPTION, new_seed, parse_seed
 from ros2nb.errors import Ros2nbError
@@ -52,6 +56,9 @@ from .learners import grade_learner
 from .report import write_report
 from .settings import CELL_TIMEOUT_S, JOBS, NOTEBOOK_TIMEOUT_S, Settings
 from .submissions import Learner, find_learners
+
+if TYPE_CHECKING:
+    from .cluster import Cluster
 
 
 def _options(argv: Optional[list[str]]) -> argparse.Namespace:
@@ -68,6 +75,8 @@ def _options(argv: Optional[list[str]]) -> argparse.Namespace:
     parser.add_argument(SEED_OPTION, type=_seed, default=None,
                         help='the seed of the judges\' drawn inputs, to grade again with the '
                              'inputs of an earlier grading (its notes.json); new by default')
+    parser.add_argument('--scheduler', metavar='ADDRESS',
+                        help='grade on the workers of this Dask scheduler (tcp://host:8786)')
     return parser.parse_args(argv)
 
 
@@ -83,7 +92,8 @@ def _refusal(submissions: Path, out: Path, args: argparse.Namespace) -> Optional
     """Why grading cannot start, in one line saying what to do; None when it can."""
     if not submissions.exists():
         return f'{submissions} does not exist: pass SUBMISSIONS=folder-of-learner-folders or a .zip'
-    why = None if args.no_sandbox else sandbox.problem()
+    # On a cluster, learners' code runs on the workers, each checked for a sandbox there.
+    why = None if args.no_sandbox or args.scheduler else sandbox.problem()
     if why:
         return (f'No sandbox can be made here ({why}); grading runs learners\' code, so it stops. '
                 'For work you trust, run again with NO_SANDBOX=1 (--no-sandbox).')
@@ -135,10 +145,29 @@ def _grade_all(course: Path, learners: list[Learner], notebooks: list[str],
                     try:
                         job.result()
                     except Exception as error:  # noqa: BLE001 - that learner's, in a note
-                        learner.note('_folder', f'the grader could not grade this learner '
-                                                f'({type(error).__name__}: {str(error)[:200]})')
+                        _not_graded(learner, error)
         finally:
             judges.close()
+
+
+def _not_graded(learner: Learner, error: BaseException) -> None:
+    """The note of a learner whose grading failed as a whole (the class goes on)."""
+    learner.note('_folder', f'the grader could not grade this learner '
+                            f'({type(error).__name__}: {str(error)[:200]})')
+
+
+def _grade_all_on(cluster: 'Cluster', course: Path, learners: list[Learner],
+                  notebooks: list[str]) -> None:
+    """Grade every learner on ``cluster``; nbgrader scores each batch as it comes back, and
+    the progress lines are a local grading's."""
+    progress = Progress(sum(len(learner.files) for learner in learners), len(learners))
+    with Scoring(course) as scoring:
+        for batch in cluster.graded(course, learners, notebooks):
+            for learner, error in batch:
+                if error is not None:
+                    _not_graded(learner, error)
+                print(progress.learner_done(learner), flush=True)
+            _score(scoring, learners, {learner.id for learner, _error in batch})
 
 
 class Progress:
@@ -233,7 +262,27 @@ def _replace(final: Path, new: Path) -> None:
 
 
 def _grade(args: argparse.Namespace, submissions: Path, out: Path, started: float) -> int:
-    """Grade into the empty folder ``out``; 0 when grading worked."""
+    """Grade into the empty folder ``out`` (here, or on ``args.scheduler``'s workers); 0 when
+    grading worked."""
+    seed = new_seed() if args.seed is None else args.seed  # one for the class: notes.json
+    settings = Settings(args.cell_timeout, args.notebook_timeout, not args.no_sandbox, seed)
+    if not args.scheduler:
+        return _grade_with(None, args, submissions, out, started, settings)
+    from .cluster import Cluster, ClusterProblem  # Dask is imported for a cluster only
+    try:
+        cluster = Cluster(args.scheduler, settings)
+    except ClusterProblem as problem:
+        print(problem)
+        return 2
+    try:
+        return _grade_with(cluster, args, submissions, out, started, settings)
+    finally:
+        cluster.close()
+
+
+def _grade_with(cluster: Optional['Cluster'], args: argparse.Namespace, submissions: Path,
+                out: Path, started: float, settings: Settings) -> int:
+    """Grade into ``out``, here (``cluster`` None) or on ``cluster``; 0 when grading worked."""
     course = out / 'nbgrader'
     course.mkdir()
     notebooks = set_up_course(course)
@@ -247,11 +296,12 @@ def _grade(args: argparse.Namespace, submissions: Path, out: Path, started: floa
     if not learners:
         print(f'{submissions} has no learner folders (<learner>/NN-title.ipynb).')
         return 2
-    seed = new_seed() if args.seed is None else args.seed  # one for the class: notes.json
-    settings = Settings(args.cell_timeout, args.notebook_timeout, not args.no_sandbox, seed)
-    _grade_all(course, learners, notebooks, settings, args.jobs)
+    if cluster is None:
+        _grade_all(course, learners, notebooks, settings, args.jobs)
+    else:
+        _grade_all_on(cluster, course, learners, notebooks)
     rows = write_results(course, out, learners, notebooks)
-    _report(out, learners, rows, refused, seed)
+    _report(out, learners, rows, refused, settings.seed)
     try:
         write_report(out, learners, notebooks, rows, refused)
     except Exception as error:  # noqa: BLE001 - the grades stand without the overview

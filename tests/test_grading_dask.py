@@ -1,0 +1,218 @@
+"""Grading on a real Dask cluster: ``dask scheduler`` and ``dask worker`` processes on loopback.
+
+The sample class (tests/grading_samples.py) graded through two workers gets the scores a local
+grading gets (tests/test_grading.py holds the local run to the same EXPECTED), although one
+worker is killed (SIGKILL) while it holds a learner: every learner is graded exactly once.  A
+worker of another course version is refused before any learner runs there; a learner whose
+task fails on the workers is that learner's note.
+"""
+
+import csv
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import threading
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+from dask_cluster import kill_when_grading, local_cluster
+from grading_samples import EXPECTED, NB00, NB01, ROOT, SOLUTION, STAGES, build
+from test_grading import CLASS_LIMIT_S, as_text, in_the_csv
+
+from ros2nb_instructor.grading import sandbox
+from ros2nb_instructor.grading.cluster import Cluster
+from ros2nb_instructor.grading.gradebook import set_up_course
+from ros2nb_instructor.grading.settings import CELL_TIMEOUT_S, NOTEBOOK_TIMEOUT_S, Settings
+from ros2nb_instructor.grading.submissions import find_learners
+
+pytestmark = [pytest.mark.sandbox, pytest.mark.timeout(CLASS_LIMIT_S),
+              pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))]
+GRADE = str(Path(sys.executable).with_name('ros2nb-grade'))
+NOTEBOOKS = sorted(SOLUTION)
+#: The learners a local grading meets with a fault planted in the grader's own process
+#: (GRADE_WITH_FAULTS); on a worker nothing is planted, so they are not in this class.
+PLANTED = ('plant-read', *(f'x-{stage}' for stage in STAGES[1:]))
+#: A progress line, as a local grading prints it.
+PROGRESS = re.compile(r'^\[\d+/\d+ notebooks, \d+/\d+ learners; .* so far, .*\] (.*) graded$')
+
+
+def grade(submissions: Path, out: Path, address: str) -> subprocess.CompletedProcess:
+    return subprocess.run([GRADE, str(submissions), '--out', str(out), '--scheduler', address],
+                          capture_output=True, text=True, timeout=CLASS_LIMIT_S)
+
+
+def graded_lines(stdout: str) -> list[str]:
+    """The learners named by the progress lines, one per line printed."""
+    return [m.group(1) for m in map(PROGRESS.match, stdout.splitlines()) if m]
+
+
+@dataclass(frozen=True)
+class OnDask:
+    out: Path
+    done: subprocess.CompletedProcess
+    killed: dict  #: the worker killed while it held a learner: address, pid, its keys
+
+
+@pytest.fixture(scope='module')
+def on_dask(tmp_path_factory):
+    """The sample class graded once on two workers, one of them killed mid-class (its nanny
+    starts it again, as Kubernetes restarts a pod; the new worker is checked before it grades)."""
+    root = tmp_path_factory.mktemp('dask-grading')
+    out = root / 'grading'
+    decoy = root / 'elsewhere' / 'gradebook.db'
+    decoy.parent.mkdir()
+    decoy.write_bytes(b'SQLite format 3\x00' + b'\x00' * 100)
+    home_file = Path.home() / f'ros2nb-dask-sample-{os.getpid()}'
+    submissions = build(root / 'class', grading_out=out, submissions=root / 'class',
+                        decoy_gradebook=decoy, home_file=home_file,
+                        forged=root / 'forged-after-grading.txt')
+    for learner in PLANTED:
+        shutil.rmtree(submissions / learner)
+    killed = {}
+    with local_cluster(root / 'cluster') as cluster:
+        # 'complete' runs first (most notebooks) and longest: its worker holds it for minutes.
+        killer = threading.Thread(target=lambda: killed.update(
+            kill_when_grading(cluster.address, 'w1')), daemon=True)
+        killer.start()
+        done = grade(submissions, out, cluster.address)
+        killer.join(timeout=1)
+    home_file.unlink(missing_ok=True)
+    yield OnDask(out, done, killed)
+
+
+@pytest.mark.judge
+@pytest.mark.kernel
+def test_the_class_on_dask_scores_as_the_local_run(on_dask):
+    out, done = on_dask.out, on_dask.done
+    assert done.returncode == 0, done.stdout + done.stderr
+    with open(out / 'grades.csv', newline='') as stream:
+        got = {(r['learner'], r['notebook']): float(r['score']) for r in csv.DictReader(stream)}
+    class_ = {learner: case for learner, case in EXPECTED.items() if learner not in PLANTED}
+    for learner, case in class_.items():
+        for notebook in NOTEBOOKS:
+            assert got[in_the_csv(learner), notebook] == case.scores.get(notebook, 0), \
+                (learner, notebook)
+    notes = json.loads((out / 'notes.json').read_text())['learners']
+    for learner, case in class_.items():
+        for notebook, phrase in case.notes.items():
+            if phrase:
+                assert phrase in notes[as_text(learner)].get(notebook, ''), (learner, notes)
+    for made in ('report.html', 'nbgrader/gradebook.db', f'feedback/complete/{NB01}.html'):
+        assert (out / made).is_file(), made
+
+
+@pytest.mark.judge
+@pytest.mark.kernel
+def test_a_worker_killed_mid_class_costs_nobody(on_dask):
+    """The worker held a learner in its sandbox when it was killed; that learner was graded
+    again elsewhere, and every learner was taken once (one progress line, one TOTAL row)."""
+    out, done, killed = on_dask.out, on_dask.done, on_dask.killed
+    assert killed.get('keys'), f'no worker was killed while grading: {done.stdout[-2000:]}'
+    assert done.returncode == 0, done.stdout + done.stderr
+    learners = sorted(as_text(name) for name in EXPECTED if name not in PLANTED)
+    assert sorted(graded_lines(done.stdout)) == learners
+    with open(out / 'grades.csv', newline='') as stream:
+        totals = [r['learner'] for r in csv.DictReader(stream) if r['notebook'] == 'TOTAL']
+    assert sorted(totals) == sorted(in_the_csv(name) for name in EXPECTED
+                                    if name not in PLANTED)
+    notes = json.loads((out / 'notes.json').read_text())['learners']
+    for key in killed['keys']:
+        learner = next(name for name in learners if str(key).endswith(f'-{name}'))
+        assert 'could not grade' not in json.dumps(notes[learner]), notes[learner]
+
+
+def other_course(folder: Path) -> Path:
+    """A copy of the course whose solutions changed by one byte: another course version."""
+    for part in ('src/ros2nb', 'src/ros2nb_instructor', 'solutions', 'environment'):
+        shutil.copytree(ROOT / part, folder / part,
+                        ignore=shutil.ignore_patterns('__pycache__'))
+    changed = folder / 'solutions' / f'{NB01}.ipynb'
+    changed.write_bytes(changed.read_bytes() + b'\n')
+    return folder
+
+
+def small_class(folder: Path, learners: dict[str, dict[str, str]]) -> Path:
+    """Learners of a few notebooks each: name -> {notebook: the notebook's text}."""
+    for name, files in learners.items():
+        (folder / name).mkdir(parents=True)
+        for notebook, text in files.items():
+            (folder / name / f'{notebook}.ipynb').write_text(text)
+    return folder
+
+
+def test_a_worker_of_another_course_is_refused(tmp_path, capsys):
+    """Refused with one line before any learner runs there; alone, grading does not start."""
+    untouched = (ROOT / 'notebooks' / f'{NB01}.ipynb').read_text()
+    submissions = small_class(tmp_path / 'class', {f'learner-{n}': {NB01: untouched}
+                                                         for n in range(4)})
+    other = other_course(tmp_path / 'other-course')
+    env = dict(os.environ, PYTHONPATH=str(other / 'src'))
+    with local_cluster(tmp_path / 'cluster', workers=0) as cluster:
+        cluster.add_worker('other', env=env, cwd=other)
+        cluster.wait_for_workers(1)
+        alone = grade(submissions, tmp_path / 'grading', cluster.address)
+        assert alone.returncode == 2, alone.stdout + alone.stderr
+        refusals = [line for line in alone.stdout.splitlines() if 'refused' in line]
+        assert len(refusals) == 1 and 'its course is version' in refusals[0], alone.stdout
+        assert 'No worker of the Dask scheduler' in alone.stdout
+        assert 'Traceback' not in alone.stdout + alone.stderr
+        assert not (tmp_path / 'grading').exists()
+
+        cluster.add_worker('same')
+        cluster.wait_for_workers(2)
+        course = tmp_path / 'course'
+        course.mkdir()
+        notebooks = set_up_course(course)
+        learners, _ = find_learners(submissions, notebooks)
+        graded = Cluster(cluster.address, Settings(CELL_TIMEOUT_S, NOTEBOOK_TIMEOUT_S, True))
+        try:
+            for _batch in graded.graded(course, learners, notebooks):
+                pass
+        finally:
+            graded.close()
+    said = capsys.readouterr().out
+    assert [line for line in said.splitlines() if 'refused' in line] == refusals
+    assert list(graded.refused) == [refusals[0].split()[1]]
+    assert sorted(graded.graded_by) == sorted(learner.id for learner in learners)
+    assert set(graded.graded_by.values()).isdisjoint(graded.refused), graded.graded_by
+    assert all('not attempted' in learner.notes[NB01] for learner in learners)
+
+
+@pytest.mark.judge
+@pytest.mark.kernel
+def test_a_learner_whose_task_fails_is_that_learners_note(tmp_path):
+    """A scheduler that gives a task no second worker (allowed-failures 0): the learner whose
+    worker is killed under them gets a note and 0; the class around them is graded (on the
+    worker started again, checked before it grades)."""
+    complete = SOLUTION[NB01].read_text()
+    sleeper = json.loads(complete)
+    sleeper['cells'].insert(1, {'cell_type': 'code', 'metadata': {}, 'outputs': [],
+                                'execution_count': None,
+                                'source': 'import time\ntime.sleep(100)'})
+    # The sleeper has fewer notebooks, so the worker takes it last: when it is killed under
+    # the sleeper it holds nobody else (honest's are the solutions, 1 point each).
+    submissions = small_class(tmp_path / 'class', {
+        'sleeper': {NB01: json.dumps(sleeper)}, 'empty': {NB00: '', NB01: ''},
+        'honest': {NB00: SOLUTION[NB00].read_text(), NB01: complete}})
+    env = dict(os.environ, DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES='0')
+    with local_cluster(tmp_path / 'cluster', workers=1, env=env) as cluster:
+        killed = {}
+        killer = threading.Thread(target=lambda: killed.update(
+            kill_when_grading(cluster.address, 'w0', learner='sleeper', alone=True)), daemon=True)
+        killer.start()
+        done = grade(submissions, tmp_path / 'grading', cluster.address)
+        killer.join(timeout=1)
+    assert killed, done.stdout
+    assert done.returncode == 0, done.stdout + done.stderr
+    notes = json.loads((tmp_path / 'grading' / 'notes.json').read_text())['learners']
+    assert 'the grader could not grade this learner (KilledWorker' in notes['sleeper']['_folder']
+    with open(tmp_path / 'grading' / 'grades.csv', newline='') as stream:
+        totals = {r['learner']: r['score'] for r in csv.DictReader(stream)
+                  if r['notebook'] == 'TOTAL'}
+    assert totals == {'sleeper': '0', 'honest': '2', 'empty': '0'}, done.stdout
+    assert sorted(graded_lines(done.stdout)) == ['empty', 'honest', 'sleeper']
