@@ -1,0 +1,119 @@
+"""Answers that look alike: each answer cell beside the course's own and every classmate's.
+
+Runs on the instructor's host, for ``grading/report.html`` (:mod:`.report`).  An answer cell
+(an nbgrader solution cell) is read as Python tokens (:mod:`tokenize`): comments, blank lines
+and indentation are dropped, and every name that is not a keyword or a builtin becomes a
+placeholder numbered by its first use, so renaming and reformatting change nothing.  Only the
+learner's part counts (between ``### BEGIN SOLUTION`` and ``### END SOLUTION`` when the cell
+keeps them): the lines the course gave are everyone's.  Two answers are compared with
+:class:`difflib.SequenceMatcher`; pairs at or above :data:`THRESHOLD` are listed for a
+person to judge.  Nothing here decides a grade.
+"""
+
+from __future__ import annotations
+
+import builtins
+import difflib
+import io
+import json
+import itertools
+import keyword
+import re
+import textwrap
+import tokenize
+from pathlib import Path
+from typing import NamedTuple, Optional
+
+from ros2nb import nbmeta
+
+#: Share of matching tokens at or above which two answers are listed (docs/decisions.md).
+THRESHOLD = 0.9
+#: Fewest tokens an answer needs to be compared: shorter ones (a call, an assignment) are
+#: written alike by any honest learner (docs/decisions.md).
+MIN_TOKENS = 30
+#: Who wrote the course's own answer, as the report names it.
+COURSE = 'the course\'s answer'
+_PART = re.compile(r'### BEGIN SOLUTION\n(.*?)### END SOLUTION', re.S)
+_KEPT_NAMES = set(keyword.kwlist) | set(dir(builtins)) | {'self'}
+
+
+class Pair(NamedTuple):
+    """Two answers alike: the notebook, the cell, who wrote each, and how alike (0-1)."""
+
+    notebook: str
+    cell: str
+    first: str
+    second: str
+    ratio: float
+
+
+def learners_part(text: str) -> str:
+    """The learner's part of an answer cell: between the solution markers when the cell keeps
+    them, else the whole cell; its ``%%part`` line left out."""
+    found = _PART.findall(text)
+    body = '\n'.join(found) if found else text
+    lines = body.splitlines()
+    if lines and lines[0].lstrip().startswith('%%'):
+        lines = lines[1:]
+    return textwrap.dedent('\n'.join(lines)) + '\n'
+
+
+def tokens(text: str) -> list[str]:
+    """The answer as normalised tokens: no comments, layout or names of its own (each such
+    name is ``_N``, numbered by its first use); words split on white space when the text
+    is not Python."""
+    names: dict[str, str] = {}
+    found = []
+    try:
+        for token in tokenize.generate_tokens(io.StringIO(text).readline):
+            if token.type in (tokenize.COMMENT, tokenize.NL, tokenize.NEWLINE, tokenize.INDENT,
+                              tokenize.DEDENT, tokenize.ENDMARKER):
+                continue
+            word = token.string
+            if token.type == tokenize.NAME and word not in _KEPT_NAMES:
+                word = names.setdefault(word, f'_{len(names)}')
+            found.append(word)
+    except (tokenize.TokenError, IndentationError, SyntaxError):
+        return text.split()
+    return found
+
+
+def answers(notebook: Path) -> dict[str, list[str]]:
+    """grade id -> normalised tokens of each code answer cell of a notebook (none for a file
+    that is not a notebook)."""
+    try:
+        nb = json.loads(notebook.read_text())
+        cells = nbmeta.cells(nb)
+    except (OSError, ValueError, AttributeError, TypeError):  # not a notebook: no answers
+        return {}
+    found = {}
+    for cell in cells:
+        meta = nbmeta.nbgrader_metadata(cell)
+        if meta.get('solution') and cell.get('cell_type') == 'code':
+            found[str(meta.get('grade_id', '?'))] = tokens(learners_part(nbmeta.text(cell)))
+    return found
+
+
+def _ratio(a: list[str], b: list[str]) -> float:
+    return difflib.SequenceMatcher(None, a, b, autojunk=False).ratio()
+
+
+def alike(notebook: str, course: Optional[Path], handed: dict[str, Path]) -> list[Pair]:
+    """Pairs of answers of one notebook at or above :data:`THRESHOLD`, most alike first.
+
+    :param course: the course's own notebook (its solutions), compared with each learner's.
+    :param handed: learner's name as shown -> their notebook file.
+    """
+    read = {who: answers(path) for who, path in sorted(handed.items())}
+    if course is not None:
+        read = {COURSE: answers(course), **read}
+    pairs = []
+    for (first, one), (second, other) in itertools.combinations(read.items(), 2):
+        for cell in sorted(set(one) & set(other)):
+            a, b = one[cell], other[cell]
+            if min(len(a), len(b)) < MIN_TOKENS:
+                continue
+            ratio = _ratio(a, b)
+            if ratio >= THRESHOLD:
+                pairs.append(Pair(notebook, cell, first, second, ratio))
+    return sorted(pairs, key=lambda p: (-p.ratio, p.notebook, p.cell, p.first, p.second))
