@@ -597,9 +597,10 @@ def _with_attachment(source: Path, data: bytes) -> nbformat.NotebookNode:
     return nb
 
 
-def written_by(learner) -> nbformat.NotebookNode:
+def written_by(learner, course: tuple[str, ...] = ()) -> nbformat.NotebookNode:
     """A corpus learner's notebook (``corpora.Learner``) as they would hand it in: their own
-    answer cells, every other answer cell as handed out (unsolved)."""
+    answer cells, the ``course`` cells (keys as in ``learner.cells``) written as the course's
+    answer, every other answer cell as handed out (unsolved)."""
     from corpora import submission
     nb = nbformat.from_dict(submission(learner))
     handed_out = nbformat.read(LEARNER[NOTEBOOKS_BY_NUMBER[learner.notebook]], as_version=4)
@@ -608,7 +609,8 @@ def written_by(learner) -> nbformat.NotebookNode:
         if isinstance(cell.source, list):
             cell.source = ''.join(cell.source)
         grade_id = cell.metadata.get('nbgrader', {}).get('grade_id', '')
-        if grade_id.endswith('-answer') and grade_id[3:-len('-answer')] not in learner.cells:
+        key = grade_id[3:-len('-answer')]
+        if grade_id.endswith('-answer') and key not in learner.cells and key not in course:
             cell.source = given[grade_id]
     return nb
 
@@ -625,9 +627,10 @@ HONEST_ALIKE_CLASS = ("03 the official tutorial's style: if/elif clamp, %-format
 
 def alike_class(folder: Path) -> dict[str, dict[str, Path]]:
     """Learners for the report's answers alike, written into ``folder``: learner -> notebook
-    -> file.  ``honest`` holds the honest class alone; ``copies`` adds a copy of the course's
-    04 callback with its names and comments changed, and two learners who share one 03
-    callback of their own (one renamed its variables)."""
+    -> file.  ``honest`` holds the honest class alone; ``mains`` the 04 learners of it with a
+    ``main()`` as its comments dictate (the course's, unless they wrote their own);
+    ``copies`` adds a copy of the course's 04 callback with its names and comments changed,
+    and two learners who share one 03 callback of their own (one renamed its variables)."""
     from corpora import every_learner
     corpus = every_learner()
     made: dict[str, dict[str, Path]] = {}
@@ -641,6 +644,14 @@ def alike_class(folder: Path) -> dict[str, dict[str, Path]]:
         learner = corpus[name]
         put(f'honest-{index}', NOTEBOOKS_BY_NUMBER[learner.notebook], written_by(learner))
     honest = dict(made)
+    mains = {}
+    for index, name in enumerate(HONEST_ALIKE_CLASS):
+        learner = corpus[name]
+        if learner.notebook == '04':
+            path = folder / 'mains' / f'honest-{index}.ipynb'
+            path.parent.mkdir(parents=True, exist_ok=True)
+            nbformat.write(written_by(learner, course=('monitor-main',)), path)
+            mains[f'honest-{index}'] = {NB04: path}
     copy = nbformat.read(SOLUTION[NB04], as_version=4)
     for cell in copy.cells:
         if cell.metadata.get('nbgrader', {}).get('grade_id') == '04-monitor-callback-answer':
@@ -653,4 +664,4 @@ def alike_class(folder: Path) -> dict[str, dict[str, Path]]:
     for cell in renamed.cells:
         cell.source = cell.source.replace('step', 'delta')
     put('shares-it-renamed', NB03, renamed)
-    return {'honest': honest, 'copies': made}
+    return {'honest': honest, 'mains': mains, 'copies': made}

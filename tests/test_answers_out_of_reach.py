@@ -51,9 +51,10 @@ print('REACHED', json.dumps({'reached': reached, 'api': [course.TOPIC, Float32._
 #: A judge that imported its checks, the stand-ins and the rules, then forks its subjects.
 JUDGE = '''
 import json, sys
-import ros2nb.checks.lesson04, ros2nb.judge.session, ros2nb.rules, ros2nb.subject.stand_ins
-from ros2nb import course
-course.monitor_status(27.0)
+from pathlib import Path
+import ros2nb.checks.lesson04, ros2nb.judge.session, ros2nb.subject.stand_ins
+import ros2nb.rules
+ros2nb.rules.monitor_status(27.0)
 from ros2nb.subject.forked import serve_from_here
 serve_from_here()  # as python -m ros2nb.judge does
 from ros2nb.judge.subjects import SubjectProcess

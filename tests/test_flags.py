@@ -21,6 +21,7 @@ from ros2nb.judge.flags import reaching_in
 from ros2nb_instructor.grading import feedback
 from ros2nb_instructor.grading import learners as learners_module
 from ros2nb_instructor.grading.judging import Verdict
+from ros2nb_instructor.grading.report import write_report
 from ros2nb_instructor.grading.submissions import Learner as ClassLearner
 
 LEARNERS = every_learner()
@@ -115,8 +116,8 @@ COPIES = [learner for learner in LEARNERS.values() if learner.twin and (
 
 @pytest.mark.parametrize('learner', COPIES, ids=[learner.name for learner in COPIES])
 def test_a_copy_of_the_course_is_flagged_on_its_feedback_page(learner: Learner, tmp_path):
-    """The judge's flags of a copy reach the learner's feedback page (and the note of the
-    report), escaped, above nbgrader's page; a page without flags has no box."""
+    """The judge's flags of a copy reach the learner's feedback page, escaped, above
+    nbgrader's page (a page without flags has no box), and the notes of report.html."""
     flags = flags_of(learner, tmp_path / 'workspace')
     assert any('stand_ins' in flag or 'monitor_status' in flag for flag in flags), flags
     notebook = NOTEBOOKS[learner.notebook].stem
@@ -132,3 +133,6 @@ def test_a_copy_of_the_course_is_flagged_on_its_feedback_page(learner: Learner, 
     box = page[page.index('id="flags"'):page.index("nbgrader's page")]
     assert all(flag in feedback.html.unescape(box) for flag in flags), box
     assert feedback.FLAGS_HEADING not in feedback.safe_feedback(made, notebook, ())
+    report = write_report(tmp_path, [ada], [notebook], [['ada', notebook, '0', '6']], [])
+    notes = feedback.html.unescape(report.read_text().split('id="notes"', 1)[1])
+    assert all(flag in notes for flag in flags), notes

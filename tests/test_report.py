@@ -105,3 +105,14 @@ def test_answers_alike_are_listed_and_an_honest_class_has_none(tmp_path):
     assert all(int(ratio) >= 90 for *_rest, ratio in rows), rows
     honest = write_report(tmp_path, *_class_of(classes['honest']), []).read_text()
     assert _alike_rows(honest) == [] and 'no two answers alike' in table(honest, 'similarity')
+    assert 'id="common"' not in honest
+
+
+def test_a_cell_most_of_the_class_writes_like_the_course_is_summed_up(tmp_path):
+    """Four honest learners of 04, three of whom write main() as its comments dictate (the
+    course's): one line says so, and no pair of them is listed."""
+    from grading_samples import alike_class
+    page = write_report(tmp_path, *_class_of(alike_class(tmp_path / 'class')['mains']),
+                        []).read_text()
+    assert _alike_rows(page) == [], _alike_rows(page)
+    assert re.search(r'<p id="common">[^<]*04-monitor-main-answer: 3 of 4</p>', page), page

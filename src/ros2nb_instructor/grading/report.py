@@ -148,12 +148,13 @@ def _learners_table(notebooks: list[str], scores: dict[str, dict[str, float]],
 
 def _similarity_table(notebooks: list[str], learners: list[Learner], course: Path) -> str:
     """Answers alike (:mod:`.similarity`): for a person to judge, never a grade."""
-    pairs = []
+    pairs, common = [], []
     for notebook in notebooks:
         own = course / f'{notebook}.ipynb'
-        pairs += similarity.alike(notebook, own if own.is_file() else None,
-                                  {lr.shown: lr.files[notebook] for lr in learners
-                                   if notebook in lr.files})
+        found, usual = similarity.alike(notebook, own if own.is_file() else None,
+                                        {lr.shown: lr.files[notebook] for lr in learners
+                                         if notebook in lr.files})
+        pairs, common = pairs + found, common + usual
     lines = ['<table id="similarity"><caption>Answers alike: each answer cell, names and '
              f'layout set aside, beside the course\'s and every classmate\'s (at least '
              f'{similarity.THRESHOLD:.0%} of {similarity.MIN_TOKENS} tokens or more alike); '
@@ -166,6 +167,10 @@ def _similarity_table(notebooks: list[str], learners: list[Learner], course: Pat
     if not pairs:
         lines.append('<tr><td colspan="5" class="none">no two answers alike</td></tr>')
     lines.append('</table>')
+    if common:
+        lines.append('<p id="common">Cells most of the class wrote like the course\'s answer '
+                     '(they leave little to choose; not listed pair by pair): ' + ', '.join(
+                         f'{_e(c.cell)}: {c.alike} of {c.handed}' for c in common) + '</p>')
     return '\n'.join(lines)
 
 

@@ -31,10 +31,23 @@ THRESHOLD = 0.9
 #: Fewest tokens an answer needs to be compared: shorter ones (a call, an assignment) are
 #: written alike by any honest learner (docs/decisions.md).
 MIN_TOKENS = 30
+#: A cell that at least this share of the learners who handed it in (and at least
+#: :data:`COMMON_LEARNERS` of them) wrote like the course's answer leaves little to choose
+#: (a ``main()`` its comments dictate): it is summed up in one line, not listed pair by pair.
+COMMON_SHARE, COMMON_LEARNERS = 0.5, 3
 #: Who wrote the course's own answer, as the report names it.
 COURSE = 'the course\'s answer'
 _PART = re.compile(r'### BEGIN SOLUTION\n(.*?)### END SOLUTION', re.S)
 _KEPT_NAMES = set(keyword.kwlist) | set(dir(builtins)) | {'self'}
+
+
+class Common(NamedTuple):
+    """A cell most of the class wrote like the course's answer: how many of how many."""
+
+    notebook: str
+    cell: str
+    alike: int
+    handed: int
 
 
 class Pair(NamedTuple):
@@ -98,8 +111,11 @@ def _ratio(a: list[str], b: list[str]) -> float:
     return difflib.SequenceMatcher(None, a, b, autojunk=False).ratio()
 
 
-def alike(notebook: str, course: Optional[Path], handed: dict[str, Path]) -> list[Pair]:
-    """Pairs of answers of one notebook at or above :data:`THRESHOLD`, most alike first.
+def alike(notebook: str, course: Optional[Path], handed: dict[str, Path]
+          ) -> tuple[list[Pair], list[Common]]:
+    """Pairs of answers of one notebook at or above :data:`THRESHOLD`, most alike first, and
+    the cells most of the class wrote like the course's answer (:data:`COMMON_SHARE`), whose
+    pairs among those learners are left out.
 
     :param course: the course's own notebook (its solutions), compared with each learner's.
     :param handed: learner's name as shown -> their notebook file.
@@ -107,13 +123,24 @@ def alike(notebook: str, course: Optional[Path], handed: dict[str, Path]) -> lis
     read = {who: answers(path) for who, path in sorted(handed.items())}
     if course is not None:
         read = {COURSE: answers(course), **read}
-    pairs = []
-    for (first, one), (second, other) in itertools.combinations(read.items(), 2):
-        for cell in sorted(set(one) & set(other)):
-            a, b = one[cell], other[cell]
-            if min(len(a), len(b)) < MIN_TOKENS:
-                continue
-            ratio = _ratio(a, b)
-            if ratio >= THRESHOLD:
-                pairs.append(Pair(notebook, cell, first, second, ratio))
-    return sorted(pairs, key=lambda p: (-p.ratio, p.notebook, p.cell, p.first, p.second))
+    pairs, common = [], []
+    for cell in sorted({cell for found in read.values() for cell in found}):
+        mine = _pairs(notebook, cell, read)
+        near = {pair.second for pair in mine if pair.first == COURSE}
+        writers = sum(1 for who, found in read.items() if who != COURSE and cell in found)
+        if len(near) >= max(COMMON_LEARNERS, COMMON_SHARE * writers):
+            common.append(Common(notebook, cell, len(near), writers))
+            near.add(COURSE)
+            mine = [pair for pair in mine if not {pair.first, pair.second} <= near]
+        pairs += mine
+    return sorted(pairs, key=lambda p: (-p.ratio, p.notebook, p.cell, p.first, p.second)), common
+
+
+def _pairs(notebook: str, cell: str, read: dict[str, dict[str, list[str]]]) -> list[Pair]:
+    """The pairs of one cell at or above :data:`THRESHOLD` (the course's answer first)."""
+    found = []
+    written = [(who, cells[cell]) for who, cells in read.items() if cell in cells]
+    for (first, a), (second, b) in itertools.combinations(written, 2):
+        if min(len(a), len(b)) >= MIN_TOKENS and (ratio := _ratio(a, b)) >= THRESHOLD:
+            found.append(Pair(notebook, cell, first, second, ratio))
+    return found
