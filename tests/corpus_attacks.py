@@ -210,8 +210,39 @@ MONITOR_RULE = """
 """
 MONITOR_RULE_TWIN = MONITOR_RULE.replace('        import ros2nb\n', '').replace(
     'ros2nb.course.monitor_status', '__import__("monitor_rules").status')
+#: 06 and 08: one method handed to the course's stand-in, through importlib; each twin to a
+#: module of its own that is not there.
+FAN_BODY = """        command = Bool()
+        command.data = msg.data > HIGH_ABOVE_C
+        self.publisher_.publish(command)
+        self.get_logger().info(f'Fan {"on" if command.data else "off"} at {msg.data:.2f}C')
+"""
+FAN_PART = [(FAN_BODY, """        import importlib
+        importlib.import_module('ros2nb.subject.' + 'stand_ins').fan_callback(self, msg)
+""")]
+FAN_PART_TWIN = [(FAN_BODY, """        __import__('fan_parts').fan_callback(self, msg)
+""")]
+ON_SET_BODY = """        new = {parameter.name: parameter.value for parameter in parameters}
+"""
+ON_SET_PART = [(ON_SET_BODY, """        import importlib
+        stand_ins = importlib.import_module('ros2nb.subject.' + 'stand_ins')
+        return stand_ins.thresholds_on_set(self, parameters)
+""" + ON_SET_BODY)]
+ON_SET_PART_TWIN = [(ON_SET_BODY, """        monitor_parts = __import__('monitor_parts')
+        return monitor_parts.thresholds_on_set(self, parameters)
+""" + ON_SET_BODY)]
 
 ATTACKS = [
+    Learner('06 twin: the fan callback from a module that is not there', '06',
+            {'fan-controller': FAN_PART_TWIN}, loses=('fan-controller',)),
+    Learner("06 attack: the fan callback from the course's stand-in, through importlib", '06',
+            {'fan-controller': FAN_PART}, flagged=True,
+            twin='06 twin: the fan callback from a module that is not there'),
+    Learner('08 twin: the on-set callback from a module that is not there', '08',
+            {'threshold-callback': ON_SET_PART_TWIN}, loses=('threshold-callback',)),
+    Learner("08 attack: the on-set callback from the course's stand-in, through importlib",
+            '08', {'threshold-callback': ON_SET_PART}, flagged=True,
+            twin='08 twin: the on-set callback from a module that is not there'),
     Learner('03 twin: a sensor from parts of its own that are not there', '03',
             SENSOR_PARTS_TWIN, loses=('sensor-constructor', 'sensor-callback', 'sensor-hour')),
     Learner("03 attack: a sensor from the course's stand-ins, through importlib", '03',

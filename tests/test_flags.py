@@ -111,7 +111,7 @@ def copy_of(nb: nbformat.NotebookNode) -> nbformat.NotebookNode:
 #: Notebooks built from the course's own parts (corpus_attacks.py): refused in the subject
 #: (their score is their twin's, test_corpora.py), and flagged.
 COPIES = [learner for learner in LEARNERS.values() if learner.twin and (
-    'stand-ins' in learner.name or "course's rule" in learner.name)]
+    'stand-in' in learner.name or "course's rule" in learner.name)]
 
 
 @pytest.mark.parametrize('learner', COPIES, ids=[learner.name for learner in COPIES])
