@@ -35,6 +35,10 @@ MIN_TOKENS = 30
 #: :data:`COMMON_LEARNERS` of them) wrote like the course's answer leaves little to choose
 #: (a ``main()`` its comments dictate): it is summed up in one line, not listed pair by pair.
 COMMON_SHARE, COMMON_LEARNERS = 0.5, 3
+#: Most tokens of one answer compared (the course's longest answer has about 100): a cell
+#: bloated to megabytes costs the report no more than this (difflib's time grows with the
+#: product of the two lengths).
+MAX_TOKENS = 2000
 #: Who wrote the course's own answer, as the report names it.
 COURSE = 'the course\'s answer'
 _PART = re.compile(r'### BEGIN SOLUTION\n(.*?)### END SOLUTION', re.S)
@@ -103,12 +107,18 @@ def answers(notebook: Path) -> dict[str, list[str]]:
     for cell in cells:
         meta = nbmeta.nbgrader_metadata(cell)
         if meta.get('solution') and cell.get('cell_type') == 'code':
-            found[str(meta.get('grade_id', '?'))] = tokens(learners_part(nbmeta.text(cell)))
+            found[str(meta.get('grade_id', '?'))] = \
+                tokens(learners_part(nbmeta.text(cell)))[:MAX_TOKENS]
     return found
 
 
 def _ratio(a: list[str], b: list[str]) -> float:
-    return difflib.SequenceMatcher(None, a, b, autojunk=False).ratio()
+    """How alike two answers are (0-1); 0 when difflib's quick upper bounds already fall
+    under :data:`THRESHOLD` (the full ratio is never above them)."""
+    matcher = difflib.SequenceMatcher(None, a, b, autojunk=False)
+    if matcher.real_quick_ratio() < THRESHOLD or matcher.quick_ratio() < THRESHOLD:
+        return 0.0
+    return matcher.ratio()
 
 
 def alike(notebook: str, course: Optional[Path], handed: dict[str, Path]
