@@ -2,8 +2,8 @@
 
 Started by the judge (:mod:`ros2nb.judge.subjects`), sandboxed while grading.  The first
 command loads the learner's code (:func:`ros2nb.subject.commands.load`) before the command
-loop exists, with the course's answers out of its reach (:mod:`.out_of_reach`); the loop answers
-the rest.
+loop exists, with the course's answers out of its reach (:mod:`.out_of_reach`); the loop
+answers the rest.
 """
 
 from __future__ import annotations

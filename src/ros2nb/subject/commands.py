@@ -30,8 +30,8 @@ from ..endpoints import node_endpoints
 from ..errors import Ros2nbError
 from ..explain.exceptions import describe_error
 from ..runtime import Runtime, enable_field_checks
-from .out_of_reach import STAND_INS, Answers
 from .judge_time import JudgeTime
+from .out_of_reach import STAND_INS, Answers
 from .replies import decode_argument, encode
 from .trials import Trials
 
