@@ -115,4 +115,5 @@ def test_a_cell_most_of_the_class_writes_like_the_course_is_summed_up(tmp_path):
     page = write_report(tmp_path, *_class_of(alike_class(tmp_path / 'class')['mains']),
                         []).read_text()
     assert _alike_rows(page) == [], _alike_rows(page)
-    assert re.search(r'<p id="common">[^<]*04-monitor-main-answer: 3 of 4</p>', page), page
+    assert re.search(r'<p id="common">[^<]*04-monitor-main-answer: 3 of 4 '
+                     r'\(honest-3, honest-4, honest-5\)</p>', page), page

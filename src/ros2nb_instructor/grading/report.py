@@ -170,7 +170,8 @@ def _similarity_table(notebooks: list[str], learners: list[Learner], course: Pat
     if common:
         lines.append('<p id="common">Cells most of the class wrote like the course\'s answer '
                      '(they leave little to choose; not listed pair by pair): ' + ', '.join(
-                         f'{_e(c.cell)}: {c.alike} of {c.handed}' for c in common) + '</p>')
+                         f'{_e(c.cell)}: {len(c.alike)} of {c.handed} '
+                         f'({_e(", ".join(c.alike))})' for c in common) + '</p>')
     return '\n'.join(lines)
 
 

@@ -46,11 +46,11 @@ _KEPT_NAMES = set(keyword.kwlist) | set(dir(builtins)) | {'self'}
 
 
 class Common(NamedTuple):
-    """A cell most of the class wrote like the course's answer: how many of how many."""
+    """A cell most of the class wrote like the course's answer: who, of how many."""
 
     notebook: str
     cell: str
-    alike: int
+    alike: tuple[str, ...]
     handed: int
 
 
@@ -139,7 +139,7 @@ def alike(notebook: str, course: Optional[Path], handed: dict[str, Path]
         near = {pair.second for pair in mine if pair.first == COURSE}
         writers = sum(1 for who, found in read.items() if who != COURSE and cell in found)
         if len(near) >= max(COMMON_LEARNERS, COMMON_SHARE * writers):
-            common.append(Common(notebook, cell, len(near), writers))
+            common.append(Common(notebook, cell, tuple(sorted(near)), writers))
             near.add(COURSE)
             mine = [pair for pair in mine if not {pair.first, pair.second} <= near]
         pairs += mine
