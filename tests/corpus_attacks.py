@@ -199,6 +199,69 @@ PLOT_LOGS_POINT = '''
         self.get_logger().info(f'Plotted {msg.data:.2f} °C at {now_s:.3f} s, point {self.logged}')
 '''
 
+#: 03 and 04 built from the course's own parts (ros2nb.subject.stand_ins, ros2nb.course's
+#: status rule), which the subject refuses to the learner's code; each twin relies on a
+#: module of its own that is not there.
+SENSOR_PARTS = {
+    'sensor-constructor': """
+class TemperatureSensor(Node):
+    \"\"\"Publishes one Float32 reading in °C every PUBLISH_PERIOD_S seconds.\"\"\"
+
+    def __init__(self):
+        import importlib
+        importlib.import_module('ros2nb.subject.' + 'stand_ins').sensor_init(self)
+""",
+    'sensor-callback': """
+    def publish_temperature(self):
+        import importlib
+        importlib.import_module('ros2nb.subject.' + 'stand_ins').sensor_callback(self)
+"""}
+SENSOR_PARTS_TWIN = {key: text.replace('import importlib\n', '').replace(
+    "importlib.import_module('ros2nb.subject.' + 'stand_ins')", '__import__("sensor_parts")')
+    for key, text in SENSOR_PARTS.items()}
+SENSOR_IMPORTED = {'sensor-constructor': """
+from ros2nb.subject.stand_ins import sensor_callback, sensor_init
+
+
+class TemperatureSensor(Node):
+    \"\"\"Publishes one Float32 reading in °C every PUBLISH_PERIOD_S seconds.\"\"\"
+
+    __init__ = sensor_init
+""", 'sensor-callback': """
+    publish_temperature = sensor_callback
+"""}
+SENSOR_IMPORTED_TWIN = {**SENSOR_IMPORTED, 'sensor-constructor': SENSOR_IMPORTED[
+    'sensor-constructor'].replace('ros2nb.subject.stand_ins', 'sensor_parts')}
+MONITOR_RULE = """
+    def temperature_callback(self, msg):
+        import ros2nb
+        status = ros2nb.course.monitor_status(msg.data)
+        self.get_logger().info(f'Temperature: {msg.data:.2f}C - Status: {status}')
+"""
+MONITOR_RULE_TWIN = MONITOR_RULE.replace('        import ros2nb\n', '').replace(
+    'ros2nb.course.monitor_status', '__import__("monitor_rules").status')
+#: 06 and 08: one method handed to the course's stand-in, through importlib; each twin to a
+#: module of its own that is not there.
+FAN_BODY = """        command = Bool()
+        command.data = msg.data > HIGH_ABOVE_C
+        self.publisher_.publish(command)
+        self.get_logger().info(f'Fan {"on" if command.data else "off"} at {msg.data:.2f}C')
+"""
+FAN_PART = [(FAN_BODY, """        import importlib
+        importlib.import_module('ros2nb.subject.' + 'stand_ins').fan_callback(self, msg)
+""")]
+FAN_PART_TWIN = [(FAN_BODY, """        __import__('fan_parts').fan_callback(self, msg)
+""")]
+ON_SET_BODY = """        new = {parameter.name: parameter.value for parameter in parameters}
+"""
+ON_SET_PART = [(ON_SET_BODY, """        import importlib
+        stand_ins = importlib.import_module('ros2nb.subject.' + 'stand_ins')
+        return stand_ins.thresholds_on_set(self, parameters)
+""" + ON_SET_BODY)]
+ON_SET_PART_TWIN = [(ON_SET_BODY, """        monitor_parts = __import__('monitor_parts')
+        return monitor_parts.thresholds_on_set(self, parameters)
+""" + ON_SET_BODY)]
+
 ATTACKS = [
     Learner('06 twin: a single-threaded worker', '06', {'responsive-worker': WORKER_SINGLE},
             loses=('responsive-worker',)),
@@ -207,6 +270,32 @@ ATTACKS = [
             twin='06 twin: a single-threaded worker'),
     Learner('07 attack: the callback logs redraw()\'s line itself', '07',
             {'plot-callback': PLOT_LOGS_POINT}, twin='07 twin: a callback that does nothing'),
+    Learner('06 twin: the fan callback from a module that is not there', '06',
+            {'fan-controller': FAN_PART_TWIN}, loses=('fan-controller',)),
+    Learner("06 attack: the fan callback from the course's stand-in, through importlib", '06',
+            {'fan-controller': FAN_PART}, flagged=True,
+            twin='06 twin: the fan callback from a module that is not there'),
+    Learner('08 twin: the on-set callback from a module that is not there', '08',
+            {'threshold-callback': ON_SET_PART_TWIN}, loses=('threshold-callback',)),
+    Learner("08 attack: the on-set callback from the course's stand-in, through importlib",
+            '08', {'threshold-callback': ON_SET_PART}, flagged=True,
+            twin='08 twin: the on-set callback from a module that is not there'),
+    Learner('03 twin: a sensor from parts of its own that are not there', '03',
+            SENSOR_PARTS_TWIN, loses=('sensor-constructor', 'sensor-callback', 'sensor-hour')),
+    Learner("03 attack: a sensor from the course's stand-ins, through importlib", '03',
+            SENSOR_PARTS, twin='03 twin: a sensor from parts of its own that are not there',
+            flagged=True),
+    Learner('03 twin: a sensor imported from a module that is not there', '03',
+            SENSOR_IMPORTED_TWIN, loses=('sensor-constructor', 'sensor-callback', 'sensor-main',
+                                         'sensor-hour')),
+    Learner("03 attack: a sensor imported from the course's stand-ins", '03', SENSOR_IMPORTED,
+            twin='03 twin: a sensor imported from a module that is not there', flagged=True),
+    Learner('04 twin: the status from a module that is not there', '04',
+            {'monitor-callback': MONITOR_RULE_TWIN},
+            loses=('monitor-callback', 'monitor-readings')),
+    Learner("04 attack: the status from the course's rule, through ros2nb.course", '04',
+            {'monitor-callback': MONITOR_RULE},
+            twin='04 twin: the status from a module that is not there', flagged=True),
     Learner('07 twin: a callback that does nothing', '07', {'plot-callback': PLOT_DEAD},
             loses=('plot-callback',)),
     Learner('07 attack: the same, replies forged', '07', {'plot-callback': '''

@@ -595,3 +595,73 @@ def _with_attachment(source: Path, data: bytes) -> nbformat.NotebookNode:
     cell['attachments'] = {'image.png': {'image/png': base64.b64encode(data).decode()}}
     nb.cells.insert(3, cell)
     return nb
+
+
+def written_by(learner, course: tuple[str, ...] = ()) -> nbformat.NotebookNode:
+    """A corpus learner's notebook (``corpora.Learner``) as they would hand it in: their own
+    answer cells, the ``course`` cells (keys as in ``learner.cells``) written as the course's
+    answer, every other answer cell as handed out (unsolved)."""
+    from corpora import submission
+    nb = nbformat.from_dict(submission(learner))
+    handed_out = nbformat.read(LEARNER[NOTEBOOKS_BY_NUMBER[learner.notebook]], as_version=4)
+    given = {c.metadata.get('nbgrader', {}).get('grade_id'): c.source for c in handed_out.cells}
+    for cell in nb.cells:
+        if isinstance(cell.source, list):
+            cell.source = ''.join(cell.source)
+        grade_id = cell.metadata.get('nbgrader', {}).get('grade_id', '')
+        key = grade_id[3:-len('-answer')]
+        if grade_id.endswith('-answer') and key not in learner.cells and key not in course:
+            cell.source = given[grade_id]
+    return nb
+
+
+NOTEBOOKS_BY_NUMBER = {notebook[:2]: notebook for notebook in NB}
+#: Learners of notebooks 03 and 04 who each wrote their answers in a style of their own
+#: (tests/corpus_honest.py): no two answers alike.
+HONEST_ALIKE_CLASS = ("03 the official tutorial's style: if/elif clamp, %-formatting",
+                      '03 keyword arguments, a lambda timer, helpers', '03 an executor in main',
+                      '04 a status table and str.format', '04 the status from a match statement',
+                      '04 a status method with early returns, the line joined with +',
+                      '04 an executor in main')
+
+
+def alike_class(folder: Path) -> dict[str, dict[str, Path]]:
+    """Learners for the report's answers alike, written into ``folder``: learner -> notebook
+    -> file.  ``honest`` holds the honest class alone; ``mains`` the 04 learners of it with a
+    ``main()`` as its comments dictate (the course's, unless they wrote their own);
+    ``copies`` adds a copy of the course's 04 callback with its names and comments changed,
+    and two learners who share one 03 callback of their own (one renamed its variables)."""
+    from corpora import every_learner
+    corpus = every_learner()
+    made: dict[str, dict[str, Path]] = {}
+
+    def put(who: str, notebook: str, nb) -> None:
+        (folder / who).mkdir(parents=True, exist_ok=True)
+        nbformat.write(nb, folder / who / f'{notebook}.ipynb')
+        made.setdefault(who, {})[notebook] = folder / who / f'{notebook}.ipynb'
+
+    for index, name in enumerate(HONEST_ALIKE_CLASS):
+        learner = corpus[name]
+        put(f'honest-{index}', NOTEBOOKS_BY_NUMBER[learner.notebook], written_by(learner))
+    honest = dict(made)
+    mains = {}
+    for index, name in enumerate(HONEST_ALIKE_CLASS):
+        learner = corpus[name]
+        if learner.notebook == '04':
+            path = folder / 'mains' / f'honest-{index}.ipynb'
+            path.parent.mkdir(parents=True, exist_ok=True)
+            nbformat.write(written_by(learner, course=('monitor-main',)), path)
+            mains[f'honest-{index}'] = {NB04: path}
+    copy = nbformat.read(SOLUTION[NB04], as_version=4)
+    for cell in copy.cells:
+        if cell.metadata.get('nbgrader', {}).get('grade_id') == '04-monitor-callback-answer':
+            cell.source = cell.source.replace('temperature_c', 'reading').replace(
+                'status', 'label').replace("label = 'Normal'", "label = 'Normal'  # my own")
+    put('copies-the-course', NB04, copy)
+    shared = corpus['03 the clamp as the middle of three']
+    put('shares-one', NB03, written_by(shared))
+    renamed = written_by(shared)
+    for cell in renamed.cells:
+        cell.source = cell.source.replace('step', 'delta')
+    put('shares-it-renamed', NB03, renamed)
+    return {'honest': honest, 'mains': mains, 'copies': made}

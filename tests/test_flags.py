@@ -18,8 +18,10 @@ import pytest
 
 from corpora import NOTEBOOKS, Learner, every_learner, flags_of
 from ros2nb.judge.flags import reaching_in
+from ros2nb_instructor.grading import feedback
 from ros2nb_instructor.grading import learners as learners_module
 from ros2nb_instructor.grading.judging import Verdict
+from ros2nb_instructor.grading.report import write_report
 from ros2nb_instructor.grading.submissions import Learner as ClassLearner
 
 LEARNERS = every_learner()
@@ -47,6 +49,16 @@ def test_flagged_exactly_when_the_code_reaches_in(learner: Learner, tmp_path):
      "ros2nb.runtime.simulated_clock (ros2nb's internals)"),
     ('import ros2nb\nros2nb.current_runtime()', 'ros2nb.current_runtime'),
     ('import ctypes', 'ctypes'),
+    ("import importlib\nimportlib.import_module('ros2nb.sub' + 'ject.stand_ins')",
+     'imports importlib'),
+    ("__import__('ros2nb.subject.' + 'stand_ins')", 'computed name'),
+    ("x = 'ros2nb.subject.' + 'stand_ins'", "names 'stand_ins' (the course's answer"),
+    ('import ros2nb\nros2nb.course.monitor_status(27.0)', 'ros2nb.course.monitor_status'),
+    ('from ros2nb import course as c\nc.monitor_status(27.0)', 'ros2nb.course.monitor_status'),
+    ('from ros2nb.course import monitor_status', 'ros2nb.course.monitor_status'),
+    ("import sys\nsys.modules['ros2nb.rules']", 'sys.modules'),
+    ('import ros2nb\nros2nb.rules.monitor_status(27.0)', "ros2nb.rules (ros2nb's internals)"),
+    ('import sys\nsys.meta_path.clear()', 'sys.meta_path'),
 ])
 def test_each_kind_is_named(code, found):
     flags = reaching_in(code, 'cell')
@@ -60,6 +72,8 @@ def test_each_kind_is_named(code, found):
     'import random\nrandom.seed(7)',
     'node.declare_parameter("x", 1.0)',
     'this is not python',
+    "import rclpy\nrclpy.qos.QoSProfile(depth=__import__('rclpy').qos.HistoryPolicy.KEEP_LAST)",
+    'def monitor_status(t):\n    return "High" if t > 26.0 else "Normal"\nself.monitor_status(t)',
 ])
 def test_honest_code_is_not_flagged(code):
     assert reaching_in(code, 'cell') == []
@@ -92,3 +106,33 @@ def test_a_flag_reaches_the_instructors_note_and_no_point(tmp_path):
 
 def copy_of(nb: nbformat.NotebookNode) -> nbformat.NotebookNode:
     return nbformat.reads(nbformat.writes(nb), as_version=4)
+
+
+#: Notebooks built from the course's own parts (corpus_attacks.py): refused in the subject
+#: (their score is their twin's, test_corpora.py), and flagged.
+COPIES = [learner for learner in LEARNERS.values() if learner.twin and (
+    'stand-in' in learner.name or "course's rule" in learner.name)]
+
+
+@pytest.mark.parametrize('learner', COPIES, ids=[learner.name for learner in COPIES])
+def test_a_copy_of_the_course_is_flagged_on_its_feedback_page(learner: Learner, tmp_path):
+    """The judge's flags of a copy reach the learner's feedback page, escaped, above
+    nbgrader's page (a page without flags has no box), and the notes of report.html."""
+    flags = flags_of(learner, tmp_path / 'workspace')
+    assert any('stand_ins' in flag or 'monitor_status' in flag for flag in flags), flags
+    notebook = NOTEBOOKS[learner.notebook].stem
+    release = nbformat.read(NOTEBOOKS[learner.notebook], as_version=4)
+    verdict: concurrent.futures.Future = concurrent.futures.Future()
+    verdict.set_result(Verdict({}, None, tuple(flags)))
+    ada = ClassLearner('ada', 'ada')
+    learners_module._file(tmp_path, ada, notebook, release, copy_of(release), verdict)
+    made = ('<html><head><style>p{color:#000}</style></head><body class="jp-Notebook">'
+            '<p>nbgrader\'s page</p></body></html>')
+    page = feedback.safe_feedback(made, notebook, ada.flags[notebook])
+    assert feedback.FLAGS_HEADING in page and "nbgrader's page" in page
+    box = page[page.index('id="flags"'):page.index("nbgrader's page")]
+    assert all(flag in feedback.html.unescape(box) for flag in flags), box
+    assert feedback.FLAGS_HEADING not in feedback.safe_feedback(made, notebook, ())
+    report = write_report(tmp_path, [ada], [notebook], [['ada', notebook, '0', '6']], [])
+    notes = feedback.html.unescape(report.read_text().split('id="notes"', 1)[1])
+    assert all(flag in notes for flag in flags), notes

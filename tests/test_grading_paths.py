@@ -311,3 +311,31 @@ def test_the_judge_reads_a_learners_bag_from_its_own_copy_links_refused(tmp_path
                 pass
     finally:
         session.close()
+
+
+@pytest.mark.sandbox
+@pytest.mark.judge
+@pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))
+@pytest.mark.timeout(300)
+@pytest.mark.parametrize('who', ['twin', 'attack'])
+def test_a_copy_of_the_stand_ins_scores_its_twins_score_in_the_sandbox(who, scratch, monkeypatch):
+    """The grader's judge, sandboxed with its subjects: notebook 03 built from the course's
+    stand-ins through importlib loses what its twin (parts from a module that is not there)
+    loses, and only it is flagged.  Before, its subjects imported the stand-ins: full marks."""
+    from corpora import Learner as CorpusLearner, _write_parts, submission
+    from corpus_attacks import SENSOR_PARTS, SENSOR_PARTS_TWIN
+    monkeypatch.setenv('ROS2NB_WORKSPACE', str(scratch.workspace))
+    monkeypatch.setattr(ws_module, '_current', None)
+    monkeypatch.setattr(course, 'reference_source', lambda name: None)
+    cells = SENSOR_PARTS if who == 'attack' else SENSOR_PARTS_TWIN
+    nb = submission(CorpusLearner(who, '03', cells))
+    course.catch_up(3)
+    _write_parts(nb)
+    notebook = '03-write-the-publisher'
+    results, problem, flags = judge_notebook(scratch, notebook, nbformat.from_dict(nb),
+                                             Settings(120, 600, True), scratch.snapshot(notebook))
+    assert problem is None, problem
+    lost = {gid for gid, r in results.items() if not r['passed']}
+    assert lost == {f'{notebook[:2]}-{part}' for part in (
+        'sensor-constructor', 'sensor-callback', 'sensor-hour')}, results
+    assert bool(flags) == (who == 'attack'), flags

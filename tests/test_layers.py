@@ -27,6 +27,7 @@ LAYERS: list[tuple[str, ...]] = [
     ('ros2nb.terminal.files', 'ros2nb.terminal.colcon', 'ros2nb.terminal.pkg_templates'),
     ('ros2nb.terminal.pkg_create',),
     ('ros2nb.course',),
+    ('ros2nb.rules',),
     ('ros2nb.explain',),
     ('ros2nb.runtime', 'ros2nb.qos'),
     ('ros2nb.terminal',),

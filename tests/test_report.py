@@ -69,3 +69,51 @@ def test_a_learners_text_stays_text(tmp_path):
     assert '<script>alert(1)</script>' not in text and '<b>bold</b>' not in text
     assert '&lt;script&gt;alert(1)&lt;/script&gt;' in text
     assert "script-src 'none'" in text or 'default-src' in text  # the page runs nothing
+
+
+def _class_of(files: dict[str, dict[str, Path]]
+              ) -> tuple[list[Learner], list[str], list[list[str]]]:
+    learners, notebooks = [], sorted({n for handed in files.values() for n in handed})
+    rows = []
+    for name, handed in sorted(files.items()):
+        learner = Learner(name, name)
+        learner.files.update(handed)
+        learners.append(learner)
+        rows += [[name, notebook, '0', '1'] for notebook in notebooks]
+    return learners, notebooks, rows
+
+
+def _alike_rows(page: str) -> list[tuple[str, ...]]:
+    return re.findall(r'<tr><td>(\d\d)</td><td>([\w-]+)</td><td>([^<]+)</td><td>([^<]+)</td>'
+                      r'<td class="n">(\d+)%</td></tr>', table(page, 'similarity'))
+
+
+def test_answers_alike_are_listed_and_an_honest_class_has_none(tmp_path):
+    """The sample class's answers alike: a copy of the course's 04 callback (names and
+    comments changed) and two learners who share a 03 callback are listed; the honest
+    learners, each in a style of their own, are not."""
+    from grading_samples import alike_class
+    classes = alike_class(tmp_path / 'class')
+    page = write_report(tmp_path, *_class_of(classes['copies']), []).read_text()
+    rows = _alike_rows(page)
+    found = {(cell, first, second) for _nb, cell, first, second, _ratio in rows}
+    course = "the course's answer"
+    assert found == {
+        ('04-monitor-callback-answer', course, 'copies-the-course'),
+        ('04-monitor-main-answer', course, 'copies-the-course'),  # copied as it was
+        ('03-sensor-callback-answer', 'shares-it-renamed', 'shares-one')}, rows
+    assert all(int(ratio) >= 90 for *_rest, ratio in rows), rows
+    honest = write_report(tmp_path, *_class_of(classes['honest']), []).read_text()
+    assert _alike_rows(honest) == [] and 'no two answers alike' in table(honest, 'similarity')
+    assert 'id="common"' not in honest
+
+
+def test_a_cell_most_of_the_class_writes_like_the_course_is_summed_up(tmp_path):
+    """Four honest learners of 04, three of whom write main() as its comments dictate (the
+    course's): one line says so, and no pair of them is listed."""
+    from grading_samples import alike_class
+    page = write_report(tmp_path, *_class_of(alike_class(tmp_path / 'class')['mains']),
+                        []).read_text()
+    assert _alike_rows(page) == [], _alike_rows(page)
+    assert re.search(r'<p id="common">[^<]*04-monitor-main-answer: 3 of 4 '
+                     r'\(honest-3, honest-4, honest-5\)</p>', page), page

@@ -1,6 +1,7 @@
-"""The course's facts, defined once: names, files, the sensor's numbers, the monitor's rule.
+"""The course's facts, defined once: names, files, the sensor's numbers, the monitor's thresholds.
 
-The checks, the judge and the notebooks take every number from here.  No ROS import.  The node files
+The checks, the judge and the notebooks take every number from here; the monitor's rule
+itself is an answer, in :mod:`ros2nb.rules`.  No ROS import.  The node files
 the learner writes (and ``ros2nb/reference/``) are standalone ROS programs, so they carry
 the same numbers as literals in their constants part; a test keeps them equal to these.
 
@@ -95,23 +96,6 @@ STEPS = {1: (), 2: ('workspace',), 3: ('workspace', 'package'),
          7: ('workspace', 'package', 'publisher', 'subscriber'),
          8: ('workspace', 'package', 'publisher', 'subscriber', 'entry_points'),
          10: ('workspace', 'package', 'publisher', 'subscriber', 'entry_points')}
-
-
-def monitor_status(temperature_c: float) -> str:
-    """Return the monitor's status for a reading: ``'High'``, ``'Low'`` or ``'Normal'``.
-
-    ``High`` strictly above :data:`HIGH_ABOVE_C`, ``Low`` strictly below
-    :data:`LOW_BELOW_C`, ``Normal`` otherwise (both boundaries are Normal).
-
-    Introduced in ``04-write-the-subscriber.ipynb``.
-
-    :param temperature_c: the reading in °C.
-    """
-    if temperature_c > HIGH_ABOVE_C:
-        return 'High'
-    if temperature_c < LOW_BELOW_C:
-        return 'Low'
-    return 'Normal'
 
 
 def reference_source(name: str) -> str | None:

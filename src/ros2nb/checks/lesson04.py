@@ -11,7 +11,7 @@ from __future__ import annotations
 import re
 from typing import Any
 
-from .. import course
+from .. import course, rules
 from ..errors import CheckFailed
 from ..judge_interface import Judge
 from .base import judged
@@ -138,7 +138,7 @@ def _statuses_verdict(readings: tuple[float, ...] | list[float], lines: list[lis
                       with_value: bool) -> None:
     words = re.compile(r'\b(High|Low|Normal)\b')
     for value, said in zip(readings, lines):
-        want = course.monitor_status(value)
+        want = rules.monitor_status(value)
         if not said:
             raise CheckFailed(f'For a reading of {value} °C the monitor logged nothing: log one '
                               'line with the reading and its status.')

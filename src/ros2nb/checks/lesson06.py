@@ -17,7 +17,7 @@ import time
 
 from std_msgs.msg import Bool
 
-from .. import course
+from .. import course, rules
 from ..errors import CheckFailed
 from ..explain.ros_settings import ros_arguments_mistake
 from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
@@ -86,7 +86,7 @@ def _fan_controller(judge: Judge) -> str:
         judge.observer.wait_until(lambda: len(commands) - before >= sent, ARRIVAL_TIMEOUT_S)
         answered_s.append(time.monotonic() - started)
         said = [heard.value for heard in commands[before:]]
-        want = course.monitor_status(value) == 'High'
+        want = rules.monitor_status(value) == 'High'
         if not said:
             raise CheckFailed(f'For a reading of {value} °C the fan controller published nothing '
                               f'on /{course.FAN_TOPIC}: publish one Bool for every reading.')

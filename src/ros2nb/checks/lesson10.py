@@ -19,7 +19,7 @@ import math
 from pathlib import Path
 from typing import Any, Callable, Optional
 
-from .. import course
+from .. import course, rules
 from ..errors import CheckFailed
 from ..runtime import current_runtime
 from ..terminal import bag
@@ -226,7 +226,7 @@ def _statuses_follow_readings(said: list[tuple[int, float, str]],
         by_step.setdefault(t, []).append((r, s))
     for index, (t_ns, value) in enumerate(heard, start=1):
         mine = by_step.get(t_ns, [])
-        want = (round(value, 2), course.monitor_status(value))
+        want = (round(value, 2), rules.monitor_status(value))
         if len(mine) != 1 or (round(mine[0][0], 2), mine[0][1]) != want:
             got = ', '.join(f'{r:.2f} {s}' for r, s in mine) or 'nothing'
             raise CheckFailed(f'For reading {index} ({value:.2f} °C, at {t_ns / 1e9:g} s) '

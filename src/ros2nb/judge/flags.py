@@ -22,6 +22,7 @@ from IPython.core.inputtransformer2 import TransformerManager
 
 from .. import course, nbmeta
 from ..checks.source import TEXT
+from ..subject.out_of_reach import ANSWERS
 
 #: ``module.function`` calls that read or change other code's frames and objects.
 REACHING_CALLS = {
@@ -38,12 +39,23 @@ REACHING_CALLS = {
 }
 #: Attributes that lead from a frame or traceback into another function's variables.
 FRAME_ATTRIBUTES = {'f_back', 'f_locals', 'f_globals', 'tb_frame', 'gi_frame', 'cr_frame'}
-#: Modules a lesson's answer never needs that reach below Python's objects.
-RAW_MODULES = {'ctypes': 'reads or writes memory directly'}
+#: Modules a lesson's answer never needs that reach below Python's objects, or import
+#: modules by a name computed as the code runs (how the course's answers were reached).
+RAW_MODULES = {'ctypes': 'reads or writes memory directly',
+               'importlib': 'imports modules by a name it computes',
+               'runpy': 'runs modules by a name it computes'}
+#: The process's own import machinery: the modules it imported (the course's too) and its finders.
+REACHING_CALLS.update({
+    'sys.modules': "reads the modules the process imported, the course's answers too",
+    'sys.meta_path': 'changes how modules are found (the course refuses its answers there)',
+    'sys.path_hooks': 'changes how modules are found (the course refuses its answers there)',
+})
+#: Names of the course's answers (ros2nb.subject.out_of_reach), in code or in a string.
+ANSWER_NAMES = (*ANSWERS, 'stand_ins', 'monitor_status', 'ros2nb.reference')
 #: ros2nb's own parts a learner's code never uses (the lessons use the top-level
 #: functions and ``ros2nb.course``): the runtime, the judge and its subjects, the checks.
 INTERNAL = {'runtime', 'subject', 'judge', 'checks', 'processes', 'explain', 'kernel',
-            'nbmeta', 'endpoints', 'reference', 'current_runtime'}
+            'nbmeta', 'endpoints', 'reference', 'current_runtime', 'rules'}
 #: Modules and classes whose attributes an answer never replaces.
 PATCHED_OWNERS = {'rclpy', 'ros2nb', 'builtins', 'sys', 'Node', 'Publisher', 'Subscription',
                   'Timer', 'Executor', 'SingleThreadedExecutor', 'MultiThreadedExecutor'}
@@ -86,8 +98,19 @@ def _internal(module: str) -> bool:
     return parts[0] == 'ros2nb' and len(parts) > 1 and parts[1] in INTERNAL
 
 
+def _answer(name: str) -> bool:
+    """Whether a dotted name or a string names one of the course's answers."""
+    return any(part in name for part in ANSWER_NAMES)
+
+
 def _why(node: ast.AST, modules: dict[str, str], setup_py: bool) -> Optional[str]:
     """What ``node`` reaches for, or None."""
+    if isinstance(node, ast.Constant) and isinstance(node.value, str) and _answer(node.value):
+        return f'names {node.value[:60]!r} (the course\'s answer, refused to graded code)'
+    if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and \
+            node.func.id == '__import__' and not (
+                node.args and isinstance(node.args[0], ast.Constant)):
+        return 'calls __import__ with a name it computes (imports modules by a computed name)'
     if isinstance(node, (ast.Import, ast.ImportFrom)):
         names = [a.name for a in node.names] if isinstance(node, ast.Import) else \
             [f'{node.module}.{a.name}' for a in node.names] if node.module else []
@@ -96,6 +119,8 @@ def _why(node: ast.AST, modules: dict[str, str], setup_py: bool) -> Optional[str
                 return f'imports {name} ({RAW_MODULES[name.split(".")[0]]})'
             if _internal(name):
                 return f"imports {name} (ros2nb's internals)"
+            if name.startswith('ros2nb.') and _answer(name):
+                return f"imports {name} (the course's answer, refused to graded code)"
         return None
     if isinstance(node, ast.Attribute) and node.attr in FRAME_ATTRIBUTES:
         return f'reads .{node.attr} (another function\'s frame)'
@@ -108,6 +133,8 @@ def _why(node: ast.AST, modules: dict[str, str], setup_py: bool) -> Optional[str
                 return f'uses {full} ({REACHING_CALLS[full]})'
             if _internal(full) and full.count('.') == 1:
                 return f"uses {full} (ros2nb's internals)"
+            if full.startswith('ros2nb.') and _answer(full) and isinstance(node, ast.Attribute):
+                return f"uses {full} (the course's answer, refused to graded code)"
         return None
     if isinstance(node, ast.Constant) and isinstance(node.value, str) and \
             (node.value == '/proc' or node.value.startswith('/proc/')):

@@ -2,7 +2,8 @@
 
 Started by the judge (:mod:`ros2nb.judge.subjects`), sandboxed while grading.  The first
 command loads the learner's code (:func:`ros2nb.subject.commands.load`) before the command
-loop exists; the loop answers the rest.
+loop exists, with the course's answers out of its reach (:mod:`.out_of_reach`); the loop
+answers the rest.
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ import sys
 
 from ..explain.plots import guard_pyplot
 from ..processes import end_this_process
-from . import judge_time
+from . import judge_time, out_of_reach
 from .commands import LOADERS, PROTOCOL_ERROR, load, serve
 
 
@@ -32,10 +33,11 @@ def main(argv: list[str]) -> int:
         request = json.loads(first)
         if request.get('op') not in LOADERS:
             return PROTOCOL_ERROR
+        refusing = out_of_reach.shut()  # the stand-ins are handed in only once the code is loaded
         namespace, reply = load(request)
         replies.write(json.dumps(reply) + '\n')
         replies.flush()
-        serve(commands, replies, namespace)
+        serve(commands, replies, namespace, refusing)
     return 0
 
 

@@ -31,8 +31,8 @@ from ..errors import Ros2nbError
 from ..explain.exceptions import describe_error
 from ..runtime import Runtime, enable_field_checks
 from .judge_time import JudgeTime
+from .out_of_reach import STAND_INS, Answers
 from .replies import decode_argument, encode
-from .stand_ins import with_stand_ins
 from .trials import Trials
 
 #: Exit code when a command could not even be read.
@@ -87,8 +87,9 @@ def load(request: dict) -> tuple[dict, dict]:
 class Subject(Trials):
     """The state of this process: the learner's namespace, their node, the runtime."""
 
-    def __init__(self, namespace: dict[str, Any]) -> None:
+    def __init__(self, namespace: dict[str, Any], answers: Answers) -> None:
         self.namespace = namespace
+        self._answers = answers  # hands in the stand-ins; the learner's code never had them
         self.rt: Optional[Runtime] = None
         self.node: Optional[Node] = None
         self.received = 0
@@ -146,7 +147,8 @@ class Subject(Trials):
             found = sorted(n for n, v in self.namespace.items()
                            if isinstance(v, type) and issubclass(v, Node) and v is not Node)
             return {'ok': False, 'no_class': True, 'classes': found}
-        node_class = with_stand_ins(node_class, stand_ins)
+        if stand_ins:
+            node_class = self._answers.hand_in(STAND_INS).with_stand_ins(node_class, stand_ins)
         rt.take_judge_time()
         if seed is not None:
             random.seed(seed)
@@ -241,9 +243,13 @@ class Subject(Trials):
 
 
 
-def serve(commands: Any, replies: Any, namespace: dict[str, Any]) -> None:
-    """Answer one JSON reply per JSON command until ``quit`` or end of input."""
-    subject = Subject(namespace)
+def serve(commands: Any, replies: Any, namespace: dict[str, Any], answers: Answers) -> None:
+    """Answer one JSON reply per JSON command until ``quit`` or end of input.
+
+    :param answers: the finder that keeps the course's answers from the learner's code
+        (:func:`.out_of_reach.shut`), which hands in the stand-ins.
+    """
+    subject = Subject(namespace, answers)
     handlers: dict[str, Callable[..., dict]] = {
         'call': subject.call, 'new_node': subject.new_node, 'run': subject.run,
         'set_attribute': subject.set_attribute, 'wait_matched': subject.wait_matched,

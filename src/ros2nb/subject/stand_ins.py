@@ -7,6 +7,9 @@ the one here (``new_node(..., stand_ins=[...])``, :mod:`ros2nb.subject.commands`
 ``main()`` with a whole stand-in node (:mod:`ros2nb.subject.program`).  A stand-in never
 counts for the learner: it only makes room for their own part to be seen.
 
+This module is an answer: the subject refuses it to the learner's code and imports it only
+after that code is loaded, and keeps it out of ``sys.modules`` (:mod:`.out_of_reach`).
+
 Each function is written for a class of the learner's (no ``super()``: the class it ends up
 in is made on the fly).  The callbacks find the node's publisher by its topic, so a
 learner's constructor that names its attribute differently still works with them.
@@ -22,6 +25,7 @@ from rclpy.node import Node
 from std_msgs.msg import Bool, Float32
 
 from .. import course
+from ..rules import monitor_status
 
 
 def _publisher_on(node: Node, topic: str) -> Any:
@@ -71,7 +75,7 @@ def monitor_init(self: Node) -> None:
 def monitor_callback(self: Node, msg: Float32) -> None:
     """Part 4 of temperature_subscriber.py: one line with the reading and its status."""
     self.get_logger().info(f'Temperature: {msg.data:.2f}C - Status: '
-                           f'{course.monitor_status(msg.data)}')
+                           f'{monitor_status(msg.data)}')
 
 
 # ------------------------------------------------------------------ notebook 06: the fan

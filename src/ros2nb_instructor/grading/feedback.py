@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import html
 import re
+from typing import Sequence
 
 import nh3
 
@@ -54,11 +55,29 @@ def page(title: str, body: str, styles: list[str] = (), body_class: str = '') ->
             f'<body class="{html.escape(body_class)}">{clean_body(body)}</body></html>\n')
 
 
-def safe_feedback(made: str, title: str) -> str:
-    """nbgrader's feedback page ``made`` rebuilt by :func:`page` (its styles kept)."""
+#: What the feedback page says above the judge's flags (:mod:`ros2nb.judge.flags`).
+FLAGS_HEADING = 'Code your instructor will look at'
+FLAGS_WHY = ('These lines reach past what the lessons use (into the course\'s own answers or '
+             'the process they run in). No point changed because of them; your instructor '
+             'reads them with your notebook.')
+
+
+def flags_html(flags: Sequence[str]) -> str:
+    """The judge's flags of one notebook as a box of the feedback page (empty for none);
+    each flag is text, escaped."""
+    if not flags:
+        return ''
+    items = ''.join(f'<li><code>{html.escape(flag)}</code></li>' for flag in flags)
+    return (f'<div id="flags" class="flags"><h2>{FLAGS_HEADING}</h2><p>{FLAGS_WHY}</p>'
+            f'<ul>{items}</ul></div>')
+
+
+def safe_feedback(made: str, title: str, flags: Sequence[str] = ()) -> str:
+    """nbgrader's feedback page ``made`` rebuilt by :func:`page` (its styles kept), with the
+    judge's ``flags`` of the notebook first (:func:`flags_html`)."""
     head, _, rest = made.partition('<body')
     tag, _, body = rest.partition('>')
-    body = body.rsplit('</body>', 1)[0]
+    body = flags_html(flags) + body.rsplit('</body>', 1)[0]
     styles = re.findall(r'<style[^>]*>(.*?)</style>', head, flags=re.S | re.I)
     found = re.search(r'class="([\w\s-]*)"', tag)
     return page(title, body, styles, found.group(1) if found else '')

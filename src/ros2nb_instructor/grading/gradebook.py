@@ -170,7 +170,8 @@ def write_results(course: Path, out: Path, learners: list[Learner],
                 page = folder / f'{notebook}.html'
                 try:
                     if notebook in learner.files and made.is_file():
-                        page.write_text(feedback.safe_feedback(made.read_text(), notebook))
+                        page.write_text(feedback.safe_feedback(made.read_text(), notebook,
+                                                           learner.flags.get(notebook, ())))
                     else:
                         page.write_text(_not_submitted_page(learner, notebook, maxima[notebook]))
                 except Exception as error:  # noqa: BLE001 - that page's problem, in a note

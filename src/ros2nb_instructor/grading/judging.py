@@ -27,6 +27,11 @@ from .scratch import Scratch, sandbox_env
 from .settings import JUDGE_TIMEOUT_S, Settings
 
 
+#: What the subjects never see: the course's reference nodes, the checks and the judge (their
+#: expectations), the grader.  The stand-ins and rules stay, refused to the learner's code
+#: and handed in to the subject once it is loaded (ros2nb.subject.out_of_reach).
+ANSWER_FOLDERS = [ROOT / 'src' / 'ros2nb' / 'reference', ROOT / 'src' / 'ros2nb' / 'checks',
+                  ROOT / 'src' / 'ros2nb' / 'judge', ROOT / 'src' / 'ros2nb_instructor']
 #: Flags of one notebook kept for the instructor's notes (each cut to 300 characters).
 MAX_FLAGS = 20
 
@@ -73,7 +78,7 @@ def judge_notebook(scratch: Scratch, notebook: str, submitted: nbformat.Notebook
         env['FASTDDS_BUILTIN_TRANSPORTS'] = 'UDPv4'  # judge and subjects: own /dev/shm each
         env['ROS2NB_SUBJECT_PREFIX'] = json.dumps(sandbox.inner_prefix(  # the course may be
             readable=[workspace, ROOT / 'src'], writable=[subjects],  # under /tmp too
-            hidden=[ROOT / 'src' / 'ros2nb' / 'reference', own, given]))
+            hidden=[*ANSWER_FOLDERS, own, given]))
         # The judge may read the course's reference nodes (a notebook handed in alone runs
         # on them where it relies on an earlier one's, as catch_up promises); its subjects
         # see only the copies it hands them.

@@ -105,6 +105,7 @@ def _file(target: Path, learner: Learner, notebook: str, release: nbformat.Noteb
             learner.note(notebook, problem)
         if flags:  # the instructor's to look at; the points are the judge's verdict alone
             learner.note(notebook, f'{FLAGGED} ' + ' | '.join(flags))
+            learner.flags[notebook] = list(flags)  # and the learner's feedback page
         scored = notebooks_of.for_scoring(release, executed, results, problem)
         learner.results[notebook] = results  # what nbgrader scores: the report counts it
     except Exception as error:  # noqa: BLE001 - one learner's problem, said in a note

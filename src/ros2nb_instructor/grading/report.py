@@ -3,7 +3,7 @@
 Runs on the instructor's host, after nbgrader scored the class.  Per notebook: who handed
 it in, how the scores spread (a matplotlib plot, embedded), and per check how many
 learners passed; the failure lines learners saw most often, with their counts; every
-learner's scores; the notes.  The page is built like the feedback pages
+learner's scores; the answers alike (:mod:`.similarity`); the notes.  The page is built like the feedback pages
 (:func:`.feedback.page`): everything a learner wrote is escaped text, nh3 cleans the body,
 and the Content-Security-Policy lets it load and run nothing.
 """
@@ -17,7 +17,8 @@ import io
 import statistics
 from pathlib import Path
 
-from . import feedback
+from ..paths import SOLUTIONS
+from . import feedback, similarity
 from .submissions import Learner
 
 #: Failure lines listed (the most frequent first).
@@ -145,6 +146,35 @@ def _learners_table(notebooks: list[str], scores: dict[str, dict[str, float]],
     return '\n'.join(lines)
 
 
+def _similarity_table(notebooks: list[str], learners: list[Learner], course: Path) -> str:
+    """Answers alike (:mod:`.similarity`): for a person to judge, never a grade."""
+    pairs, common = [], []
+    for notebook in notebooks:
+        own = course / f'{notebook}.ipynb'
+        found, usual = similarity.alike(notebook, own if own.is_file() else None,
+                                        {lr.shown: lr.files[notebook] for lr in learners
+                                         if notebook in lr.files})
+        pairs, common = pairs + found, common + usual
+    lines = ['<table id="similarity"><caption>Answers alike: each answer cell, names and '
+             f'layout set aside, beside the course\'s and every classmate\'s (at least '
+             f'{similarity.THRESHOLD:.0%} of {similarity.MIN_TOKENS} tokens or more alike); '
+             'for you to judge, no point changed</caption><tr><th>notebook</th><th>cell</th>'
+             '<th>answer</th><th>beside</th><th>alike</th></tr>']
+    for pair in pairs:
+        lines.append(f'<tr><td>{_e(pair.notebook[:2])}</td><td>{_e(pair.cell)}</td>'
+                     f'<td>{_e(pair.first)}</td><td>{_e(pair.second)}</td>'
+                     f'<td class="n">{pair.ratio:.0%}</td></tr>')
+    if not pairs:
+        lines.append('<tr><td colspan="5" class="none">no two answers alike</td></tr>')
+    lines.append('</table>')
+    if common:
+        lines.append('<p id="common">Cells most of the class wrote like the course\'s answer '
+                     '(they leave little to choose; not listed pair by pair): ' + ', '.join(
+                         f'{_e(c.cell)}: {len(c.alike)} of {c.handed} '
+                         f'({_e(", ".join(c.alike))})' for c in common) + '</p>')
+    return '\n'.join(lines)
+
+
 def _notes(learners: list[Learner], refused: list[str]) -> str:
     lines = ['<h2 id="notes">Notes</h2><dl>']
     for learner in learners:
@@ -158,12 +188,13 @@ def _notes(learners: list[Learner], refused: list[str]) -> str:
 
 
 def write_report(out: Path, learners: list[Learner], notebooks: list[str],
-                 rows: list[list[str]], refused: list[str]) -> Path:
+                 rows: list[list[str]], refused: list[str], course: Path = SOLUTIONS) -> Path:
     """Write ``out/report.html`` for the graded class; return its path.
 
     :param rows: grades.csv's rows (learner's name as shown, notebook or ``TOTAL``, score,
         most points), as :func:`.gradebook.write_results` returns them.
     :param refused: the lines about entries not graded.
+    :param course: the course's own notebooks (``NN-title.ipynb``), for the answers alike.
     """
     scores = _scores(rows)
     maxima = {notebook: 0.0 for notebook in notebooks}
@@ -182,6 +213,7 @@ def write_report(out: Path, learners: list[Learner], notebooks: list[str],
         '<h2>Checks</h2>', _checks_table(notebooks, learners),
         '<h2>Failures</h2>', _failures_table(learners),
         '<h2>Learners</h2>', _learners_table(notebooks, scores, learners, totals),
+        '<h2 id="alike">Answers alike</h2>', _similarity_table(notebooks, learners, course),
         _notes(learners, refused)])
     path = out / 'report.html'
     path.write_text(feedback.page('The class at a glance', body, [STYLE]))

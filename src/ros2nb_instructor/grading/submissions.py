@@ -36,6 +36,8 @@ class Learner:
     :ivar files: notebook (e.g. ``03-write-the-publisher``) -> the file graded for it.
     :ivar notes: notebook (or ``_folder``) -> what happened, in a sentence.
     :ivar results: notebook -> the judge's results (grade id -> ``passed``, ``message``).
+    :ivar flags: notebook -> the judge's flags (code that reaches into the course,
+        :mod:`ros2nb.judge.flags`), shown on the feedback page and in the report's notes.
     """
 
     name: str
@@ -43,6 +45,7 @@ class Learner:
     files: dict[str, Path] = field(default_factory=dict)
     notes: dict[str, str] = field(default_factory=dict)
     results: dict[str, dict] = field(default_factory=dict)
+    flags: dict[str, list[str]] = field(default_factory=dict)
 
     @property
     def shown(self) -> str:
