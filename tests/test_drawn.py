@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from ros2nb import course
+from ros2nb import course, rules
 from ros2nb.checks import drawn, lesson03, lesson04, lesson06, lesson07, lesson08
 from ros2nb.errors import Ros2nbError
 from ros2nb.judge.__main__ import arguments
@@ -87,7 +87,7 @@ def test_drawn_inputs_keep_their_boundaries_and_their_purpose():
     for seed in range(20):
         judge = type('Graded', (), {'seed': seed})()
         readings = lesson04.drawn_readings_c(judge, '04 monitor callback', 2)
-        assert sorted(course.monitor_status(v) for v in readings) == ['High'] * 2 + \
+        assert sorted(rules.monitor_status(v) for v in readings) == ['High'] * 2 + \
             ['Low'] * 2 + ['Normal'] * 2
         assert not {course.LOW_BELOW_C, course.HIGH_ABOVE_C} & set(readings)
         for number, start_c in enumerate(drawn.clamp_probes_c(judge)):
