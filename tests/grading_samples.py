@@ -142,7 +142,7 @@ plant(learners, 'readable', 'read', lambda path: str(path))
 plant(learners, 'run_notebook', 'run', lambda scratch, nb, prepared, settings: json.dumps(prepared))
 plant(judging, 'judge_notebook', 'judge', lambda s, n, submitted, *rest: json.dumps(submitted))
 plant(notebooks, 'for_scoring', 'file', lambda release, executed, *rest: json.dumps(executed))
-plant(feedback, 'safe_feedback', 'feedback', lambda made, title: made)
+plant(feedback, 'safe_feedback', 'feedback', lambda made, title, *rest: made)
 sys.exit(cli.main(sys.argv[1:]))
 '''
 
