@@ -32,6 +32,9 @@ POLL_S = 0.05
 #: (:class:`~ros2nb.processes.Patience`: every process's stat, milliseconds on a busy
 #: machine, where a step often takes longer than POLL_S).
 PATIENCE_LOOK_S = 0.25
+#: Where the judge's clock starts (ns): rcl takes a ROS time of 0 for a clock not yet set,
+#: and a timer a node starts then first fires one step late (docs/decisions.md).
+START_NS = 1_000_000_000
 
 
 class JudgeClock:
@@ -44,6 +47,8 @@ class JudgeClock:
         self._observer = observer
         self._publisher = observer.node.create_publisher(Clock, '/clock', JUDGE_CLOCK_QOS,
                                                          event_callbacks=QUIET_PUBLISHER)
+        with observer.changed:
+            observer.now_ns = max(observer.now_ns, START_NS)
         self._publish()
 
     @property
@@ -73,11 +78,16 @@ class JudgeClock:
         self._publish()
 
     def drive(self, subject: SubjectProcess, op: str, *, step_s: float, limit_s: float,
-              timeout: float = REPLY_TIMEOUT_S, what: str = 'your code',
+              probe_s: float = 0.0, timeout: float = REPLY_TIMEOUT_S, what: str = 'your code',
               **arguments: Any) -> dict:
         """Send ``op`` to ``subject`` and move the clock on, a step of ``step_s`` at a time,
         for as long as the subject's spin wants it (at most ``limit_s`` simulated seconds);
         return the subject's reply once it comes.
+
+        With ``probe_s``, the clock also stops ``probe_s`` before each whole step: a timer
+        of period ``step_s`` started now fires on the whole steps, and one whose period is
+        shorter or longer by more than ``probe_s`` over the run fires on a probe (its
+        messages are stamped off the whole steps), two steps per period instead of one.
 
         Before each step the judge waits until every message the subject says it published
         on a topic the judge watches, and every line it says it logged, has arrived.
@@ -88,15 +98,17 @@ class JudgeClock:
         :raises SubjectHung: when the subject neither answers nor finishes a step in time.
         """
         try:
-            return self._drive(subject, op, step_s, limit_s, timeout, what, arguments)
+            return self._drive(subject, op, (step_s, probe_s), limit_s, timeout, what,
+                               arguments)
         except BaseException:
             # The subject is left in the middle of its command: it serves no other.
             kill_process_group(subject.proc)
             raise
 
-    def _drive(self, subject: SubjectProcess, op: str, step_s: float, limit_s: float,
-               timeout: float, what: str, arguments: dict) -> dict:
-        step_ns, limit_ns = round(step_s * 1e9), self.now_ns + round(limit_s * 1e9)
+    def _drive(self, subject: SubjectProcess, op: str, steps: tuple[float, float],
+               limit_s: float, timeout: float, what: str, arguments: dict) -> dict:
+        step_ns, probe_ns = round(steps[0] * 1e9), round(steps[1] * 1e9)
+        limit_ns, whole_ns = self.now_ns + round(limit_s * 1e9), self.now_ns + step_ns
         subject.send(op, **arguments)
         # Patience reads /proc: it starts only once the subject has been quiet for
         # PATIENCE_LOOK_S (an hour of steps would otherwise read it 7200 times), and looks
@@ -117,12 +129,16 @@ class JudgeClock:
             wants = latest.get('wants') if latest else None
             if latest is not None and latest['t'] >= self.now_ns and wants is not None \
                     and wants > self.now_ns:
-                if self.now_ns + step_ns > limit_ns:
+                if whole_ns > limit_ns:
                     kill_process_group(subject.proc)
                     raise CheckFailed(f'{what} kept the nodes spinning past {limit_s:g} '
                                       'simulated seconds of the grader\'s clock: spin only as '
                                       'long as the task says.')
-                self.step_to(self.now_ns + step_ns)
+                if 0 < probe_ns < step_ns and self.now_ns < whole_ns - probe_ns:
+                    self.step_to(whole_ns - probe_ns)
+                else:
+                    self.step_to(whole_ns)
+                    whole_ns += step_ns
                 patience, quiet_since = None, time.monotonic()
             elif time.monotonic() - max(quiet_since, looked) < PATIENCE_LOOK_S:
                 continue
