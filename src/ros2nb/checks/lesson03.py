@@ -20,7 +20,7 @@ from std_msgs.msg import Float32
 
 from .. import course
 from ..errors import CheckFailed
-from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
+from ..judge_interface import ARRIVAL_TIMEOUT_S, Flooded, Judge, learner_error
 from .base import direct, judged
 from .mains import run_main
 from .file_nodes import lines_logged, new_node
@@ -269,7 +269,7 @@ def _sensor_constructor(judge: Judge) -> str:
     """Part 3 alone: the learner's __init__, with the course's callback (their own when the
     course's cannot work with their constructor)."""
     run, problem = _attempt(judge, ('sensor_callback',))
-    if problem is not None:
+    if problem is not None and not isinstance(problem, Flooded):  # theirs would flood too
         own, own_problem = _attempt(judge, ())
         if own_problem is None:
             run, problem = own, None
@@ -305,9 +305,12 @@ def _callback_run(judge: Judge, seconds: float, seed: int) -> SensorRun:
     constructor is at fault, in the course's (a mistake in part 3 costs part 3 only)."""
     whole = seconds <= CALLBACK_RUN_S  # else a short probe decides whose constructor runs
     trial_s = seconds if whole else CONSTRUCTOR_RUN_S
-    run = _sensor_run(judge, (), trial_s, probe_s=PROBE_S, seed=seed)
     stand_ins: tuple[str, ...] = ()
-    if _constructor_problem(judge, run, trial_s) is not None:
+    try:
+        run: Optional[SensorRun] = _sensor_run(judge, (), trial_s, probe_s=PROBE_S, seed=seed)
+    except Flooded:  # its constructor floods: part 3's fault, which the course's stands in for
+        run = None
+    if run is None or _constructor_problem(judge, run, trial_s) is not None:
         stand_ins = ('sensor_init',)
         run = _sensor_run(judge, stand_ins, trial_s, probe_s=PROBE_S, seed=seed)
     if whole:

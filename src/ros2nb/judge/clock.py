@@ -116,11 +116,12 @@ class JudgeClock:
         patience: Optional[Patience] = None
         quiet_since = looked = time.monotonic()
         while True:
+            self._observer.floods.raise_any()  # its processes were ended: none will answer
             reply = subject.poll_reply(POLL_S)
             ack = subject.take_ack()
             if ack is not None:
                 patience, quiet_since = None, time.monotonic()
-                self._settle(ack, subject.heard_base)
+                self._settle(ack, subject.heard_base, subject.proc.pid)
                 if ack.get('wants') is None:  # its spin ended, and all it told of arrived:
                     self._publish()  # the same time again lets it go on (destroy its nodes)
             if reply is not None:
@@ -150,10 +151,12 @@ class JudgeClock:
             else:
                 looked = time.monotonic()
 
-    def _settle(self, ack: dict, base: tuple[dict[str, int], dict[str, int]]) -> None:
-        """Wait until what the subject announced in ``ack`` (all it published and logged
-        since it started) has arrived: what the judge heard since then (``base``: what it
-        had heard when the subject started), on the topics it watched then and on /rosout."""
+    def _settle(self, ack: dict, base: tuple[dict[str, int], dict[str, int]], pid: int) -> None:
+        """Wait until what the subject ``pid`` announced in ``ack`` (all it published and
+        logged since it started) has arrived: what the judge heard since then (``base``: what
+        it had heard when the subject started), on the topics it watched then and on /rosout.
+        What it announced beyond :data:`~ros2nb.judge.floods.FLOOD_LIMIT` in a second of
+        the judge's clock is a flood, raised before any wait."""
         topics0, logs0 = base
         observer = self._observer
         failure = ack.get('failure')
@@ -164,6 +167,13 @@ class JudgeClock:
                 'type': failure['kind'], 'message': message, 'where': failure['where'],
                 'explanation': failure['error'] if explained else None,
                 'traceback': failure['traceback']})
+
+        for logger, total in ack.get('logged', {}).items():
+            observer.floods.announced(pid, '/rosout', logger, total)
+        for topic, total in ack.get('published', {}).items():
+            if topic in topics0:
+                observer.floods.announced(pid, topic, topic, total)
+        observer.floods.raise_any()
 
         def missing() -> list[str]:
             topics, logs = observer.counts()
