@@ -113,6 +113,8 @@ def responsive_worker():
 HONEST = [
     Learner('03 keyword arguments, a lambda timer, helpers', '03',
             {'sensor-constructor': SENSOR_KEYWORDS, 'sensor-callback': SENSOR_HELPERS}),
+    Learner('03 a timer of 1 (an int)', '03', {'sensor-constructor': [(
+        'self.create_timer(PUBLISH_PERIOD_S,', 'self.create_timer(1,')]}),
     Learner('03 spin_once loop, cleanup in a helper called from finally', '03',
             {'sensor-main': MAIN_SPIN_ONCE}),
     Learner('03 an executor in main', '03', {'sensor-main': MAIN_EXECUTOR}),

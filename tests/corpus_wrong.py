@@ -10,6 +10,11 @@ WRONG = [
         '        self.timer = self.create_timer(',
         '        if False:\n            self.timer = self.create_timer(')]},
         loses=('sensor-constructor',)),
+    # A timer a little off the period: on a clock stepped once a period, 0.99 s fired as 1.0 s
+    # does (6 of 6) and 1.02 s kept the constructor's points; each loses what a 2-s timer loses.
+    *(Learner(f'03 a timer of {period} s', '03', {'sensor-constructor': [(
+        'self.create_timer(PUBLISH_PERIOD_S,', f'self.create_timer({period},')]},
+        loses=('sensor-constructor',)) for period in ('0.99', '1.02', '2.0')),
     Learner('03 a step of up to one degree', '03', {'sensor-callback': [(
         'random.uniform(-MAX_STEP_C, MAX_STEP_C)',
         'random.uniform(-2 * MAX_STEP_C, 2 * MAX_STEP_C)')]},

@@ -105,6 +105,13 @@ SENSOR_MISTAKES = [
     ('period', 'PUBLISH_PERIOD_S = 1.0 ', 'PUBLISH_PERIOD_S = 2.0 ',
      checks.check_sensor_constructor, r'Readings came 2 s apart on the grader.s clock; the sensor '
                                       r'publishes every 1.0 s: give the timer PUBLISH_PERIOD_S'),
+    ('period a little short', 'PUBLISH_PERIOD_S = 1.0 ', 'PUBLISH_PERIOD_S = 0.99 ',
+     checks.check_sensor_constructor, r'A reading came 0.999 s after the sensor started on the '
+                                      r'grader.s clock, off its whole periods of 1.0 s: use '
+                                      r'PUBLISH_PERIOD_S'),
+    ('period a little long', 'PUBLISH_PERIOD_S = 1.0 ', 'PUBLISH_PERIOD_S = 1.02 ',
+     checks.check_sensor_constructor, r'A reading came 1.999 s after the sensor started on the '
+                                      r'grader.s clock, off its whole periods of 1.0 s'),
     ('start value', 'self.temperature = START_TEMPERATURE_C', 'self.temperature = 0.0',
      checks.check_sensor_constructor, r'The first reading is 18.00 °C: the walk '
                                       r'starts at START_TEMPERATURE_C = 22.0 °C \(set '

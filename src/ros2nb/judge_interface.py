@@ -68,6 +68,12 @@ class Judge(Protocol):
     def taken_back(self, folder: Path) -> ContextManager[Path]: ...
 
 
+class Flooded(CheckFailed):
+    """The learner's code sent more to /rosout or a topic the judge hears than any node of
+    the course would (:data:`ros2nb.judge.floods.FLOOD_LIMIT`): the judge ended its processes
+    and kept no more of it.  A check may grade the other parts with a stand-in."""
+
+
 def learner_error(what: str, error: dict, *, context: str = '') -> CheckFailed:
     """The CheckFailed for an exception the learner's code raised in a subject.
 

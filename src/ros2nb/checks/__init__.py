@@ -72,6 +72,19 @@ def run_check(name: str, judge: Optional[Judge], *args: Any, **kwargs: Any) -> N
         getattr(sys.modules[__name__], name)  # loads its lesson's module, which registers it
     if name not in CHECKS:
         raise ValueError(f'no check is named {name!r}')
-    passed(CHECKS[name](judge, *args, **kwargs))
+    observer = getattr(judge, 'observer', None) if judge is not None else None
+    if observer is None:
+        passed(CHECKS[name](judge, *args, **kwargs))
+        return
+    # A flood of the learner's code fails the check it happened in, whatever the check made
+    # of what was left (the judge ended the flooding processes): its line says what happened.
+    observer.floods.forget()
+    try:
+        message = CHECKS[name](judge, *args, **kwargs)
+    except BaseException:
+        observer.floods.raise_any()
+        raise
+    observer.floods.raise_any()
+    passed(message)
 
 __all__ = ['CheckFailed', *sorted(_MODULE_OF)]

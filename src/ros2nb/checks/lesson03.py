@@ -20,7 +20,7 @@ from std_msgs.msg import Float32
 
 from .. import course
 from ..errors import CheckFailed
-from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
+from ..judge_interface import ARRIVAL_TIMEOUT_S, Flooded, Judge, learner_error
 from .base import direct, judged
 from .drawn import clamp_probes_c, sensor_seed
 from .mains import run_main
@@ -35,9 +35,9 @@ LOGGED_READING_TOLERANCE_C = 0.011
 #: Simulated seconds the judge runs the sensor: for the constructor, the callback, each clamp
 #: probe, and the hidden hour.
 CONSTRUCTOR_RUN_S, CALLBACK_RUN_S, CLAMP_RUN_S, HOUR_S = 6, 20, 40, 3600
-#: Steps of the judge's clock (s): four to a period, so a timer of another period shows; the
-#: hour in steps of one period.
-FINE_STEP_S, HOUR_STEP_S = 0.25, 1.0
+#: Steps of the judge's clock (s), and the probe before each while a constructor runs: a timer
+#: of another period fires on the probe, off the whole periods (JudgeClock.drive's probe_s).
+STEP_S, PROBE_S = course.PUBLISH_PERIOD_S, 0.001
 TOPIC = '/' + course.TOPIC
 
 
@@ -78,15 +78,14 @@ def _make_sensor(judge: Judge, stand_ins: tuple[str, ...], seed: int) -> SensorR
     return SensorRun(subject, info, found, lines_logged(judge, info, mark, info['started_lines']))
 
 
-def _run(judge: Judge, sensor: SensorRun, seconds: float, *, step_s: float, seed: int,
+def _run(judge: Judge, sensor: SensorRun, seconds: float, *, probe_s: float, seed: int,
          start_c: Optional[float] = None) -> SensorRun:
-    """Run ``sensor`` ``seconds`` of the judge's clock (the walk from ``start_c`` if given);
-    return what the judge heard meanwhile, as a run of its own."""
+    """Run ``sensor`` ``seconds`` of the judge's clock (the walk from ``start_c`` if given,
+    ``probe_s``: :data:`PROBE_S` or 0); return what the judge heard, as a run of its own."""
     observer, subject = judge.observer, sensor.subject
     readings = observer.watch(TOPIC, Float32, lambda m: float(m.data))
     run = SensorRun(subject, sensor.info, sensor.found, sensor.started_lines)
-    if (course.MESSAGE_TYPE, 'publisher') not in {(t, k) for k, topic, t in run.found
-                                                  if topic == TOPIC}:
+    if ('publisher', TOPIC, course.MESSAGE_TYPE) not in run.found:
         return run  # nothing the judge could hear: the constructor's verdict says why
     if start_c is not None:
         subject.request('set_attribute', name='temperature', value=start_c)
@@ -95,8 +94,8 @@ def _run(judge: Judge, sensor: SensorRun, seconds: float, *, step_s: float, seed
                           '(is the machine very busy?): run this check again.')
     first, log_mark, began = len(readings), len(observer.logs), judge.clock.now_ns
     try:
-        reply = judge.clock.drive(subject, 'run', seconds=seconds, seed=seed, step_s=step_s,
-                                  limit_s=seconds + step_s, what=course.SENSOR_CLASS)
+        reply = judge.clock.drive(subject, 'run', seconds=seconds, seed=seed, step_s=STEP_S,
+                                  probe_s=probe_s, limit_s=seconds + 1, what=course.SENSOR_CLASS)
         if reply.get('failure'):
             raise learner_error(reply['failure']['callback'], reply['failure'])
     except CheckFailed as problem:
@@ -106,10 +105,10 @@ def _run(judge: Judge, sensor: SensorRun, seconds: float, *, step_s: float, seed
     return run
 
 
-def _sensor_run(judge: Judge, stand_ins: tuple[str, ...], seconds: float, *, step_s: float,
+def _sensor_run(judge: Judge, stand_ins: tuple[str, ...], seconds: float, *, probe_s: float,
                 seed: int) -> SensorRun:
     """A new sensor of the learner's (with ``stand_ins``), run ``seconds``."""
-    return _run(judge, _make_sensor(judge, stand_ins, seed), seconds, step_s=step_s, seed=seed)
+    return _run(judge, _make_sensor(judge, stand_ins, seed), seconds, probe_s=probe_s, seed=seed)
 
 
 # ------------------------------------------------------------------ what each part must do
@@ -120,10 +119,8 @@ def _constructor_problem(judge: Judge, run: SensorRun, seconds: float) -> Option
         endpoint_verdict(run.info['name'], run.found, 'publisher', TOPIC, course.MESSAGE_TYPE)
     except CheckFailed as problem:
         return problem
-    if run.problem is not None:
-        return run.problem
-    if not run.readings:
-        return CheckFailed(_no_readings(judge))
+    if run.problem is not None or not run.readings:
+        return run.problem or CheckFailed(_no_readings(judge))
     problem = _period_problem(run.readings, seconds)
     if problem is not None:
         return problem
@@ -142,8 +139,7 @@ def _constructor_problem(judge: Judge, run: SensorRun, seconds: float) -> Option
 def _no_readings(judge: Judge) -> str:
     """Why no reading arrived, in the words the learner's file suggests (read after the fact)."""
     source = ClassSource.read(judge.workspace, course.PUBLISHER_FILE, course.SENSOR_CLASS)
-    timers = source.timers() if source is not None else []
-    if source is not None and not timers:
+    if source is not None and not source.timers():
         return (f'No reading arrived on {TOPIC} in {CONSTRUCTOR_RUN_S} s: {course.SENSOR_CLASS} '
                 'has no timer; create one in __init__ that calls self.publish_temperature '
                 f'every PUBLISH_PERIOD_S = {course.PUBLISH_PERIOD_S} s.')
@@ -170,7 +166,11 @@ def _period_problem(readings: list[tuple[float, float]], seconds: float) -> Opti
     if odd is not None:
         return CheckFailed(f'Readings came {odd:g} s apart on the grader\'s clock; the sensor '
                            f'publishes every {period} s: give the timer PUBLISH_PERIOD_S.')
-    if times and times[0] > 2 * period + 1e-6:  # a step's delivery may stamp it one step late
+    off = next((t for t in times if abs(t - round(t / period) * period) > 1e-6), None)
+    if off is not None:
+        return CheckFailed(f'A reading came {off:g} s after the sensor started on the grader\'s '
+                           f'clock, off its whole periods of {period} s: use PUBLISH_PERIOD_S.')
+    if times and times[0] > period + 1e-6:
         return CheckFailed(f'The first reading came after {times[0]:g} s; the timer fires every '
                            f'{period} s: give the timer PUBLISH_PERIOD_S.')
     if abs(len(readings) - seconds / period) > 1:
@@ -255,7 +255,7 @@ def _attempt(judge: Judge, stand_ins: tuple[str, ...]) -> tuple[Optional[SensorR
                                                                  Optional[CheckFailed]]:
     """A constructor run with ``stand_ins``, and what part 3 got wrong in it (None: nothing)."""
     try:
-        run = _sensor_run(judge, stand_ins, CONSTRUCTOR_RUN_S, step_s=FINE_STEP_S,
+        run = _sensor_run(judge, stand_ins, CONSTRUCTOR_RUN_S, probe_s=PROBE_S,
                           seed=sensor_seed(judge, '03 sensor constructor'))
     except CheckFailed as problem:
         return None, problem
@@ -266,7 +266,7 @@ def _sensor_constructor(judge: Judge) -> str:
     """Part 3 alone: the learner's __init__, with the course's callback (their own when the
     course's cannot work with their constructor)."""
     run, problem = _attempt(judge, ('sensor_callback',))
-    if problem is not None:
+    if problem is not None and not isinstance(problem, Flooded):  # theirs would flood too
         own, own_problem = _attempt(judge, ())
         if own_problem is None:
             run, problem = own, None
@@ -297,19 +297,22 @@ def check_sensor_constructor(judge: Judge) -> str:
 
 
 # ------------------------------------------------------------------ part 4: the callback
-def _callback_run(judge: Judge, seconds: float, step_s: float, seed: int) -> SensorRun:
+def _callback_run(judge: Judge, seconds: float, seed: int) -> SensorRun:
     """The learner's callback running ``seconds``: in their own sensor, or, when its
     constructor is at fault, in the course's (a mistake in part 3 costs part 3 only)."""
     whole = seconds <= CALLBACK_RUN_S  # else a short probe decides whose constructor runs
-    probe_s = seconds if whole else CONSTRUCTOR_RUN_S
-    run = _sensor_run(judge, (), probe_s, step_s=FINE_STEP_S, seed=seed)
+    trial_s = seconds if whole else CONSTRUCTOR_RUN_S
     stand_ins: tuple[str, ...] = ()
-    if _constructor_problem(judge, run, probe_s) is not None:
+    try:
+        run: Optional[SensorRun] = _sensor_run(judge, (), trial_s, probe_s=PROBE_S, seed=seed)
+    except Flooded:  # its constructor floods: part 3's fault, which the course's stands in for
+        run = None
+    if run is None or _constructor_problem(judge, run, trial_s) is not None:
         stand_ins = ('sensor_init',)
-        run = _sensor_run(judge, stand_ins, probe_s, step_s=FINE_STEP_S, seed=seed)
+        run = _sensor_run(judge, stand_ins, trial_s, probe_s=PROBE_S, seed=seed)
     if whole:
         return run
-    return _sensor_run(judge, stand_ins, seconds, step_s=step_s, seed=seed)
+    return _sensor_run(judge, stand_ins, seconds, probe_s=0.0, seed=seed)
 
 
 def _callback_problem(run: SensorRun, seconds: float) -> None:
@@ -327,12 +330,11 @@ def _callback_problem(run: SensorRun, seconds: float) -> None:
 
 
 def _sensor_callback(judge: Judge) -> str:
-    run = _callback_run(judge, CALLBACK_RUN_S, FINE_STEP_S,
-                        sensor_seed(judge, '03 sensor callback'))
+    run = _callback_run(judge, CALLBACK_RUN_S, sensor_seed(judge, '03 sensor callback'))
     _callback_problem(run, CALLBACK_RUN_S)
     for number, start_c in enumerate(clamp_probes_c(judge)):
         seed = sensor_seed(judge, f'03 clamp probe {number}', start_c, CLAMP_RUN_S)
-        probe = _run(judge, run, CLAMP_RUN_S, step_s=HOUR_STEP_S, seed=seed, start_c=start_c)
+        probe = _run(judge, run, CLAMP_RUN_S, probe_s=0.0, seed=seed, start_c=start_c)
         if probe.problem is not None:
             raise probe.problem
         _samples_verdict(probe.values, seconds=CLAMP_RUN_S, start_c=start_c)
@@ -360,7 +362,7 @@ def check_sensor_callback(judge: Judge) -> str:
 
 
 def _sensor_hour(judge: Judge) -> str:
-    run = _callback_run(judge, HOUR_S, HOUR_STEP_S,
+    run = _callback_run(judge, HOUR_S,
                         sensor_seed(judge, '03 sensor hour', course.START_TEMPERATURE_C, HOUR_S))
     if run.problem is not None:
         raise run.problem

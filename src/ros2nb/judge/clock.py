@@ -32,6 +32,9 @@ POLL_S = 0.05
 #: (:class:`~ros2nb.processes.Patience`: every process's stat, milliseconds on a busy
 #: machine, where a step often takes longer than POLL_S).
 PATIENCE_LOOK_S = 0.25
+#: Where the judge's clock starts (ns): rcl takes a ROS time of 0 for a clock not yet set,
+#: and a timer a node starts then first fires one step late (docs/decisions.md).
+START_NS = 1_000_000_000
 
 
 class JudgeClock:
@@ -44,6 +47,8 @@ class JudgeClock:
         self._observer = observer
         self._publisher = observer.node.create_publisher(Clock, '/clock', JUDGE_CLOCK_QOS,
                                                          event_callbacks=QUIET_PUBLISHER)
+        with observer.changed:
+            observer.now_ns = max(observer.now_ns, START_NS)
         self._publish()
 
     @property
@@ -73,11 +78,16 @@ class JudgeClock:
         self._publish()
 
     def drive(self, subject: SubjectProcess, op: str, *, step_s: float, limit_s: float,
-              timeout: float = REPLY_TIMEOUT_S, what: str = 'your code',
+              probe_s: float = 0.0, timeout: float = REPLY_TIMEOUT_S, what: str = 'your code',
               **arguments: Any) -> dict:
         """Send ``op`` to ``subject`` and move the clock on, a step of ``step_s`` at a time,
         for as long as the subject's spin wants it (at most ``limit_s`` simulated seconds);
         return the subject's reply once it comes.
+
+        With ``probe_s``, the clock also stops ``probe_s`` before each whole step: a timer
+        of period ``step_s`` started now fires on the whole steps, and one whose period is
+        shorter or longer by more than ``probe_s`` over the run fires on a probe (its
+        messages are stamped off the whole steps), two steps per period instead of one.
 
         Before each step the judge waits until every message the subject says it published
         on a topic the judge watches, and every line it says it logged, has arrived.
@@ -88,15 +98,17 @@ class JudgeClock:
         :raises SubjectHung: when the subject neither answers nor finishes a step in time.
         """
         try:
-            return self._drive(subject, op, step_s, limit_s, timeout, what, arguments)
+            return self._drive(subject, op, (step_s, probe_s), limit_s, timeout, what,
+                               arguments)
         except BaseException:
             # The subject is left in the middle of its command: it serves no other.
             kill_process_group(subject.proc)
             raise
 
-    def _drive(self, subject: SubjectProcess, op: str, step_s: float, limit_s: float,
-               timeout: float, what: str, arguments: dict) -> dict:
-        step_ns, limit_ns = round(step_s * 1e9), self.now_ns + round(limit_s * 1e9)
+    def _drive(self, subject: SubjectProcess, op: str, steps: tuple[float, float],
+               limit_s: float, timeout: float, what: str, arguments: dict) -> dict:
+        step_ns, probe_ns = round(steps[0] * 1e9), round(steps[1] * 1e9)
+        limit_ns, whole_ns = self.now_ns + round(limit_s * 1e9), self.now_ns + step_ns
         subject.send(op, **arguments)
         # Patience reads /proc: it starts only once the subject has been quiet for
         # PATIENCE_LOOK_S (an hour of steps would otherwise read it 7200 times), and looks
@@ -104,11 +116,12 @@ class JudgeClock:
         patience: Optional[Patience] = None
         quiet_since = looked = time.monotonic()
         while True:
+            self._observer.floods.raise_any()  # its processes were ended: none will answer
             reply = subject.poll_reply(POLL_S)
             ack = subject.take_ack()
             if ack is not None:
                 patience, quiet_since = None, time.monotonic()
-                self._settle(ack, subject.heard_base)
+                self._settle(ack, subject.heard_base, subject.proc.pid)
                 if ack.get('wants') is None:  # its spin ended, and all it told of arrived:
                     self._publish()  # the same time again lets it go on (destroy its nodes)
             if reply is not None:
@@ -117,12 +130,16 @@ class JudgeClock:
             wants = latest.get('wants') if latest else None
             if latest is not None and latest['t'] >= self.now_ns and wants is not None \
                     and wants > self.now_ns:
-                if self.now_ns + step_ns > limit_ns:
+                if whole_ns > limit_ns:
                     kill_process_group(subject.proc)
                     raise CheckFailed(f'{what} kept the nodes spinning past {limit_s:g} '
                                       'simulated seconds of the grader\'s clock: spin only as '
                                       'long as the task says.')
-                self.step_to(self.now_ns + step_ns)
+                if 0 < probe_ns < step_ns and self.now_ns < whole_ns - probe_ns:
+                    self.step_to(whole_ns - probe_ns)
+                else:
+                    self.step_to(whole_ns)
+                    whole_ns += step_ns
                 patience, quiet_since = None, time.monotonic()
             elif time.monotonic() - max(quiet_since, looked) < PATIENCE_LOOK_S:
                 continue
@@ -134,10 +151,12 @@ class JudgeClock:
             else:
                 looked = time.monotonic()
 
-    def _settle(self, ack: dict, base: tuple[dict[str, int], dict[str, int]]) -> None:
-        """Wait until what the subject announced in ``ack`` (all it published and logged
-        since it started) has arrived: what the judge heard since then (``base``: what it
-        had heard when the subject started), on the topics it watched then and on /rosout."""
+    def _settle(self, ack: dict, base: tuple[dict[str, int], dict[str, int]], pid: int) -> None:
+        """Wait until what the subject ``pid`` announced in ``ack`` (all it published and
+        logged since it started) has arrived: what the judge heard since then (``base``: what
+        it had heard when the subject started), on the topics it watched then and on /rosout.
+        What it announced beyond :data:`~ros2nb.judge.floods.FLOOD_LIMIT` in a second of
+        the judge's clock is a flood, raised before any wait."""
         topics0, logs0 = base
         observer = self._observer
         failure = ack.get('failure')
@@ -148,6 +167,13 @@ class JudgeClock:
                 'type': failure['kind'], 'message': message, 'where': failure['where'],
                 'explanation': failure['error'] if explained else None,
                 'traceback': failure['traceback']})
+
+        for logger, total in ack.get('logged', {}).items():
+            observer.floods.announced(pid, '/rosout', logger, total)
+        for topic, total in ack.get('published', {}).items():
+            if topic in topics0:
+                observer.floods.announced(pid, topic, topic, total)
+        observer.floods.raise_any()
 
         def missing() -> list[str]:
             topics, logs = observer.counts()

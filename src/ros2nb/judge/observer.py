@@ -29,6 +29,7 @@ from ..errors import CheckFailed
 from ..processes import Patience, wait_for_work
 from ..runtime import QUIET_SUBSCRIPTION, node_serving_nothing
 from ..runtime.services import call_until_answered
+from .floods import Floods
 
 
 #: Longest wait of the judge's spin thread for work (s); None: until work comes, or
@@ -45,8 +46,6 @@ EVERY_MESSAGE = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=Reliabili
 #: shortly before the judge matched them (rcl keeps each node's last lines).
 ROSOUT_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE,
                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
-
-
 class _GivenUp(Exception):
     """The processes a wait attended to had their patience (:meth:`Observer.spins`)."""
 
@@ -99,6 +98,8 @@ class Observer:
         self.log_counts: collections.Counter[str] = collections.Counter()
         #: Messages heard per watched topic, in order of arrival.
         self.heard: dict[str, list[Heard]] = {}
+        #: What the learner's code sends beyond any node of the course, and its one line.
+        self.floods = Floods(self)
         self._quiet: Any = None
         self._stop = False
         #: The processes whose work the judge waits for (its subjects and the learner's
@@ -122,6 +123,8 @@ class Observer:
 
     def _on_log(self, msg: Log) -> None:
         with self.changed:
+            if self.floods.count('/rosout', msg.name):
+                return
             self.logs.append(Line(self.now_ns, msg.name, msg.level, msg.msg))
             self.log_counts[msg.name] += 1
             self.changed.notify_all()
@@ -138,6 +141,8 @@ class Observer:
 
             def note(msg: Any) -> None:
                 with self.changed:
+                    if self.floods.count(topic, topic):
+                        return
                     store.append(Heard(self.now_ns, keep(msg)))
                     self.changed.notify_all()
 
@@ -160,8 +165,14 @@ class Observer:
     def wait_until(self, condition: Callable[[], bool], seconds: float) -> bool:
         """Wait until ``condition()`` holds (looked at whenever something arrives), while the
         processes the judge attends to work towards it: False once they had ``seconds``
-        (:func:`~ros2nb.processes.wait_for_work`: of their work, or of their idle waiting)."""
-        return wait_for_work(condition, self.attending(), seconds, look=self._wait_briefly)
+        (:func:`~ros2nb.processes.wait_for_work`: of their work, or of their idle waiting).
+
+        :raises Flooded: when a flood was found (:class:`~ros2nb.judge.floods.Floods`), at once.
+        """
+        met = wait_for_work(lambda: self.floods.line is not None or condition(),
+                            self.attending(), seconds, look=self._wait_briefly)
+        self.floods.raise_any()
+        return met
 
     def _wait_briefly(self, condition: Callable[[], bool], seconds: float) -> bool:
         """Wait until ``condition()`` holds, at most ``seconds`` on the wall clock."""
@@ -265,6 +276,7 @@ class Observer:
         patience = Patience(self.attending(), seconds)
 
         def given_up() -> None:
+            self.floods.raise_any()
             if patience.exhausted():
                 raise _GivenUp
 

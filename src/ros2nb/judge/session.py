@@ -76,6 +76,7 @@ class Session:
         if self._observer is None:
             self._observer = Observer()
             self._observer.attending = self.working_pids
+            self._observer.floods.on_flood = self._end_flood
             # The course's topics are heard from the start, before any subject: what a
             # subject announces it published there is waited for before each step of the
             # clock (JudgeClock.drive), so every message is stamped with the step it came in.
@@ -125,6 +126,13 @@ class Session:
         self._programs = [proc for proc in self._programs if proc.poll() is None]
         return [proc.pid for proc in (*(s.proc for s in self._subjects.values()),
                                       *self._programs) if proc.poll() is None]
+
+    def _end_flood(self) -> None:
+        """End every process that runs the learner's code now (one of them floods), before
+        the flood is raised (:meth:`ros2nb.judge.floods.Floods.raise_any`); what runs next
+        starts its subjects afresh."""
+        for proc in (*(s.proc for s in self._subjects.values()), *self._programs):
+            kill_process_group(proc)
 
     def drop(self, key: tuple) -> None:
         subject = self._subjects.pop(key, None)

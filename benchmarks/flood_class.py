@@ -1,0 +1,149 @@
+#!/usr/bin/env python3
+"""What a flooder costs a class: two complete learners graded alone, then beside a learner
+whose sensor floods /rosout.
+
+``python benchmarks/flood_class.py [--reps N] [--topic]`` grades, with ``ros2nb-grade`` in
+its sandboxes, a class of two learners who handed in every notebook complete, and the same
+class with a third who handed in only notebook 03, written as the solution but with a
+constructor that starts a thread logging as fast as it can (``--topic``: publishing on
+/temperature as fast as it can; ``tests/test_floods.py`` has both).  The two classes are
+graded in turn, ``--reps`` times (default 1).  It prints, per grading, the wall seconds and
+the CPU seconds of ``ros2nb-grade`` and every process it started (read from ``/proc`` every
+50 ms, by parent: other work on the machine is left out), the flooder's score of 03 and the
+line of its failed part; then the ratio of the class with the flooder to the two alone (the
+issue's target: at most 1.5).  Needs what grading needs (root and bubblewrap); Linux only.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+sys.path.insert(0, str(HERE))
+sys.path.insert(0, str(ROOT / 'tests'))
+from sampling import Sampling  # noqa: E402
+
+GRADE = str(Path(sys.executable).with_name('ros2nb-grade'))
+TICKS_PER_S = os.sysconf('SC_CLK_TCK')
+STARTED = "        self.get_logger().info('Temperature Sensor Node Started')\n"
+FLOOD = STARTED + '''\
+        import threading
+
+        def chatter():
+            while True:
+                {work}
+
+        threading.Thread(target=chatter, daemon=True).start()
+'''
+WORK = {'rosout': "self.get_logger().info('still here')",
+        'topic': 'self.publisher_.publish(Float32(data=self.temperature))'}
+
+
+class TreeCpu(Sampling):
+    """CPU seconds of a process and of every process started under it (found by parent,
+    every 50 ms: one that lives less is missed)."""
+
+    def __init__(self, root: int) -> None:
+        super().__init__(0.05)
+        self._ours: set[int] = {root}
+        self.seen: dict[tuple[int, str], float] = {}
+
+    def sample(self) -> None:
+        stats = {}
+        for entry in os.listdir('/proc'):
+            if entry.isdigit():
+                try:
+                    stats[int(entry)] = Path(f'/proc/{entry}/stat').read_text().rsplit(
+                        ')', 1)[1].split()
+                except OSError:  # ended meanwhile
+                    continue
+        grew = True
+        while grew:  # a child seen before its parent was known is found on the next pass
+            grew = False
+            for pid, stat in stats.items():
+                if pid not in self._ours and int(stat[1]) in self._ours:
+                    self._ours.add(pid)
+                    grew = True
+        for pid in self._ours & stats.keys():
+            stat = stats[pid]
+            self.seen[(pid, stat[19])] = (int(stat[11]) + int(stat[12])) / TICKS_PER_S
+
+
+def flooder_notebook(kind: str) -> dict:
+    """Notebook 03 as the solution, its constructor starting a flood of ``kind``."""
+    from corpora import Learner, submission
+    return submission(Learner('flooder', '03', {'sensor-constructor': [
+        (STARTED, FLOOD.format(work=WORK[kind]))]}))
+
+
+def grade(folder: Path, out: Path) -> tuple[float, float]:
+    """Grade ``folder``'s learners: wall seconds and CPU seconds of the grading's processes."""
+    started = time.monotonic()
+    proc = subprocess.Popen([GRADE, str(folder), '--out', str(out)], stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True)
+    with TreeCpu(proc.pid) as cpu:
+        output, _ = proc.communicate()
+    if proc.returncode != 0:
+        sys.exit(f'ros2nb-grade exited {proc.returncode}: {output[-800:]}')
+    return time.monotonic() - started, sum(cpu.seen.values())
+
+
+def flooder_result(out: Path) -> str:
+    """The flooder's score of 03 and the lines of its failed checks, from its feedback page."""
+    import html
+    import re
+    found = [row for row in (out / 'grades.csv').read_text().splitlines()
+             if row.startswith('flooder,03')]
+    for page in (out / 'feedback' / 'flooder').rglob('03*.html'):
+        text = html.unescape(re.sub(r'<[^>]+>', ' ', page.read_text()))
+        found += sorted({m.strip() for m in re.findall(
+            r'(?:CheckFailed|LearnerCodeError|Your node|Your code)[^\n]{0,300}', text)})
+    return '\n'.join(found)
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
+    parser.add_argument('--reps', type=int, default=1)
+    parser.add_argument('--topic', action='store_true', help='flood /temperature instead')
+    options = parser.parse_args()
+    kind = 'topic' if options.topic else 'rosout'
+    solutions = sorted((ROOT / 'solutions').glob('*.ipynb'))
+    measured: dict[str, list[tuple[float, float]]] = {'two alone': [], 'with flooder': []}
+    with tempfile.TemporaryDirectory(prefix='ros2nb-flood-') as tmp:
+        for rep in range(options.reps):
+            for label in measured:
+                root = Path(tmp) / f'{rep}-{label.replace(" ", "-")}'
+                for name in ('learner1', 'learner2'):
+                    (root / 'class' / name).mkdir(parents=True)
+                    for notebook in solutions:
+                        shutil.copy2(notebook, root / 'class' / name / notebook.name)
+                if label == 'with flooder':
+                    (root / 'class' / 'flooder').mkdir()
+                    target = root / 'class' / 'flooder' / next(
+                        n.name for n in solutions if n.name.startswith('03'))
+                    target.write_text(json.dumps(flooder_notebook(kind)))
+                wall, cpu = grade(root / 'class', root / 'grading')
+                measured[label].append((wall, cpu))
+                print(f'| {rep + 1} | {label} | {wall:.0f} | {cpu:.0f} |', flush=True)
+                if label == 'with flooder':
+                    print(flooder_result(root / 'grading'), flush=True)
+    alone = statistics.median(c for _w, c in measured['two alone'])
+    flooded = statistics.median(c for _w, c in measured['with flooder'])
+    walls = [statistics.median(w for w, _c in measured[k]) for k in measured]
+    print(f'CPU-s ratio with the flooder / two alone: {flooded / alone:.2f} '
+          f'(wall {walls[1] / walls[0]:.2f})')
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

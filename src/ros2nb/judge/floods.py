@@ -1,0 +1,109 @@
+"""What the learner's code sends beyond any node of the course: a flood, counted on the
+judge's clock and ended at once.
+
+Part of the judge (:mod:`ros2nb.judge`).  A loop that logs or publishes without waiting (a
+thread started in a constructor, a ``while True`` in a callback) sends more than the judge
+can read: it waited for all of it, and a class waited with it.  The judge's observer counts
+what it hears per logger on ``/rosout`` and per topic it watches, and the subject's word of
+what it sent (:meth:`Floods.announced`), in windows of one second of the judge's clock (or
+while it stands still); past :data:`FLOOD_LIMIT` the judge keeps no more of it, ends the
+processes that run the learner's code and fails the check with one line
+(:class:`~ros2nb.judge_interface.Flooded`).  Introduced in ``03-write-the-publisher.ipynb``.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any, Callable, Optional
+
+from ..judge_interface import Flooded
+
+#: Lines one logger may send to /rosout, and messages a watched topic may carry, within one
+#: second of the judge's clock (or while it stands still): the course's nodes send one a
+#: reading or a tick, notebook 10's replay sixty in a step, notebook 04's checks feed thirty
+#: readings while the clock stands still.
+FLOOD_LIMIT = 500
+FLOOD_WINDOW_NS = 1_000_000_000
+#: Wall-clock seconds without a message of a flood that end its draining, and the longest
+#: drain: its processes are ended by then, and what they sent is only on its way.
+FLOOD_QUIET_S, FLOOD_DRAIN_S = 0.2, 10.0
+
+
+class Floods:
+    """The flood counts of one judge's observer (``observer.now_ns``, ``observer.changed``).
+
+    :ivar line: the first flood's one line since :meth:`forget`, or None.
+    :ivar on_flood: ends the processes that may be flooding (the session's subjects and
+        programs); called by :meth:`raise_any`, never in the observer's spin thread.
+    """
+
+    def __init__(self, observer: Any) -> None:
+        self._observer = observer
+        self.line: Optional[str] = None
+        self.on_flood: Callable[[], None] = lambda: None
+        self._windows: dict[tuple[str, str, str], list[int]] = {}
+        self._said: dict[tuple[int, str, str], int] = {}
+
+    def count(self, where: str, who: str, count: int = 1, source: str = 'heard') -> bool:
+        """Count ``count`` messages of ``who`` on ``where`` (``source``: heard by the judge,
+        or ``said`` by a subject) in their window of the judge's clock; True (keep them not)
+        once the window holds more than :data:`FLOOD_LIMIT`.  The caller holds
+        ``observer.changed``."""
+        now = self._observer.now_ns
+        window = self._windows.setdefault((source, where, who), [now, 0])
+        if now - window[0] >= FLOOD_WINDOW_NS:
+            window[:] = [now, 0]
+        window[1] += count
+        if window[1] <= FLOOD_LIMIT:
+            return False
+        if self.line is None:
+            self.line = flood_line(where, who, now - window[0])
+            self._observer.changed.notify_all()
+        return True
+
+    def announced(self, subject: int, where: str, who: str, total: int) -> None:
+        """A subject's word (``subject``: its process id) that ``who`` sent ``total``
+        messages on ``where`` since it started: what it added since its last word counts
+        towards a flood.  Its word may only fail it: the judge waits for no more than it hears."""
+        with self._observer.changed:
+            last = self._said.get((subject, where, who))
+            self._said[(subject, where, who)] = total
+            if last is not None and total > last:
+                self.count(where, who, total - last, 'said')
+
+    def forget(self) -> None:
+        """Count afresh (a new check, or a flood raised): no flood, every window empty."""
+        with self._observer.changed:
+            self.line = None
+            self._windows.clear()
+
+    def raise_any(self) -> None:
+        """Raise :class:`~ros2nb.judge_interface.Flooded` with the flood's line when there
+        was one, once the processes that may flood are ended (:attr:`on_flood`) and what they
+        sent stopped arriving (a flooded window counts on, unkept); then count afresh."""
+        line = self.line
+        if line is None:
+            return
+        self.on_flood()
+        deadline = time.monotonic() + FLOOD_DRAIN_S
+        while time.monotonic() < deadline:
+            before = sum(window[1] for window in self._windows.values())
+            time.sleep(FLOOD_QUIET_S)
+            if sum(window[1] for window in self._windows.values()) == before:
+                break
+        self.forget()
+        raise Flooded(line)
+
+
+def flood_line(where: str, who: str, span_ns: int) -> str:
+    """The one line of a flood of ``who`` on ``where`` (``/rosout``: ``who`` is the logger),
+    counted over ``span_ns`` of the judge's clock."""
+    when = (f'in {span_ns / 1e9:g} s of the grader\'s clock' if span_ns else
+            'while the grader\'s clock stood still')
+    if where == '/rosout':
+        return (f'Your node {who} logged over {FLOOD_LIMIT:,} lines to /rosout {when} (a node '
+                'of the course logs one line per reading or tick): look for a loop that logs '
+                'without waiting for a timer.')
+    return (f'Your code published over {FLOOD_LIMIT:,} messages on {who} {when} (the sensor '
+            'publishes one a second): look for a loop that publishes without waiting for a '
+            'timer.')
