@@ -216,3 +216,33 @@ def test_a_learner_whose_task_fails_is_that_learners_note(tmp_path):
                   if r['notebook'] == 'TOTAL'}
     assert totals == {'sleeper': '0', 'honest': '2', 'empty': '0'}, done.stdout
     assert sorted(graded_lines(done.stdout)) == ['empty', 'honest', 'sleeper']
+
+
+@pytest.mark.judge
+@pytest.mark.kernel
+def test_a_class_outlives_its_only_worker(tmp_path):
+    """The one worker is killed while it holds every learner left (one in its sandbox, the
+    others queued on it): its nanny starts it again, the new worker is checked, the learners
+    no worker could take are submitted to it, and each is graded once, as if nothing happened."""
+    complete = SOLUTION[NB01].read_text()
+    slow = json.loads(complete)
+    slow['cells'].insert(1, {'cell_type': 'code', 'metadata': {}, 'outputs': [],
+                             'execution_count': None, 'source': 'import time\ntime.sleep(20)'})
+    # The slow learner has more notebooks, so the worker takes it first and holds the rest.
+    submissions = small_class(tmp_path / 'class', {
+        'slow': {NB00: SOLUTION[NB00].read_text(), NB01: json.dumps(slow)},
+        'honest': {NB01: complete}, 'empty': {NB01: ''}})
+    with local_cluster(tmp_path / 'cluster', workers=1) as cluster:
+        killed = {}
+        killer = threading.Thread(target=lambda: killed.update(
+            kill_when_grading(cluster.address, 'w0', learner='slow')), daemon=True)
+        killer.start()
+        done = grade(submissions, tmp_path / 'grading', cluster.address)
+        killer.join(timeout=1)
+    assert killed, done.stdout
+    assert done.returncode == 0, done.stdout + done.stderr
+    with open(tmp_path / 'grading' / 'grades.csv', newline='') as stream:
+        totals = {r['learner']: r['score'] for r in csv.DictReader(stream)
+                  if r['notebook'] == 'TOTAL'}
+    assert totals == {'slow': '2', 'honest': '1', 'empty': '0'}, done.stdout
+    assert sorted(graded_lines(done.stdout)) == ['empty', 'honest', 'slow']

@@ -86,8 +86,11 @@ class Cluster:
         if not new:
             return False
         before = len(self._accepted)
-        answers = self.client.run(accept, self.version, self.settings.sandboxed, workers=new,
-                                  on_error='return')
+        try:
+            answers = self.client.run(accept, self.version, self.settings.sandboxed,
+                                      workers=new, on_error='return')
+        except (OSError, ValueError, KeyError):  # one left meanwhile: look again next time
+            return False
         for worker in new:
             why = answers.get(worker, 'it left before it was checked')
             if isinstance(why, BaseException):
