@@ -25,8 +25,11 @@ from ..judge_interface import Flooded
 FLOOD_LIMIT = 500
 FLOOD_WINDOW_NS = 1_000_000_000
 #: Wall-clock seconds without a message of a flood that end its draining, and the longest
-#: drain: its processes are ended by then, and what they sent is only on its way.
-FLOOD_QUIET_S, FLOOD_DRAIN_S = 0.2, 10.0
+#: drain.  Its processes are ended by then, so what still arrives is their backlog, finite:
+#: the drain ends when it stops, however long the judge takes to read it (what a cut-off
+#: drain left would count as a flood of the next check); the cap only guards against a
+#: publisher the judge did not end.
+FLOOD_QUIET_S, FLOOD_DRAIN_S = 0.2, 300.0
 
 
 class Floods:
