@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import shutil
 import statistics
 import subprocess
@@ -31,10 +30,9 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(ROOT / 'tests'))
-from sampling import Sampling  # noqa: E402
+from sampling import TreeCpu  # noqa: E402
 
 GRADE = str(Path(sys.executable).with_name('ros2nb-grade'))
-TICKS_PER_S = os.sysconf('SC_CLK_TCK')
 STARTED = "        self.get_logger().info('Temperature Sensor Node Started')\n"
 FLOOD = STARTED + '''\
         import threading
@@ -47,36 +45,6 @@ FLOOD = STARTED + '''\
 '''
 WORK = {'rosout': "self.get_logger().info('still here')",
         'topic': 'self.publisher_.publish(Float32(data=self.temperature))'}
-
-
-class TreeCpu(Sampling):
-    """CPU seconds of a process and of every process started under it (found by parent,
-    every 50 ms: one that lives less is missed)."""
-
-    def __init__(self, root: int) -> None:
-        super().__init__(0.05)
-        self._ours: set[int] = {root}
-        self.seen: dict[tuple[int, str], float] = {}
-
-    def sample(self) -> None:
-        stats = {}
-        for entry in os.listdir('/proc'):
-            if entry.isdigit():
-                try:
-                    stats[int(entry)] = Path(f'/proc/{entry}/stat').read_text().rsplit(
-                        ')', 1)[1].split()
-                except OSError:  # ended meanwhile
-                    continue
-        grew = True
-        while grew:  # a child seen before its parent was known is found on the next pass
-            grew = False
-            for pid, stat in stats.items():
-                if pid not in self._ours and int(stat[1]) in self._ours:
-                    self._ours.add(pid)
-                    grew = True
-        for pid in self._ours & stats.keys():
-            stat = stats[pid]
-            self.seen[(pid, stat[19])] = (int(stat[11]) + int(stat[12])) / TICKS_PER_S
 
 
 def flooder_notebook(kind: str) -> dict:

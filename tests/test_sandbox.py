@@ -309,6 +309,34 @@ def test_wall_time_kills_the_program_even_when_it_outlives_bwrap():
     assert running.timed_out and code == -signal.SIGKILL
 
 
+#: Two processes that each keep a CPU busy for ever (a learner's thread that logs in a loop).
+BUSY = 'import os\nos.fork()\nwhile True: pass'
+
+
+def test_cpu_time_of_all_processes_together_kills_the_sandbox():
+    result = boxed(Sandbox(env=ENV), python_code(BUSY), Limits(wall_s=PATIENCE_S, cpu_s=2))
+    if 'cpu(cgroup)' not in result.limits_enforced:
+        pytest.skip('no cgroup counts CPU time here: CPU time is limited per process only')
+    assert result.out_of_cpu and not result.timed_out and result.returncode == -signal.SIGKILL
+    assert result.cpu_s >= 2
+    # The control: without the limit the same program burns its CPUs until the wall time.
+    control = boxed(Sandbox(env=ENV), python_code(BUSY), Limits(wall_s=3))
+    assert control.timed_out and not control.out_of_cpu and control.cpu_s > 0
+    # CPU time, not wall time: a program that waits keeps running past the CPU limit's seconds.
+    waiting = boxed(Sandbox(env=ENV), ['sleep', '2'], Limits(wall_s=PATIENCE_S, cpu_s=1))
+    assert (waiting.returncode, waiting.out_of_cpu, waiting.timed_out) == (0, False, False)
+
+
+def test_cpu_time_falls_back_to_a_limit_per_process(monkeypatch):
+    monkeypatch.setattr(sandbox.cgroups_of, 'make_cgroups', lambda pids, memory: ([], []))
+    started = time.monotonic()
+    result = boxed(Sandbox(env=ENV), python_code('while True: pass'),
+                   Limits(wall_s=PATIENCE_S, cpu_s=1))
+    assert 'cpu(rlimit-cpu, per process)' in result.limits_enforced
+    assert result.returncode != 0 and not result.timed_out and result.cpu_s is None
+    assert time.monotonic() - started < PATIENCE_S
+
+
 WRITE = 'import sys; open(sys.argv[1], "wb").write(bytes(2 << 20)); print("wrote")'
 
 

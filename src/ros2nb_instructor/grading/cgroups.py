@@ -1,8 +1,10 @@
-"""Cgroups for a sandbox: a fresh group per sandbox limits its tasks and its memory.
+"""Cgroups for a sandbox: a fresh group per sandbox limits its tasks and its memory and
+counts its CPU time.
 
 Part of :mod:`.sandbox` (runs on the instructor's host, as root while grading).  cgroup v1
-``pids`` and ``memory`` when the host has them, else cgroup v2 with both controllers
-delegated; none when neither can be made (then :mod:`.sandbox` falls back to rlimits).
+``pids`` and ``memory`` (and ``cpuacct``, to count) when the host has them, else cgroup v2
+with both controllers delegated (v2 counts CPU time in every group); none when neither can be
+made (then :mod:`.sandbox` falls back to rlimits).
 """
 
 from __future__ import annotations
@@ -34,7 +36,8 @@ def _own_cgroup(controller: str) -> Path | None:
 
 
 def make_cgroups(pids: int, memory_bytes: int) -> tuple[list[Path], list[str]]:
-    """Fresh cgroups limiting tasks and memory: v1 pids+memory, else v2; [] when impossible."""
+    """Fresh cgroups limiting tasks and memory, v1 pids+memory (with cpuacct), else v2;
+    [] when impossible.  :func:`cpu_seconds` reads their CPU time."""
     name = f'{_CGROUP_PREFIX}{os.getpid()}-{next(_counter)}'
     v1 = {'pids': {'pids.max': pids},
           'memory': {'memory.limit_in_bytes': memory_bytes,
@@ -45,6 +48,9 @@ def make_cgroups(pids: int, memory_bytes: int) -> tuple[list[Path], list[str]]:
         if parent and _try_cgroup(parent / name, files):
             made.append(parent / name)
             enforced.append(f'{controller}(cgroup)')
+    parent = _own_cgroup('cpuacct')
+    if made and parent and _try_cgroup(parent / name, {}):  # counts, limits nothing
+        made.append(parent / name)
     parent = _own_cgroup('')
     if not made and parent and {'pids', 'memory'} <= set(
             _read(parent / 'cgroup.subtree_control').split()):
@@ -52,6 +58,20 @@ def make_cgroups(pids: int, memory_bytes: int) -> tuple[list[Path], list[str]]:
         if _try_cgroup(parent / name, files):
             made, enforced = [parent / name], ['pids(cgroup)', 'memory(cgroup)']
     return made, enforced
+
+
+def cpu_seconds(cgroups: list[Path]) -> float | None:
+    """CPU seconds (user + system) the processes of these cgroups used, the ended ones
+    included; None when none of them counts CPU time (no v1 ``cpuacct``, no v2 group)."""
+    for cgroup in cgroups:
+        usage = _read(cgroup / 'cpuacct.usage').strip()
+        if usage.isdigit():
+            return int(usage) / 1e9
+        for line in _read(cgroup / 'cpu.stat').splitlines():
+            key, _, value = line.partition(' ')
+            if key == 'usage_usec' and value.strip().isdigit():
+                return int(value) / 1e6
+    return None
 
 
 def _read(path: Path) -> str:

@@ -54,7 +54,7 @@ from .gradebook import Scoring, collect_zip, set_up_course, write_results
 from .judging import Judges
 from .learners import grade_learner
 from .report import write_report
-from .settings import CELL_TIMEOUT_S, JOBS, NOTEBOOK_TIMEOUT_S, Settings
+from .settings import CELL_TIMEOUT_S, JOBS, NOTEBOOK_CPU_S, NOTEBOOK_TIMEOUT_S, Settings
 from .submissions import Learner, find_learners
 
 if TYPE_CHECKING:
@@ -67,6 +67,8 @@ def _options(argv: Optional[list[str]]) -> argparse.Namespace:
     parser.add_argument('--out', type=Path, default=ROOT / 'grading')
     parser.add_argument('--cell-timeout', type=int, default=CELL_TIMEOUT_S)
     parser.add_argument('--notebook-timeout', type=int, default=NOTEBOOK_TIMEOUT_S)
+    parser.add_argument('--notebook-cpu', type=int, default=NOTEBOOK_CPU_S,
+                        help="CPU seconds one notebook's run may use in its sandbox")
     parser.add_argument('--jobs', type=int, default=JOBS)
     parser.add_argument('--force', action='store_true',
                         help='replace an earlier grading/ (and any manual grades in it)')
@@ -265,7 +267,8 @@ def _grade(args: argparse.Namespace, submissions: Path, out: Path, started: floa
     """Grade into the empty folder ``out`` (here, or on ``args.scheduler``'s workers); 0 when
     grading worked."""
     seed = new_seed() if args.seed is None else args.seed  # one for the class: notes.json
-    settings = Settings(args.cell_timeout, args.notebook_timeout, not args.no_sandbox, seed)
+    settings = Settings(args.cell_timeout, args.notebook_timeout, not args.no_sandbox, seed,
+                        args.notebook_cpu)
     if not args.scheduler:
         return _grade_with(None, args, submissions, out, started, settings)
     from .cluster import Cluster, ClusterProblem  # Dask is imported for a cluster only

@@ -25,6 +25,8 @@ def _launch(spec: dict[str, Any], bwrap: list[str]) -> None:
     resource.setrlimit(resource.RLIMIT_FSIZE, (spec['fsize'], spec['fsize']))
     if spec['as']:
         resource.setrlimit(resource.RLIMIT_AS, (spec['as'], spec['as']))
+    if spec['cpu']:  # SIGXCPU at the limit (it ends a process that does not handle it)
+        resource.setrlimit(resource.RLIMIT_CPU, (spec['cpu'], spec['cpu'] + 1))
     if spec['stage']:
         _mount_sources(spec['sources'], Path(spec['stage']))
     if spec['uid'] is not None:

@@ -47,7 +47,7 @@ def run_notebook(scratch: Scratch, notebook: str, prepared: nbformat.NotebookNod
             str(out / f'{notebook}.run.ipynb'), f'--cell-timeout={settings.cell_timeout}',
             f'--folder={scratch.home / "notebooks"}']
     env = sandbox_env(scratch.home, ROS2NB_WORKSPACE=str(scratch.workspace))
-    limits = sandbox.Limits(wall_s=settings.notebook_timeout)
+    limits = sandbox.Limits(wall_s=settings.notebook_timeout, cpu_s=settings.notebook_cpu)
     stopped = None
     if settings.sandboxed:
         box = sandbox.Sandbox(writable=[scratch.home, out], env=env, cwd=scratch.home,
@@ -55,6 +55,11 @@ def run_notebook(scratch: Scratch, notebook: str, prepared: nbformat.NotebookNod
                               hidden=[ROOT / 'src' / 'ros2nb' / 'reference'])
         result = box.run(argv, limits, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         timed_out = result.timed_out
+        if result.out_of_cpu:
+            stopped = (f'its processes used more than {settings.notebook_cpu:g} CPU-seconds, '
+                       "the limit for a notebook (the course's own use at most a third of it), "
+                       'and were stopped: look for a loop that never waits, such as a thread '
+                       'that logs or publishes as fast as it can')
     else:
         try:
             subprocess.run(argv, env=env, cwd=scratch.home, timeout=settings.notebook_timeout,

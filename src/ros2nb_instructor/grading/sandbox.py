@@ -19,10 +19,12 @@ What a sandbox covers, each with a test in ``tests/test_sandbox.py``:
   paths are chowned to it first).  Mapped to root instead, a sandbox could write global
   sysctls under ``/proc/sys``, could read every root-only file it is shown, and bubblewrap's
   read-only covers on its ``/proc`` would stop nested sandboxes from mounting a ``/proc``.
-- Limits (:class:`Limits`): wall time (the whole sandbox is killed), file size
+- Limits (:class:`Limits`): wall time and CPU time (the whole sandbox is killed), file size
   (``RLIMIT_FSIZE``), and, when a cgroup can be made, number of tasks and memory (tmpfs
-  pages included).  Without a cgroup, memory falls back to a per-process ``RLIMIT_AS``
-  and tasks are not limited; :attr:`Running.limits_enforced` says which applied.
+  pages included).  CPU time is that of all its processes together, read from the cgroup
+  by the caller; without a cgroup, CPU time falls back to a per-process ``RLIMIT_CPU``,
+  memory to a per-process ``RLIMIT_AS``, and tasks are not limited;
+  :attr:`Running.limits_enforced` says which applied.
 
 Use (``limits_enforced`` of the result says which limits applied)::
 
@@ -34,10 +36,10 @@ Use (``limits_enforced`` of the result says which limits applied)::
     judge = Sandbox(..., nested=True)  # its program runs inner_prefix() + subject argv
 
 What it does not cover: the kernel is shared (a kernel exploit escapes, and unprivileged
-user namespaces widen the kernel's attack surface); CPU time is not limited, only wall
-time (a busy sandbox slows the others); disk space in ``writable`` folders is limited per
-file here, in total only where the caller mounted a size-capped tmpfs there (the grader
-does, :mod:`.scratch`), while ``/tmp`` and ``/dev/shm`` hold :data:`TMPFS_BYTES` each; a
+user namespaces widen the kernel's attack surface); CPU time is limited in total, not in
+rate (a busy sandbox slows the others until its limit); disk space in ``writable``
+folders is limited per file here, in total only where the caller mounted a size-capped
+tmpfs there (the grader does, :mod:`.scratch`), while ``/tmp`` and ``/dev/shm`` hold :data:`TMPFS_BYTES` each; a
 sandbox with ``share_network=True`` reaches every port its network
 namespace offers (a judge's subjects reach the judge's ports); timing and host-wide
 information such as ``/proc/meminfo`` stay visible.  A caller killed with SIGKILL takes its
@@ -52,18 +54,16 @@ import shutil
 import subprocess
 import sys
 import tempfile
-import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Mapping, Sequence
 
 from . import cgroups as cgroups_of
+from .running import Limits, MiB, Result, Running, remove
 
 #: The launcher program bwrap is started through (run as a file, by an isolated Python).
 LAUNCHER = Path(__file__).resolve().with_name('launcher.py')
 
-GiB = 1 << 30
-MiB = 1 << 20
 #: The uid and gid a sandboxed program sees.
 INNER_UID = 1000
 #: Host uid and gid of sandboxes started by root: no user, file or process has it.
@@ -73,40 +73,6 @@ TMPFS_BYTES = 512 * MiB
 _SIZE = ['--size', str(TMPFS_BYTES)]
 ETC_FILES = ('ld.so.cache', 'ld.so.conf', 'ld.so.conf.d', 'passwd', 'group', 'nsswitch.conf',
              'hosts', 'localtime')
-
-
-@dataclass(frozen=True)
-class Limits:
-    """Resource limits of one sandbox (defaults fit a Jupyter kernel running ROS 2 nodes).
-
-    :param wall_s: seconds before the whole sandbox is killed.
-    :param memory_bytes: memory of all its processes together (per process without a cgroup).
-    :param pids: tasks (processes and threads) at once; a ROS 2 node has about 16 threads.
-    :param file_size_bytes: largest file a process may write.
-    """
-
-    wall_s: float = 900.0
-    memory_bytes: int = 4 * GiB
-    pids: int = 512
-    file_size_bytes: int = 256 * MiB
-
-
-@dataclass(frozen=True)
-class Result:
-    """How a sandboxed run ended.
-
-    :param returncode: the program's exit code; negative (a signal) when it was killed.
-    :param timed_out: True when ``Limits.wall_s`` ran out and the sandbox was killed.
-    :param limits_enforced: e.g. ``('wall', 'file-size', 'pids(cgroup)', 'memory(cgroup)')``.
-    :param stdout: captured output when ``stdout=subprocess.PIPE`` was given, else None.
-    :param stderr: the same for stderr.
-    """
-
-    returncode: int
-    timed_out: bool
-    limits_enforced: tuple[str, ...]
-    stdout: Any = None
-    stderr: Any = None
 
 
 Source = Callable[[Path], str]
@@ -259,23 +225,28 @@ class Sandbox:
         bwrap = self.command(argv, staged if stage else str)
         cgroups, enforced = cgroups_of.make_cgroups(limits.pids, limits.memory_bytes)
         memory_rlimit = None if 'memory(cgroup)' in enforced else limits.memory_bytes
+        counted = cgroups_of.cpu_seconds(cgroups) is not None
+        cpu_rlimit = None if counted or limits.cpu_s is None else max(1, round(limits.cpu_s))
         spec = {'procs': [str(c / 'cgroup.procs') for c in cgroups], 'stage': stage and str(stage),
                 'sources': sources, 'uid': HOST_UID if drop else None,
-                'fsize': limits.file_size_bytes, 'as': memory_rlimit}
+                'fsize': limits.file_size_bytes, 'as': memory_rlimit, 'cpu': cpu_rlimit}
         launcher = [sys.executable, '-I', '-S', str(LAUNCHER), '--launch',
                     json.dumps(spec), '--', *bwrap]
         enforced = ['wall', 'file-size', *enforced]
+        enforced += ['cpu(cgroup)'] if counted and limits.cpu_s is not None else []
+        enforced += ['cpu(rlimit-cpu, per process)'] if cpu_rlimit else []
         enforced += ['memory(rlimit-as, per process)'] if memory_rlimit else []
         try:
             process = subprocess.Popen(launcher, env={'PATH': '/usr/bin:/bin'}, **popen)
         except OSError:
-            _remove(cgroups, stage)
+            remove(cgroups, stage)
             raise
-        return Running(process, tuple(enforced), cgroups, stage, limits.wall_s)
+        return Running(process, tuple(enforced), cgroups, stage, limits)
 
     def run(self, argv: Sequence[str], limits: Limits = Limits(), input: Any = None,
             **popen: Any) -> Result:
-        """Run ``argv`` in the sandbox to its end or until ``limits.wall_s`` runs out.
+        """Run ``argv`` in the sandbox to its end or until ``limits.wall_s`` or ``limits.cpu_s``
+        runs out.
 
         :param argv: the program and its arguments, as seen inside.
         :param limits: resource limits.
@@ -286,66 +257,8 @@ class Sandbox:
         with self.start(argv, limits, **popen) as running:
             out, err = running.process.communicate(input)
             code = running.stop()
-        return Result(code, running.timed_out, running.limits_enforced, out, err)
-
-
-class Running:
-    """A started sandbox: ``process`` is the :class:`subprocess.Popen` of its bwrap."""
-
-    def __init__(self, process: subprocess.Popen[Any], limits_enforced: tuple[str, ...],
-                 cgroups: list[Path], stage: Path | None, wall_s: float) -> None:
-        self.process = process
-        self.limits_enforced = limits_enforced
-        self.timed_out = False
-        self._cgroups, self._stage = cgroups, stage
-        self._timer = threading.Timer(wall_s, self._expire)
-        self._timer.daemon = True
-        self._timer.start()
-
-    def _expire(self) -> None:
-        if self.process.poll() is None:
-            self.timed_out = True
-            self.process.kill()
-            # Not bwrap alone: killed while it sets up, its child can outlive it, still
-            # running the program and holding its pipes (bubblewrap#633), so that a reader
-            # waiting for their end would wait forever.  The cgroup holds them all.
-            cgroups_of.kill(self._cgroups)
-
-    def wait(self, timeout: float | None = None) -> int:
-        """Wait for the program to end, then clean up as :meth:`stop` does.
-
-        :param timeout: seconds to wait at most (the wall-time limit applies in any case).
-        :return: the exit code.
-        :raises subprocess.TimeoutExpired: when ``timeout`` passed first (still running).
-        """
-        self.process.wait(timeout)
-        return self.stop()
-
-    def stop(self) -> int:
-        """Kill the sandbox and everything in it (if still running), then remove its cgroup.
-
-        :return: the exit code (negative: killed by that signal).
-        """
-        self._timer.cancel()
-        if self.process.poll() is None:
-            self.process.kill()
-        code = self.process.wait()
-        _remove(self._cgroups, self._stage)
-        self._cgroups, self._stage = [], None
-        return code
-
-    def __enter__(self) -> Running:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.stop()
-
-
-def _remove(cgroups: list[Path], stage: Path | None) -> None:
-    """Remove a sandbox's cgroups (killing what is left in them) and its staging folder."""
-    cgroups_of.remove(cgroups)
-    if stage:
-        shutil.rmtree(stage, ignore_errors=True)
+        return Result(code, running.timed_out, running.limits_enforced, out, err,
+                      running.out_of_cpu, running.cpu_s)
 
 
 def _check_world_readable(paths: Sequence[Path]) -> None:

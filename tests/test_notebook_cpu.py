@@ -1,0 +1,67 @@
+"""A notebook whose run keeps a CPU busy without waiting is stopped at its CPU limit, with a
+note that says so, instead of burning on until the cell and notebook limits.
+
+The learner is notebook 03 written as the solution, but with a sensor whose constructor
+starts a thread that logs as fast as it can (``benchmarks/flood_class.py`` grades it beside
+two complete learners).  Its run once kept its kernel busy for over 300 CPU-seconds, two
+cells running into the 120-s cell limit; the judge's side of such a flood is
+``tests/test_floods.py``.
+"""
+
+import pytest
+
+from ros2nb_instructor.grading import sandbox
+from ros2nb_instructor.grading.runs import run_note, run_notebook
+from ros2nb_instructor.grading.scratch import Scratch
+from ros2nb_instructor.grading.settings import Settings
+from ros2nb_instructor.grading.submissions import Learner
+
+pytestmark = [pytest.mark.sandbox, pytest.mark.kernel, pytest.mark.ros,
+              pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem())),
+              pytest.mark.timeout(400)]
+
+NOTEBOOK = '03-write-the-publisher'
+STARTED = "        self.get_logger().info('Temperature Sensor Node Started')\n"
+FLOOD = STARTED + '''\
+        import threading
+
+        def chatter():
+            while True:
+                self.get_logger().info('still here')
+
+        threading.Thread(target=chatter, daemon=True).start()
+'''
+
+
+def flooder_run(tmp_path, settings: Settings, monkeypatch) -> tuple[dict, str, sandbox.Result]:
+    """The flooder's 03 run in its sandbox, as the grader runs it: the runner's status, the
+    note the learner gets, and how the sandbox ended (its CPU seconds)."""
+    import nbformat
+    from corpora import Learner as CorpusLearner, submission
+    notebook = nbformat.from_dict(submission(CorpusLearner(
+        'flooder', '03', {'sensor-constructor': [(STARTED, FLOOD)]})))
+    ended = []
+    run = sandbox.Sandbox.run
+    monkeypatch.setattr(sandbox.Sandbox, 'run', lambda *a, **kw: ended.append(run(*a, **kw))
+                        or ended[-1])
+    tmp_path.mkdir()
+    scratch = Scratch(tmp_path, Learner('flooder', 'flooder'))
+    try:
+        _executed, status, stopped = run_notebook(scratch, NOTEBOOK, notebook, settings)
+    finally:
+        scratch.remove()
+    return status, run_note(status, stopped) or '', ended[-1]
+
+
+def test_a_kernel_that_floods_is_stopped_at_its_cpu_limit(tmp_path, monkeypatch):
+    status, note, ended = flooder_run(
+        tmp_path / 'limited', Settings(120, 600, True, notebook_cpu=10), monkeypatch)
+    assert ended.out_of_cpu and ended.cpu_s >= 10 and not status['finished'], (ended, status)
+    assert note.startswith('its processes used more than 10 CPU-seconds, the limit for a '
+                           'notebook'), note
+    assert 'a thread that logs or publishes as fast as it can' in note
+    # The control: without a CPU limit the same run burns on until its wall limit, far
+    # past the CPU seconds the limit allowed (the course's own 03 uses under 10 in all).
+    _status, note, ended = flooder_run(
+        tmp_path / 'unlimited', Settings(120, 60, True, notebook_cpu=None), monkeypatch)
+    assert not ended.out_of_cpu and ended.cpu_s > 20, ended
