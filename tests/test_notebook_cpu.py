@@ -16,21 +16,13 @@ from ros2nb_instructor.grading.scratch import Scratch
 from ros2nb_instructor.grading.settings import Settings
 from ros2nb_instructor.grading.submissions import Learner
 
+from test_floods import LOG_FLOOD, STARTED_LINE
+
 pytestmark = [pytest.mark.sandbox, pytest.mark.kernel, pytest.mark.ros,
               pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem())),
               pytest.mark.timeout(400)]
 
 NOTEBOOK = '03-write-the-publisher'
-STARTED = "        self.get_logger().info('Temperature Sensor Node Started')\n"
-FLOOD = STARTED + '''\
-        import threading
-
-        def chatter():
-            while True:
-                self.get_logger().info('still here')
-
-        threading.Thread(target=chatter, daemon=True).start()
-'''
 
 
 def flooder_run(tmp_path, settings: Settings, monkeypatch) -> tuple[dict, str, sandbox.Result]:
@@ -39,7 +31,7 @@ def flooder_run(tmp_path, settings: Settings, monkeypatch) -> tuple[dict, str, s
     import nbformat
     from corpora import Learner as CorpusLearner, submission
     notebook = nbformat.from_dict(submission(CorpusLearner(
-        'flooder', '03', {'sensor-constructor': [(STARTED, FLOOD)]})))
+        'flooder', '03', {'sensor-constructor': [(STARTED_LINE, LOG_FLOOD)]})))
     ended = []
     run = sandbox.Sandbox.run
     monkeypatch.setattr(sandbox.Sandbox, 'run', lambda *a, **kw: ended.append(run(*a, **kw))
