@@ -97,6 +97,10 @@ MISTAKES = [
      r'^Incompatible QoS: the sensor publishes with BEST_EFFORT, KEEP_LAST \(5\), VOLATILE, your '
      r'subscription asks for RELIABLE, (KEEP_LAST \(5\), )?VOLATILE; rclpy says: Best effort '
      r'publisher and reliable subscription; a best-effort publisher never resends'),
+    ('sensor_subscription_profile', 'depth 10', 'depth=5', 'depth=10',
+     r'^After a burst of 30 while its callback was busy, your subscription kept 10 '
+     r'\[20, 21, \.\.\., 29\]: the task keeps the last 5 readings \[25, 26, \.\.\., 29\]: '
+     r'KEEP_LAST with depth=5\.$'),
     ('sensor_subscription_profile', 'transient local', 'BEST_EFFORT)',
      'BEST_EFFORT, durability=DurabilityPolicy.TRANSIENT_LOCAL)',
      r'rclpy says: Volatile publisher and transient local subscription'),

@@ -12,6 +12,7 @@ a late joiner of the judge's receives from it.  Either way the same rules decide
 
 from __future__ import annotations
 
+import copy
 import secrets
 from typing import Any, Optional
 
@@ -32,8 +33,10 @@ NEWEST = [BURST - 1]
 #: Part 3: thresholds published before the late joiner, and the last ones it must get.
 LATCHED_SENT, LATCHED_KEPT = 20, 5
 LATCHED = list(range(LATCHED_SENT - LATCHED_KEPT, LATCHED_SENT))
-#: Part 2: readings the sensor publishes once matched.
+#: Part 2: readings the sensor publishes once matched, and what the subscription keeps of a
+#: burst it fell behind on: the last five.
 READINGS = 5
+SENSOR_KEPT = list(range(BURST - 5, BURST))
 #: The sensor's publisher of part 2: rclpy's sensor-data preset (best effort, depth 5).
 SENSOR_QOS = qos_profile_sensor_data
 
@@ -63,14 +66,14 @@ class _Endpoint:
     and the judge's view of it."""
 
     def __init__(self, judge: Judge, ref: AnswerRef, kind: str,
-                 numbers: tuple[int, ...] = ()) -> None:
+                 numbers: tuple[int, ...] = (), reliable: bool = False) -> None:
         judge.drop_all()  # nothing of the learner's left to publish on a trial's topic
         self.judge, self.observer = judge, judge.observer
         self.topic = f'/ros2nb_qos_trial_{secrets.token_hex(4)}'
         self.mark = len(self.observer.logs)
         self.subject = judge.answer_subject(ref)
         reply = self.subject.request('qos_endpoint', name=ref.name, topic=self.topic, kind=kind,
-                                     numbers=list(numbers))
+                                     numbers=list(numbers), reliable=reliable)
         defined_verdict(reply, ref.name)
         if 'error' in reply:
             raise learner_error(f'{ref.name}()', reply['error'])
@@ -106,11 +109,13 @@ class _Endpoint:
         self.judge.drop_all()
 
 
-def _judged_burst(judge: Judge, ref: AnswerRef) -> tuple[qos.Deliveries, QoSProfile]:
+def _judged_burst(judge: Judge, ref: AnswerRef,
+                  reliable: bool = False) -> tuple[qos.Deliveries, QoSProfile]:
     """The burst of part 1, from the judge's publisher to a subscription with the learner's
-    profile that takes nothing until the whole burst was acknowledged; and that subscription's
-    profile as discovery reports it."""
-    endpoint = _Endpoint(judge, ref, 'subscription')
+    profile (made reliable when ``reliable``: what it keeps is then its history's alone) that
+    takes nothing until the whole burst was acknowledged; and that subscription's profile as
+    discovery reports it."""
+    endpoint = _Endpoint(judge, ref, 'subscription', reliable=reliable)
     node = endpoint.observer.node
     publisher = node.create_publisher(Int32, endpoint.topic, QoSProfile(depth=BURST))
     out = qos.Deliveries()
@@ -288,7 +293,8 @@ def check_latched_thresholds(judge: Optional[Judge], make_profile: Any) -> str:
 
 
 def _sensor_subscription(judge: Optional[Judge], make_profile: Any) -> str:
-    if isinstance(make_profile, AnswerRef) and judge is not None:
+    judged = isinstance(make_profile, AnswerRef) and judge is not None
+    if judged:
         got, profile = _judged_pair(judge, make_profile)
     else:
         profile = learner_profile(make_profile)
@@ -298,8 +304,26 @@ def _sensor_subscription(judge: Optional[Judge], make_profile: Any) -> str:
         raise CheckFailed(f'Incompatible QoS: the sensor publishes with {sensor}, your '
                           f'subscription asks for {qos.describe(profile)}; '
                           f'{got.explanation or "they never matched."}')
-    return (f'a subscription with {qos.describe(profile)} matches the sensor ({sensor}): '
-            'no incompatible-QoS event.')
+    # What it keeps when it falls behind: its history's alone.  A best-effort subscription
+    # keeps what arrived, which varies from run to run; made reliable, it keeps the same.
+    if judged:
+        kept, _ = _judged_burst(judge, make_profile, reliable=True)
+    else:
+        kept = qos.burst(_reliable(profile), count=BURST)
+    if kept.received != SENSOR_KEPT:
+        raise CheckFailed(f'After a burst of {BURST} while its callback was busy, your '
+                          f'subscription kept {len(kept.received)} {_span(kept.received)}: '
+                          f'the task keeps the last {len(SENSOR_KEPT)} readings '
+                          f'{_span(SENSOR_KEPT)}: KEEP_LAST with depth={len(SENSOR_KEPT)}.')
+    return (f'a subscription with {qos.describe(profile)} matches the sensor ({sensor}), no '
+            f'incompatible-QoS event, and keeps the last {len(SENSOR_KEPT)} readings.')
+
+
+def _reliable(profile: QoSProfile) -> QoSProfile:
+    """``profile`` made reliable, its other policies kept."""
+    made = copy.copy(profile)
+    made.reliability = ReliabilityPolicy.RELIABLE
+    return made
 
 
 @direct
@@ -308,11 +332,14 @@ def check_sensor_subscription(judge: Optional[Judge], make_profile: Any) -> str:
 
     A publisher with rclpy's sensor-data preset (best effort, keep last 5, volatile) meets a
     subscription with your profile: rclpy's ``qos_check_compatible``, on both profiles as
-    discovery reports them, must find nothing incompatible, and the two must match.
+    discovery reports them, must find nothing incompatible, and the two must match.  Then a
+    burst of 30 (0 to 29) reaches a subscription with your profile's history while its
+    callback is busy: it must keep the last five, 25 to 29.
 
     Introduced in ``09-qos.ipynb``.
 
     :param make_profile: your function returning the profile (no parentheses).
-    :raises CheckFailed: with the one-line reason when the pair is incompatible.
+    :raises CheckFailed: with the one-line reason when the pair is incompatible, or naming
+        what the subscription kept instead.
     """
     return _sensor_subscription(judge, make_profile)

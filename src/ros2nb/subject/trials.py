@@ -11,6 +11,7 @@ that the judge can say why what it saw went wrong.
 
 from __future__ import annotations
 
+import copy
 import threading
 import time
 from typing import Any, Optional
@@ -18,7 +19,7 @@ from typing import Any, Optional
 from rclpy.duration import Duration
 from rclpy.executors import Executor
 from rclpy.node import Node
-from rclpy.qos import QoSProfile
+from rclpy.qos import QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float32, Int32
 
 from ..endpoints import node_endpoints
@@ -147,9 +148,11 @@ class Trials:
                                       for n in made]}
 
     # ------------------------------------------------------------ notebook 09
-    def qos_endpoint(self, name: str, topic: str, kind: str, numbers: tuple = ()) -> dict:
+    def qos_endpoint(self, name: str, topic: str, kind: str, numbers: tuple = (),
+                     reliable: bool = False) -> dict:
         """Make a ``kind`` ('subscription' or 'publisher') of Int32 on ``topic`` with the
-        profile the learner's ``name()`` returns.  A subscription takes nothing until
+        profile the learner's ``name()`` returns (made reliable when ``reliable``: only its
+        history then decides what it keeps of a burst).  A subscription takes nothing until
         :meth:`qos_take`; a publisher publishes ``numbers`` (the judge's) at once."""
         function = self.namespace.get(name)
         if not callable(function):
@@ -162,6 +165,9 @@ class Trials:
             return {'ok': False, 'error': describe_error(error)}
         if not isinstance(profile, QoSProfile):
             return {'ok': False, 'returned': encode(profile)}
+        if reliable:
+            profile = copy.copy(profile)
+            profile.reliability = ReliabilityPolicy.RELIABLE
         node = Node(QOS_NODE, start_parameter_services=False)
         try:
             if kind == 'subscription':
