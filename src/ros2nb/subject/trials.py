@@ -195,6 +195,14 @@ class Trials:
                 took += 1
         return {'ok': True, 'took': took}
 
+    def qos_matched(self) -> dict:
+        """How many publishers the learner's subscription matched, counted on its own side:
+        the judge's publisher matches it first, and what is published before this side
+        matched too may never reach it (the judge publishes once both sides did)."""
+        if self._qos is None or not hasattr(self._qos[1], 'get_publisher_count'):
+            return {'ok': False, 'count': 0}
+        return {'ok': True, 'count': self._qos[1].get_publisher_count()}
+
     def qos_acked(self, seconds: float) -> dict:
         """Wait (at most ``seconds``) until the judge's late joiner matched this publisher and
         acknowledged the burst."""
