@@ -97,6 +97,10 @@ MISTAKES = [
      r'^Incompatible QoS: the sensor publishes with BEST_EFFORT, KEEP_LAST \(5\), VOLATILE, your '
      r'subscription asks for RELIABLE, (KEEP_LAST \(5\), )?VOLATILE; rclpy says: Best effort '
      r'publisher and reliable subscription; a best-effort publisher never resends'),
+    ('sensor_subscription_profile', 'depth 10', 'depth=5', 'depth=10',
+     r'^After a burst of 30 while its callback was busy, your subscription kept 10 '
+     r'\[20, 21, \.\.\., 29\]: the task keeps the last 5 readings \[25, 26, \.\.\., 29\]: '
+     r'KEEP_LAST with depth=5\.$'),
     ('sensor_subscription_profile', 'transient local', 'BEST_EFFORT)',
      'BEST_EFFORT, durability=DurabilityPolicy.TRANSIENT_LOCAL)',
      r'rclpy says: Volatile publisher and transient local subscription'),
@@ -182,3 +186,34 @@ def test_a_thread_of_the_answer_cell_cannot_feed_the_trial(session):
     with pytest.raises(CheckFailed, match=r'Something other than the publisher made with your '
                                           r'profile published|got none: make durability'):
         run_check(session, 'judge', 'latched_thresholds_profile', answer)
+
+
+#: The sensor's profile, honest, whose first burst's "took N" lines never reach the judge: the
+#: subject that holds that burst's subscription logs below INFO (its lines stay unsent), as a
+#: busy machine or a lost /rosout line leaves the judge without them.  Calls are counted in a
+#: file, since each trial runs in a new subject: call 1 is the pairing, call 2 the first burst.
+UNHEARD_ONCE = '''
+import os as _os
+import rclpy.logging as _logging
+
+_honest = sensor_subscription_profile
+
+
+def sensor_subscription_profile():
+    with open({calls!r}, 'a') as calls:
+        calls.write('.')
+    if _os.path.getsize({calls!r}) == 2:
+        _logging.get_logger('qos_answer').set_level(_logging.LoggingSeverity.WARN)
+    return _honest()
+'''
+
+
+def test_a_burst_the_judge_did_not_hear_whole_is_sent_again(session, capsys, tmp_path):
+    """What the sensor's subscription kept is judged only from a burst the judge saw reach it
+    whole: one it heard nothing of is sent again.  Before, this honest depth 5 lost the part:
+    'your subscription kept 0 []', as once in make test."""
+    calls = tmp_path / 'calls'
+    answer = ANSWERS['sensor_subscription_profile'] + UNHEARD_ONCE.format(calls=str(calls))
+    run_check(session, 'judge', 'sensor_subscription_profile', answer)
+    assert calls.read_text() == '...'  # the pairing, the burst unheard, the burst again
+    assert 'keeps the last 5 readings' in capsys.readouterr().out

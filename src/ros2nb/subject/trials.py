@@ -11,6 +11,7 @@ that the judge can say why what it saw went wrong.
 
 from __future__ import annotations
 
+import copy
 import threading
 import time
 from typing import Any, Optional
@@ -18,7 +19,7 @@ from typing import Any, Optional
 from rclpy.duration import Duration
 from rclpy.executors import Executor
 from rclpy.node import Node
-from rclpy.qos import QoSProfile
+from rclpy.qos import QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float32, Int32
 
 from ..endpoints import node_endpoints
@@ -147,9 +148,11 @@ class Trials:
                                       for n in made]}
 
     # ------------------------------------------------------------ notebook 09
-    def qos_endpoint(self, name: str, topic: str, kind: str, numbers: tuple = ()) -> dict:
+    def qos_endpoint(self, name: str, topic: str, kind: str, numbers: tuple = (),
+                     reliable: bool = False) -> dict:
         """Make a ``kind`` ('subscription' or 'publisher') of Int32 on ``topic`` with the
-        profile the learner's ``name()`` returns.  A subscription takes nothing until
+        profile the learner's ``name()`` returns (made reliable when ``reliable``: only its
+        history then decides what it keeps of a burst).  A subscription takes nothing until
         :meth:`qos_take`; a publisher publishes ``numbers`` (the judge's) at once."""
         function = self.namespace.get(name)
         if not callable(function):
@@ -162,6 +165,9 @@ class Trials:
             return {'ok': False, 'error': describe_error(error)}
         if not isinstance(profile, QoSProfile):
             return {'ok': False, 'returned': encode(profile)}
+        if reliable:
+            profile = copy.copy(profile)
+            profile.reliability = ReliabilityPolicy.RELIABLE
         node = Node(QOS_NODE, start_parameter_services=False)
         try:
             if kind == 'subscription':
@@ -188,6 +194,14 @@ class Trials:
                 node.get_logger().info(f'took {got[0].data}')
                 took += 1
         return {'ok': True, 'took': took}
+
+    def qos_matched(self) -> dict:
+        """How many publishers the learner's subscription matched, counted on its own side:
+        the judge's publisher matches it first, and what is published before this side
+        matched too may never reach it (the judge publishes once both sides did)."""
+        if self._qos is None or not hasattr(self._qos[1], 'get_publisher_count'):
+            return {'ok': False, 'count': 0}
+        return {'ok': True, 'count': self._qos[1].get_publisher_count()}
 
     def qos_acked(self, seconds: float) -> dict:
         """Wait (at most ``seconds``) until the judge's late joiner matched this publisher and
