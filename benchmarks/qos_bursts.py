@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
-"""How often the judge's burst of notebook 09, part 2, reaches the learner's subscription whole.
+"""How often 09's part-2 burst reaches a subscription with the learner's history whole.
 
 ``python benchmarks/qos_bursts.py [--checks N] [--depth D]`` runs the judge's part-2 check
 (:func:`ros2nb.checks.lesson09.check_sensor_subscription`) N times on the solution's answer
-with ``depth=D`` (a real judge session, each trial in a real subject, as the grader runs it)
-and prints the verdicts and, per burst, whether it matched and came back whole
+with ``depth=D`` (a real judge session, the learner's subscription in a real subject, as the
+grader runs it, then the burst to the judge's own subscription with its history) and prints
+the verdicts and, per burst, whether it matched and came back whole
 (:func:`ros2nb.checks.lesson09._whole`): a burst that did not is sent again, and these counts
 say how often that happens.  Start two ``python3 -c 'while True: pass'`` beside it for a
 busy machine.
@@ -39,15 +40,15 @@ def main() -> None:
         'depth=5', f'depth={arguments.depth}')
     bursts: collections.Counter = collections.Counter()
     verdicts: collections.Counter = collections.Counter()
-    one_burst = lesson09._one_burst
+    burst = lesson09.qos.burst
 
     def counted(*args, **kwargs):  # type: ignore[no-untyped-def]
-        out, profile = one_burst(*args, **kwargs)
+        out = burst(*args, **kwargs)
         bursts['whole' if out.matched and lesson09._whole(out.received) else
                f'matched={out.matched} kept={out.received}'] += 1
-        return out, profile
+        return out
 
-    lesson09._one_burst = counted
+    lesson09.qos.burst = counted
     root = Path(tempfile.mkdtemp(prefix='qos-bursts-'))
     (root / 'ws').mkdir()
     session = Session(root / 'ws')

@@ -6,8 +6,10 @@ private context.  The judge calls it from the learner's answer cell in a subject
 a subscription or a publisher with the very profile it returned; the judge then sees, itself,
 what that endpoint does: the profile discovery reports for it (as ``ros2 topic info
 --verbose`` shows it), whether the judge's publisher matches it (rclpy's
-``qos_check_compatible`` names why not), which numbers of the judge's burst it kept, and what
-a late joiner of the judge's receives from it.  Either way the same rules decide.
+``qos_check_compatible`` names why not), and what a late joiner of the judge's receives from
+it.  What a subscription keeps of a burst is its history's doing: the judge sees what a
+subscription of its own with that history and depth keeps (discovery does not carry them;
+the subject says what the function returned).  Either way the same rules decide.
 """
 
 from __future__ import annotations
@@ -25,7 +27,6 @@ from ..explain.ros_settings import zero_depth_refused
 from ..errors import CheckFailed
 from .answers import defined_verdict, type_name_of
 from ..judge_interface import ARRIVAL_TIMEOUT_S, AnswerRef, Judge, learner_error
-from ..processes import wait_for_work
 from .base import call_learner, direct
 
 #: The burst of part 1 and what a display of the newest reading must be left with.
@@ -70,14 +71,14 @@ class _Endpoint:
     and the judge's view of it."""
 
     def __init__(self, judge: Judge, ref: AnswerRef, kind: str,
-                 numbers: tuple[int, ...] = (), reliable: bool = False) -> None:
+                 numbers: tuple[int, ...] = ()) -> None:
         judge.drop_all()  # nothing of the learner's left to publish on a trial's topic
         self.judge, self.observer = judge, judge.observer
         self.topic = f'/ros2nb_qos_trial_{secrets.token_hex(4)}'
         self.mark = len(self.observer.logs)
         self.subject = judge.answer_subject(ref)
         reply = self.subject.request('qos_endpoint', name=ref.name, topic=self.topic, kind=kind,
-                                     numbers=list(numbers), reliable=reliable)
+                                     numbers=list(numbers))
         defined_verdict(reply, ref.name)
         if 'error' in reply:
             raise learner_error(f'{ref.name}()', reply['error'])
@@ -94,33 +95,26 @@ class _Endpoint:
                               'check again.')
         #: The endpoint's profile as discovery reports it (history and depth: not carried).
         self.profile: QoSProfile = found[0].qos_profile
-
-    def matched_there(self) -> bool:
-        """Wait until the learner's subscription matched the judge's publisher on its own
-        side too: the judge's side matches first, and a burst published in between may never
-        reach the subscription.  The subject's word only says when to publish."""
-        return wait_for_work(
-            lambda: self.subject.request('qos_matched').get('count', 0) >= 1,
-            self.observer.attending(), ARRIVAL_TIMEOUT_S)
-
-    def took(self) -> list[int]:
-        """Let the learner's subscription take what it kept; the numbers it logged taking
-        (none when the judge did not hear every line: what it heard would mislead)."""
-        reply = self.subject.request('qos_take')
-        lines = []
-
-        def heard() -> bool:
-            nonlocal lines
-            lines = [text for text in self.observer.lines_of(self.node, self.mark)
-                     if text.startswith('took ')]
-            return len(lines) >= reply.get('took', 0)
-
-        if not self.observer.wait_until(heard, ARRIVAL_TIMEOUT_S):
-            return []
-        return [int(text.split()[1]) for text in lines if text.split()[1].isdigit()]
+        #: A reliable, volatile profile with the history and depth the learner's function
+        #: returned, as the subject read them: what a subscription of the judge's keeps with
+        #: it is what the learner's keeps (:func:`_kept`).
+        self.history = _history_of(reply)
 
     def close(self) -> None:
         self.judge.drop_all()
+
+
+def _history_of(reply: dict) -> QoSProfile:
+    """The reliable, volatile profile with the history and depth of a subject's reply; a
+    depth past the burst keeps what the burst's own length would (all of it)."""
+    try:
+        history = HistoryPolicy(int(reply['history']))
+        depth = min(max(int(reply['depth']), 0), BURST + 1)
+    except (KeyError, TypeError, ValueError):
+        raise CheckFailed('The grader could not read the history and depth of your profile '
+                          'from the trial (its process was disturbed): run this check again.'
+                          ) from None
+    return QoSProfile(history=history, depth=depth)
 
 
 def _whole(received: list[int]) -> bool:
@@ -129,68 +123,55 @@ def _whole(received: list[int]) -> bool:
     return bool(received) and received == list(range(BURST - len(received), BURST))
 
 
-def _judged_burst(judge: Judge, ref: AnswerRef,
-                  reliable: bool = False) -> tuple[qos.Deliveries, QoSProfile]:
-    """The burst of part 1, from the judge's publisher to a subscription with the learner's
-    profile (made reliable when ``reliable``: what it keeps is then its history's alone) that
-    takes nothing until the whole burst was acknowledged; and that subscription's profile as
-    discovery reports it.  A reliable subscription that matched and still did not get the
-    whole burst met a busy machine, not its profile: the burst is sent again, to a new one.
+def _kept(history: QoSProfile) -> qos.Deliveries:
+    """What a reliable subscription with ``history`` keeps of a burst of :data:`BURST` while
+    its callback is busy: the trial of :func:`ros2nb.qos.burst`, in this process (the
+    kernel's, or the judge's own, never a subject's).  A burst that did not arrive whole met
+    a busy machine, not the profile: it is sent again, to a new subscription.
 
     :raises CheckFailed: when that happened :data:`BURST_TRIES` times (run it again).
     """
     for _ in range(BURST_TRIES):
-        out, profile = _one_burst(judge, ref, reliable)
-        if out.explanation is not None or profile.reliability != ReliabilityPolicy.RELIABLE \
-                or (out.matched and _whole(out.received)):
-            return out, profile
-    raise CheckFailed(f'The grader\'s burst of {BURST} never reached the subscription made with '
-                      f'your profile whole in {BURST_TRIES} tries (is the machine very busy?): '
-                      'run this check again.')
+        got = qos.burst(_reliable(history), count=BURST)
+        if got.matched and _whole(got.received):
+            return got
+    raise CheckFailed(f'The grader\'s burst of {BURST} never reached a subscription with your '
+                      f'profile whole in {BURST_TRIES} tries (is the machine very busy?): run '
+                      'this check again.')
 
 
-def _one_burst(judge: Judge, ref: AnswerRef,
-               reliable: bool) -> tuple[qos.Deliveries, QoSProfile]:
-    endpoint = _Endpoint(judge, ref, 'subscription', reliable=reliable)
-    node = endpoint.observer.node
-    publisher = node.create_publisher(Int32, endpoint.topic, QoSProfile(depth=BURST))
-    out = qos.Deliveries()
-    try:
-        sender = qos.discovered(node, endpoint.topic, 'publisher')
-        out.explanation = qos.incompatibility(sender[0].qos_profile, endpoint.profile) \
-            if sender else None
-        if out.explanation is None:
-            out.matched = endpoint.observer.wait_until(
-                lambda: publisher.get_subscription_count() >= 1, ARRIVAL_TIMEOUT_S)
-        if out.matched and endpoint.matched_there():
-            for number in range(BURST):
-                publisher.publish(Int32(data=number))
-            publisher.wait_for_all_acked()
-            out.received = endpoint.took()
-    finally:
-        node.destroy_publisher(publisher)
-        endpoint.close()
-    return out, endpoint.profile
+def _judged_match(judge: Judge, ref: AnswerRef,
+                  offered: QoSProfile) -> tuple[qos.Deliveries, QoSProfile, QoSProfile]:
+    """Does a publisher of the judge's with ``offered`` match the subscription the learner's
+    profile made in a subject?  rclpy decides from both profiles as discovery reports them.
 
-
-def _judged_pair(judge: Judge, ref: AnswerRef) -> tuple[qos.Deliveries, QoSProfile]:
-    """Part 2: does the judge's sensor publisher match a subscription with the learner's
-    profile?  rclpy decides from both profiles as discovery reports them."""
+    :return: whether it matched (or why not), that subscription's profile as discovery
+        reports it, and its history and depth (:attr:`_Endpoint.history`).
+    """
     endpoint = _Endpoint(judge, ref, 'subscription')
     node = endpoint.observer.node
-    publisher = node.create_publisher(Int32, endpoint.topic, SENSOR_QOS)
+    publisher = node.create_publisher(Int32, endpoint.topic, offered)
     out = qos.Deliveries()
     try:
         sender = qos.discovered(node, endpoint.topic, 'publisher')
-        offered = sender[0].qos_profile if sender else SENSOR_QOS
-        out.explanation = qos.incompatibility(offered, endpoint.profile)
+        out.explanation = qos.incompatibility(sender[0].qos_profile if sender else offered,
+                                              endpoint.profile)
         if out.explanation is None:
             out.matched = endpoint.observer.wait_until(
                 lambda: publisher.get_subscription_count() >= 1, ARRIVAL_TIMEOUT_S)
     finally:
         node.destroy_publisher(publisher)
         endpoint.close()
-    return out, endpoint.profile
+    return out, endpoint.profile, endpoint.history
+
+
+def _judged_burst(judge: Judge, ref: AnswerRef) -> tuple[qos.Deliveries, QoSProfile]:
+    """Part 1: the learner's subscription meets the judge's reliable, volatile publisher;
+    when they match, what a subscription with its history keeps of the burst."""
+    out, profile, history = _judged_match(judge, ref, QoSProfile(depth=BURST))
+    if out.matched:
+        out.received = _kept(history).received
+    return out, profile
 
 
 def _judged_late_joiner(judge: Judge, ref: AnswerRef) -> tuple[qos.Deliveries, QoSProfile]:
@@ -329,11 +310,10 @@ def check_latched_thresholds(judge: Optional[Judge], make_profile: Any) -> str:
 
 
 def _sensor_subscription(judge: Optional[Judge], make_profile: Any) -> str:
-    judged = isinstance(make_profile, AnswerRef) and judge is not None
-    if judged:
-        got, profile = _judged_pair(judge, make_profile)
+    if isinstance(make_profile, AnswerRef) and judge is not None:
+        got, profile, history = _judged_match(judge, make_profile, SENSOR_QOS)
     else:
-        profile = learner_profile(make_profile)
+        profile = history = learner_profile(make_profile)
         got = qos.pair(SENSOR_QOS, profile, count=READINGS)
     sensor = qos.describe(SENSOR_QOS)
     if not got.matched:
@@ -342,13 +322,7 @@ def _sensor_subscription(judge: Optional[Judge], make_profile: Any) -> str:
                           f'{got.explanation or "they never matched."}')
     # What it keeps when it falls behind: its history's alone.  A best-effort subscription
     # keeps what arrived, which varies from run to run; made reliable, it keeps the same.
-    if judged:
-        kept, _ = _judged_burst(judge, make_profile, reliable=True)
-    else:
-        for _ in range(BURST_TRIES):  # as the judge does: a busy machine's burst is sent again
-            kept = qos.burst(_reliable(profile), count=BURST)
-            if _whole(kept.received):
-                break
+    kept = _kept(history)
     if kept.received != SENSOR_KEPT:
         raise CheckFailed(f'After a burst of {BURST} while its callback was busy, your '
                           f'subscription kept {len(kept.received)} {_span(kept.received)}: '

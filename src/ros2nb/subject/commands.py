@@ -257,8 +257,7 @@ def serve(commands: Any, replies: Any, namespace: dict[str, Any], answers: Answe
         'serve': subject.serve, 'worker': subject.worker, 'worker_stop': subject.worker_stop,
         'plot_shown': subject.plot_shown,
         'room_nodes': subject.room_nodes, 'wait_publishers': subject.wait_publishers,
-        'qos_endpoint': subject.qos_endpoint, 'qos_take': subject.qos_take,
-        'qos_acked': subject.qos_acked, 'qos_matched': subject.qos_matched,
+        'qos_endpoint': subject.qos_endpoint, 'qos_acked': subject.qos_acked,
     }
     for line in commands:
         request = json.loads(line)

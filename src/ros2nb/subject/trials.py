@@ -11,7 +11,6 @@ that the judge can say why what it saw went wrong.
 
 from __future__ import annotations
 
-import copy
 import threading
 import time
 from typing import Any, Optional
@@ -19,7 +18,7 @@ from typing import Any, Optional
 from rclpy.duration import Duration
 from rclpy.executors import Executor
 from rclpy.node import Node
-from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rclpy.qos import QoSProfile
 from std_msgs.msg import Float32, Int32
 
 from ..endpoints import node_endpoints
@@ -148,12 +147,11 @@ class Trials:
                                       for n in made]}
 
     # ------------------------------------------------------------ notebook 09
-    def qos_endpoint(self, name: str, topic: str, kind: str, numbers: tuple = (),
-                     reliable: bool = False) -> dict:
+    def qos_endpoint(self, name: str, topic: str, kind: str, numbers: tuple = ()) -> dict:
         """Make a ``kind`` ('subscription' or 'publisher') of Int32 on ``topic`` with the
-        profile the learner's ``name()`` returns (made reliable when ``reliable``: only its
-        history then decides what it keeps of a burst).  A subscription takes nothing until
-        :meth:`qos_take`; a publisher publishes ``numbers`` (the judge's) at once."""
+        profile the learner's ``name()`` returns, and say its history and depth (discovery
+        does not carry them).  A subscription takes nothing; a publisher publishes ``numbers``
+        (the judge's) at once."""
         function = self.namespace.get(name)
         if not callable(function):
             return {'ok': False, 'undefined': True}
@@ -165,9 +163,6 @@ class Trials:
             return {'ok': False, 'error': describe_error(error)}
         if not isinstance(profile, QoSProfile):
             return {'ok': False, 'returned': encode(profile)}
-        if reliable:
-            profile = copy.copy(profile)
-            profile.reliability = ReliabilityPolicy.RELIABLE
         node = Node(QOS_NODE, start_parameter_services=False)
         try:
             if kind == 'subscription':
@@ -180,28 +175,8 @@ class Trials:
             node.destroy_node()
             return {'ok': False, 'error': describe_error(error)}
         self._qos = (node, endpoint, [])
-        return {'ok': True, 'node': QOS_NODE}
-
-    def qos_take(self) -> dict:
-        """Take everything the learner's subscription kept, logging ``took N`` for each."""
-        if self._qos is None:
-            return {'ok': False, 'took': 0}
-        node, subscription, _ = self._qos
-        took = 0
-        with subscription.handle:
-            while (got := subscription.handle.take_message(subscription.msg_type,
-                                                            subscription.raw)) is not None:
-                node.get_logger().info(f'took {got[0].data}')
-                took += 1
-        return {'ok': True, 'took': took}
-
-    def qos_matched(self) -> dict:
-        """How many publishers the learner's subscription matched, counted on its own side:
-        the judge's publisher matches it first, and what is published before this side
-        matched too may never reach it (the judge publishes once both sides did)."""
-        if self._qos is None or not hasattr(self._qos[1], 'get_publisher_count'):
-            return {'ok': False, 'count': 0}
-        return {'ok': True, 'count': self._qos[1].get_publisher_count()}
+        return {'ok': True, 'node': QOS_NODE, 'history': int(profile.history),
+                'depth': int(profile.depth)}
 
     def qos_acked(self, seconds: float) -> dict:
         """Wait (at most ``seconds``) until the judge's late joiner matched this publisher and
