@@ -75,7 +75,6 @@ class _Endpoint:
         judge.drop_all()  # nothing of the learner's left to publish on a trial's topic
         self.judge, self.observer = judge, judge.observer
         self.topic = f'/ros2nb_qos_trial_{secrets.token_hex(4)}'
-        self.mark = len(self.observer.logs)
         self.subject = judge.answer_subject(ref)
         reply = self.subject.request('qos_endpoint', name=ref.name, topic=self.topic, kind=kind,
                                      numbers=list(numbers))
@@ -86,7 +85,6 @@ class _Endpoint:
             returned = reply['returned']
             raise CheckFailed(f'{ref.name}() returned {returned["type"]} {returned["value"]}; '
                               'return a QoSProfile(...).')
-        self.node = reply['node']
         found = qos.discovered(self.observer.node, self.topic, kind,
                                seconds=ARRIVAL_TIMEOUT_S)
         if not found:

@@ -41,7 +41,7 @@ class Trials:
     rooms: list[Node]
     node: Optional[Node]
     _spun: Optional[tuple[Node, Executor, threading.Thread, threading.Event, list, Shown]]
-    _qos: Optional[tuple[Node, Any, list[int]]]
+    _qos: Optional[tuple[Node, Any]]
     _plot_shown: Optional[Shown] = None
 
     def _runtime(self) -> Any:  # provided by Subject
@@ -174,16 +174,15 @@ class Trials:
         except BaseException as error:
             node.destroy_node()
             return {'ok': False, 'error': describe_error(error)}
-        self._qos = (node, endpoint, [])
-        return {'ok': True, 'node': QOS_NODE, 'history': int(profile.history),
-                'depth': int(profile.depth)}
+        self._qos = (node, endpoint)
+        return {'ok': True, 'history': int(profile.history), 'depth': int(profile.depth)}
 
     def qos_acked(self, seconds: float) -> dict:
         """Wait (at most ``seconds``) until the judge's late joiner matched this publisher and
         acknowledged the burst."""
         if self._qos is None:
             return {'ok': False}
-        _, publisher, _ = self._qos
+        _, publisher = self._qos
         deadline = time.monotonic() + seconds  # the judge's joiner matched on its side: wait
         while publisher.get_subscription_count() < 1 and time.monotonic() < deadline:
             time.sleep(0.01)  # for this side too, or nothing waits to be acknowledged yet
