@@ -31,29 +31,9 @@ ROOT = HERE.parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(ROOT / 'tests'))
 from sampling import TreeCpu  # noqa: E402
+from test_floods import flooder_notebook  # noqa: E402
 
 GRADE = str(Path(sys.executable).with_name('ros2nb-grade'))
-STARTED = "        self.get_logger().info('Temperature Sensor Node Started')\n"
-FLOOD = STARTED + '''\
-        import threading
-
-        def chatter():
-            while True:
-                {work}
-
-        threading.Thread(target=chatter, daemon=True).start()
-'''
-WORK = {'rosout': "self.get_logger().info('still here')",
-        'topic': 'self.publisher_.publish(Float32(data=self.temperature))'}
-
-
-def flooder_notebook(kind: str) -> dict:
-    """Notebook 03 as the solution, its constructor starting a flood of ``kind``."""
-    from corpora import Learner, submission
-    return submission(Learner('flooder', '03', {'sensor-constructor': [
-        (STARTED, FLOOD.format(work=WORK[kind]))]}))
-
-
 def grade(folder: Path, out: Path) -> tuple[float, float]:
     """Grade ``folder``'s learners: wall seconds and CPU seconds of the grading's processes."""
     started = time.monotonic()

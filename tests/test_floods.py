@@ -21,49 +21,46 @@ from test_checks import PUB, fails, mutated, restore
 pytestmark = [pytest.mark.judge, pytest.mark.timeout(300)]
 
 STARTED_LINE = "        self.get_logger().info('Temperature Sensor Node Started')\n"
-#: The constructor's last lines, then a thread that logs without waiting.
-LOG_FLOOD = STARTED_LINE + '''\
+#: The constructor's last lines, then a thread that does ``{work}`` without waiting.
+FLOODING_CONSTRUCTOR = STARTED_LINE + '''\
         import threading
 
         def chatter():
             while True:
-                self.get_logger().info('still here')
+                {work}
 
         threading.Thread(target=chatter, daemon=True).start()
 '''
-#: The constructor's last lines, then a thread that publishes readings without waiting.
-TOPIC_FLOOD = STARTED_LINE + '''\
-        import threading
-
-        def chatter():
-            while True:
-                self.publisher_.publish(Float32(data=self.temperature))
-
-        threading.Thread(target=chatter, daemon=True).start()
-'''
+#: What each flooder's thread does: log, or publish readings.
+WORK = {'rosout': "self.get_logger().info('still here')",
+        'topic': 'self.publisher_.publish(Float32(data=self.temperature))'}
+#: The constructor that floods ``kind`` (a key of WORK).
+FLOODS = {kind: FLOODING_CONSTRUCTOR.format(work=work) for kind, work in WORK.items()}
 WHEN = r"(while the grader's clock stood still|in [\d.]+ s of the grader's clock)"
+#: The line each flood fails the constructor's check with.
+LINES = {'rosout': rf'^Your node temperature_sensor logged over 500 lines to /rosout {WHEN} .*'
+                   r'look for a loop that logs without waiting for a timer\.$',
+         'topic': rf'^Your code published over 500 messages on /temperature {WHEN} .*'
+                  r'look for a loop that publishes without waiting for a timer\.$'}
 
 
-def test_a_constructor_that_floods_rosout(session):
-    mutated(session, PUB, STARTED_LINE, LOG_FLOOD)
+def flooder_notebook(kind: str) -> dict:
+    """Notebook 03 as the solution, its constructor flooding ``kind`` (a key of WORK), as
+    a learner hands it in (for the grader: ``benchmarks/flood_class.py``,
+    ``tests/test_notebook_cpu.py``)."""
+    from corpora import Learner, submission
+    return submission(Learner('flooder', '03', {'sensor-constructor': [
+        (STARTED_LINE, FLOODS[kind])]}))
+
+
+@pytest.mark.parametrize('kind', sorted(WORK))
+def test_a_constructor_that_floods(session, kind):
+    mutated(session, PUB, STARTED_LINE, FLOODS[kind])
     try:
-        fails(session, checks.check_sensor_constructor,
-              rf'^Your node temperature_sensor logged over 500 lines to /rosout {WHEN} .*'
-              r'look for a loop that logs without waiting for a timer\.$')
+        fails(session, checks.check_sensor_constructor, LINES[kind])
         # part 4 is the reference's: with the course's constructor it keeps its points
         run_check(session, checks.check_sensor_callback)
     finally:
         restore(session, PUB)
     # what the ended flooder still had on its way reaches no later check
     run_check(session, checks.check_sensor_constructor)
-
-
-def test_a_constructor_that_floods_the_topic(session):
-    mutated(session, PUB, STARTED_LINE, TOPIC_FLOOD)
-    try:
-        fails(session, checks.check_sensor_constructor,
-              rf'^Your code published over 500 messages on /temperature {WHEN} .*'
-              r'look for a loop that publishes without waiting for a timer\.$')
-        run_check(session, checks.check_sensor_callback)
-    finally:
-        restore(session, PUB)

@@ -16,7 +16,7 @@ from ros2nb_instructor.grading.scratch import Scratch
 from ros2nb_instructor.grading.settings import Settings
 from ros2nb_instructor.grading.submissions import Learner
 
-from test_floods import LOG_FLOOD, STARTED_LINE
+from test_floods import flooder_notebook
 
 pytestmark = [pytest.mark.sandbox, pytest.mark.kernel, pytest.mark.ros,
               pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem())),
@@ -29,9 +29,7 @@ def flooder_run(tmp_path, settings: Settings, monkeypatch) -> tuple[dict, str, s
     """The flooder's 03 run in its sandbox, as the grader runs it: the runner's status, the
     note the learner gets, and how the sandbox ended (its CPU seconds)."""
     import nbformat
-    from corpora import Learner as CorpusLearner, submission
-    notebook = nbformat.from_dict(submission(CorpusLearner(
-        'flooder', '03', {'sensor-constructor': [(STARTED_LINE, LOG_FLOOD)]})))
+    notebook = nbformat.from_dict(flooder_notebook('rosout'))
     ended = []
     run = sandbox.Sandbox.run
     monkeypatch.setattr(sandbox.Sandbox, 'run', lambda *a, **kw: ended.append(run(*a, **kw))
