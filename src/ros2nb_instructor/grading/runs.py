@@ -57,9 +57,8 @@ def run_notebook(scratch: Scratch, notebook: str, prepared: nbformat.NotebookNod
         timed_out = result.timed_out
         if result.out_of_cpu:
             stopped = (f'its processes used more than {settings.notebook_cpu:g} CPU-seconds, '
-                       "the limit for a notebook (the course's own use at most a third of it), "
-                       'and were stopped: look for a loop that never waits, such as a thread '
-                       'that logs or publishes as fast as it can')
+                       'the limit for a notebook, and were stopped: look for a loop that never '
+                       'waits, such as a thread that logs or publishes as fast as it can')
     else:
         try:
             subprocess.run(argv, env=env, cwd=scratch.home, timeout=settings.notebook_timeout,
