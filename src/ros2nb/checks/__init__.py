@@ -72,7 +72,7 @@ def run_check(name: str, judge: Optional[Judge], *args: Any, **kwargs: Any) -> N
         getattr(sys.modules[__name__], name)  # loads its lesson's module, which registers it
     if name not in CHECKS:
         raise ValueError(f'no check is named {name!r}')
-    observer = getattr(judge, 'observer', None) if judge is not None else None
+    observer = getattr(judge, 'observer', None)
     if observer is None:
         passed(CHECKS[name](judge, *args, **kwargs))
         return

@@ -46,6 +46,8 @@ EVERY_MESSAGE = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=Reliabili
 #: shortly before the judge matched them (rcl keeps each node's last lines).
 ROSOUT_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE,
                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
+
+
 class _GivenUp(Exception):
     """The processes a wait attended to had their patience (:meth:`Observer.spins`)."""
 
