@@ -28,7 +28,7 @@ LAYERS: list[tuple[str, ...]] = [
     ('ros2nb.terminal.pkg_create',),
     ('ros2nb.course',),
     ('ros2nb.rules',),
-    ('ros2nb.explain',),
+    ('ros2nb.explain', 'ros2nb.figures'),
     ('ros2nb.runtime', 'ros2nb.qos'),
     ('ros2nb.terminal',),
     ('ros2nb.kernel',),
