@@ -5,6 +5,7 @@ processes, verdicts come from the judge's own ROS node.  The course's reference 
 first, so every failure below is its mistake's.
 """
 
+import dataclasses
 import re
 from pathlib import Path
 
@@ -495,5 +496,11 @@ def test_a_witness_message_without_the_token_counts_for_nothing(session, capsys,
     monkeypatch.setattr(lesson07, 'told', lambda heard, start, token: [
         fact for fact in witnessed.told(heard, start, 'guessed')])
     # the subject counts only what the course's redraw() told: wait for one message each
-    monkeypatch.setattr(lesson07, '_shown', lambda counts: None)
+    real_feed = lesson07.feed
+
+    def feed_counting_nothing(*args, **kwargs):
+        counts, lines = real_feed(*args, **kwargs)
+        return dataclasses.replace(counts, shown=None), lines
+
+    monkeypatch.setattr(lesson07, 'feed', feed_counting_nothing)
     passes_with(session, capsys, PLOT, RIGHT_PLOT, WITNESS_FORGED, checks.check_plot_callback)

@@ -27,20 +27,17 @@ POLL_S = 0.02
 
 
 class Process(Protocol):
-    """A process the course started: a :class:`subprocess.Popen`, or a child of the judge's
-    fork server (:class:`ros2nb.subject.forked.ForkedProcess`), in a session of its own."""
+    """A process the course started in a session of its own: a :class:`subprocess.Popen`, or
+    a child of the fork server (:class:`ros2nb.subject.forked.ForkedProcess`)."""
 
     pid: int  #: also its process group's id
-    returncode: Optional[int]  #: the exit code once reaped (negative: the signal), else None
+    returncode: Optional[int]  #: its exit code once reaped (negative: the signal), else None
 
     def poll(self) -> Optional[int]:
-        """The exit code once it ended, else None (it never waits)."""
+        """Its exit code once it ended, else None (it never waits)."""
 
     def wait(self, timeout: Optional[float] = None) -> int:
-        """The exit code, waiting at most ``timeout`` s.
-
-        :raises subprocess.TimeoutExpired: when it still runs then.
-        """
+        """Its exit code, waited for ``timeout`` s at most (then subprocess.TimeoutExpired)."""
 
 
 def signal_group(proc: Process, sig: int) -> bool:
