@@ -1,13 +1,12 @@
 """Checks of notebook 06, the five promises: a third node, its main(), a counting monitor,
-a worker that stays responsive, and the arguments that make two rooms of one package.
+and the arguments that make two rooms of one package (the responsive worker is
+:mod:`.lesson06_worker`).
 
 Part of :mod:`ros2nb.checks`.  Every part is in a file of the learner's package
 (``fan_controller.py``, ``promises.py``); the judge runs it in a subject and decides from
-what its own node sees: the ROS graph, the commands on ``/fan_command``, the counting
-monitor's lines on ``/rosout``, and what the course's own callbacks on the worker's timers
-tell it while the learner's executor spins them (:mod:`.witnessed`).  What the subject
-reports (its counts, the executor it was given) only says how long to wait, or why a failure
-happened.
+what its own node sees: the ROS graph, the commands on ``/fan_command`` and the counting
+monitor's lines on ``/rosout``.  What the subject reports (its counts) only says how long to
+wait, or why a failure happened.
 """
 
 from __future__ import annotations
@@ -20,13 +19,14 @@ from std_msgs.msg import Bool
 from .. import course, rules
 from ..errors import CheckFailed
 from ..explain.ros_settings import ros_arguments_mistake
-from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
+from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, Subject
+from ..subject_interface import Call, RoomNodes, WaitMatched
+from ..subject_replies import Counts
 from .base import judged
 from .drawn import chooser
 from .mains import run_main
-from .file_nodes import announced, feed, lines_logged, new_node, reach
+from .file_nodes import announced, feed, lines_logged, new_node, raised, reach
 from .verdicts import endpoint_verdict, node_name_verdict
-from .witnessed import WITNESS_TOPIC, events, new_token, told_to
 
 #: Readings the fan check sends (°C): both sides of the High threshold; then drawn ones.
 FAN_READINGS_C = (22.0, 26.0, 26.01, 27.5, 25.99, 19.0)
@@ -60,17 +60,17 @@ def _fan_controller(judge: Judge) -> str:
     commands = judge.observer.watch('/' + course.FAN_TOPIC, Bool, lambda m: bool(m.data))
     subject, info = new_node(judge, course.FAN_FILE, course.FAN_CLASS)
     node_name_verdict(info, course.FAN_NODE)
-    found = judge.observer.endpoints(info['name'], info['namespace'], info['endpoints'])
-    endpoint_verdict(info['name'], found, 'subscription', '/' + course.TOPIC, course.MESSAGE_TYPE)
-    endpoint_verdict(info['name'], found, 'publisher', '/' + course.FAN_TOPIC,
+    found = judge.observer.endpoints(info.name, info.namespace, info.endpoints)
+    endpoint_verdict(info.name, found, 'subscription', '/' + course.TOPIC, course.MESSAGE_TYPE)
+    endpoint_verdict(info.name, found, 'publisher', '/' + course.FAN_TOPIC,
                      course.FAN_MESSAGE_TYPE)
-    if not subject.request('wait_matched', topic='/' + course.FAN_TOPIC,
-                           seconds=ARRIVAL_TIMEOUT_S)['ok']:
+    if not subject.request(WaitMatched(topic='/' + course.FAN_TOPIC,
+                                       seconds=ARRIVAL_TIMEOUT_S)).ok:
         raise CheckFailed(f'The fan controller\'s publisher never reached the grader\'s '
                           f'subscription on /{course.FAN_TOPIC}: is the machine very busy? '
                           'Run this check again.')
-    reach(judge, subject, info['name'])
-    counts = info
+    reach(judge, subject, info.name)
+    counts: Counts = info
     fan_topic = '/' + course.FAN_TOPIC
     answered_s = []  # per reading: from the judge's publishing it to its command arriving
     readings = _fan_readings(judge)
@@ -98,7 +98,7 @@ def _fan_controller(judge: Judge) -> str:
                               f'should be {want}: the fan is on only when the reading is High, '
                               f'strictly above HIGH_ABOVE_C = {course.HIGH_ABOVE_C} °C.')
     _slow_callback_verdict(min(answered_s), len(readings))
-    return (f'{info["name"]} hears /{course.TOPIC} and publishes one command on '
+    return (f'{info.name} hears /{course.TOPIC} and publishes one command on '
             f'/{course.FAN_TOPIC} per reading, True only when High ({len(readings)} '
             'readings).')
 
@@ -150,14 +150,14 @@ def _counting_monitor(judge: Judge) -> str:
     observer = judge.observer
     mark = len(observer.logs)
     subject, info = new_node(judge, course.PROMISES_FILE, course.COUNTING_CLASS, args=(name,))
-    if info['name'] != name:
-        raise CheckFailed(f"{course.COUNTING_CLASS}('{name}') made a node called {info['name']}: "
+    if info.name != name:
+        raise CheckFailed(f"{course.COUNTING_CLASS}('{name}') made a node called {info.name}: "
                           'pass the name it is given on to super().__init__(name).')
-    found = observer.endpoints(info['name'], info['namespace'], info['endpoints'])
+    found = observer.endpoints(info.name, info.namespace, info.endpoints)
     endpoint_verdict(name, found, 'subscription', '/' + course.TOPIC, course.MESSAGE_TYPE)
-    lines_logged(judge, info, mark, info['started_lines'])
+    lines_logged(judge, info, mark, info.started_lines)
     reach(judge, subject, name)
-    counts = info
+    counts: Counts = info
     source = chooser(judge, '06 counted readings')
     for index in range(1, COUNTED_READINGS + 1):
         value = round(source.uniform(*COUNTED_RANGE_C), 2)
@@ -184,8 +184,8 @@ def _named_as_told(judge: Judge, name: str) -> None:
     """A counting monitor given ``name`` (drawn for this run: no table holds it) is called
     ``name``."""
     _subject, info = new_node(judge, course.PROMISES_FILE, course.COUNTING_CLASS, args=(name,))
-    if info['name'] != name:
-        raise CheckFailed(f"{course.COUNTING_CLASS}('{name}') made a node called {info['name']}: "
+    if info.name != name:
+        raise CheckFailed(f"{course.COUNTING_CLASS}('{name}') made a node called {info.name}: "
                           'pass the name it is given on to super().__init__(name).')
 
 
@@ -204,139 +204,20 @@ def check_counting_monitor(judge: Judge) -> str:
     return _counting_monitor(judge)
 
 
-# ------------------------------------------------------------------ concurrency
-#: How long the course's slow_work works (s, wall clock): as part 3's, within its 0.5 s period.
-SLOW_WORK_S = 0.45
-#: slow_work runs the judge waits for, at most, before it says no heartbeat came meanwhile.
-SLOW_RUNS_WATCHED = 3
-
-
-def _overlapped(events: list[str]) -> tuple[bool, int]:
-    """Whether a heartbeat came while slow_work worked (between one of its starts and the
-    done after it), and how many slow_work runs were done, from the course's callbacks'
-    events in the order they were published (one publisher keeps it)."""
-    working, done = 0, 0
-    for event in events:
-        if event == 'start':
-            working += 1
-        elif event == 'done' and working:
-            working, done = working - 1, done + 1
-        elif event == 'beat' and working:
-            return True, done
-    return False, done
-
-
-def _worker_cause(reply: dict) -> str:
-    """Why no heartbeat came during slow_work, from the executor and groups the subject
-    says it was given (only to name the cause of what the judge saw)."""
-    groups = {name: (kind, number) for name, kind, number in reply.get('groups', [])}
-    if reply.get('executor') == 'SingleThreadedExecutor':
-        return ('a SingleThreadedExecutor runs one callback at a time, so slow_work holds up '
-                'heartbeat; return a MultiThreadedExecutor')
-    if reply.get('threads') == 1:
-        return ('a MultiThreadedExecutor with num_threads=1 runs one callback at a time: give '
-                'it num_threads=2')
-    if groups.get('slow_work') == groups.get('heartbeat') and \
-            groups.get('heartbeat', ('', 0))[0] == 'MutuallyExclusiveCallbackGroup':
-        return ("both timers are in one MutuallyExclusiveCallbackGroup (the node's default), "
-                'which runs one of its callbacks at a time; give each timer a group of its own')
-    return ('let the timers overlap: a MultiThreadedExecutor(num_threads=2), and a callback '
-            'group of its own for each timer')
-
-
-def _worker_refused(reply: dict) -> None:
-    """Raise for a worker the subject could not spin (its reply names what it found)."""
-    if reply.get('undefined'):
-        raise CheckFailed(f'promises.py defines no function {course.WORKER_FUNCTION}: write '
-                          'part 4 (and run its cell).')
-    if 'error' in reply:
-        raise learner_error(f'{course.WORKER_FUNCTION}()', reply['error'])
-    if 'returned' in reply:
-        raise CheckFailed(f'{course.WORKER_FUNCTION}() returned {reply["returned"]["value"]}; '
-                          'return two things, the Worker node and the executor to spin it: '
-                          'return node, executor.')
-    if 'timers' in reply:
-        raise CheckFailed(f'{course.WORKER_FUNCTION}() returned a node with {reply["timers"]} '
-                          'timer(s): return a Worker (part 3), whose two timers run slow_work '
-                          'and heartbeat.')
-    if reply.get('unmatched'):
-        raise CheckFailed("The worker's witness never reached the grader: is the machine very "
-                          'busy? Run this check again.')
-
-
-def _responsive_worker(judge: Judge) -> str:
-    subject = judge.file_subject(course.PROMISES_FILE)
-    observer = judge.observer
-    told = told_to(judge)
-    mark, token, name = len(told), new_token(), 'responsive_worker'
-    reply = subject.request('worker', name=course.WORKER_FUNCTION, topic=WITNESS_TOPIC,
-                            token=token, work_s=SLOW_WORK_S, seconds=ARRIVAL_TIMEOUT_S,
-                            timeout=ARRIVAL_TIMEOUT_S + 30)
-    if not reply.get('ok'):
-        judge.drop(('file', course.PROMISES_FILE))
-        _worker_refused(reply)
-
-    def seen() -> bool:
-        overlap, done = _overlapped(events(told, mark, token))
-        return overlap or done >= SLOW_RUNS_WATCHED
-
-    try:
-        observer.wait_until(seen, ARRIVAL_TIMEOUT_S)
-        # the name as the graph shows it, while the node runs (the reply only words a failure)
-        named = reply.get('name') == name and \
-            observer.wait_until(lambda: observer.has_node(name), ARRIVAL_TIMEOUT_S)
-    finally:
-        stopped = subject.request('worker_stop', timeout=60)
-        judge.drop(('file', course.PROMISES_FILE))
-    overlap, done = _overlapped(events(told, mark, token))
-    if stopped.get('failure'):
-        raise learner_error(stopped['failure']['callback'], stopped['failure'])
-    if not named:
-        raise CheckFailed(f"{course.WORKER_FUNCTION}() returned a Worker called "
-                          f"{reply.get('name')}; name it '{name}'.")
-    if overlap:
-        return (f'a heartbeat came while slow_work was busy, on a {reply["executor"]}: the two '
-                'timers run side by side.')
-    if done == 0:
-        raise CheckFailed(f'slow_work never finished in {ARRIVAL_TIMEOUT_S:g} s: keep both timers '
-                          'of the Worker running.')
-    raise CheckFailed(f'No heartbeat came while slow_work was busy ({done} runs of slow_work '
-                      f'watched): {_worker_cause(reply)}.')
-
-
-@judged
-def check_responsive_worker(judge: Judge) -> str:
-    """Check part 4 of ``promises.py``: a slow callback no longer holds up the heartbeat.
-
-    Calls your ``responsive_worker()`` for its node and executor, puts the course's own
-    callbacks on the Worker's two timers (in the callback groups you chose: a slow one that
-    works 0.45 s, a quick one) and spins your executor on the wall clock.  The course's
-    callbacks tell the grader when each runs: a heartbeat must run while ``slow_work`` is
-    busy.  When none does, the line says why, from the executor and the timers' callback
-    groups.
-
-    Introduced in ``06-five-promises.ipynb``.
-
-    :raises CheckFailed: naming the cause.
-    """
-    return _responsive_worker(judge)
-
-
 # ------------------------------------------------------------------ reusability
-def _room_arguments_of(subject, room: str) -> list[str]:
-    reply = subject.request('call', name=course.ROOMS_FUNCTION, inputs=[[room]])
-    if reply.get('undefined'):
+def _room_arguments_of(subject: Subject, room: str) -> list[str]:
+    reply = subject.request(Call(name=course.ROOMS_FUNCTION, inputs=[[room]]))
+    if reply.undefined:
         raise CheckFailed(f'promises.py defines no function {course.ROOMS_FUNCTION}: write part 5 '
                           '(and run its cell).')
-    output = reply['outputs'][0]
-    if 'error' in output:
-        raise learner_error(f"{course.ROOMS_FUNCTION}('{room}')", output['error'])
-    result = output['result']
-    if result['type'] not in ('list', 'tuple') or \
-            any(item['type'] != 'str' for item in result['value']):
-        raise CheckFailed(f"{course.ROOMS_FUNCTION}('{room}') returned {result['value']!r}; "
+    output = reply.outputs[0] if reply.outputs else None
+    if output is None or output.result is None:
+        raise raised(f"{course.ROOMS_FUNCTION}('{room}')", output.error if output else None)
+    result = output.result
+    if not isinstance(result.value, list) or any(item.type != 'str' for item in result.value):
+        raise CheckFailed(f"{course.ROOMS_FUNCTION}('{room}') returned {result.value!r}; "
                           "return a list of strings, e.g. ['--ros-args', '-r', ...].")
-    arguments = [item['value'] for item in result['value']]
+    arguments = [str(item.value) for item in result.value]
     if '--ros-args' not in arguments:
         raise CheckFailed(f"{course.ROOMS_FUNCTION}('{room}') returned {arguments}: a node reads "
                           "only the arguments after '--ros-args'; start the list with it.")
@@ -354,14 +235,16 @@ def _rooms(judge: Judge) -> str:
     seen: dict[str, str] = {}
     for room in (*course.ROOMS, _drawn_room(judge)):
         arguments = _room_arguments_of(subject, room)
-        reply = subject.request('room_nodes', arguments=arguments)
-        if not reply['ok']:
-            error = reply['error']
-            kind, text = str(error.get('type')), str(error.get('message'))
-            why = ros_arguments_mistake(kind, text) or f'{kind}: {text.splitlines()[0][:160]}'
+        reply = subject.request(RoomNodes(arguments=arguments))
+        if not reply.ok:
+            if reply.error is None:
+                raise raised(f"rooms started with {course.ROOMS_FUNCTION}('{room}')", None)
+            kind, text = reply.error.type, reply.error.message
+            why = ros_arguments_mistake(kind, text) or \
+                f'{kind}: {(text.splitlines() or [""])[0][:160]}'
             raise CheckFailed(f"rclpy refused the arguments {course.ROOMS_FUNCTION}('{room}') "
                               f'returned, {arguments}: {why}')
-        for name, namespace, endpoints in reply['nodes']:
+        for name, namespace, endpoints in reply.nodes:
             full = namespace.rstrip('/') + '/' + name
             found = judge.observer.endpoints(name, namespace, endpoints)
             if namespace != f'/{room}':
