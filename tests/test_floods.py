@@ -36,6 +36,16 @@ WORK = {'rosout': "self.get_logger().info('still here')",
         'topic': 'self.publisher_.publish(Float32(data=self.temperature))'}
 #: The constructor that floods ``kind`` (a key of WORK).
 FLOODS = {kind: FLOODING_CONSTRUCTOR.format(work=work) for kind, work in WORK.items()}
+READING_LINE = "        self.get_logger().info(f'Publishing: {self.temperature:.2f}C')\n"
+#: A slow flood inside the callback: each reading logged with 449 lines more, under the
+#: judge's flood limit per second of its clock (500), so that no flood is ever raised: a
+#: judge that hears it all for notebook 03's simulated hour (1.6 million lines) once cost
+#: 269 CPU-seconds, an honest one about 14; now it is stopped at its CPU limit.
+CALLBACK_LINES = 450
+SLOW_FLOOD = READING_LINE + f"""\
+        for line in range({CALLBACK_LINES - 1}):
+            self.get_logger().info(f'and again: line {{line}}')
+"""
 WHEN = r"(while the grader's clock stood still|in [\d.]+ s of the grader's clock)"
 #: The line each flood fails the constructor's check with.
 LINES = {'rosout': rf'^Your node temperature_sensor logged over 500 lines to /rosout {WHEN} .*'
@@ -45,10 +55,14 @@ LINES = {'rosout': rf'^Your node temperature_sensor logged over 500 lines to /ro
 
 
 def flooder_notebook(kind: str) -> dict:
-    """Notebook 03 as the solution, its constructor flooding ``kind`` (a key of WORK), as
-    a learner hands it in (for the grader: ``benchmarks/flood_class.py``,
+    """Notebook 03 as the solution, its constructor flooding ``kind`` (a key of WORK), or
+    with ``'callback'`` its callback logging :data:`CALLBACK_LINES` lines a reading, as a
+    learner hands it in (for the grader: ``benchmarks/flood_class.py``,
     ``tests/test_notebook_cpu.py``)."""
     from corpora import Learner, submission
+    if kind == 'callback':
+        return submission(Learner('flooder', '03', {'sensor-callback': [
+            (READING_LINE, SLOW_FLOOD)]}))
     return submission(Learner('flooder', '03', {'sensor-constructor': [
         (STARTED_LINE, FLOODS[kind])]}))
 
