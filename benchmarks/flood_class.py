@@ -57,7 +57,8 @@ def flooder_result(out: Path) -> str:
     for page in (out / 'feedback' / 'flooder').rglob('03*.html'):
         text = html.unescape(re.sub(r'<[^>]+>', ' ', page.read_text()))
         found += sorted({m.strip() for m in re.findall(
-            r'(?:CheckFailed|LearnerCodeError|Your node|Your code|Checking it)[^\n]{0,300}',
+            r'(?:CheckFailed|LearnerCodeError|Your node|Your code|checking it reached)'
+            r'[^\n]{0,300}',
             text)})
     return '\n'.join(found)
 

@@ -117,7 +117,7 @@ def expected_score(learner: Learner) -> float:
     return sum(p for gid, p in points(learner.notebook).items() if gid not in learner.loses)
 
 
-def _write_parts(nb: dict) -> None:
+def write_parts(nb: dict) -> None:
     """What the notebook's ``%%part`` cells write, in notebook order (as its kernel did)."""
     from ros2nb import course
     from ros2nb.terminal.files import write_part
@@ -165,7 +165,7 @@ def learner_workspace(learner: Learner, root: Path) -> Iterator[tuple[Path, dict
             course.catch_up(number)
         else:
             create_workspace()
-        _write_parts(nb)
+        write_parts(nb)
         yield ws, nb
 
 
@@ -194,12 +194,22 @@ def grade_learner(learner: Learner, root: Path, *, knows_nothing: bool = False
     command = [sys.executable, str(ROOT / 'tests' / 'judge_apart.py'),
                *(['--knows-nothing'] if knows_nothing else []),
                str(given / 'source.ipynb'), str(given / 'submission.ipynb')]
-    judge = subprocess.Popen(command, env=env, cwd=root, text=True, stdout=subprocess.PIPE,
-                             stderr=subprocess.PIPE, start_new_session=True)
+    # Bounded as the grader bounds a judge: its CPU time and its subjects' together.
+    from ros2nb_instructor.grading import sandbox
+    from ros2nb_instructor.grading.judging import stopped_verdict
+    from ros2nb_instructor.grading.settings import JUDGE_CPU_S
+    judge = sandbox.watched(command, sandbox.Limits(wall_s=JUDGE_TIMEOUT_S, cpu_s=JUDGE_CPU_S),
+                            env=env, cwd=root, text=True, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, start_new_session=True)
     try:
-        out, err = judge.communicate(timeout=JUDGE_TIMEOUT_S)
+        ended = sandbox.run_to_end(judge)
     finally:
-        kill_process_group(judge)  # what it left (nothing, once it answered)
+        kill_process_group(judge.process)  # what it left (nothing, once it answered)
+    out, err = ended.stdout, ended.stderr
+    assert not ended.timed_out, f'the judge took over {JUDGE_TIMEOUT_S} s: {out}{err}'
+    if ended.out_of_cpu:
+        verdict = stopped_verdict(out, given / 'source.ipynb', JUDGE_CPU_S)
+        return {gid[3:]: result for gid, result in verdict.results.items()}
     lines = out.strip().splitlines()
     assert lines and lines[-1].startswith('{'), f'the judge printed no result: {out}{err}'
     results = json.loads(lines[-1])['results']

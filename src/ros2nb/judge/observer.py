@@ -123,9 +123,9 @@ class Observer:
     def _stopping(self) -> bool:
         return self._stop
 
-    def _on_log(self, msg: Log) -> None:
+    def _on_log(self, msg: Log, info: Any) -> None:
         with self.changed:
-            if self.floods.count('/rosout', msg.name):
+            if self.floods.stale(info) or self.floods.count('/rosout', msg.name):
                 return
             self.logs.append(Line(self.now_ns, msg.name, msg.level, msg.msg))
             self.log_counts[msg.name] += 1
@@ -141,9 +141,9 @@ class Observer:
         if topic not in self.heard:
             self.heard[topic] = store = []
 
-            def note(msg: Any) -> None:
+            def note(msg: Any, info: Any) -> None:
                 with self.changed:
-                    if self.floods.count(topic, topic):
+                    if self.floods.stale(info) or self.floods.count(topic, topic):
                         return
                     store.append(Heard(self.now_ns, keep(msg)))
                     self.changed.notify_all()
