@@ -34,7 +34,8 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / 'tests'))  # judging.py, the corpora
 SOLUTIONS = ROOT / 'solutions'
 NOTEBOOKS = {p.stem[:2]: p for p in SOLUTIONS.glob('*.ipynb')}
-#: Seconds one learner's judge may take (below the corpora's test limit of 300 s).
+#: Seconds one learner's judge may take (below the corpora's test limit of 300 s); then, as
+#: at its CPU limit, the cells it had not checked fail with the line that says so.
 JUDGE_TIMEOUT_S = 270
 #: A cell's new text, or (old, new) replacements in it.
 Change = Union[str, list[tuple[str, str]]]
@@ -206,10 +207,12 @@ def grade_learner(learner: Learner, root: Path, *, knows_nothing: bool = False
     finally:
         kill_process_group(judge.process)  # what it left (nothing, once it answered)
     out, err = ended.stdout, ended.stderr
-    assert not ended.timed_out, f'the judge took over {JUDGE_TIMEOUT_S} s: {out}{err}'
-    if ended.out_of_cpu:
-        verdict = stopped_verdict(out, given / 'source.ipynb', JUDGE_CPU_S)
-        return {gid[3:]: result for gid, result in verdict.results.items()}
+    if ended.out_of_cpu or ended.timed_out:  # what it had not checked scores nothing, as
+        verdict = stopped_verdict(out, given / 'source.ipynb',  # in the grader
+                                  ended.out_of_cpu and JUDGE_CPU_S)
+        unchecked = {'passed': False, 'type': 'GradingError', 'message': verdict.problem}
+        return {gid: verdict.results.get(f'{learner.notebook}-{gid}', unchecked)
+                for gid in points(learner.notebook)}
     lines = out.strip().splitlines()
     assert lines and lines[-1].startswith('{'), f'the judge printed no result: {out}{err}'
     results = json.loads(lines[-1])['results']
