@@ -88,6 +88,11 @@ def class_folder(folder: Path, learners: int, corpus: bool) -> None:
                 json.dumps(submission(learner)))
 
 
+def handed(folder: Path) -> set[tuple[str, str]]:
+    """(learner, notebook number) of every notebook in the class ``folder``."""
+    return {(p.parent.name, p.name[:2]) for p in folder.glob('*/*.ipynb')}
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--learners', type=int, default=2)
@@ -112,6 +117,11 @@ def main() -> int:
             with TreeCpu(proc.pid) as cpu:
                 output, _ = proc.communicate()
             wall = time.monotonic() - started
+            short = [row for row in (Path(tmp) / 'grading' / 'grades.csv').read_text()
+                     .splitlines()[1:] if 'TOTAL' not in row and
+                     (row.split(',')[0], row.split(',')[1][:2]) in handed(Path(tmp) / 'class')
+                     and row.split(',')[2] != row.split(',')[3]] \
+                if proc.returncode == 0 else []
     finally:
         for burner in burners:
             burner.kill()
@@ -119,6 +129,9 @@ def main() -> int:
             group.rmdir()
     if proc.returncode != 0:
         sys.exit(f'ros2nb-grade exited {proc.returncode}: {output[-800:]}')
+    noted = [line for line in output.splitlines() if line.endswith(')') and ': ' in line]
+    print(f'handed-in notebooks below full marks: {short or "none"}')
+    print('notes: ' + ('\n'.join(noted) if noted else 'none'))
     largest: dict[tuple[str, str], float] = {}
     for (_learner, part, notebook), seconds in per_notebook(cpu).items():
         largest[(notebook, part)] = max(largest.get((notebook, part), 0.0), seconds)
