@@ -52,7 +52,7 @@ from ..paths import ROOT
 from . import sandbox
 from .gradebook import Scoring, collect_zip, set_up_course, write_results
 from .judging import Judges
-from .learners import grade_learner
+from .learners import file_graded, grade_learner
 from .report import write_report
 from .settings import CELL_TIMEOUT_S, JOBS, NOTEBOOK_CPU_S, NOTEBOOK_TIMEOUT_S, Settings
 from .submissions import Learner, find_learners
@@ -125,7 +125,8 @@ def _grade_all(course: Path, learners: list[Learner], notebooks: list[str],
 
         def grade(learner: Learner) -> None:
             try:
-                grade_learner(course, Path(scratch_root), learner, notebooks, settings, judges)
+                file_graded(course, learner, grade_learner(course, Path(scratch_root), learner,
+                                                           notebooks, settings, judges))
             finally:
                 print(progress.learner_done(learner), flush=True)
 
