@@ -6,15 +6,29 @@ module is the second wall: the page's body goes through nh3 (the Ammonia sanitis
 head is rebuilt from the template's own style sheets only (no script, no remote load), and
 a Content-Security-Policy forbids every script and every load but inline styles and
 ``data:`` images.  A page opens the same in the instructor's and the learner's browser.
+The pages' HTML is jinja2's, from ``templates/`` (autoescape on: every value is text unless
+a template says it is HTML the grader made, such as a body nh3 cleaned).
 """
 
 from __future__ import annotations
 
-import html
 import re
-from typing import Sequence
+from typing import Any, Sequence
 
+import jinja2
 import nh3
+
+#: The grader's templates (``templates/*.j2``); every value they show is escaped.
+TEMPLATES = jinja2.Environment(loader=jinja2.PackageLoader(__package__, 'templates'),
+                               autoescape=True, undefined=jinja2.StrictUndefined)
+
+
+def render(template: str, **values: Any) -> str:
+    """``templates/<template>`` with ``values`` (escaped, unless the template marks one safe).
+
+    :raises jinja2.UndefinedError: when the template uses a value not given.
+    """
+    return TEMPLATES.get_template(template).render(**values)
 
 #: The page may show inline styles and data: images, and load or run nothing else.
 CSP = ("default-src 'none'; img-src data:; style-src 'unsafe-inline'; font-src data:; "
@@ -46,13 +60,11 @@ def clean_body(body: str) -> str:
                      strip_comments=True)
 
 
-def page(title: str, body: str, styles: list[str] = (), body_class: str = '') -> str:
-    """A whole page: CSP, the title as text, the given style sheets, the body sanitised."""
-    css = ''.join(f'<style>{s}</style>' for s in styles if '</' not in s)
-    return (f'<!DOCTYPE html>\n<html><head><meta charset="utf-8">'
-            f'<meta http-equiv="Content-Security-Policy" content="{CSP}">'
-            f'<title>{html.escape(title)}</title>{css}</head>\n'
-            f'<body class="{html.escape(body_class)}">{clean_body(body)}</body></html>\n')
+def page(title: str, body: str, styles: Sequence[str] = (), body_class: str = '') -> str:
+    """A whole page (``templates/page.html.j2``): CSP, the title as text, the given style
+    sheets (none that could end its ``<style>``), the body sanitised."""
+    return render('page.html.j2', csp=CSP, title=title, body_class=body_class,
+                  styles=[s for s in styles if '</' not in s], body=clean_body(body)) + '\n'
 
 
 #: What the feedback page says above the judge's flags (:mod:`ros2nb.judge.flags`).
@@ -64,12 +76,8 @@ FLAGS_WHY = ('These lines reach past what the lessons use (into the course\'s ow
 
 def flags_html(flags: Sequence[str]) -> str:
     """The judge's flags of one notebook as a box of the feedback page (empty for none);
-    each flag is text, escaped."""
-    if not flags:
-        return ''
-    items = ''.join(f'<li><code>{html.escape(flag)}</code></li>' for flag in flags)
-    return (f'<div id="flags" class="flags"><h2>{FLAGS_HEADING}</h2><p>{FLAGS_WHY}</p>'
-            f'<ul>{items}</ul></div>')
+    each flag is text, escaped (``templates/flags.html.j2``)."""
+    return render('flags.html.j2', flags=flags, heading=FLAGS_HEADING, why=FLAGS_WHY)
 
 
 def safe_feedback(made: str, title: str, flags: Sequence[str] = ()) -> str:

@@ -11,7 +11,6 @@ import contextlib
 import csv
 import fcntl
 import hashlib
-import html
 import json
 import os
 import shutil
@@ -145,8 +144,8 @@ def collect_zip(archive: Path, course: Path) -> tuple[Path, list[str]]:
 
 
 def _not_submitted_page(learner: Learner, notebook: str, points: float) -> str:
-    return feedback.page(notebook, f'<h1>{html.escape(learner.shown)}: {notebook}</h1><p>Not '
-                                   f'submitted: 0 of {points:g} points.</p>')
+    return feedback.page(notebook, feedback.render('not_submitted.html.j2', learner=learner.shown,
+                                                   notebook=notebook, points=f'{points:g}'))
 
 
 def write_results(course: Path, out: Path, learners: list[Learner],
@@ -178,7 +177,8 @@ def write_results(course: Path, out: Path, learners: list[Learner],
                     why = (f'its feedback page could not be written ({type(error).__name__}: '
                            f'{str(error)[:200]}); the score stands')
                     learner.note(notebook, why)
-                    page.write_text(feedback.page(notebook, f'<p>{html.escape(why)}</p>'))
+                    page.write_text(feedback.page(notebook, feedback.render(
+                        'paragraph.html.j2', text=why)))
             rows.append([learner.shown, 'TOTAL', f'{total:g}', f'{sum(maxima.values()):g}'])
     with open(out / 'grades.csv', 'w', newline='') as stream:
         writer = csv.writer(stream)
