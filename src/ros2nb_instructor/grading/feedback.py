@@ -13,7 +13,7 @@ a template says it is HTML the grader made, such as a body nh3 cleaned).
 from __future__ import annotations
 
 import re
-from typing import Any, Sequence
+from typing import Any, Mapping, Optional, Sequence
 
 import jinja2
 import nh3
@@ -80,12 +80,29 @@ def flags_html(flags: Sequence[str]) -> str:
     return render('flags.html.j2', flags=flags, heading=FLAGS_HEADING, why=FLAGS_WHY)
 
 
-def safe_feedback(made: str, title: str, flags: Sequence[str] = ()) -> str:
-    """nbgrader's feedback page ``made`` rebuilt by :func:`page` (its styles kept), with the
-    judge's ``flags`` of the notebook first (:func:`flags_html`)."""
+def late_html(late: Any) -> str:
+    """A notebook's :class:`.deadlines.Lateness` as the box of the feedback page that says when
+    it was due and handed in, its score before lateness, the penalty and its score (empty
+    when it had no due date)."""
+    if late is None or late.due is None:
+        return ''
+    when = late.handed_in.isoformat(sep=' ') + f' ({late.source})' if late.handed_in else \
+        'the submission says no time'
+    return render('late.html.j2', late={
+        'due': late.due.isoformat(sep=' '), 'handed_in': when, 'raw': f'{late.raw:g}',
+        'penalty': f'{late.penalty:g}', 'final': f'{late.final:g}', 'note': late.note})
+
+
+def safe_feedback(made: str, title: str, flags: Sequence[str] = (), late: Any = None,
+                  progress: Optional[Sequence[Mapping[str, Any]]] = None) -> str:
+    """nbgrader's feedback page ``made`` rebuilt by :func:`page` (its styles kept), headed by
+    the learner's ``progress`` (rows of ``notebook``, ``part``, ``status``, ``points``, from
+    wherever the course keeps it; none: no table), the notebook's lateness
+    (:func:`late_html`) and the judge's ``flags`` (:func:`flags_html`)."""
     head, _, rest = made.partition('<body')
     tag, _, body = rest.partition('>')
-    body = flags_html(flags) + body.rsplit('</body>', 1)[0]
+    body = (render('progress.html.j2', progress=progress) + late_html(late) + flags_html(flags)
+            + body.rsplit('</body>', 1)[0])
     styles = re.findall(r'<style[^>]*>(.*?)</style>', head, flags=re.S | re.I)
     found = re.search(r'class="([\w\s-]*)"', tag)
     return page(title, body, styles, found.group(1) if found else '')

@@ -19,6 +19,7 @@ from pathlib import Path
 
 from ..paths import SOLUTIONS
 from . import feedback, similarity
+from .deadlines import late_by
 from .submissions import Learner
 
 #: Failure lines listed (the most frequent first).
@@ -138,6 +139,22 @@ def _alike(notebooks: list[str], learners: list[Learner], course: Path) -> dict[
             'min_tokens': similarity.MIN_TOKENS}
 
 
+def _late_rows(notebooks: list[str], learners: list[Learner]) -> list[dict[str, object]]:
+    """Per learner and notebook with a due date: when it was handed in, its score before
+    lateness, the penalty, its score, and the note (:mod:`.deadlines`)."""
+    rows = []
+    for learner in learners:
+        for notebook in notebooks:
+            late = learner.late.get(notebook)
+            if late is not None and late.due is not None:
+                rows.append({'learner': learner.shown, 'notebook': notebook,
+                             'handed_in': late.handed_in.isoformat(sep=' ') if late.handed_in
+                             else '–', 'late_by': late_by(late.late_s) if late.late_s else '',
+                             'raw': f'{late.raw:g}', 'penalty': f'{late.penalty:g}',
+                             'final': f'{late.final:g}', 'note': late.note})
+    return rows
+
+
 def write_report(out: Path, learners: list[Learner], notebooks: list[str],
                  rows: list[list[str]], refused: list[str], course: Path = SOLUTIONS) -> Path:
     """Write ``out/report.html`` for the graded class (``templates/report.html.j2``); return
@@ -164,6 +181,7 @@ def write_report(out: Path, learners: list[Learner], notebooks: list[str],
         failures=_failure_rows(learners), notebook_names=notebooks,
         learner_rows=_learner_rows(notebooks, scores, learners, totals),
         alike=_alike(notebooks, learners, course), refused=refused,
+        late_rows=_late_rows(notebooks, learners),
         notes=[(learner.shown, key, text) for learner in learners
                for key, text in sorted(learner.notes.items())])
     path = out / 'report.html'
