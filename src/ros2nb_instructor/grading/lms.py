@@ -2,8 +2,7 @@
 
 Runs on the instructor's host, after nbgrader scored the class (``make grade ... EXPORT=canvas``).
 Each format is an nbgrader export plugin (:class:`nbgrader.plugins.ExportPlugin`: ``to``, and
-``export(gradebook)``), so ``nbgrader export --exporter`` can run it on the gradebook under
-``grading/nbgrader`` too.  A score is nbgrader's, less the late penalty grading stored beside it
+``export(gradebook)``), given the roster and the learners' names by :mod:`.term`.  A score is nbgrader's, less the late penalty grading stored beside it
 (:mod:`.deadlines`).  A roster (CSV, :func:`read_roster`) maps the course's learner names (their
 folders) to the platform's ids: a learner of the roster with nothing handed in gets 0 on every
 notebook, with a note; a learner who handed in and is not in the roster is written to
