@@ -137,9 +137,15 @@ def on_dask(tmp_path_factory):
     yield OnDask(out, done, killed, here, done_here)
 
 
+#: A learner's scratch folder, as a cell's output may show it: new for every grading (here
+#: under the grader's temporary folder, on a worker under the worker's).
+SCRATCH = re.compile(r'/tmp/ros2nb-(?:grading|worker)-\w+/(?:scratch/)?learner-\w+/')
+
+
 def pages(out: Path) -> dict[str, str]:
-    """Every feedback page of a grading: its path under feedback/ -> its text."""
-    return {str(p.relative_to(out / 'feedback')): p.read_text()
+    """Every feedback page of a grading: its path under feedback/ -> its text, the learner's
+    scratch folder aside."""
+    return {str(p.relative_to(out / 'feedback')): SCRATCH.sub('<scratch>/', p.read_text())
             for p in sorted((out / 'feedback').rglob('*.html'))}
 
 
@@ -171,8 +177,9 @@ def test_the_class_on_dask_scores_as_the_local_run(on_dask):
 @pytest.mark.judge
 @pytest.mark.kernel
 def test_a_class_graded_on_dask_ends_as_graded_here(on_dask):
-    """The same feedback pages, byte for byte (the flags box of a flagged learner too), the
-    same grades.csv and the same notes: what a worker made of a learner came back whole."""
+    """The same feedback pages, byte for byte but for the learner's scratch folder a cell may
+    print (the flags box of a flagged learner too), the same grades.csv and the same notes:
+    what a worker made of a learner came back whole."""
     assert on_dask.done_here.returncode == 0, on_dask.done_here.stdout + on_dask.done_here.stderr
     assert on_dask.done.returncode == 0, on_dask.done.stdout + on_dask.done.stderr
     here, there = pages(on_dask.here), pages(on_dask.out)
