@@ -250,5 +250,6 @@ def test_a_class_under_two_policies_exported_and_one_learner_again(tmp_path):
     assert again.returncode == 0, again.stdout + again.stderr
     rows = csv_rows(tmp_path / 'daily')
     assert float(rows['a-day-late']['late_penalty']) == pytest.approx(0.3)  # hourly now
-    assert float(rows['past-cutoff']['score']) == 0  # the others as graded under the daily
+    # The others are not graded again; the settings as they are now apply to the whole class.
+    assert float(rows['past-cutoff']['score']) == pytest.approx(0.7)
     assert 'a-day-late graded' in again.stdout and 'on-time graded' not in again.stdout
