@@ -142,6 +142,10 @@ def on_dask(tmp_path_factory):
 SCRATCH = re.compile(r'/tmp/ros2nb-(?:grading|worker)-\w+/(?:scratch/)?learner-\w+/')
 
 
+#: The box of "Code your instructor will look at" on a feedback page.
+FLAGS_BOX = re.compile(r'<div id="flags".*?</ul>', re.S)
+
+
 def pages(out: Path) -> dict[str, str]:
     """Every feedback page of a grading: its path under feedback/ -> its text, the learner's
     scratch folder aside."""
@@ -185,6 +189,8 @@ def test_a_class_graded_on_dask_ends_as_graded_here(on_dask):
     here, there = pages(on_dask.here), pages(on_dask.out)
     assert FLAGS_HEADING in here[f'reaches-in/{NB01}.html']  # the box the cluster must carry
     assert sorted(there) == sorted(here)
+    for page in here:  # the flags box first: a worker that lost the flags fails here, named
+        assert FLAGS_BOX.findall(there[page]) == FLAGS_BOX.findall(here[page]), page
     for page in here:
         assert there[page] == here[page], page
     for made in ('grades.csv', 'notes.json'):
