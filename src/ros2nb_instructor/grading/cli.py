@@ -312,8 +312,9 @@ def _grade_with(cluster: Optional['Cluster'], args: argparse.Namespace, submissi
                                            term.deadlines.zip_time_zone)
     learners, not_learners = find_learners(submissions, notebooks)
     for learner in learners:  # a platform zip's times, where its folder had no timestamp.txt
-        learner.handed_in.update({n: times[learner.name, p.name] for n, p in learner.files.items()
-                                  if n not in learner.handed_in and (learner.name, p.name) in times})
+        learner.handed_in.update({n: times[learner.name, p.name]
+                                  for n, p in learner.files.items() if n not in learner.handed_in
+                                  and (learner.name, p.name) in times})
     refused += not_learners
     for line in refused:
         print(f'not graded: {line}')

@@ -2,11 +2,12 @@
 
 Runs on the instructor's host, after nbgrader scored the class (``make grade ... EXPORT=canvas``).
 Each format is an nbgrader export plugin (:class:`nbgrader.plugins.ExportPlugin`: ``to``, and
-``export(gradebook)``), given the roster and the learners' names by :mod:`.term`.  A score is nbgrader's, less the late penalty grading stored beside it
-(:mod:`.deadlines`).  A roster (CSV, :func:`read_roster`) maps the course's learner names (their
-folders) to the platform's ids: a learner of the roster with nothing handed in gets 0 on every
-notebook, with a note; a learner who handed in and is not in the roster is written to
-``not-in-roster.csv`` beside the export, with their scores, and named on the console.
+``export(gradebook)``), given the roster and the learners' names by :mod:`.term`. A score is
+nbgrader's, less the late penalty grading stored beside it (:mod:`.deadlines`). A roster (CSV,
+:func:`read_roster`) maps the course's learner names (their folders) to the platform's ids: a
+learner of the roster with nothing handed in gets 0 on every notebook, with a note; a learner who
+handed in and is not in the roster is written to ``not-in-roster.csv`` beside the export, with their
+scores, and named on the console.
 
 The columns follow the platforms' documented imports (docs/instructors.md cites the pages):
 Canvas matches a row by ``ID``, ``SIS User ID`` or ``SIS Login ID`` and reads one column per
