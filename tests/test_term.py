@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pytest
 
-from ros2nb_instructor.grading import deadlines, lms, sandbox
+from ros2nb_instructor.grading import deadlines, feedback, lms, sandbox
 from ros2nb_instructor.grading.submissions import TIMESTAMP, ZIP_ENTRY, find_learners, screen_zip
 
 NB01 = '01-create-a-workspace'
@@ -91,6 +91,17 @@ def test_each_policy_costs_what_it_says(tmp_path, policy):
         assert (late.raw, late.penalty, late.final) == pytest.approx(EXPECTED[policy][learner]), \
             (learner, late)
         assert bool(late.note) == (EXPECTED[policy][learner][1] > 0 or stamp is None), late
+
+
+def test_the_feedback_box_shows_both_times_in_the_due_dates_zone(tmp_path):
+    """Due at 01:59 in +02:00, handed in 23:59 UTC the next day: the box says 01:59+02:00 for
+    both, a day apart, and is red (lateness cost points)."""
+    late = deadlines.assess(settings(tmp_path, HOURLY), NB01, 1.0,
+                            (deadlines_time(HANDED_IN['a-day-late']), TIMESTAMP))
+    box = feedback.late_html(late)
+    assert '<th>due</th><td>2026-10-06 01:59:00+02:00</td>' in box, box
+    assert '<th>handed in</th><td>2026-10-07 01:59:00+02:00 (timestamp.txt)</td>' in box, box
+    assert 'panel-danger' in box and '<th>score</th><td>0.7</td>' in box, box
 
 
 def deadlines_time(stamp: str) -> datetime.datetime:

@@ -138,6 +138,17 @@ class Lateness:
     def final(self) -> float:
         return max(0.0, self.raw - self.penalty)
 
+    def shown(self) -> tuple[str, str]:
+        """The due date, and when the notebook was handed in with where that time comes from
+        ('' when the submission says none), both in the due date's time zone, to the second:
+        the two compare at a glance."""
+        zone = self.due.tzinfo if self.due else None
+        due = self.due.isoformat(sep=' ', timespec='seconds') if self.due else ''
+        if self.handed_in is None:
+            return due, ''
+        when = self.handed_in.astimezone(zone) if zone else self.handed_in
+        return due, f'{when.isoformat(sep=" ", timespec="seconds")} ({self.source})'
+
 
 def late_by(seconds: float) -> str:
     """``seconds`` of lateness in words: ``1 day 2 h 5 min``."""

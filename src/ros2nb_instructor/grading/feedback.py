@@ -13,10 +13,13 @@ a template says it is HTML the grader made, such as a body nh3 cleaned).
 from __future__ import annotations
 
 import re
-from typing import Any, Mapping, Optional, Sequence
+from typing import TYPE_CHECKING, Any, Mapping, Optional, Sequence
 
 import jinja2
 import nh3
+
+if TYPE_CHECKING:
+    from .deadlines import Lateness
 
 #: The grader's templates (``templates/*.j2``); every value they show is escaped.
 TEMPLATES = jinja2.Environment(loader=jinja2.PackageLoader(__package__, 'templates'),
@@ -80,20 +83,29 @@ def flags_html(flags: Sequence[str]) -> str:
     return render('flags.html.j2', flags=flags, heading=FLAGS_HEADING, why=FLAGS_WHY)
 
 
-def late_html(late: Any) -> str:
-    """A notebook's :class:`.deadlines.Lateness` as the box of the feedback page that says when
-    it was due and handed in, its score before lateness, the penalty and its score (empty
-    when it had no due date)."""
+def late_html(late: Optional[Lateness]) -> str:
+    """A notebook's lateness as the box of the feedback page that says when it was due and
+    handed in (both in the due date's time zone), its score before lateness, the penalty and
+    its score (empty when it had no due date)."""
     if late is None or late.due is None:
         return ''
-    when = late.handed_in.isoformat(sep=' ') + f' ({late.source})' if late.handed_in else \
-        'the submission says no time'
+    due, when = late.shown()
     return render('late.html.j2', late={
-        'due': late.due.isoformat(sep=' '), 'handed_in': when, 'raw': f'{late.raw:g}',
-        'penalty': f'{late.penalty:g}', 'final': f'{late.final:g}', 'note': late.note})
+        'due': due, 'handed_in': when or 'the submission says no time', 'raw': f'{late.raw:g}',
+        'penalty': f'{late.penalty:g}', 'final': f'{late.final:g}', 'note': late.note,
+        'cost': late.penalty > 0})
 
 
-def safe_feedback(made: str, title: str, flags: Sequence[str] = (), late: Any = None,
+#: The boxes above nbgrader's feedback (:func:`safe_feedback`): bootstrap's panels, which
+#: nbgrader's page already styles, with room between a table's label and its value.
+ABOVE_STYLE = ('div.above .panel-heading h4{margin:0}'
+               'div.late th{padding:2px 2em 2px 0}div.late td{padding:2px 0}'
+               'div.late p{margin:.8em 0 0}'
+               'div.flags code{white-space:pre-wrap}')
+
+
+def safe_feedback(made: str, title: str, flags: Sequence[str] = (),
+                  late: Optional[Lateness] = None,
                   progress: Optional[Sequence[Mapping[str, Any]]] = None) -> str:
     """nbgrader's feedback page ``made`` rebuilt by :func:`page` (its styles kept), headed by
     the learner's ``progress`` (rows of ``notebook``, ``part``, ``status``, ``points``, from
@@ -101,8 +113,8 @@ def safe_feedback(made: str, title: str, flags: Sequence[str] = (), late: Any = 
     (:func:`late_html`) and the judge's ``flags`` (:func:`flags_html`)."""
     head, _, rest = made.partition('<body')
     tag, _, body = rest.partition('>')
-    body = (render('progress.html.j2', progress=progress) + late_html(late) + flags_html(flags)
-            + body.rsplit('</body>', 1)[0])
+    boxes = [render('progress.html.j2', progress=progress), late_html(late), flags_html(flags)]
+    body = render('above.html.j2', boxes=boxes) + body.rsplit('</body>', 1)[0]
     styles = re.findall(r'<style[^>]*>(.*?)</style>', head, flags=re.S | re.I)
     found = re.search(r'class="([\w\s-]*)"', tag)
-    return page(title, body, styles, found.group(1) if found else '')
+    return page(title, body, [*styles, ABOVE_STYLE], found.group(1) if found else '')

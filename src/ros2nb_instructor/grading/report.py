@@ -140,16 +140,17 @@ def _alike(notebooks: list[str], learners: list[Learner], course: Path) -> dict[
 
 
 def _late_rows(notebooks: list[str], learners: list[Learner]) -> list[dict[str, object]]:
-    """Per learner and notebook with a due date: when it was handed in, its score before
-    lateness, the penalty, its score, and the note (:mod:`.deadlines`)."""
+    """Per learner and notebook with a due date: when it was due and handed in, its score
+    before lateness, the penalty, its score, and the note (:mod:`.deadlines`)."""
     rows = []
     for learner in learners:
         for notebook in notebooks:
             late = learner.late.get(notebook)
             if late is not None and late.due is not None:
-                rows.append({'learner': learner.shown, 'notebook': notebook,
-                             'handed_in': late.handed_in.isoformat(sep=' ') if late.handed_in
-                             else '–', 'late_by': late_by(late.late_s) if late.late_s else '',
+                due, handed_in = late.shown()
+                rows.append({'learner': learner.shown, 'notebook': notebook, 'due': due,
+                             'handed_in': handed_in or '–',
+                             'late_by': late_by(late.late_s) if late.late_s else '',
                              'raw': f'{late.raw:g}', 'penalty': f'{late.penalty:g}',
                              'final': f'{late.final:g}', 'note': late.note})
     return rows
