@@ -26,6 +26,7 @@ import pytest
 
 from dask_cluster import kill_when_grading, local_cluster
 from grading_samples import EXPECTED, LEARNER, NB00, NB01, NB02, ROOT, SOLUTION, Case
+from notebook_outputs import sanitize
 from test_grading import CLASS_LIMIT_S, as_text, in_the_csv
 
 from ros2nb_instructor.grading import sandbox
@@ -148,8 +149,10 @@ FLAGS_BOX = re.compile(r'<div id="flags".*?</ul>', re.S)
 
 def pages(out: Path) -> dict[str, str]:
     """Every feedback page of a grading: its path under feedback/ -> its text, the learner's
-    scratch folder aside."""
-    return {str(p.relative_to(out / 'feedback')): SCRATCH.sub('<scratch>/', p.read_text())
+    scratch folder aside, and what nbval sets aside of the notebooks' outputs in ``make test``
+    (tests/sanitize.cfg: a build's seconds, a kernel's domain)."""
+    return {str(p.relative_to(out / 'feedback')): sanitize(SCRATCH.sub('<scratch>/',
+                                                                       p.read_text()))
             for p in sorted((out / 'feedback').rglob('*.html'))}
 
 
@@ -182,8 +185,8 @@ def test_the_class_on_dask_scores_as_the_local_run(on_dask):
 @pytest.mark.kernel
 def test_a_class_graded_on_dask_ends_as_graded_here(on_dask):
     """The same feedback pages, byte for byte but for the learner's scratch folder a cell may
-    print (the flags box of a flagged learner too), the same grades.csv and the same notes:
-    what a worker made of a learner came back whole."""
+    print and what nbval sets aside (the flags box of a flagged learner too), the same
+    grades.csv and the same notes: what a worker made of a learner came back whole."""
     assert on_dask.done_here.returncode == 0, on_dask.done_here.stdout + on_dask.done_here.stderr
     assert on_dask.done.returncode == 0, on_dask.done.stdout + on_dask.done.stderr
     here, there = pages(on_dask.here), pages(on_dask.out)
