@@ -11,6 +11,7 @@ from __future__ import annotations
 import csv
 import datetime
 import json
+import os
 import subprocess
 import sys
 import zipfile
@@ -18,8 +19,9 @@ from pathlib import Path
 
 import pytest
 
-from ros2nb_instructor.grading import deadlines, feedback, lms, sandbox
-from ros2nb_instructor.grading.submissions import TIMESTAMP, ZIP_ENTRY, find_learners, screen_zip
+from ros2nb_instructor.grading import deadlines, feedback, lms, sandbox, term
+from ros2nb_instructor.grading.submissions import (TIMESTAMP, ZIP_ENTRY, Learner, find_learners,
+                                                   screen_zip)
 
 NB01 = '01-create-a-workspace'
 NOTEBOOKS = ['00-setup-and-the-pubsub-idea', NB01]
@@ -136,6 +138,17 @@ def test_the_hand_in_time_comes_from_the_submission(tmp_path):
     assert times['bo', f'{NB01}.ipynb'] == (datetime.datetime(2026, 10, 6, 9, 30, tzinfo=berlin),
                                             ZIP_ENTRY)
     assert times['cy', f'{NB01}.ipynb'][1] == TIMESTAMP
+
+
+def test_learners_json_keeps_a_folder_name_that_is_not_utf8(tmp_path):
+    """A Windows zip's folder name in cp1252 (not UTF-8) comes back exactly as it was, so
+    LEARNER= finds its folder again (written as UTF-8 text, it stopped the class's grading)."""
+    name = os.fsdecode(b'Zo\xeb-cp1252')
+    learner = Learner(name, 'learner-001', {NB01: tmp_path / name / f'{NB01}.ipynb'})
+    learner.handed_in[NB01] = (DUE, TIMESTAMP)
+    term.save_state(tmp_path, [learner])
+    (back,) = term.load_state(tmp_path)
+    assert (back.name, back.files, back.handed_in) == (name, learner.files, learner.handed_in)
 
 
 ROSTER = ('learner,name,lms_id,sis_id,login,email,section\n'

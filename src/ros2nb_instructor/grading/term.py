@@ -101,12 +101,13 @@ def export(term: Term, course: Path, out: Path, learners: list[Learner],
 
 def save_state(out: Path, learners: list[Learner]) -> None:
     """``learners.json``: each learner's files, notes, results, flags and hand-in times, as
-    grading left them before nbgrader scored them (``--learner`` starts from it)."""
+    grading left them before nbgrader scored them (``--learner`` starts from it).  JSON's
+    ASCII escapes keep a folder name that is not UTF-8 (a Windows zip's) exactly as it is."""
     (out / STATE).write_text(json.dumps({learner.name: {
         'id': learner.id, 'files': {n: str(p) for n, p in learner.files.items()},
         'notes': learner.notes, 'results': learner.results, 'flags': learner.flags,
         'handed_in': {n: [t.isoformat(), s] for n, (t, s) in learner.handed_in.items()}}
-        for learner in learners}, ensure_ascii=False, indent=1) + '\n')
+        for learner in learners}, indent=1) + '\n')
 
 
 def load_state(out: Path) -> list[Learner]:
