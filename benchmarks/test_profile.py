@@ -2,11 +2,12 @@
 """Where ``make test``'s CPU goes: each test file (and each nbval pass) run alone, its CPU by kind.
 
 ``python benchmarks/test_profile.py [FILE ...]`` runs ``pytest FILE`` for every file of
-``tests/`` (or those named; ``solutions`` and ``notebooks`` name the two nbval passes), one
-after the other, each in one pytest process, and meanwhile reads every new process's CPU
-time from ``/proc`` (:class:`grading_profile.Sampler`).  It prints, per file, the wall
-seconds, the CPU seconds of every process started (pytest's own included) and the three
-kinds that took most; then the total.  ``make test`` is CPU-bound on two cores (its wall
+``tests/`` (or those named, ``test_x.py`` or ``tests/test_x.py``; ``solutions`` and
+``notebooks`` name the two nbval passes), one after the other, each in one pytest process,
+and meanwhile reads every new process's CPU time from ``/proc``
+(:class:`grading_profile.Sampler`).  It prints, per file, the wall seconds, the CPU seconds
+of every process started (pytest's own included) and the three kinds that took most; then
+the total.  ``make test`` is CPU-bound on two cores (its wall
 time is its CPU time over the cores it gets), so the total is what a cut must lower.
 
 The sampled CPU-s count every process started meanwhile, the test's or not: run it on an
@@ -39,7 +40,7 @@ NBVAL = {
 def profile(name: str) -> tuple[float, float, float, list[tuple[str, float, int]], int]:
     """Run one file (or nbval pass) alone: wall s, busy CPU s, own CPU s, CPU by kind,
     pytest's exit code."""
-    arguments = NBVAL.get(name, [f'tests/{name}'])
+    arguments = NBVAL.get(name, [f'tests/{Path(name).name}'])  # test_x.py or tests/test_x.py
     with Sampler() as sampler:
         busy, own, started = busy_cpu_s(), reaped_cpu_s(), time.monotonic()
         done = subprocess.run([sys.executable, '-m', 'pytest', '-q',
@@ -50,6 +51,9 @@ def profile(name: str) -> tuple[float, float, float, list[tuple[str, float, int]
 
 
 def main(names: list[str]) -> int:
+    if any(name.startswith('-') for name in names):
+        print(__doc__)
+        return 0 if names == ['--help'] else 2
     names = names or [*sorted(p.name for p in (ROOT / 'tests').glob('test_*.py')), *NBVAL]
     adopt_orphans()
     sys.stdout.reconfigure(line_buffering=True)
