@@ -154,8 +154,8 @@ bench: $(STAMP) bytecode sandbox-tool
 # Grade a class: SUBMISSIONS is a folder of <learner-id>/NN-*.ipynb or a platform .zip.
 # Output goes to grading/ (git-ignored); FORCE=1 replaces an earlier grading/.
 grade: $(STAMP) bytecode sandbox-tool
-	@test -n "$(SUBMISSIONS)" || { echo "Usage: make grade SUBMISSIONS=DIR (DIR/<learner>/NN-title.ipynb) or SUBMISSIONS=class.zip [FORCE=1] [NO_SANDBOX=1] [SEED=N] [SCHEDULER=tcp://host:8786]"; exit 2; }
-	$(VENV)/bin/ros2nb-grade "$(SUBMISSIONS)" $(if $(FORCE),--force) $(if $(NO_SANDBOX),--no-sandbox) $(if $(SEED),--seed $(SEED)) $(if $(SCHEDULER),--scheduler "$(SCHEDULER)")
+	@test -n "$(SUBMISSIONS)" || { echo "Usage: make grade SUBMISSIONS=DIR (DIR/<learner>/NN-title.ipynb) or SUBMISSIONS=class.zip [FORCE=1] [NO_SANDBOX=1] [SEED=N] [SCHEDULER=tcp://host:8786] [SETTINGS=course.toml] [EXPORT=canvas|moodle|csv ROSTER=roster.csv] [LEARNER=name]"; exit 2; }
+	$(VENV)/bin/ros2nb-grade "$(SUBMISSIONS)" $(if $(FORCE),--force) $(if $(NO_SANDBOX),--no-sandbox) $(if $(SEED),--seed $(SEED)) $(if $(SCHEDULER),--scheduler "$(SCHEDULER)") $(if $(SETTINGS),--settings "$(SETTINGS)") $(if $(EXPORT),--export "$(EXPORT)") $(if $(ROSTER),--roster "$(ROSTER)") $(if $(LEARNER),--learner "$(LEARNER)")
 
 clean:
 	rm -rf $(VENV) .cache .jupyter

@@ -113,6 +113,23 @@ def test_malformed_nbgrader_metadata_is_removed_not_fatal():
     assert json.dumps(scored)  # nothing unserialisable left
 
 
+def test_what_a_cell_printed_is_filed_whole_however_the_kernel_cut_it():
+    """The same prints, sent by the kernel in one piece or in three (its flushes fall where a
+    busy machine puts them), file the same notebook: the feedback page is the same."""
+    release = nbformat.read(SOLUTION[NB01], as_version=4)
+    printed = ['average rate: 2.000\n', '\tmin: 0.500s max: 0.500s\n', 'done\n']
+    made = []
+    for pieces in (printed, [''.join(printed)]):
+        executed = nbformat.read(SOLUTION[NB01], as_version=4)
+        cell = next(c for c in executed.cells
+                    if c.cell_type == 'code' and not c.metadata.get('nbgrader', {}).get('grade'))
+        cell.outputs = [*(nbformat.v4.new_output('stream', name='stdout', text=piece)
+                          for piece in pieces),
+                        nbformat.v4.new_output('stream', name='stderr', text='a warning\n')]
+        made.append(nbformat.writes(notebooks.for_scoring(release, executed, {})))
+    assert made[0] == made[1]
+
+
 def test_a_notebook_without_code_of_the_learner_is_not_attempted():
     """Only a notebook whose code cells are the release's, text for text, goes unrun (0 points,
     noted); any code of the learner's, wherever they put it, gets the notebook run."""

@@ -39,8 +39,8 @@ What it does not cover: the kernel is shared (a kernel exploit escapes, and unpr
 user namespaces widen the kernel's attack surface); CPU time is limited in total, not in
 rate (a busy sandbox slows the others until its limit); disk space in ``writable``
 folders is limited per file here, in total only where the caller mounted a size-capped
-tmpfs there (the grader does, :mod:`.scratch`), while ``/tmp`` and ``/dev/shm`` hold :data:`TMPFS_BYTES` each; a
-sandbox with ``share_network=True`` reaches every port its network
+tmpfs there (the grader does, :mod:`.scratch`), while ``/tmp`` and ``/dev/shm`` hold
+:data:`TMPFS_BYTES` each; a sandbox with ``share_network=True`` reaches every port its network
 namespace offers (a judge's subjects reach the judge's ports); timing and host-wide
 information such as ``/proc/meminfo`` stay visible.  A caller killed with SIGKILL takes its
 sandboxes along but leaves empty ``ros2nb-sandbox-*`` cgroups and ``/tmp/ros2nb-stage-*``.

@@ -143,8 +143,9 @@ def graded(cells: list[dict], course: Course) -> dict[str, str]:
             if old is not None:
                 found.pop(old, None)
             answer = course.parts.get(part)
+            own = bool(answer) and meta.get('solution') and meta.get('grade_id') == answer
             name = (str(meta.get('grade_id', '?')) if meta.get('solution') and answer is None
-                    else answer if answer and meta.get('solution') and meta.get('grade_id') == answer
+                    else str(answer) if own
                     else f'{answer} (an added cell)' if answer else f'{part[0]} part {part[1]}')
             written[part] = name
         elif meta.get('solution'):
