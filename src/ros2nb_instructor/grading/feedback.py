@@ -72,12 +72,19 @@ def flags_html(flags: Sequence[str]) -> str:
             f'<ul>{items}</ul></div>')
 
 
-def safe_feedback(made: str, title: str, flags: Sequence[str] = ()) -> str:
-    """nbgrader's feedback page ``made`` rebuilt by :func:`page` (its styles kept), with the
-    judge's ``flags`` of the notebook first (:func:`flags_html`)."""
+def standing_html(table: str) -> str:
+    """The learner's table of every notebook's parts (:func:`ros2nb.graded_parts.table_html`,
+    from the grader's results) as the box that heads each feedback page."""
+    return f'<div id="standing" class="standing">{table}</div>'
+
+
+def safe_feedback(made: str, title: str, flags: Sequence[str] = (), standing: str = '') -> str:
+    """nbgrader's feedback page ``made`` rebuilt by :func:`page` (its styles kept), headed by
+    the learner's ``standing`` in every notebook (:func:`standing_html`), then the judge's
+    ``flags`` of the notebook (:func:`flags_html`)."""
     head, _, rest = made.partition('<body')
     tag, _, body = rest.partition('>')
-    body = flags_html(flags) + body.rsplit('</body>', 1)[0]
+    body = standing + flags_html(flags) + body.rsplit('</body>', 1)[0]
     styles = re.findall(r'<style[^>]*>(.*?)</style>', head, flags=re.S | re.I)
     found = re.search(r'class="([\w\s-]*)"', tag)
     return page(title, body, styles, found.group(1) if found else '')

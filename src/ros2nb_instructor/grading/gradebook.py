@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Iterable, Optional
 
 from nbgrader.api import Gradebook, MissingEntry
+from ros2nb import graded_parts
 
 from ..paths import ASSIGNMENT, ROOT, SOLUTIONS, gradebook_url
 from . import feedback
@@ -144,9 +145,24 @@ def collect_zip(archive: Path, course: Path) -> tuple[Path, list[str]]:
     return collected, refused
 
 
-def _not_submitted_page(learner: Learner, notebook: str, points: float) -> str:
-    return feedback.page(notebook, f'<h1>{html.escape(learner.shown)}: {notebook}</h1><p>Not '
-                                   f'submitted: 0 of {points:g} points.</p>')
+def _not_submitted_page(learner: Learner, notebook: str, points: float, standing: str) -> str:
+    return feedback.page(notebook, f'{standing}<h1>{html.escape(learner.shown)}: {notebook}</h1>'
+                                   f'<p>Not submitted: 0 of {points:g} points.</p>')
+
+
+def standing_table(learner: Learner) -> str:
+    """The learner's table of every graded part of the course (:mod:`ros2nb.graded_parts`),
+    from this grading's own results (the judge's, never the learner's record of their lab):
+    passed, failed, or not handed in, with its points."""
+    parts = graded_parts.parts(SOLUTIONS)
+    states = {}
+    for part in parts:
+        result = learner.results.get(part.notebook, {}).get(part.grade_id, {})
+        states[part.grade_id] = (graded_parts.NOT_HANDED_IN if part.notebook not in learner.files
+                                 else graded_parts.PASSED if result.get('passed') is True
+                                 else graded_parts.FAILED)
+    return graded_parts.table_html(graded_parts.rows(parts, states),
+                                   'Every notebook, as the grader found it')
 
 
 def write_results(course: Path, out: Path, learners: list[Learner],
@@ -157,6 +173,7 @@ def write_results(course: Path, out: Path, learners: list[Learner],
         maxima = {nb.name: nb.max_score for nb in gb.find_assignment(ASSIGNMENT).notebooks}
         for learner in learners:
             total = 0.0
+            standing = feedback.standing_html(standing_table(learner))
             folder = out / 'feedback' / learner.name
             folder.mkdir(parents=True, exist_ok=True)
             for notebook in notebooks:
@@ -170,10 +187,11 @@ def write_results(course: Path, out: Path, learners: list[Learner],
                 page = folder / f'{notebook}.html'
                 try:
                     if notebook in learner.files and made.is_file():
-                        page.write_text(feedback.safe_feedback(made.read_text(), notebook,
-                                                           learner.flags.get(notebook, ())))
+                        page.write_text(feedback.safe_feedback(
+                            made.read_text(), notebook, learner.flags.get(notebook, ()), standing))
                     else:
-                        page.write_text(_not_submitted_page(learner, notebook, maxima[notebook]))
+                        page.write_text(_not_submitted_page(learner, notebook, maxima[notebook],
+                                                            standing))
                 except Exception as error:  # noqa: BLE001 - that page's problem, in a note
                     why = (f'its feedback page could not be written ({type(error).__name__}: '
                            f'{str(error)[:200]}); the score stands')
