@@ -11,14 +11,12 @@ from __future__ import annotations
 
 import contextlib
 import io
-import json
-import os
-import queue
 import re
 import textwrap
 from pathlib import Path
 
 import pytest
+from kernels import Kernel, solution_cells
 
 import ros2nb
 from ros2nb import course
@@ -30,13 +28,7 @@ ROOT = Path(__file__).resolve().parent.parent
 MARKERS = ('### BEGIN SOLUTION', '### END SOLUTION')
 
 
-def cells(notebook: str) -> dict[str, str]:
-    """A solution notebook's code cells by id."""
-    nb = json.loads((ROOT / 'solutions' / f'{notebook}.ipynb').read_text())
-    return {c['id']: ''.join(c['source']) for c in nb['cells'] if c['cell_type'] == 'code'}
-
-
-N04, N08 = cells('04-write-the-subscriber'), cells('08-parameters')
+N04, N08 = solution_cells('04-write-the-subscriber'), solution_cells('08-parameters')
 #: The subscriber's parts as 04 writes them, and as 08 writes them.
 PARTS_04 = {3: N04['c43c4e05'], 4: N04['9bfa2c2b']}
 PARTS_08 = {1: N08['08-18'], 2: N08['08-19'], 3: N08['08-21'], 4: N08['08-24'], 5: N08['08-27']}
@@ -214,68 +206,30 @@ def test_import_file_follows_every_edit(workspace):
 
 
 # ------------------------------------------------------------------ the walk, in real kernels
-class Kernel:
-    """A real kernel and a way to run one cell in it (stdout, and the error's one line)."""
-
-    def __init__(self, env: dict[str, str]) -> None:
-        from jupyter_client.manager import start_new_kernel
-        self.manager, self.client = start_new_kernel(kernel_name='python3', env=env)
-
-    def run(self, code: str, seconds: float = 300) -> dict:
-        from waiting import wait_until
-        msg_id = self.client.execute(code)
-        result = {'error': None, 'stdout': ''}
-
-        def finished() -> bool:
-            try:
-                msg = self.client.get_iopub_msg(timeout=0.25)
-            except queue.Empty:
-                return False
-            if msg['parent_header'].get('msg_id') != msg_id:
-                return False
-            kind, content = msg['msg_type'], msg['content']
-            if kind == 'error':
-                result['error'] = (content['ename'], [re.sub(r'\x1b\[[0-9;]*m', '', line)
-                                                      for line in content['traceback']])
-            elif kind == 'stream' and content['name'] == 'stdout':
-                result['stdout'] += content['text']
-            return kind == 'status' and content['execution_state'] == 'idle'
-
-        assert wait_until(finished, seconds, interval=0), f'the cell did not finish: {code!r}'
-        return result
-
-    def close(self) -> None:
-        self.client.stop_channels()
-        self.manager.shutdown_kernel(now=True)
-
-
 @pytest.mark.kernel
 @pytest.mark.ros
 @pytest.mark.timeout(900)
 def test_10_after_an_unfinished_08_says_what_to_finish_and_passes_once_it_is(tmp_path):
-    env = {k: v for k, v in os.environ.items() if k != 'ROS_DOMAIN_ID'}
-    env['ROS2NB_WORKSPACE'] = str(tmp_path / 'ws')
-    n10 = cells('10-record-and-replay')
-    eight, ten = Kernel(env), Kernel(env)
+    n10 = solution_cells('10-record-and-replay')
+    eight, ten = Kernel(tmp_path / 'ws'), Kernel(tmp_path / 'ws')
     try:
         # 04's monitor, whole; then 08's parts, part 4 left out: the walk's workspace.
         eight.run('%load_ext ros2nb\nimport ros2nb\nws = ros2nb.course.catch_up(5)\n'
                   'SUBSCRIBER = ros2nb.course.SUBSCRIBER_FILE')
         for cell in (N04['72a68119'], N04['426b2e3a'], PARTS_04[3], PARTS_04[4], N04['20f95939'],
                      PARTS_08[1], PARTS_08[2], PARTS_08[3], PARTS_08[5]):
-            assert eight.run(cell)['error'] is None
+            assert eight.run(cell).error is None
         set_up = ten.run(n10['b61bfe20'])  # catch_up(10): before anything uses the monitor
-        unfinished = [line for line in set_up['stdout'].splitlines() if 'not finished' in line]
+        unfinished = [line for line in set_up.stdout.splitlines() if 'not finished' in line]
         assert len(unfinished) == 1 and 'on_set_thresholds' in unfinished[0] \
             and 'notebook 08, part 4' in unfinished[0], set_up
         for cell in ('5d79509a', '2cbd3dc0'):  # the context (imports the monitor), replay()
-            assert ten.run(n10[cell])['error'] is None
+            assert ten.run(n10[cell]).error is None
         failed = ten.run(n10['efb946fb'])  # check_replay(replay)
-        assert failed['error'] is not None and failed['error'][0] == 'CheckFailed', failed
-        assert failed['error'][1] == [f'CheckFailed: {unfinished[0]}'], failed  # the same line
-        assert eight.run(PARTS_08[4])['error'] is None  # 08 finished, in its own kernel
+        assert failed.error == ('CheckFailed', [f'CheckFailed: {unfinished[0]}']), failed
+        assert eight.run(PARTS_08[4]).error is None  # 08 finished, in its own kernel
         passed = ten.run(n10['efb946fb'])  # no restart, no import cell run again
-        assert passed['error'] is None and passed['stdout'].startswith('Check passed: '), passed
+        assert passed.error is None and passed.stdout.startswith('Check passed: '), passed
     finally:
         eight.close()
         ten.close()

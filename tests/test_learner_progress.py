@@ -10,13 +10,11 @@ page, made from the grader's own results.
 from __future__ import annotations
 
 import html
-import json
-import os
-import queue
 import re
 from pathlib import Path
 
 import pytest
+from kernels import Kernel, solution_cells
 
 from ros2nb import course, graded_parts
 from ros2nb.checks import base
@@ -127,40 +125,6 @@ def test_the_feedback_page_is_headed_by_the_graders_own_table():
 
 
 # ------------------------------------------------------------------ in a real kernel
-class Kernel:
-    def __init__(self, env: dict[str, str]) -> None:
-        from jupyter_client.manager import start_new_kernel
-        self.manager, self.client = start_new_kernel(kernel_name='python3', env=env)
-
-    def run(self, code: str, seconds: float = 900) -> dict:
-        from waiting import wait_until
-        msg_id = self.client.execute(code)
-        result = {'error': None, 'stdout': '', 'html': []}
-
-        def finished() -> bool:
-            try:
-                msg = self.client.get_iopub_msg(timeout=0.25)
-            except queue.Empty:
-                return False
-            if msg['parent_header'].get('msg_id') != msg_id:
-                return False
-            kind, content = msg['msg_type'], msg['content']
-            if kind == 'error':
-                result['error'] = content['ename']
-            elif kind == 'stream' and content['name'] == 'stdout':
-                result['stdout'] += content['text']
-            elif kind == 'display_data' and 'text/html' in content['data']:
-                result['html'].append(content['data']['text/html'])
-            return kind == 'status' and content['execution_state'] == 'idle'
-
-        assert wait_until(finished, seconds, interval=0), f'the cell did not finish: {code!r}'
-        return result
-
-    def close(self) -> None:
-        self.client.stop_channels()
-        self.manager.shutdown_kernel(now=True)
-
-
 def states(table: str) -> dict[str, str]:
     """Each part's state in a progress table's HTML, by its label."""
     return {html.unescape(label): state for label, state in re.findall(
@@ -172,28 +136,24 @@ def states(table: str) -> dict[str, str]:
 @pytest.mark.ros
 @pytest.mark.timeout(1800)
 def test_progress_in_a_kernel_after_checks_pass_and_fail_and_after_a_restart(tmp_path):
-    env = {k: v for k, v in os.environ.items() if k != 'ROS_DOMAIN_ID'}
-    env.update(ROS2NB_WORKSPACE=str(tmp_path / 'ws'), ROS2NB_PROGRESS='', ROS2NB_WORK=str(tmp_path))
-    n00 = {c['id']: ''.join(c['source']) for c in json.loads(
-        (ROOT / 'solutions' / '00-setup-and-the-pubsub-idea.ipynb').read_text())['cells']}
-    kernel = Kernel(env)
+    n00 = solution_cells('00-setup-and-the-pubsub-idea')
+    kernel = Kernel(tmp_path / 'ws', ROS2NB_PROGRESS='', ROS2NB_WORK=str(tmp_path))
     try:
         kernel.run('%load_ext ros2nb\nimport ros2nb\n_ = ros2nb.start(sim_time=True)')
         for cell in ('b2444720', 'ca255581'):  # the context, the learner's LoudListener
             kernel.run(n00[cell])
         passed = kernel.run(n00['aefca06a'])  # check_endpoint: passes
-        assert passed['stdout'].splitlines()[-1].startswith('Progress: 00 · Challenge 1'), passed
+        assert passed.stdout.splitlines()[-1].startswith('Progress: 00 · Challenge 1'), passed
         failed = kernel.run("from pathlib import Path\nros2nb.checks.check_expanded_path("
                             "lambda: Path('/Documents/ROS2_and_RL_Tutorials'), "
                             "ends_with='Documents/ROS2_and_RL_Tutorials')")
-        assert failed['error'] == 'CheckFailed'
-        assert 'not passed yet' in failed['stdout'].splitlines()[-1], failed
+        assert failed.error[0] == 'CheckFailed'
+        assert 'not passed yet' in failed.stdout.splitlines()[-1], failed
         shown = kernel.run('ros2nb.progress()')
         assert (tmp_path / graded_parts.RECORD).is_file()  # kept in the work folder
-        kernel.manager.restart_kernel(now=True)
-        kernel.client.wait_for_ready(timeout=120)
+        kernel.restart()
         again = kernel.run('import ros2nb\nros2nb.progress()')
-        for table in (shown['html'], again['html']):
+        for table in (shown.html, again.html):
             assert len(table) == 1 and 'Your progress in this lab' in table[0]
             found = states(table[0])
             assert found['Challenge 1: Your own listener'] == 'passed'
@@ -204,11 +164,10 @@ def test_progress_in_a_kernel_after_checks_pass_and_fail_and_after_a_restart(tmp
         # Asked, it runs the quick checks of the files again: 03's constructor is written.
         kernel.run('%load_ext ros2nb\nws = ros2nb.course.catch_up(3)\n'
                    'PUBLISHER = ros2nb.course.PUBLISHER_FILE')
-        n03 = {c['id']: ''.join(c['source']) for c in json.loads(
-            (ROOT / 'solutions' / '03-write-the-publisher.ipynb').read_text())['cells']}
+        n03 = solution_cells('03-write-the-publisher')
         for cell in ('e26c89f9', '156a7e26', '6eb7ef07'):  # parts 1 to 3
             kernel.run(n03[cell])
-        checked = states(kernel.run('ros2nb.progress(check=True)')['html'][0])
+        checked = states(kernel.run('ros2nb.progress(check=True)').html[0])
         assert checked['Part 3: the node class and its constructor'] == 'passed'
         assert checked['Part 4: the timer callback'] == 'failed'
         assert checked['Your turn: the entry points'] == 'not yet'  # builds: not a quick one

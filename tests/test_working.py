@@ -9,21 +9,18 @@ build) and 10's part 1 (an hour of simulated time).
 
 from __future__ import annotations
 
-import json
 import os
-import queue
 import subprocess
 import sys
 import time
-from pathlib import Path
 
 import nbformat
 import pytest
+from kernels import Kernel, solution_cells
 
 from ros2nb import working
 from ros2nb_instructor.authoring.solutions import drop_empty_displays
 
-ROOT = Path(__file__).resolve().parent.parent
 JUDGE_LIKE = f'''
 import os, subprocess, sys, time
 from ros2nb import working
@@ -85,40 +82,6 @@ def test_make_solutions_drops_only_the_emptied_displays():
 
 
 # ------------------------------------------------------------------ in a real kernel
-class Kernel:
-    """A real kernel whose cells' messages are kept with the second each came."""
-
-    def __init__(self, workspace: Path) -> None:
-        from jupyter_client.manager import start_new_kernel
-        env = {k: v for k, v in os.environ.items() if k != 'ROS_DOMAIN_ID'}
-        env['ROS2NB_WORKSPACE'] = str(workspace)
-        self.manager, self.client = start_new_kernel(kernel_name='python3', env=env)
-
-    def run(self, code: str, seconds: float = 600) -> tuple[list[tuple[str, dict]], float]:
-        """The cell's output messages (kind, content), and its wall seconds."""
-        from waiting import wait_until
-        msg_id, began, messages = self.client.execute(code), time.monotonic(), []
-
-        def finished() -> bool:
-            try:
-                msg = self.client.get_iopub_msg(timeout=0.25)
-            except queue.Empty:
-                return False
-            if msg['parent_header'].get('msg_id') != msg_id:
-                return False
-            kind, content = msg['msg_type'], msg['content']
-            if kind in ('stream', 'error', 'display_data', 'update_display_data'):
-                messages.append((kind, content))
-            return kind == 'status' and content['execution_state'] == 'idle'
-
-        assert wait_until(finished, seconds, interval=0), f'the cell did not finish: {code!r}'
-        return messages, time.monotonic() - began
-
-    def close(self) -> None:
-        self.client.stop_channels()
-        self.manager.shutdown_kernel(now=True)
-
-
 def shown_lines(messages: list[tuple[str, dict]]) -> list[str]:
     """What the cell's one updating line said, in order; and the display's life checked:
     sent empty, emptied at the end, before the check's own answer."""
@@ -153,11 +116,6 @@ def stored(messages: list[tuple[str, dict]]) -> list[dict]:
     return nb.cells[0].outputs
 
 
-def solution_cells(notebook: str) -> dict[str, str]:
-    data = json.loads((ROOT / 'solutions' / f'{notebook}.ipynb').read_text())
-    return {c['id']: ''.join(c['source']) for c in data['cells'] if c['cell_type'] == 'code'}
-
-
 @pytest.mark.kernel
 @pytest.mark.judge
 @pytest.mark.ros
@@ -168,13 +126,13 @@ def test_05s_entry_point_check_says_it_builds_then_answers(tmp_path):
     try:
         kernel.run(cells['b9930eef'] + '\nws = ros2nb.course.catch_up(5)\n' + cells['c0838a32'])
         kernel.run(cells['74a671f4'])  # the entry points, written
-        messages, took = kernel.run(cells['dd03a93b'])  # check_entry_points()
+        check = kernel.run(cells['dd03a93b'])  # check_entry_points()
     finally:
         kernel.close()
-    said = shown_lines(messages)
-    assert took < 2 or any(line.startswith('check_entry_points: running colcon build (')
-                           for line in said), (took, said)
-    assert {o.output_type for o in stored(messages)} == {'stream'}  # as make solutions keeps it
+    said = shown_lines(check.messages)
+    assert check.seconds < 2 or any(line.startswith('check_entry_points: running colcon build (')
+                                    for line in said), (check.seconds, said)
+    assert {o.output_type for o in stored(check.messages)} == {'stream'}  # as make solutions keeps
 
 
 @pytest.mark.kernel
@@ -186,11 +144,11 @@ def test_10s_recording_check_says_how_far_the_hour_is(tmp_path):
     try:
         for cell in ('b61bfe20', '5d79509a', '1266d1a4'):  # set-up, context, record_hour
             kernel.run(cells[cell])
-        messages, took = kernel.run(cells['fededecd'])  # check_recording(record_hour)
+        check = kernel.run(cells['fededecd'])  # check_recording(record_hour)
     finally:
         kernel.close()
-    said = shown_lines(messages)
+    said = shown_lines(check.messages)
     counted = [line for line in said if line.startswith('check_recording: spinning the nodes: ')
                and ' of 3600 simulated s (' in line]
-    assert took < 2 or counted, (took, said)
-    assert {o.output_type for o in stored(messages)} == {'stream'}
+    assert check.seconds < 2 or counted, (check.seconds, said)
+    assert {o.output_type for o in stored(check.messages)} == {'stream'}

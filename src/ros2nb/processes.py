@@ -16,8 +16,6 @@ import sys
 import time
 from typing import Any, Callable, NoReturn, Optional, Sequence
 
-from . import working
-
 #: Seconds a process gets to exit after Ctrl+C (SIGINT) before SIGTERM, then SIGKILL.
 STOP_GRACE_S = 5.0
 #: Seconds after SIGTERM before SIGKILL.
@@ -325,7 +323,6 @@ def interrupt(proc: subprocess.Popen, sig: int = signal.SIGINT) -> None:
     program could handle it: ``sig`` goes to every process under ``proc`` that is not
     bubblewrap.
     """
-    working.say('pressing Ctrl+C')
     if _name(proc.pid) != 'bwrap':
         signal_group(proc, sig)
         return

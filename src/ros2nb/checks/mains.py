@@ -18,6 +18,7 @@ import subprocess
 from pathlib import Path
 from typing import Any, Optional
 
+from .. import working
 from ..errors import CheckFailed
 from ..processes import interrupt, kill_process_group, until_waiting, wait_patiently
 from ..judge_interface import Judge
@@ -128,8 +129,9 @@ def _watch_stop(observer: Any, path: Path, node_name: str, part: int, proc: Any,
                           'start it): main() should bring rclpy up, create the node and spin it '
                           'until Ctrl+C.')
     until_waiting(proc, START_PATIENCE_S)  # the node idle in its spin, its call answered
-    interrupt(proc, sig)
     pressed = STOPPING_SIGNALS[sig]
+    working.say(f'{pressed} for {node_name}')
+    interrupt(proc, sig)
     code = _wait_for_exit(observer, proc, node_name, sig)
     if code is None:
         raise CheckFailed(f'{path.name} did not stop within {EXIT_AFTER_CTRL_C_S:g} s of '
