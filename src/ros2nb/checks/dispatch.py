@@ -61,26 +61,29 @@ def ask_judge(check: str) -> None:
     show_result(result)
 
 
-def _read_until_done(proc: subprocess.Popen, work: working.Working
-                     ) -> tuple[str, str]:
+def _read_until_done(proc: subprocess.Popen, work: working.Working) -> tuple[str, str]:
     """The judge's stdout and its own stderr lines, read as they come until it ends; each
     line of what it does shown on the way.
 
     :raises CheckFailed: when the judge had its patience (:data:`CHECK_TIMEOUT_S`).
     """
     patience = Patience(proc.pid, CHECK_TIMEOUT_S)  # a busy machine slows the judge down
-    chunks: dict[int, list[bytes]] = {proc.stdout.fileno(): [], proc.stderr.fileno(): []}
-    err_fd, err_lines, partial = proc.stderr.fileno(), [], b''
+    if proc.stdout is None or proc.stderr is None:  # pragma: no cover - both are pipes
+        raise Ros2nbError('The check could not run: its judge has no output to read.')
+    out_fd, err_fd = proc.stdout.fileno(), proc.stderr.fileno()
+    out: list[bytes] = []
+    err_lines: list[str] = []
+    partial = b''
     with selectors.DefaultSelector() as selector:
-        for stream in (proc.stdout, proc.stderr):
-            selector.register(stream, selectors.EVENT_READ)
+        for fd in (out_fd, err_fd):
+            selector.register(fd, selectors.EVENT_READ)
         while selector.get_map():
             for key, _events in selector.select(LOOK_S):
                 data = os.read(key.fd, 65536)
                 if not data:
-                    selector.unregister(key.fileobj)
-                elif key.fd != err_fd:
-                    chunks[key.fd].append(data)
+                    selector.unregister(key.fd)
+                elif key.fd == out_fd:
+                    out.append(data)
                 else:
                     *whole, partial = (partial + data).split(b'\n')
                     for raw in whole:
@@ -96,5 +99,5 @@ def _read_until_done(proc: subprocess.Popen, work: working.Working
                 raise CheckFailed(f'The check did not finish within {CHECK_TIMEOUT_S:g} s: '
                                   'does your code wait for something that never happens?')
     proc.wait()
-    out = b''.join(chunks[proc.stdout.fileno()]).decode(errors='replace')
-    return out, '\n'.join([*err_lines, partial.decode(errors='replace')])
+    return (b''.join(out).decode(errors='replace'),
+            '\n'.join([*err_lines, partial.decode(errors='replace')]))
