@@ -206,8 +206,9 @@ def show_table(table: list[dict], caption: str) -> None:
         from IPython import get_ipython
         from IPython.display import display
     except ImportError:  # pragma: no cover - IPython comes with the course
-        get_ipython = None  # type: ignore[assignment]
-    if get_ipython is not None and getattr(get_ipython(), 'kernel', None) is not None:
+        print(text)
+        return
+    if getattr(get_ipython(), 'kernel', None) is not None:
         display({'text/html': table_html(table, caption), 'text/plain': text}, raw=True)
     else:
         print(text)
