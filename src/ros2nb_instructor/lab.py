@@ -116,6 +116,7 @@ def main(argv: Optional[list[str]] = None) -> NoReturn:
         print(f'Your notebooks are in {root} (the course never overwrites them); keep each '
               'notebook open in one tab only.', file=sys.stderr)
         learner_environment(os.environ)
+        os.environ[WORK_ENV] = str(root)  # the kernels keep the learner's progress there
         default_url = '/lab'
     # Localhost unless told otherwise (the course's image listens on every interface of its
     # container: `make lab LAB_ARGS=--ServerApp.ip=0.0.0.0`); traitlets refuses two values.

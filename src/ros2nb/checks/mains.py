@@ -18,6 +18,7 @@ import subprocess
 from pathlib import Path
 from typing import Optional
 
+from .. import working
 from ..errors import CheckFailed
 from ..processes import Process, interrupt, kill_process_group, until_waiting, wait_patiently
 from ..judge_interface import Judge, Observer, ProgramOutput
@@ -129,8 +130,9 @@ def _watch_stop(observer: Observer, path: Path, node_name: str, part: int, proc:
                           'start it): main() should bring rclpy up, create the node and spin it '
                           'until Ctrl+C.')
     until_waiting(proc, START_PATIENCE_S)  # the node idle in its spin, its call answered
-    interrupt(proc, sig)
     pressed = STOPPING_SIGNALS[sig]
+    working.say(f'{pressed} for {node_name}')
+    interrupt(proc, sig)
     code = _wait_for_exit(observer, proc, node_name, sig)
     if code is None:
         raise CheckFailed(f'{path.name} did not stop within {EXIT_AFTER_CTRL_C_S:g} s of '

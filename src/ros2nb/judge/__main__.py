@@ -15,7 +15,7 @@ import sys
 from pathlib import Path
 from typing import Any, Optional
 
-from .. import checks
+from .. import checks, working
 from ..checks.drawn import SEED_OPTION, parse_seed
 from ..errors import Ros2nbError
 from ..processes import end_this_process
@@ -52,6 +52,7 @@ def main(argv: list[str]) -> int:
     except Ros2nbError as problem:
         print(problem, file=sys.stderr)
         return 2
+    working.tell_on_stderr()  # what it does, for the kernel that waits (none of its children)
     if not subject_prefix():  # subjects not sandboxed: forked from here, before ROS starts
         serve_from_here()
     session = Session(default_workspace(), seed)

@@ -63,9 +63,10 @@ def copy_missing_notebooks(source: Path, folder: Path) -> list[str]:
 
 
 def learner_environment(env: MutableMapping[str, str], folder: Path, venv_bin: Path) -> None:
-    """Give the learner their own ROS workspace, the course's venv first on ``PATH``,
-    the learner's lab."""
+    """Give the learner their own ROS workspace and work folder, the course's venv first on
+    ``PATH``, the learner's lab."""
     env.setdefault('ROS2NB_WORKSPACE', str(folder / 'workspace' / WORKSPACE_NAME))
+    env.setdefault(lab.WORK_ENV, str(folder / 'notebooks'))  # where their progress is kept
     env['PATH'] = os.pathsep.join([str(venv_bin), env.get('PATH', os.defpath)])
     env['VIRTUAL_ENV'] = str(venv_bin.parent)
     lab.learner_environment(env)  # nbgrader's instructor tools, news and Extension Manager off
