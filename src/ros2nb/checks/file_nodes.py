@@ -47,9 +47,11 @@ def new_node(judge: Judge, relative: str, cls: str, *, stand_ins: tuple[str, ...
 
 
 def started_log_verdict(judge: Judge, info: dict, mark: int, cls: str) -> None:
+    """Raise when the node ``info`` logged nothing while it was made (after ``mark``)."""
     if info['started_lines'] == 0 or not lines_logged(judge, info, mark, info['started_lines']):
+        words = ''.join(f' {c}' if c.isupper() else c for c in cls).strip()
         raise CheckFailed(f'{cls} logged nothing when it started: log a line such as '
-                          f"'{cls[:11]} {cls[11:]} Node Started' with the node's logger.")
+                          f"'{words} Node Started' with the node's logger.")
 
 
 def lines_logged(judge: Judge, info: dict, mark: int, lines: int) -> list[str]:

@@ -23,7 +23,7 @@ from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
 from .base import judged
 from .drawn import chooser
 from .mains import run_main
-from .file_nodes import announced, feed, lines_logged, new_node, reach
+from .file_nodes import announced, feed, lines_logged, new_node, reach, started_log_verdict
 from .verdicts import endpoint_verdict, node_name_verdict
 
 #: Readings the fan check sends (°C): both sides of the High threshold; then drawn ones.
@@ -56,12 +56,14 @@ def _fan_readings(judge: Judge) -> list[float]:
 def _fan_controller(judge: Judge) -> str:
     judge.drop(('file', course.PROMISES_FILE))  # the fan is the only subscription here
     commands = judge.observer.watch('/' + course.FAN_TOPIC, Bool, lambda m: bool(m.data))
+    mark = len(judge.observer.logs)
     subject, info = new_node(judge, course.FAN_FILE, course.FAN_CLASS)
     node_name_verdict(info, course.FAN_NODE)
     found = judge.observer.endpoints(info['name'], info['namespace'], info['endpoints'])
     endpoint_verdict(info['name'], found, 'subscription', '/' + course.TOPIC, course.MESSAGE_TYPE)
     endpoint_verdict(info['name'], found, 'publisher', '/' + course.FAN_TOPIC,
                      course.FAN_MESSAGE_TYPE)
+    started_log_verdict(judge, info, mark, course.FAN_CLASS)  # the task's third step
     if not subject.request('wait_matched', topic='/' + course.FAN_TOPIC,
                            seconds=ARRIVAL_TIMEOUT_S)['ok']:
         raise CheckFailed(f'The fan controller\'s publisher never reached the grader\'s '

@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any, Optional
 
 from ..errors import CheckFailed
+from ..explain.programs import read_explained
 from ..processes import interrupt, kill_process_group, until_waiting, wait_patiently
 from ..judge_interface import Judge
 from .source import TEXT
@@ -142,9 +143,7 @@ def _watch_stop(observer: Any, path: Path, node_name: str, part: int, proc: Any,
                           'constructor or callback: repeat work with a timer (create_timer) '
                           'and let main() spin.')
     if not spinning:  # the node was there but never answered: main() did not spin it
-        raise CheckFailed(f'{path.name} created its node {node_name} but never spun it (it did '
-                          'not answer the grader): main() should spin it with rclpy.spin(node) '
-                          'until Ctrl+C.')
+        raise CheckFailed(_NOT_SPUN.format(file=path.name))
     if code != 0 or 'Traceback' in text:
         last = _error_line(text)
         if all(mark in last for mark in RACE_MARKS):
@@ -185,11 +184,22 @@ def _ended_early(path: Path, part: int, text: str, code: int) -> CheckFailed:
     if 'NotImplementedError' in text:
         return CheckFailed(f'main() still raises NotImplementedError: write part {part} where '
                            'it says YOUR CODE HERE.')
+    facts = read_explained(text)
+    if facts is not None and facts.get('explanation'):
+        where = f' ({facts["where"]})' if facts.get('where') else ''
+        return CheckFailed(f'{path.name} crashed before Ctrl+C: {facts["explanation"]}{where}')
     if 'Traceback' in text:
         return CheckFailed(f'{path.name} crashed before Ctrl+C{_crash_place(text, path)} '
                            f'({_error_line(text)}): fix that line, then run this check again.')
+    if code == 0:  # as when its node was seen, not spinning: how busy the machine is decides
+        return CheckFailed(_NOT_SPUN.format(file=path.name))
     return CheckFailed(f'{path.name} ended by itself before Ctrl+C (exit code {code}); main() '
                        'should spin until Ctrl+C.')
+
+
+#: A main() that never spins, whether the judge saw its node before it ended or not.
+_NOT_SPUN = ('{file} did not spin its node until Ctrl+C (it ended by itself, or did not answer '
+             'the grader): main() should spin it with rclpy.spin(node) until Ctrl+C.')
 
 
 def _caught(main: ast.FunctionDef) -> set[str]:

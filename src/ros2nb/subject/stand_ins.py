@@ -18,6 +18,7 @@ learner's constructor that names its attribute differently still works with them
 from __future__ import annotations
 
 import random
+import types
 from typing import Any, Callable
 
 from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor, SetParametersResult
@@ -29,11 +30,17 @@ from ..rules import monitor_status
 
 
 def _publisher_on(node: Node, topic: str) -> Any:
-    """The node's publisher on ``topic`` (relative to its namespace), whatever its attribute."""
+    """The node's publisher on ``topic`` (relative to its namespace), whatever its attribute;
+    an AttributeError for ``publisher_`` (the task's name) when no attribute keeps it."""
     full = node.resolve_topic_name(topic)
     found = [p for p in node.publishers if p.topic_name == full]
     if not found:
         raise AttributeError(f'{node.get_name()} has no publisher on {full}')
+    kept = [name for name, value in vars(node).items()
+            if value is found[-1] and not name.startswith('_')]
+    if not kept:  # made in a local name: the learner's own callback could never reach it
+        raise AttributeError(f"'{type(node).__name__}' object has no attribute 'publisher_'",
+                             name='publisher_', obj=node)
     return found[-1]
 
 
@@ -50,12 +57,11 @@ def sensor_init(self: Node) -> None:
 def sensor_callback(self: Node) -> None:
     """Part 4 of temperature_publisher.py: one step of the walk, clamped, published, logged.
 
-    Does nothing on a node without ``temperature`` (a constructor that calls it before it
-    sets the walk's start, or keeps the walk under another name): the learner's own
-    callback is then tried instead.
+    On a node without ``temperature`` (a constructor that keeps the walk in a local name, or
+    under another name) it raises the AttributeError of reading it: the check names the
+    constructor's line (:mod:`ros2nb.explain.everyday`), and tries the learner's own
+    callback with it.
     """
-    if not hasattr(self, 'temperature'):
-        return
     step = random.uniform(-course.MAX_STEP_C, course.MAX_STEP_C)
     self.temperature = max(course.MIN_TEMPERATURE_C,
                            min(course.MAX_TEMPERATURE_C, self.temperature + step))
@@ -154,8 +160,18 @@ def with_stand_ins(cls: type, names: list[str]) -> type:
 
     :raises KeyError: for a name that is no stand-in (a mistake of the course's).
     """
-    methods = dict(STAND_INS[name] for name in names)
+    methods = {method: _named(function, f"the course's {cls.__name__}.{method}")
+               for method, function in (STAND_INS[name] for name in names)}
     return type(cls.__name__, (cls,), methods) if methods else cls
+
+
+def _named(function: Callable[..., Any], qualname: str) -> Callable[..., Any]:
+    """A copy of ``function`` that a report names ``qualname``: an error in a stand-in is
+    reported as the course's method of the learner's class, never as a function of ours."""
+    named = types.FunctionType(function.__code__, function.__globals__, function.__name__,
+                               function.__defaults__, function.__closure__)
+    named.__qualname__ = qualname
+    return named
 
 
 def stand_in_node(class_name: str) -> type:
