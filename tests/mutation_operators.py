@@ -483,18 +483,42 @@ def _given_answer(answer: Answer, text: str) -> Answer:
 
 
 def _wrong_types(cell: Cell) -> Iterator[Mutant]:
+    """A message type swapped for another, imported where the learner imports: in the file's
+    first part (a ``%%part`` answer), else at the top of the cell."""
     for node in cell.nodes(ast.Name):
         wrong = WRONG_TYPE.get(node.id)
         if wrong is None or not isinstance(node.ctx, ast.Load):
             continue
-        statement = node
-        while not isinstance(statement, ast.stmt):
-            statement = statement.parent  # type: ignore[attr-defined]
-        first, col, _last, _end = cell.span(statement)
-        imported = (first, col, first, col,
-                    f'from {MESSAGE_MODULE} import {wrong}\n{cell.lines[first][:col]}')
-        yield _replaced(cell, node, ast.Name(wrong, ast.Load()), 'wrong message type',
-                        f'{node.id} -> {wrong}', extra=(imported,))
+        what = f'{node.id} -> {wrong} (line {cell.line(node) + 1})'
+        changed = apply(cell.lines, [_node_edit(cell, node, ast.Name(wrong, ast.Load()))])
+        affected = frozenset({node.id, wrong})
+        if not cell.answer.is_part:
+            line = f'from {MESSAGE_MODULE} import {wrong}'
+            yield make(cell.answer, 'wrong message type', what, f'{line}\n{changed}',
+                       affected=affected)
+            continue
+        given = _imported_in_part_one(cell.answer, wrong)
+        if given is not None:
+            yield make(cell.answer, 'wrong message type', what, changed, given, affected)
+
+
+def _imported_in_part_one(answer: Answer, name: str) -> Optional[dict]:
+    """The given cell that holds the imports of the answer's file, with ``name`` imported
+    from std_msgs.msg too (``{index: text}``; {} when it imports it already), or None when
+    there is none."""
+    target = answer.source.split('\n')[0].split()[1]
+    for index, text in given_cells(answer.notebook).items():
+        if text.split('\n')[0].split()[1] != target:
+            continue
+        given = Cell(_given_answer(answer, text))
+        for node in ast.walk(given.tree):
+            if isinstance(node, ast.ImportFrom) and node.module == MESSAGE_MODULE:
+                if any(alias.name == name for alias in node.names):
+                    return {}
+                new = copy.copy(node)
+                new.names = [*node.names, ast.alias(name)]
+                return {index: apply(given.lines, [_node_edit(given, node, new)])}
+    return None
 
 
 PYTHON_OPERATORS: tuple[Callable[[Cell], Iterator[Mutant]], ...] = (

@@ -200,30 +200,35 @@ class NotebookRun:
         return Shown.of_outcome(result)
 
     # ------------------------------------------------------------------ going through it
-    def run(self, chosen: Optional[set[str]] = None) -> Iterator[Outcome]:
+    def run(self, chosen: Optional[set[str]] = None, baseline: bool = True
+            ) -> Iterator[Outcome]:
         """Go through the notebook: set-up cells, then at each answer its mutants (those
         named in ``chosen``, or all), then the answer itself; yield each mutant's outcome.
 
-        The unchanged answer runs first at each cell, as a mutant of its own (operator
-        ``none``): it must pass both ways.
+        With ``baseline``, the unchanged answer runs first at each cell with mutants, as a
+        mutant of its own (operator ``none``): it must pass both ways.
         """
         setup = setup_cells(self.number)
         by_index = {a.index: a for a in self.answers}
-        for index in sorted({*setup, *by_index}):
+        last = max((a.index for a in self.answers if chosen is None or any(
+            m.ident in chosen for m in mutants(a))), default=-1)
+        for index in sorted(i for i in {*setup, *by_index} if i <= last):
             if index in setup:
                 self._run(setup[index])
                 continue
             answer = by_index[index]
             made = [m for m in mutants(answer) if chosen is None or m.ident in chosen]
-            for mutant in [None, *made] if chosen is None or made else []:
+            for mutant in [*([None] if baseline else []), *made] if chosen is None or made \
+                    else []:
                 yield self._one(answer, mutant)
-            self._run(_without_markers(notebook(self.number)['cells'][index]['source']
-                      if isinstance(notebook(self.number)['cells'][index]['source'], str)
-                      else ''.join(notebook(self.number)['cells'][index]['source'])))
+            self._run(self._cell(index))  # the answer as written, for the cells after it
+
+    def _cell(self, index: int) -> str:
+        """The solution's cell ``index`` as a learner's notebook holds it (no markers)."""
+        return _without_markers(''.join(notebook(self.number)['cells'][index]['source']))
 
     def _one(self, answer: Answer, mutant: Optional[Mutant]) -> Outcome:
         began = time.monotonic()
-        original = notebook(self.number)['cells']
         given = mutant.given if mutant else {}
         for index, text in given.items():
             self._run(text)
@@ -232,7 +237,7 @@ class NotebookRun:
         lab = self._lab_check(answer)
         file_text = self._file_text(answer)
         for index in given:
-            self._run(_without_markers(''.join(original[index]['source'])))
+            self._run(self._cell(index))
         self._run(RESET)
         grading = self._grading_check(answer, mutant)
         return Outcome(
@@ -259,15 +264,17 @@ class NotebookRun:
         return path.read_text() if path.is_file() else ''
 
 
-def run_notebook(number: str, out: Path, chosen: Optional[set[str]] = None) -> list[dict]:
-    """Run notebook ``number``'s mutants (``chosen``, or all); write each outcome to ``out``
-    as a JSON line as it comes; return them."""
+def run_notebook(number: str, out: Path, chosen: Optional[set[str]] = None,
+                 baseline: bool = True) -> list[dict]:
+    """Run notebook ``number``'s mutants (``chosen``, or all, with the unchanged answers
+    when ``baseline``); write each outcome to ``out`` as a JSON line as it comes; return
+    them."""
     found = []
     with tempfile.TemporaryDirectory(prefix=f'ros2nb-mutants-{number}-') as root:
         run = NotebookRun(number, Path(root))
         try:
             with out.open('w') as written:
-                for outcome in run.run(chosen):
+                for outcome in run.run(chosen, baseline):
                     found.append(asdict(outcome))
                     written.write(json.dumps(found[-1]) + '\n')
                     written.flush()

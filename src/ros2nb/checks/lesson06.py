@@ -18,7 +18,7 @@ from std_msgs.msg import Bool
 
 from .. import course, rules
 from ..errors import CheckFailed
-from ..explain.ros_settings import ros_arguments_mistake
+from ..explain.ros_settings import ros_arguments_mistake, without_c_location
 from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
 from .base import judged
 from .drawn import chooser
@@ -173,8 +173,8 @@ def _counting_monitor(judge: Judge) -> str:
                               'with the count.')
         if index not in numbers:
             raise CheckFailed(f'After {index} reading{"s" if index > 1 else ""} {name} logged '
-                              f'"{lines[0]}": add one to self.received for every message, and '
-                              'log the new count.')
+                              f'"{lines[0]}"; the count is {index}: start self.received at 0 '
+                              'in __init__, add one for every message, and log the new count.')
     _named_as_told(judge, f'monitor_{chooser(judge, "06 counting name").randrange(10, 1000)}')
     return (f"{course.COUNTING_CLASS}('{name}') is called {name} and counted "
             f'{COUNTED_READINGS} of {COUNTED_READINGS} readings, as its lines on /rosout say.')
@@ -240,7 +240,8 @@ def _rooms(judge: Judge) -> str:
         if not reply['ok']:
             error = reply['error']
             kind, text = str(error.get('type')), str(error.get('message'))
-            why = ros_arguments_mistake(kind, text) or f'{kind}: {text.splitlines()[0][:160]}'
+            why = ros_arguments_mistake(kind, text) or \
+                f'{kind}: {without_c_location(text.splitlines()[0])[:160]}'
             raise CheckFailed(f"rclpy refused the arguments {course.ROOMS_FUNCTION}('{room}') "
                               f'returned, {arguments}: {why}')
         for name, namespace, endpoints in reply['nodes']:

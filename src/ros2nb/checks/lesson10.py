@@ -139,7 +139,8 @@ def _recording(judge: Optional[Judge], record_hour: Any) -> str:
     label = f'{record_hour.__name__}(bag_path)'
     with fresh_path(judge, 'hour') as path:
         with witnessing(judge) as seen:
-            _call(judge, record_hour, label, path, spin_s=course.RECORD_S)
+            _call(judge, record_hour, label, path, spin_s=course.RECORD_S,
+                  stops=course.SENSOR_NODE)  # the task ends the hour with ros2nb.stop()
         if not path.is_dir():
             _bag_verdict(path, label)  # the line for "no bag at all"
         with read_back(judge, path) as copy:

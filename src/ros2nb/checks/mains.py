@@ -48,6 +48,8 @@ STOPPING_SIGNALS = {signal.SIGINT: 'Ctrl+C',
                     signal.SIGTERM: 'a shutdown from outside (SIGTERM)'}
 STOP_EXCEPTIONS = {signal.SIGINT: 'KeyboardInterrupt',
                    signal.SIGTERM: 'ExternalShutdownException'}
+#: What a stop itself raises in a main(): its line is the stop's, not an error of the code's.
+STOP_KINDS = ('KeyboardInterrupt', 'ExternalShutdownException', 'RCLError')
 #: On Jazzy Ctrl+C shuts rclpy down itself; then, depending on where the signal lands, the spin
 #: ends with ExternalShutdownException or a later rclpy.shutdown() fails. One race, one cause:
 #: the learner is told the cause, in the same words whichever way the race went.
@@ -145,6 +147,11 @@ def _watch_stop(observer: Any, path: Path, node_name: str, part: int, proc: Any,
     if not spinning:  # the node was there but never answered: main() did not spin it
         raise CheckFailed(_NOT_SPUN.format(file=path.name))
     if code != 0 or 'Traceback' in text:
+        facts = read_explained(text)  # an error of the learner's code, not of the stop
+        if facts and facts.get('explanation') and facts.get('type') not in STOP_KINDS:
+            where = f' ({facts["where"]})' if facts.get('where') else ''
+            raise CheckFailed(f'{path.name} exited with code {code} after {pressed}: '
+                              f'{facts["explanation"]}{where}')
         last = _error_line(text)
         if all(mark in last for mark in RACE_MARKS):
             raise _ShutdownRace(f'{path.name} exited with code {code} after {pressed}: rclpy '

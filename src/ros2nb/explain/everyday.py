@@ -13,8 +13,10 @@ from __future__ import annotations
 import builtins
 import difflib
 import dis
+import inspect
 import linecache
 import re
+import sys
 from pathlib import Path
 from types import CodeType, FrameType
 from typing import Any, Iterator, Optional
@@ -29,14 +31,37 @@ IMPORTS.update({'Node': 'from rclpy.node import Node', 'rclpy': 'import rclpy',
                 'ExternalShutdownException':
                     'from rclpy.executors import ExternalShutdownException'})
 _CONSTRUCTOR_ARGUMENTS = re.compile(r'Invalid arguments passed to constructor: '
-                                    r'dict_keys\(\[(?P<names>[^\]]*)\]\)')
+                                    r'(?:dict_keys\(\[(?P<keys>[^\]]*)\]\)|(?P<names>.+))')
+#: Python's refusal of two values an operator cannot take together.
+_OPERANDS = re.compile(r"(?:not supported between instances of|unsupported operand type\(s\) "
+                       r"for \S+:) '(\w+)' and '(\w+)'")
 
 
 def _similar(name: str, candidates: Any) -> Optional[str]:
-    """The candidate ``name`` was most likely meant to be (a typo away), or None."""
-    names = sorted({c for c in candidates if isinstance(c, str) and not c.startswith('__')})
+    """The candidate ``name`` was most likely meant to be (a typo away), or None; never one
+    that differs only in case from a lower-case name (``node`` is no typo of ``Node``)."""
+    names = sorted({c for c in candidates if isinstance(c, str) and not c.startswith('__')
+                    and not (name.islower() and c.lower() == name)})
     found = difflib.get_close_matches(name, names, n=1, cutoff=0.75)
     return found[0] if found else None
+
+
+#: Where an import the learner left out is looked for, in this order (what the course uses).
+_PACKAGES = ('std_msgs.msg', 'rclpy', 'rcl_interfaces.msg', 'pathlib', 'random')
+
+
+def _import_of(name: str) -> Optional[str]:
+    """``from MODULE import name`` for a name a module of the course's packages defines
+    (the shortest public module among those loaded), or None."""
+    if name in IMPORTS:
+        return IMPORTS[name]
+    found = sorted((module_name for module_name, module in list(sys.modules.items())
+                    if module_name.startswith(_PACKAGES) and '._' not in module_name
+                    and isinstance(getattr(module, name, None), type)), key=len)
+    if not found:
+        return None
+    defined = getattr(sys.modules[found[0]], name).__module__  # where the class is written
+    return f'from {defined if defined in found else found[0]} import {name}'
 
 
 def _first_line(exc: BaseException) -> str:
@@ -85,8 +110,9 @@ def made_where(exc: BaseException, obj: Any) -> str:
 
 
 def _unset_attribute(obj: Any, name: str, owner: str) -> Optional[str]:
-    """``self.name`` read on the learner's node, where no method of theirs sets it as an
-    attribute: a local of that name (``temperature = ...``), or nothing at all."""
+    """``self.name`` read on the learner's node, where no method of theirs keeps it: a local
+    of that name (``temperature = ...``), an attribute of a name a typo away, one set only
+    later, or none at all."""
     methods = list(_learners_functions(type(obj)))
     if not methods:
         return None
@@ -96,15 +122,19 @@ def _unset_attribute(obj: Any, name: str, owner: str) -> Optional[str]:
             return (f'{owner} has no attribute {name}: {code.co_name} sets a local name '
                     f'{name} ({_place(code, line)}), which is gone when it returns: write '
                     f'self.{name} = ... there, so that the node keeps it.')
+    kept = _similar(name, [key for key in vars(obj) if not key.startswith('_')])
+    if kept:
+        return (f'{owner} has no attribute {name}, but it has {kept}: names must match '
+                f'exactly where they are set and where they are used (self.{name}).')
     if any(_stored(code, name, 'STORE_ATTR') for code in methods):
         return (f'{owner} has no attribute {name} yet: it is read before any method sets it: '
                 f'set self.{name} in __init__.')
     meant = _similar(name, dir(obj))
     if meant:
         return (f'{owner} has no attribute {name}: did you mean self.{meant}? Names must '
-                'match exactly where they are set and where they are used.')
-    return (f'{owner} has no attribute {name}: the class neither defines a method {name} nor '
-            f'sets self.{name} in __init__: write it, or use the name the class has.')
+                'match exactly.')
+    return (f'{owner} has no attribute {name}: no method of the class sets self.{name}, and '
+            f'none is called {name}: set self.{name} in __init__ (or write the method).')
 
 
 def _attribute(exc: AttributeError) -> Optional[str]:
@@ -129,13 +159,20 @@ def _name(exc: NameError, frame: FrameType) -> str:
         quoted = re.match(r"name '(\w+)'", _first_line(exc))
         name = quoted.group(1) if quoted else '?'
     visible = {*frame.f_locals, *frame.f_globals, *vars(builtins)}
+    if name == 'self':  # self.NAME in a plain function: the notebook's own names are plain
+        used = re.search(r'\bself\.(\w+)', linecache.getline(frame.f_code.co_filename,
+                                                             frame.f_lineno))
+        plain = used.group(1) if used else 'the name'
+        return (f"name 'self' is not defined: {frame.f_code.co_name}() is a function, not a "
+                f'method of a node, so there is no self: write {plain}, not self.{plain}.')
     meant = _similar(name, visible)
     if meant:
         return (f"name '{name}' is not defined: did you mean {meant}? Names must match "
                 'exactly.')
-    if name in IMPORTS:
+    imported = _import_of(name)
+    if imported:
         return (f"name '{name}' is not defined: import it at the top of the file (or cell), "
-                f'{IMPORTS[name]}.')
+                f'{imported}.')
     return (f"name '{name}' is not defined where this line runs: define it (or import it) "
             'before, or check its spelling.')
 
@@ -149,7 +186,7 @@ def _constructor_arguments(exc: AssertionError) -> Optional[str]:
     if not found or made is None:
         return None
     takes = [slot.lstrip('_') for slot in getattr(type(made), '__slots__', ())]
-    given = [name.strip(" '") for name in found['names'].split(',')]
+    given = [name.strip(" '") for name in (found['keys'] or found['names']).split(',')]
     unknown = [name for name in given if name not in takes]
     if not unknown:
         return None
@@ -158,6 +195,53 @@ def _constructor_arguments(exc: AssertionError) -> Optional[str]:
     hint = f': did you mean {meant}?' if meant else ''
     return (f'{cls}() takes no argument {unknown[0]}{hint} (it takes '
             f'{", ".join(t for t in takes if not t.startswith("check"))}).')
+
+
+def _unset_local(exc: UnboundLocalError, frame: FrameType) -> str:
+    """A name the function sets (which makes it local everywhere in it) used before that."""
+    quoted = re.search(r"'(\w+)'", _first_line(exc))
+    name = quoted.group(1) if quoted else '?'
+    line = _stored(frame.f_code, name, 'STORE_FAST')
+    where = f' ({_place(frame.f_code, line)})' if line is not None else ''
+    return (f'{name} is used before {frame.f_code.co_name} sets it{where}: a name the '
+            f'function sets is its own local name everywhere in it; set it first, or, for an '
+            f'import, import it at the top of the file.')
+
+
+_UNEXPECTED_KEYWORD = re.compile(r"^(?P<called>[\w.]+)\(\) got an unexpected keyword argument "
+                                 r"'(?P<name>\w+)'")
+
+
+def _unexpected_keyword(exc: TypeError, frame: FrameType) -> Optional[str]:
+    """``Worker(heartbat_group=...)``: the keyword the callable takes that was meant."""
+    found = _UNEXPECTED_KEYWORD.match(_first_line(exc))
+    if found is None:
+        return None
+    called = found['called'].removesuffix('.__init__')
+    target = {**frame.f_globals, **frame.f_locals}.get(called.split('.')[0])
+    for part in called.split('.')[1:]:
+        target = getattr(target, part, None)
+    try:
+        takes = [p for p in inspect.signature(target).parameters if p not in ('self', 'args',
+                                                                               'kwargs')]
+    except (TypeError, ValueError):
+        return None
+    meant = _similar(found['name'], takes)
+    hint = f': did you mean {meant}?' if meant else ''
+    return (f'{called}() takes no argument {found["name"]}{hint} (it takes '
+            f'{", ".join(takes) or "none"}).')
+
+
+def _operands(text: str, frame: FrameType, kinds: set[str]) -> str:
+    """``low_c >= high_c`` with a str on one side: which names on the line hold what."""
+    line = linecache.getline(frame.f_code.co_filename, frame.f_lineno)
+    held = [f'{name} is {value!r} ({type(value).__name__})'
+            for name, value in frame.f_locals.items()
+            if re.search(rf'\b{name}\b', line) and type(value).__name__ in kinds
+            and len(repr(value)) <= 40]
+    shown = f': here {", ".join(held)}' if held else ''
+    return (f'TypeError: {text}{shown}: find where the value of the wrong kind comes from, '
+            'and give the line two values it can take together.')
 
 
 def everyday_explanation(exc: BaseException) -> Optional[str]:
@@ -175,12 +259,21 @@ def everyday_explanation(exc: BaseException) -> Optional[str]:
     if frame is None:
         return None
     text = _first_line(exc)
-    if isinstance(exc, NameError) and not isinstance(exc, UnboundLocalError):
+    if isinstance(exc, UnboundLocalError):
+        return _unset_local(exc, frame)
+    if isinstance(exc, NameError):
         return _name(exc, frame)
     if isinstance(exc, AssertionError):
         found = _constructor_arguments(exc)
         if found:
             return found
+    if isinstance(exc, TypeError):
+        found = _unexpected_keyword(exc, frame)
+        if found:
+            return found
+    operands = _OPERANDS.search(text) if isinstance(exc, TypeError) else None
+    if operands:
+        return _operands(text, frame, set(operands.groups()))
     if isinstance(exc, KeyError):
         return (f'KeyError: {text}: the line reads a key that is not there: check its '
                 'spelling, or read it with .get(key, default).')

@@ -33,16 +33,25 @@ def _callback(value: Any) -> bool:
     return callable(value) and not isinstance(value, type)
 
 
+def _descriptor(value: Any) -> bool:
+    return value is None or type(value).__name__ == 'ParameterDescriptor'
+
+
 #: What each parameter takes: its test, and how the line names it.
 KINDS: dict[str, tuple[Callable[[Any], bool], str]] = {
+    'name': (lambda value: isinstance(value, str), "the parameter's name ('high_above_c')"),
+    'value': (lambda value: not _descriptor(value) or value is None,
+              'its default value (26.0)'),
+    'descriptor': (_descriptor, 'its ParameterDescriptor(...)'),
     'msg_type': (_message_type, 'the message type (Float32)'),
     'topic': (lambda value: isinstance(value, str), "the topic ('temperature')"),
     'qos_profile': (_depth, 'the queue depth (10)'),
-    'callback': (_callback, 'the callback (self.temperature_callback, without ())'),
+    'callback': (_callback, 'the callback (a method, without ())'),
     'timer_period_sec': (_seconds, 'the period in seconds (1.0)'),
 }
 #: The rclpy calls a beginner writes, with their parameters in order.
-CALLS = {'create_publisher': ('msg_type', 'topic', 'qos_profile'),
+CALLS = {'declare_parameter': ('name', 'value', 'descriptor'),
+         'create_publisher': ('msg_type', 'topic', 'qos_profile'),
          'create_subscription': ('msg_type', 'topic', 'callback', 'qos_profile'),
          'create_timer': ('timer_period_sec', 'callback')}
 

@@ -160,15 +160,16 @@ def with_stand_ins(cls: type, names: list[str]) -> type:
 
     :raises KeyError: for a name that is no stand-in (a mistake of the course's).
     """
-    methods = {method: _named(function, f"the course's {cls.__name__}.{method}")
+    methods = {method: _named(function, method, f"the course's {cls.__name__}.{method}")
                for method, function in (STAND_INS[name] for name in names)}
     return type(cls.__name__, (cls,), methods) if methods else cls
 
 
-def _named(function: Callable[..., Any], qualname: str) -> Callable[..., Any]:
-    """A copy of ``function`` that a report names ``qualname``: an error in a stand-in is
-    reported as the course's method of the learner's class, never as a function of ours."""
-    named = types.FunctionType(function.__code__, function.__globals__, function.__name__,
+def _named(function: Callable[..., Any], name: str, qualname: str) -> Callable[..., Any]:
+    """A copy of ``function`` named as the method it stands in for (``qualname`` in a
+    report): an error is reported as the course's method of the learner's class, never as a
+    function of ours."""
+    named = types.FunctionType(function.__code__, function.__globals__, name,
                                function.__defaults__, function.__closure__)
     named.__qualname__ = qualname
     return named
