@@ -174,3 +174,35 @@ def context_sources(number: str) -> list[str]:
     """The course's grading-context cells of notebook ``number`` (what a graded answer of a
     function or class runs after)."""
     return [_text(c) for c in notebook(number)['cells'] if 'grading-context' in _tags(c)]
+
+
+def bound_names(source: str) -> set[str]:
+    """The names a cell binds at its top level: imports, functions, classes, assignments."""
+    if source.startswith('%%'):
+        return set()
+    try:
+        tree = ast.parse('\n'.join('' if line.lstrip().startswith(('%', '!')) else line
+                                   for line in source.split('\n')))
+    except SyntaxError:
+        return set()
+    names: set[str] = set()
+    for statement in tree.body:
+        if isinstance(statement, (ast.FunctionDef, ast.ClassDef, ast.AsyncFunctionDef)):
+            names.add(statement.name)
+        elif isinstance(statement, (ast.Import, ast.ImportFrom)):
+            names.update((a.asname or a.name).split('.')[0] for a in statement.names)
+        elif isinstance(statement, ast.Assign):
+            names.update(n.id for t in statement.targets for n in ast.walk(t)
+                         if isinstance(n, ast.Name))
+    return names
+
+
+def own_names(answer: Answer) -> set[str]:
+    """The names only ``answer`` binds, of those the kernel has when it runs: what a mutant
+    run after the answer itself would otherwise still find there."""
+    if answer.is_part:
+        return set()
+    before = set().union(*(bound_names(text) for index, text in setup_cells(answer.notebook)
+                           .items() if index < answer.index))
+    return bound_names(answer.source) - before
+

@@ -3,7 +3,8 @@
 The course mirrors one tutorial (``/work/shared/seeds/``) and fixes its mistakes
 (``docs/tutorial-fixes.md``): the misspelt ``TemperaturSensor``, the 10.2 °C floor, a
 ``main()`` that calls ``rclpy.shutdown()`` after Ctrl+C or never cleans up, the path without
-``~``, no setup.cfg.  Each entry of :data:`TUTORIAL` writes the learner's lines of one answer
+``~`` (its setup.py without setup.cfg is 05's own demonstration; setup.cfg's keys as the older
+template dashed them are 05's mutants in ``mutation_operators``).  Each entry of :data:`TUTORIAL` writes the learner's lines of one answer
 cell the tutorial's way (our own wording of its code, with its literal values), or renames
 what the tutorial misspelt, found with :mod:`tokenize`.  Some are equivalent on purpose (the
 tutorial's literals for the course's constants): honest code in its style must pass.
@@ -46,11 +47,6 @@ def renamed(old: str, new: str, after: str) -> Callable[[Answer], str]:
                 previous = token.string
         raise LookupError(f'{old} after {after!r} is not in {answer.key}')
     return text
-
-
-def emptied(answer: Answer) -> str:
-    """A ``%%part`` cell run with nothing under its first line."""
-    return answer.source.split('\n')[0] + '\n'
 
 
 TUTORIAL_MAIN_SENSOR = '''
@@ -125,5 +121,4 @@ TUTORIAL: list[tuple[str, str, Callable[[Answer], str]]] = [
         rclpy.spin(node)
     except KeyboardInterrupt:
         pass''')),
-    ('05-setup-cfg', 'no setup.cfg, as in the tutorial (the cell run empty)', emptied),
 ]

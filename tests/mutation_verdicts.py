@@ -21,8 +21,56 @@ from __future__ import annotations
 import re
 from typing import Optional
 
-#: Survivors that are no mistake at all, by the start of their mutant's name: why.
-EQUIVALENT: dict[str, str] = {}
+_KEPT_BY_THE_NODE = ("rclpy's node keeps every {0} it made (node.{0}s), whatever self keeps: "
+                     'it works the same, under any name or none')
+_STOPPED_ALREADY = ('on Jazzy Ctrl+C and a shutdown from outside have already shut rclpy down '
+                    "when the spin ends, and the process's exit destroys the node: nothing "
+                    'that the grader, or anyone, can observe differs')
+_DEVELOP = ('[develop] is read only by a development install (setup.py develop); colcon, as '
+            'the course runs it, makes a normal install, which [install] alone decides')
+#: Survivors that are no mistake at all: a part of their mutant's name (``operator | what``)
+#: and why no behaviour differs.
+EQUIVALENT: dict[str, str] = {
+    'constant changed | QUEUE_DEPTH -> 5': (
+        'a queue of 5 keeps what a queue of 10 keeps here: at one reading a second nothing '
+        'waits in it (the depth matters only to a subscription that falls behind)'),
+    'local, not attribute | self.timer = -> timer =': _KEPT_BY_THE_NODE.format('timer'),
+    'local, not attribute | self.subscription = -> subscription =':
+        _KEPT_BY_THE_NODE.format('subscription'),
+    'name one edit away | .subscription -> .subsciption':
+        _KEPT_BY_THE_NODE.format('subscription'),
+    "tutorial mistake | the tutorial's literals for the constants (equivalent)": (
+        "the same values, written as the tutorial writes them: honest code in its style"),
+    "tutorial mistake | the tutorial's callback with 18.0 for its floor (equivalent)": (
+        'the step added, then clamped into [18.0, 28.0] in a second statement: the same walk'),
+    "tutorial mistake | the tutorial's callback: 'Status:{status}' without a space": (
+        "the line still shows the reading with two decimals and its status: the task's line is "
+        'an example, the check reads what it must hold'),
+    'arguments swapped | random.uniform(-MAX_STEP_C <-> MAX_STEP_C)': (
+        'uniform(b, a) draws from the same interval as uniform(a, b)'),
+    'arguments swapped | max(MIN_TEMPERATURE_C <-> min(': 'max does not depend on the order',
+    'arguments swapped | min(MAX_TEMPERATURE_C <-> self.temperature + step)':
+        'min does not depend on the order',
+    'statement deleted | node.destroy_node()': _STOPPED_ALREADY,
+    'statement deleted | rclpy.try_shutdown()': _STOPPED_ALREADY,
+    "arguments swapped | ros2nb.bag_record('/temperature' <-> '/rosout')": (
+        'the bag records the same two topics, in whichever order they are named'),
+    '05-setup-cfg | name one edit away | [develop] -> [devlop]': _DEVELOP,
+    '05-setup-cfg | name one edit away | script_dir -> scrit_dir': _DEVELOP,
+    '05-setup-cfg | name one edit away | $base/lib/sensor_simulator -> .../sensor_imulator':
+        _DEVELOP,
+    '05-setup-cfg | constant changed | script_dir: $base/lib -> $base/bin': _DEVELOP,
+    '05-setup-cfg | statement deleted | [develop] and its line': _DEVELOP,
+    '05-setup-cfg | statement deleted | script_dir=$base/lib/sensor_simulator': _DEVELOP,
+    '05-setup-cfg | tutorial mistake | install_scripts with dashes': (
+        'the package built from it runs with ros2 run, and its build warns of nothing (as it '
+        'does for script-dir, which the check names): nothing the grader can observe differs'),
+    '02-create-a-package-challenge-1 | import removed | from pathlib import Path': (
+        'the notebook imports Path in its first cell, and the grader runs that cell too'),
+    '01-create-a-workspace-challenge-1 | import removed | from pathlib import Path': (
+        'the notebook imports Path before (its cell with the tutorial\'s two paths), and the '
+        'grader runs that cell too'),
+}
 
 #: Words in a line that only a traceback through ros2nb or the ROS libraries shows.
 THROUGH_LIBRARIES = ('site-packages', '/ros2nb/', 'rclpy/', '_rclpy', 'pybind11',
@@ -122,4 +170,4 @@ def verdict(outcome: dict) -> tuple[str, list[str]]:
 
 def equivalent(ident: str) -> Optional[str]:
     """Why the mutant named ``ident`` is no mistake, if :data:`EQUIVALENT` says."""
-    return next((why for start, why in EQUIVALENT.items() if ident.startswith(start)), None)
+    return next((why for part, why in EQUIVALENT.items() if part in ident), None)
