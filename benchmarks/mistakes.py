@@ -28,6 +28,7 @@ import sys
 import time
 from collections import Counter, defaultdict
 from pathlib import Path
+from typing import Optional
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path[:0] = [str(ROOT), str(ROOT / 'tests')]  # the root's conftest: the tests' set-up
@@ -108,11 +109,36 @@ def _fenced(text: str) -> str:
     return '```\n' + text.replace('```', "'''") + '\n```'
 
 
-def report(out: Path, wall_s: float = 0.0, cpu_s: float = 0.0) -> dict[str, int]:
-    """Write ``out/report.md`` from the outcomes there; return the totals by kind."""
+def _judged(out: Path) -> list[tuple[dict, str, list[str]]]:
     outcomes = [json.loads(line) for path in sorted(out.glob('*.jsonl'))
                 for line in path.read_text().splitlines() if line.strip()]
-    judged = [(o, *verdict(o)) for o in outcomes]
+    return [(o, *verdict(o)) for o in outcomes]
+
+
+def _compared(before: Path, after: list[tuple[dict, str, list[str]]]) -> list[str]:
+    """A table of the counts by notebook, before (the outcomes in ``before``) and after."""
+    then = _judged(before)
+    lines = ['## Before and after', '', f'Before: the outcomes in `{before}`.', '',
+             '| notebook | mutants | killed well | survived (equivalent / weak) | bad |',
+             '|---|---|---|---|---|']
+    for number in sorted({o['notebook'] for o, _k, _w in then + after}):
+        cells = []
+        for judged in (then, after):
+            kinds = Counter(k for o, k, _w in judged
+                            if o['notebook'] == number and o['operator'] != 'none')
+            cells.append((sum(kinds.values()), kinds['killed well'],
+                          f'{kinds["survived (equivalent)"]} / {kinds["survived (weak)"]}',
+                          kinds['bad']))
+        lines.append(f'| {number} | ' + ' | '.join(f'{a} → {b}' for a, b in zip(*cells)) + ' |')
+    return lines + ['']
+
+
+def report(out: Path, wall_s: float = 0.0, cpu_s: float = 0.0,
+           before: Optional[Path] = None) -> dict[str, int]:
+    """Write ``out/report.md`` from the outcomes there (and a table against the outcomes in
+    ``before``, when given); return the totals by kind."""
+    judged = _judged(out)
+    outcomes = [o for o, _kind, _why in judged]
     totals: Counter = Counter(kind for o, kind, _ in judged if o['operator'] != 'none')
     lines = ['# Mutants of the answers: what each check answered', '',
              'Made by `make mistakes` (`benchmarks/mistakes.py`): each answer cell of solutions/ '
@@ -123,6 +149,8 @@ def report(out: Path, wall_s: float = 0.0, cpu_s: float = 0.0) -> dict[str, int]
     mutated = sum(totals.values())
     lines += [f'**{mutated} mutants** of {len({o["answer"] for o in outcomes})} answer cells: '
               + ', '.join(f'{totals[k]} {k}' for k in KINDS) + '.', '']
+    if before is not None:
+        lines += _compared(before, judged)
     baseline = [(o, why) for o, kind, why in judged if o['operator'] == 'none' and kind != 'passes']
     for o, why in baseline:
         lines += [f'- the answer {o["answer"]} as written fails: {"; ".join(why)}',
@@ -172,18 +200,20 @@ def main(argv: list[str]) -> int:
     parser.add_argument('--one', help=argparse.SUPPRESS)
     parser.add_argument('--only', nargs='*', default=[], help=argparse.SUPPRESS)
     parser.add_argument('--report', action='store_true', help='only write the report again')
+    parser.add_argument('--before', help='a folder of earlier outcomes to compare with')
     args = parser.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     if args.one:
         return _one(args.one, out / f'{args.one}.jsonl', args.only)
+    before = Path(args.before) if args.before else None
     if args.report:
-        print(report(out))
+        print(report(out, before=before))
         return 0
     numbers = args.notebooks.split(',') if args.notebooks else \
         sorted({a.notebook for a in answers()})
     wall_s, cpu_s = run_all(numbers, args.workers, out)
-    totals = report(out, wall_s, cpu_s)
+    totals = report(out, wall_s, cpu_s, before)
     print(f'{sum(totals.values())} mutants: {totals}; wall {wall_s:.0f} s, CPU {cpu_s:.0f} s; '
           f'report: {out / "report.md"}')
     return 1 if totals.get('bad') else 0

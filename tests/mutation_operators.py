@@ -11,7 +11,8 @@ Operators (:data:`OPERATORS`): a name one edit away (identifiers, topic and para
 strings, entry points), ``self.`` dropped or added, positional arguments swapped, a constant
 changed, a comparison flipped or loosened, a statement deleted, a ``return`` removed, a local
 assigned instead of an attribute, a method called where it should be passed, an import
-removed, a wrong message type, and the tutorial's own mistakes (:mod:`mutation_tutorial`).
+removed, a wrong message type, a message used for its value (``msg`` for ``msg.data``), and
+the tutorial's own mistakes (:mod:`mutation_tutorial`).
 """
 
 from __future__ import annotations
@@ -31,7 +32,7 @@ OPERATORS = ('name one edit away', 'self. dropped', 'self. added', 'arguments sw
              'constant changed', 'comparison flipped', 'comparison loosened',
              'statement deleted', 'return removed', 'local, not attribute',
              'method called, not passed', 'import removed', 'wrong message type',
-             'tutorial mistake')
+             'message for its value', 'tutorial mistake')
 #: Most mutants of one operator in one answer cell (evenly chosen among those it can make).
 PER_OPERATOR = 6
 #: The message types a learner confuses: each with the one taken by mistake.
@@ -521,9 +522,18 @@ def _imported_in_part_one(answer: Answer, name: str) -> Optional[dict]:
     return None
 
 
+def _messages_for_values(cell: Cell) -> Iterator[Mutant]:
+    """``msg`` where ``msg.data`` is meant: the message used as the number it carries."""
+    fields = [n for n in cell.nodes(ast.Attribute) if n.attr == 'data'
+              and isinstance(n.ctx, ast.Load) and isinstance(n.value, (ast.Name, ast.Call))]
+    for node in fields:
+        yield _replaced(cell, node, node.value, 'message for its value',
+                        f'{ast.unparse(node)} -> {ast.unparse(node.value)}')
+
+
 PYTHON_OPERATORS: tuple[Callable[[Cell], Iterator[Mutant]], ...] = (
     _typos, _self_dropped, _self_added, _swapped, _constants, _comparisons, _deleted,
-    _returns, _locals, _called, _imports, _wrong_types)
+    _returns, _locals, _called, _imports, _wrong_types, _messages_for_values)
 
 
 # ------------------------------------------------------------------ 05's setup.cfg

@@ -3,11 +3,12 @@
 The course mirrors one tutorial (``/work/shared/seeds/``) and fixes its mistakes
 (``docs/tutorial-fixes.md``): the misspelt ``TemperaturSensor``, the 10.2 °C floor, a
 ``main()`` that calls ``rclpy.shutdown()`` after Ctrl+C or never cleans up, the path without
-``~`` (its setup.py without setup.cfg is 05's own demonstration; setup.cfg's keys as the older
-template dashed them are 05's mutants in ``mutation_operators``).  Each entry of :data:`TUTORIAL` writes the learner's lines of one answer
-cell the tutorial's way (our own wording of its code, with its literal values), or renames
-what the tutorial misspelt, found with :mod:`tokenize`.  Some are equivalent on purpose (the
-tutorial's literals for the course's constants): honest code in its style must pass.
+``~`` (its setup.py without setup.cfg is 05's own demonstration; setup.cfg's keys as the
+older template dashed them are 05's mutants in ``mutation_operators``).  Each entry of
+:data:`TUTORIAL` writes the learner's lines of one answer cell the tutorial's way (our own
+wording of its code, with its literal values), or renames what the tutorial misspelt, found
+with :mod:`tokenize`.  Some are equivalent on purpose (the tutorial's literals for the
+course's constants): honest code in its style must pass.
 """
 
 from __future__ import annotations

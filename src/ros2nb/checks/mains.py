@@ -145,7 +145,7 @@ def _watch_stop(observer: Any, path: Path, node_name: str, part: int, proc: Any,
                           'constructor or callback: repeat work with a timer (create_timer) '
                           'and let main() spin.')
     if not spinning:  # the node was there but never answered: main() did not spin it
-        raise CheckFailed(_NOT_SPUN.format(file=path.name))
+        raise _crashed(path, text) or CheckFailed(_NOT_SPUN.format(file=path.name))
     if code != 0 or 'Traceback' in text:
         facts = read_explained(text)  # an error of the learner's code, not of the stop
         if facts and facts.get('explanation') and facts.get('type') not in STOP_KINDS:
@@ -191,10 +191,9 @@ def _ended_early(path: Path, part: int, text: str, code: int) -> CheckFailed:
     if 'NotImplementedError' in text:
         return CheckFailed(f'main() still raises NotImplementedError: write part {part} where '
                            'it says YOUR CODE HERE.')
-    facts = read_explained(text)
-    if facts is not None and facts.get('explanation'):
-        where = f' ({facts["where"]})' if facts.get('where') else ''
-        return CheckFailed(f'{path.name} crashed before Ctrl+C: {facts["explanation"]}{where}')
+    crashed = _crashed(path, text)
+    if crashed is not None:
+        return crashed
     if 'Traceback' in text:
         return CheckFailed(f'{path.name} crashed before Ctrl+C{_crash_place(text, path)} '
                            f'({_error_line(text)}): fix that line, then run this check again.')
@@ -207,6 +206,17 @@ def _ended_early(path: Path, part: int, text: str, code: int) -> CheckFailed:
 #: A main() that never spins, whether the judge saw its node before it ended or not.
 _NOT_SPUN = ('{file} did not spin its node until Ctrl+C (it ended by itself, or did not answer '
              'the grader): main() should spin it with rclpy.spin(node) until Ctrl+C.')
+
+
+def _crashed(path: Path, text: str) -> Optional[CheckFailed]:
+    """The line for an error of the learner's code that ended the program by itself (its
+    explained line, :mod:`ros2nb.explain.programs`), or None: whether the judge pressed
+    Ctrl+C before it was reaped or not, as a busy machine decides."""
+    facts = read_explained(text)
+    if facts is None or not facts.get('explanation') or facts.get('type') in STOP_KINDS:
+        return None
+    where = f' ({facts["where"]})' if facts.get('where') else ''
+    return CheckFailed(f'{path.name} crashed before Ctrl+C: {facts["explanation"]}{where}')
 
 
 def _caught(main: ast.FunctionDef) -> set[str]:
