@@ -11,8 +11,8 @@ Operators (:data:`OPERATORS`): a name one edit away (identifiers, topic and para
 strings, entry points), ``self.`` dropped or added, positional arguments swapped, a constant
 changed, a comparison flipped or loosened, a statement deleted, a ``return`` removed, a local
 assigned instead of an attribute, a method called where it should be passed, an import
-removed, a wrong message type, a message used for its value (``msg`` for ``msg.data``), and
-the tutorial's own mistakes (:mod:`mutation_tutorial`).
+removed, a wrong message type, a message used for its value (``msg`` for ``msg.data``), an
+argument left out, and the tutorial's own mistakes (:mod:`mutation_tutorial`).
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ OPERATORS = ('name one edit away', 'self. dropped', 'self. added', 'arguments sw
              'constant changed', 'comparison flipped', 'comparison loosened',
              'statement deleted', 'return removed', 'local, not attribute',
              'method called, not passed', 'import removed', 'wrong message type',
-             'message for its value', 'tutorial mistake')
+             'message for its value', 'argument left out', 'tutorial mistake')
 #: Most mutants of one operator in one answer cell (evenly chosen among those it can make).
 PER_OPERATOR = 6
 #: The message types a learner confuses: each with the one taken by mistake.
@@ -531,9 +531,22 @@ def _messages_for_values(cell: Cell) -> Iterator[Mutant]:
                         f'{ast.unparse(node)} -> {ast.unparse(node.value)}')
 
 
+def _left_out(cell: Cell) -> Iterator[Mutant]:
+    """A call given fewer arguments: its last left out, or all but its first."""
+    for node in cell.nodes(ast.Call):
+        if len(node.args) < 2 or any(isinstance(a, ast.Starred) for a in node.args):
+            continue
+        for kept in sorted({len(node.args) - 1, 1}, reverse=True):
+            new = copy.copy(node)
+            new.args = node.args[:kept]
+            new.keywords = node.keywords if kept > 1 else []
+            yield _replaced(cell, node, new, 'argument left out',
+                            f'{ast.unparse(node.func)}: {len(node.args)} arguments -> {kept}')
+
+
 PYTHON_OPERATORS: tuple[Callable[[Cell], Iterator[Mutant]], ...] = (
     _typos, _self_dropped, _self_added, _swapped, _constants, _comparisons, _deleted,
-    _returns, _locals, _called, _imports, _wrong_types, _messages_for_values)
+    _returns, _locals, _called, _imports, _wrong_types, _messages_for_values, _left_out)
 
 
 # ------------------------------------------------------------------ 05's setup.cfg

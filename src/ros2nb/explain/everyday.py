@@ -11,25 +11,16 @@ judge's subject.  Introduced in ``03-write-the-publisher.ipynb``.
 from __future__ import annotations
 
 import builtins
-import difflib
-import dis
 import inspect
 import linecache
 import re
-import sys
-from pathlib import Path
-from types import CodeType, FrameType
-from typing import Any, Iterator, Optional
+from types import FrameType
+from typing import Any, Optional
 
-from .frames import frames_of, is_library_file, learner_frame
+from .frames import frames_of, learner_frame
+from .names import (declared, import_of, learners_functions, place, similar,
+                    stored)
 
-#: Names a learner uses without importing them, by the import that brings each.
-IMPORTS = {name: f'from std_msgs.msg import {name}' for name in
-           ('Float32', 'Float64', 'Bool', 'String', 'Int32', 'Int64')}
-IMPORTS.update({'Node': 'from rclpy.node import Node', 'rclpy': 'import rclpy',
-                'random': 'import random', 'Path': 'from pathlib import Path',
-                'ExternalShutdownException':
-                    'from rclpy.executors import ExternalShutdownException'})
 _CONSTRUCTOR_ARGUMENTS = re.compile(r'Invalid arguments passed to constructor: '
                                     r'(?:dict_keys\(\[(?P<keys>[^\]]*)\]\)|(?P<names>.+))')
 #: Python's refusal of two values an operator cannot take together.
@@ -37,99 +28,31 @@ _OPERANDS = re.compile(r"(?:not supported between instances of|unsupported opera
                        r"for \S+:) '(\w+)' and '(\w+)'")
 
 
-def _similar(name: str, candidates: Any) -> Optional[str]:
-    """The candidate ``name`` was most likely meant to be (a typo away), or None; never one
-    that differs only in case from a lower-case name (``node`` is no typo of ``Node``)."""
-    names = sorted({c for c in candidates if isinstance(c, str) and not c.startswith('__')
-                    and not (name.islower() and c.lower() == name)})
-    found = difflib.get_close_matches(name, names, n=1, cutoff=0.75)
-    return found[0] if found else None
-
-
-#: Where an import the learner left out is looked for, in this order (what the course uses).
-_PACKAGES = ('std_msgs.msg', 'rclpy', 'rcl_interfaces.msg', 'pathlib', 'random')
-
-
-def _import_of(name: str) -> Optional[str]:
-    """``from MODULE import name`` for a name a module of the course's packages defines
-    (the shortest public module among those loaded), or None."""
-    if name in IMPORTS:
-        return IMPORTS[name]
-    found = sorted((module_name for module_name, module in list(sys.modules.items())
-                    if module_name.startswith(_PACKAGES) and '._' not in module_name
-                    and isinstance(getattr(module, name, None), type)), key=len)
-    if not found:
-        return None
-    defined = getattr(sys.modules[found[0]], name).__module__  # where the class is written
-    return f'from {defined if defined in found else found[0]} import {name}'
-
-
 def _first_line(exc: BaseException) -> str:
     return (str(exc).splitlines() or [''])[0][:200]
-
-
-def _place(code: CodeType, line: int) -> str:
-    """``FILE line N: source`` of a line of the learner's (``cell line N`` for a cell)."""
-    name = Path(code.co_filename)
-    place = name.name if name.is_file() and 'ipykernel' not in code.co_filename else 'cell'
-    return f'{place} line {line}: {linecache.getline(code.co_filename, line).strip()}'
-
-
-def _learners_functions(cls: type) -> Iterator[CodeType]:
-    """The code of every method the learner wrote in ``cls`` and its bases (not ROS's)."""
-    for klass in cls.__mro__:
-        for value in vars(klass).values():
-            code = getattr(getattr(value, '__func__', value), '__code__', None)
-            if isinstance(code, CodeType) and not is_library_file(code.co_filename):
-                yield code
-
-
-def _stored(code: CodeType, name: str, opname: str) -> Optional[int]:
-    """The line where ``code`` stores ``name`` with ``opname`` (STORE_FAST: a local;
-    STORE_ATTR: an attribute), or None."""
-    line = None
-    for instruction in dis.get_instructions(code):
-        if instruction.starts_line is not None:
-            line = instruction.starts_line
-        if instruction.opname == opname and instruction.argval == name:
-            return line
-    return None
-
-
-def made_where(exc: BaseException, obj: Any) -> str:
-    """`` (FILE line N: name = ...)``: where the learner's code put ``obj`` in the local name
-    it goes by where ``exc`` was raised (a message made of the wrong type), or ''."""
-    frame = learner_frame(exc)
-    if frame is None:
-        return ''
-    for name, value in frame.f_locals.items():
-        line = _stored(frame.f_code, name, 'STORE_FAST') if value is obj else None
-        if line is not None:
-            return f' ({_place(frame.f_code, line)})'
-    return ''
 
 
 def _unset_attribute(obj: Any, name: str, owner: str) -> Optional[str]:
     """``self.name`` read on the learner's node, where no method of theirs keeps it: a local
     of that name (``temperature = ...``), an attribute of a name a typo away, one set only
     later, or none at all."""
-    methods = list(_learners_functions(type(obj)))
+    methods = list(learners_functions(type(obj)))
     if not methods:
         return None
     for code in methods:
-        line = _stored(code, name, 'STORE_FAST')
+        line = stored(code, name, 'STORE_FAST')
         if line is not None:
             return (f'{owner} has no attribute {name}: {code.co_name} sets a local name '
-                    f'{name} ({_place(code, line)}), which is gone when it returns: write '
+                    f'{name} ({place(code, line)}), which is gone when it returns: write '
                     f'self.{name} = ... there, so that the node keeps it.')
-    kept = _similar(name, [key for key in vars(obj) if not key.startswith('_')])
+    kept = similar(name, [key for key in vars(obj) if not key.startswith('_')])
     if kept:
         return (f'{owner} has no attribute {name}, but it has {kept}: names must match '
                 f'exactly where they are set and where they are used (self.{name}).')
-    if any(_stored(code, name, 'STORE_ATTR') for code in methods):
+    if any(stored(code, name, 'STORE_ATTR') for code in methods):
         return (f'{owner} has no attribute {name} yet: it is read before any method sets it: '
                 f'set self.{name} in __init__.')
-    meant = _similar(name, dir(obj))
+    meant = similar(name, dir(obj))
     if meant:
         return (f'{owner} has no attribute {name}: did you mean self.{meant}? Names must '
                 'match exactly.')
@@ -147,7 +70,7 @@ def _attribute(exc: AttributeError) -> Optional[str]:
         unset = _unset_attribute(obj, name, owner)
         if unset:
             return unset
-    meant = _similar(name, dir(obj))
+    meant = similar(name, dir(obj))
     if meant:
         return f"{owner} has no attribute {name}: did you mean {meant}? Names must match exactly."
     return f'{owner} has no attribute {name}: check the name against what {owner} offers.'
@@ -165,11 +88,11 @@ def _name(exc: NameError, frame: FrameType) -> str:
         plain = used.group(1) if used else 'the name'
         return (f"name 'self' is not defined: {frame.f_code.co_name}() is a function, not a "
                 f'method of a node, so there is no self: write {plain}, not self.{plain}.')
-    meant = _similar(name, visible)
+    meant = similar(name, visible)
     if meant:
         return (f"name '{name}' is not defined: did you mean {meant}? Names must match "
                 'exactly.')
-    imported = _import_of(name)
+    imported = import_of(name)
     if imported:
         return (f"name '{name}' is not defined: import it at the top of the file (or cell), "
                 f'{imported}.')
@@ -191,7 +114,7 @@ def _constructor_arguments(exc: AssertionError) -> Optional[str]:
     if not unknown:
         return None
     cls = type(made).__name__
-    meant = _similar(unknown[0], takes)
+    meant = similar(unknown[0], takes)
     hint = f': did you mean {meant}?' if meant else ''
     return (f'{cls}() takes no argument {unknown[0]}{hint} (it takes '
             f'{", ".join(t for t in takes if not t.startswith("check"))}).')
@@ -201,11 +124,26 @@ def _unset_local(exc: UnboundLocalError, frame: FrameType) -> str:
     """A name the function sets (which makes it local everywhere in it) used before that."""
     quoted = re.search(r"'(\w+)'", _first_line(exc))
     name = quoted.group(1) if quoted else '?'
-    line = _stored(frame.f_code, name, 'STORE_FAST')
-    where = f' ({_place(frame.f_code, line)})' if line is not None else ''
+    line = stored(frame.f_code, name, 'STORE_FAST')
+    where = f' ({place(frame.f_code, line)})' if line is not None else ''
     return (f'{name} is used before {frame.f_code.co_name} sets it{where}: a name the '
             f'function sets is its own local name everywhere in it; set it first, or, for an '
             f'import, import it at the top of the file.')
+
+
+_MISSING = re.compile(r"^(?P<called>[\w.]+)\(\) missing \d+ required positional "
+                      r"arguments?: (?P<names>.+)$")
+
+
+def _missing_arguments(exc: TypeError, frame: FrameType) -> Optional[str]:
+    """``create_publisher(Float32)``: which arguments the call still needs, in its order."""
+    found = _MISSING.match(_first_line(exc))
+    if found is None:
+        return None
+    called = found['called'].removesuffix('.__init__').rpartition('.')[2]
+    names = ', '.join(re.findall(r"'(\w+)'", found['names']))
+    return (f'{called}() was called without {names}: give it every argument it needs, in '
+            f'its order.')
 
 
 _UNEXPECTED_KEYWORD = re.compile(r"^(?P<called>[\w.]+)\(\) got an unexpected keyword argument "
@@ -226,7 +164,7 @@ def _unexpected_keyword(exc: TypeError, frame: FrameType) -> Optional[str]:
                                                                                'kwargs')]
     except (TypeError, ValueError):
         return None
-    meant = _similar(found['name'], takes)
+    meant = similar(found['name'], takes)
     hint = f': did you mean {meant}?' if meant else ''
     return (f'{called}() takes no argument {found["name"]}{hint} (it takes '
             f'{", ".join(takes) or "none"}).')
@@ -244,6 +182,26 @@ def _operands(text: str, frame: FrameType, kinds: set[str]) -> str:
             'and give the line two values it can take together.')
 
 
+def cause_place(exc: BaseException) -> Optional[str]:
+    """``FILE line N: source`` of the learner's line that caused ``exc`` where that is not
+    the line that raised it, or None.  A parameter's value of the wrong kind (None: declared
+    without a default) fails where it is used, perhaps in a line the course gave: the cause
+    is the learner's ``declare_parameter`` of it."""
+    frame = learner_frame(exc)
+    if frame is None or not isinstance(exc, (TypeError, ValueError)):
+        return None
+    used = re.search(r"get_parameter\(\s*'(\w+)'", linecache.getline(frame.f_code.co_filename,
+                                                                   frame.f_lineno))
+    owner = frame.f_locals.get('self')
+    if used is None or owner is None:
+        return None
+    for code in learners_functions(type(owner)):
+        line = declared(code, used.group(1))
+        if line is not None:
+            return place(code, line)
+    return None
+
+
 def everyday_explanation(exc: BaseException) -> Optional[str]:
     """The line for an error of Python's own that the learner's code raised, with what to do,
     or None when it is not theirs to fix: no frame of the error is the learner's, and it is
@@ -252,7 +210,7 @@ def everyday_explanation(exc: BaseException) -> Optional[str]:
     frame = learner_frame(exc)
     if isinstance(exc, AttributeError):
         obj = getattr(exc, 'obj', None)
-        if frame is not None or any(True for _ in _learners_functions(type(obj))):
+        if frame is not None or any(True for _ in learners_functions(type(obj))):
             found = _attribute(exc)
             if found:
                 return found
@@ -268,7 +226,7 @@ def everyday_explanation(exc: BaseException) -> Optional[str]:
         if found:
             return found
     if isinstance(exc, TypeError):
-        found = _unexpected_keyword(exc, frame)
+        found = _unexpected_keyword(exc, frame) or _missing_arguments(exc, frame)
         if found:
             return found
     operands = _OPERANDS.search(text) if isinstance(exc, TypeError) else None

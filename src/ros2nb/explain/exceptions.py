@@ -21,7 +21,8 @@ from rclpy.exceptions import NameValidationException, NotInitializedException
 
 from ..errors import SHUT_DOWN_MESSAGE
 from .bag_reading import bag_reading_mistake
-from .everyday import everyday_explanation, made_where
+from .everyday import cause_place, everyday_explanation
+from .names import made_where
 from .frames import frames_of, is_library_file, learner_entry, learner_frame, raised_in
 from .plain_python import python_mistake
 from .plots import plot_in_callback
@@ -76,7 +77,7 @@ def describe_error(error: BaseException) -> dict:
         explanation = None
     return {'type': type(error).__name__, 'message': str(error)[:500],
             'explanation': explanation, 'traceback': learner_traceback(error),
-            'where': learner_line(error)}
+            'where': cause_place(error) or learner_line(error)}
 
 
 def _called_code(exc: BaseException) -> Any:
