@@ -25,7 +25,7 @@ import textwrap
 from dataclasses import dataclass, field
 from typing import Callable, Iterator, Optional
 
-from mutation_cells import Answer, given_cells
+from mutation_cells import Answer, answers, given_cells
 from mutation_tutorial import TUTORIAL
 
 OPERATORS = ('name one edit away', 'self. dropped', 'self. added', 'arguments swapped',
@@ -420,9 +420,10 @@ def _locals(cell: Cell) -> Iterator[Mutant]:
 
 
 def _methods_of(answer: Answer) -> set[str]:
-    """Functions and methods the notebook's code defines (given cells and this answer)."""
+    """Functions and methods the notebook's code defines (given cells and its answers)."""
     found = set()
-    for text in [*given_cells(answer.notebook).values(), answer.source]:
+    for text in [*given_cells(answer.notebook).values(),
+                 *(a.source for a in answers(answer.notebook))]:
         body = text.split('\n', 1)[1] if text.startswith('%%') else text
         try:
             tree = ast.parse(textwrap.dedent(body))

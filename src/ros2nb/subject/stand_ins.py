@@ -18,6 +18,7 @@ learner's constructor that names its attribute differently still works with them
 from __future__ import annotations
 
 import random
+import sys
 import types
 from typing import Any, Callable
 
@@ -44,6 +45,16 @@ def _publisher_on(node: Node, topic: str) -> Any:
     return found[-1]
 
 
+def _constructing(node: Node) -> bool:
+    """Whether ``node``'s own ``__init__`` is running further up this thread's stack."""
+    frame = sys._getframe(1)
+    while frame is not None:
+        if frame.f_code.co_name == '__init__' and frame.f_locals.get('self') is node:
+            return True
+        frame = frame.f_back
+    return False
+
+
 # ------------------------------------------------------------------ notebook 03: the sensor
 def sensor_init(self: Node) -> None:
     """Part 3 of temperature_publisher.py: name, publisher, timer, start value, a log line."""
@@ -60,8 +71,12 @@ def sensor_callback(self: Node) -> None:
     On a node without ``temperature`` (a constructor that keeps the walk in a local name, or
     under another name) it raises the AttributeError of reading it: the check names the
     constructor's line (:mod:`ros2nb.explain.everyday`), and tries the learner's own
-    callback with it.
+    callback with it.  Called by the constructor itself (``self.publish_temperature()``
+    where the method should be passed), before the walk's start is set, it does nothing, as
+    a call of a part not written yet would: the check then names the call.
     """
+    if not hasattr(self, 'temperature') and _constructing(self):
+        return
     step = random.uniform(-course.MAX_STEP_C, course.MAX_STEP_C)
     self.temperature = max(course.MIN_TEMPERATURE_C,
                            min(course.MAX_TEMPERATURE_C, self.temperature + step))
