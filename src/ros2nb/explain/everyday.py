@@ -17,6 +17,7 @@ import re
 from types import FrameType
 from typing import Any, Optional
 
+from ..errors import Ros2nbError, UsageError
 from .frames import frames_of, learner_frame
 from .names import (declared, import_of, learners_functions, place, similar,
                     stored)
@@ -156,8 +157,11 @@ def _unexpected_keyword(exc: TypeError, frame: FrameType) -> Optional[str]:
     if found is None:
         return None
     called = found['called'].removesuffix('.__init__')
-    target = {**frame.f_globals, **frame.f_locals}.get(called.split('.')[0])
-    for part in called.split('.')[1:]:
+    line = linecache.getline(frame.f_code.co_filename, frame.f_lineno)
+    written = re.search(rf'([\w.]*\b{re.escape(called.split(".")[-1])})\(', line)
+    path = written.group(1) if written else called  # ros2nb.spin, as the line calls it
+    target = {**frame.f_globals, **frame.f_locals}.get(path.split('.')[0])
+    for part in path.split('.')[1:]:
         target = getattr(target, part, None)
     try:
         takes = [p for p in inspect.signature(target).parameters if p not in ('self', 'args',
@@ -208,6 +212,8 @@ def everyday_explanation(exc: BaseException) -> Optional[str]:
     no attribute missing on an object of a class of theirs (the course's code standing in
     for a part reads what their constructor should have set)."""
     frame = learner_frame(exc)
+    if isinstance(exc, (Ros2nbError, UsageError)):
+        return str(exc)  # ros2nb's own line, which says what to do
     if isinstance(exc, AttributeError):
         obj = getattr(exc, 'obj', None)
         if frame is not None or any(True for _ in learners_functions(type(obj))):

@@ -43,6 +43,9 @@ KINDS: dict[str, tuple[Callable[[Any], bool], str]] = {
     'value': (lambda value: not _descriptor(value) or value is None,
               'its default value (26.0)'),
     'descriptor': (_descriptor, 'its ParameterDescriptor(...)'),
+    'rawdata': (lambda value: isinstance(value, (bytes, bytearray, memoryview)),
+                "the message's raw bytes (raw)"),
+    'typ': (lambda value: isinstance(value, str), 'its type (connection.msgtype)'),
     'msg_type': (_message_type, 'the message type (Float32)'),
     'topic': (lambda value: isinstance(value, str), "the topic ('temperature')"),
     'qos_profile': (_depth, 'the queue depth (10)'),
@@ -51,6 +54,7 @@ KINDS: dict[str, tuple[Callable[[Any], bool], str]] = {
 }
 #: The rclpy calls a beginner writes, with their parameters in order.
 CALLS = {'declare_parameter': ('name', 'value', 'descriptor'),
+         'deserialize': ('rawdata', 'typ'),  # rosbags' reader (notebook 10)
          'create_publisher': ('msg_type', 'topic', 'qos_profile'),
          'create_subscription': ('msg_type', 'topic', 'callback', 'qos_profile'),
          'create_timer': ('timer_period_sec', 'callback')}
