@@ -19,8 +19,8 @@ from typing import Any, Optional
 
 from ..errors import Ros2nbError, UsageError
 from .frames import frames_of, learner_frame
-from .names import (declared, import_of, learners_functions, place, similar,
-                    stored)
+from .names import (declared, import_of, learners_functions, place, raising_text,
+                    similar, stored)
 
 _CONSTRUCTOR_ARGUMENTS = re.compile(r'Invalid arguments passed to constructor: '
                                     r'(?:dict_keys\(\[(?P<keys>[^\]]*)\]\)|(?P<names>.+))')
@@ -194,8 +194,7 @@ def cause_place(exc: BaseException) -> Optional[str]:
     frame = learner_frame(exc)
     if frame is None or not isinstance(exc, (TypeError, ValueError)):
         return None
-    used = re.search(r"get_parameter\(\s*'(\w+)'", linecache.getline(frame.f_code.co_filename,
-                                                                   frame.f_lineno))
+    used = re.search(r"get_parameter\(\s*'(\w+)'", raising_text(exc))
     owner = frame.f_locals.get('self')
     if used is None or owner is None:
         return None

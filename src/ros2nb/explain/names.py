@@ -16,7 +16,7 @@ from pathlib import Path
 from types import CodeType
 from typing import Any, Iterator, Optional
 
-from .frames import is_library_file, learner_frame
+from .frames import is_library_file, learner_entry, learner_frame
 
 #: Names a learner uses without importing them, by the import that brings each.
 IMPORTS = {name: f'from std_msgs.msg import {name}' for name in
@@ -120,3 +120,18 @@ def declared(code: CodeType, name: str) -> Optional[int]:
         elif method and instruction.opname == 'LOAD_CONST' and instruction.argval == name:
             return line
     return None
+
+
+def raising_text(exc: BaseException) -> str:
+    """The source of the learner's lines that the instruction raising ``exc`` spans (one
+    line of a statement that runs over several: the f-string's line, not the call's first)."""
+    entry = learner_entry(exc)
+    if entry is None:
+        return ''
+    code = entry.tb_frame.f_code
+    positions = list(code.co_positions())
+    first, last = positions[entry.tb_lasti // 2][:2] if entry.tb_lasti // 2 < len(
+        positions) else (entry.tb_lineno, entry.tb_lineno)
+    first, last = first or entry.tb_lineno, last or first or entry.tb_lineno
+    return ''.join(linecache.getline(code.co_filename, line) for line in range(first, last + 1))
+
