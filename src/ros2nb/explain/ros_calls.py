@@ -74,13 +74,16 @@ def shown(value: Any) -> str:
 
 def _called(exc: BaseException) -> Optional[FrameType]:
     """The frame of the rclpy call the learner's own code made, where the error went through
-    one of :data:`CALLS`: the first library frame after their innermost one."""
+    one of :data:`CALLS`: the first library frame of one after their innermost frame."""
     frames = list(frames_of(exc))
     learner = [i for i, f in enumerate(frames) if not is_library_file(f.f_code.co_filename)]
-    if not learner or learner[-1] + 1 >= len(frames):
+    if not learner:
         return None
-    entered = frames[learner[-1] + 1]
-    return entered if entered.f_code.co_name in CALLS else None
+    for entered in frames[learner[-1] + 1:]:  # past a wrapper (the kernel's guards)
+        names = CALLS.get(entered.f_code.co_name, ())
+        if names and all(name in entered.f_locals for name in names):
+            return entered
+    return None
 
 
 def wrong_arguments(exc: BaseException) -> Optional[str]:
