@@ -24,7 +24,7 @@ export UV_SYSTEM_CERTS := 1
 # numpy (rclpy's message types), and none of them does linear algebra (docs/decisions.md).
 export OPENBLAS_NUM_THREADS := 1
 
-.PHONY: image image-tool lab lab-instructor check test setup bytecode sandbox-tool browser-tool axe-tool graph-tool grading-course solutions learner-notebooks bench grade clean docs
+.PHONY: image image-tool lab lab-instructor check test setup bytecode sandbox-tool browser-tool axe-tool graph-tool grading-course solutions learner-notebooks bench grade clean docs mistakes
 
 setup: $(STAMP)
 
@@ -153,6 +153,13 @@ learner-notebooks: $(STAMP)
 # ros2nb against bare rclpy, and grading seconds per notebook (benchmarks/bench.py).
 bench: $(STAMP) bytecode sandbox-tool
 	$(PY) benchmarks/bench.py $(BENCH_ARGS)
+
+# The mutation test of the checks (benchmarks/mistakes.py): every answer cell of solutions/
+# mutated by a fixed set of operators, each mutant run in a real kernel and through the
+# grader's path, each answer judged; the report goes to mistakes/report.md (git-ignored).
+# MISTAKES_ARGS='--notebooks 03,04 --workers 3' narrows or widens it; fails on a bad answer.
+mistakes: $(STAMP) bytecode
+	$(PY) benchmarks/mistakes.py $(MISTAKES_ARGS)
 
 # Grade a class: SUBMISSIONS is a folder of <learner-id>/NN-*.ipynb or a platform .zip.
 # Output goes to grading/ (git-ignored); FORCE=1 replaces an earlier grading/.

@@ -76,6 +76,7 @@ def pytest_runtest_call(item):
 #: make test passes --no-loadscope-reorder: xdist otherwise sorts files by their number of
 #: tests, whatever this order says.
 LONGEST_FIRST = ('test_grading.py', 'test_corpus_honest.py', 'test_corpus_wrong.py',
+                 'test_mutants.py',
                  'test_jupyterhub.py', 'test_checks_forged.py', 'test_image.py',
                  'test_checks.py', 'test_lessons_06_07.py', 'test_corpora.py',
                  'test_checks_parameters.py',

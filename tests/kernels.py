@@ -1,8 +1,9 @@
 """A real Jupyter kernel for a test, and what one of its cells sent: every output message.
 
 The tests of what a learner sees in a cell (a check's lines, the line long work updates, the
-progress table) read the kernel's own messages, as JupyterLab gets them.  The wait for a cell
-counts the kernel's work, not the wall clock (tests/waiting.py).
+progress table, the mutation tests' ``mutation_runs.py``) read the kernel's own messages, as
+JupyterLab gets them.  The wait for a cell counts the kernel's work, not the wall clock
+(tests/waiting.py).
 """
 
 from __future__ import annotations
@@ -39,6 +40,11 @@ class Cell:
                        if kind == 'stream' and content['name'] == 'stdout')
 
     @property
+    def stderr(self) -> str:
+        return ''.join(content['text'] for kind, content in self.messages
+                       if kind == 'stream' and content['name'] == 'stderr')
+
+    @property
     def error(self) -> Optional[tuple[str, list[str]]]:
         """The error's name and its traceback lines as shown (colours removed), or None."""
         for kind, content in self.messages:
@@ -53,11 +59,15 @@ class Cell:
                 if k == 'display_data' and 'text/html' in c['data']]
 
 
+class CellHung(AssertionError):
+    """A cell that neither finished nor worked for the seconds it was given."""
+
+
 class Kernel:
     """A real ``python3`` kernel with the test process's environment (no ROS domain of its
     own: the kernel claims one), the given workspace and ``env`` on top."""
 
-    def __init__(self, workspace: Optional[Path] = None, **env: str) -> None:
+    def __init__(self, workspace: Optional[Path | str] = None, **env: str) -> None:
         environment = {k: v for k, v in os.environ.items() if k != 'ROS_DOMAIN_ID'}
         if workspace is not None:
             environment['ROS2NB_WORKSPACE'] = str(workspace)
@@ -67,7 +77,9 @@ class Kernel:
     def run(self, code: str, seconds: float = 600) -> Cell:
         """Run a cell; what it sent.
 
-        :param seconds: for the whole cell: of the kernel's work, or of its idle waiting.
+        :param seconds: for the whole cell (a node may print for ever): of the kernel's work,
+            or of its idle waiting.
+        :raises CellHung: when the cell had them and had not finished.
         """
         msg_id, began, cell = self.client.execute(code), time.monotonic(), Cell()
 
@@ -83,9 +95,20 @@ class Kernel:
                 cell.messages.append((kind, content))
             return kind == 'status' and content['execution_state'] == 'idle'
 
-        assert wait_until(finished, seconds, interval=0), f'the cell did not finish: {code!r}'
+        if not wait_until(finished, seconds, interval=0):
+            raise CellHung(f'the cell did not finish within {seconds} s: {code!r}')
         cell.seconds = time.monotonic() - began
         return cell
+
+    def one_line(self, code: str, *fragments: str) -> str:
+        """Run a cell that must fail; check it shows one line with every fragment."""
+        cell = self.run(code)
+        assert cell.error is not None, f'no error for {code!r}: {cell.messages}'
+        shown = cell.error[1]
+        assert len(shown) == 1, shown
+        for fragment in fragments:
+            assert fragment in shown[0], (fragment, shown[0])
+        return shown[0]
 
     def restart(self) -> None:
         self.manager.restart_kernel(now=True)

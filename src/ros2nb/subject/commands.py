@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import linecache
 import random
 import sys
 import time
@@ -79,8 +80,11 @@ def load(command: Command[Any]) -> tuple[dict[str, Any], Reply]:
     assert isinstance(command, ExecCells)  # the only other loader
     errors = []
     for index, source in enumerate(command.sources):
+        text, name = _without_magics(source), f'<cell {index + 1}>'
+        # its lines for tracebacks and explanations, as a kernel keeps a cell's
+        linecache.cache[name] = (len(text), None, text.splitlines(keepends=True), name)
         try:
-            exec(compile(_without_magics(source), f'<cell {index + 1}>', 'exec'), namespace)
+            exec(compile(text, name, 'exec'), namespace)
         except BaseException as error:  # the learner's cell may raise anything
             errors.append(described(error))
     return namespace, CellsRun(ok=True, cell_errors=errors)
