@@ -182,7 +182,7 @@ class NotebookRun:
         return nb
 
     def _grading_check(self, answer: Answer, mutant: Optional[Mutant]) -> Shown:
-        from corpora import _write_parts
+        from corpora import write_parts
         nb = self._submission(mutant)
         source = notebook(self.number)
         graded = {'cells': [c for c in source['cells']
@@ -191,7 +191,7 @@ class NotebookRun:
         with self._grading() as ws, contextlib.redirect_stdout(io.StringIO()):
             if not ws.exists():  # what the notebook's own cells made, then its parts
                 course.catch_up(MADE_BY.get(int(self.number), int(self.number)))
-            _write_parts(nb)
+            write_parts(nb)
             result = grade(graded, nb, self.session)[answer.check_id]
         if result['passed']:
             return Shown(lines=list(result['lines']))
