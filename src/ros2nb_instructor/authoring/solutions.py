@@ -12,6 +12,7 @@ Usage: ros2nb-solutions [NOTEBOOK ...]   (default: every solution notebook; ``ma
 
 from __future__ import annotations
 
+import argparse
 import os
 import shutil
 import sys
@@ -64,9 +65,22 @@ def drop_empty_displays(nb: nbformat.NotebookNode) -> None:
 
 
 def main(argv: Optional[list[str]] = None) -> int:
-    """Execute the given solution notebooks (default all), in order, in place."""
-    argv = sys.argv[1:] if argv is None else argv
-    paths = [Path(a).resolve() for a in argv] or sorted(SOLUTIONS.glob('*.ipynb'))
+    """Execute the given solution notebooks (default all), in order, in place.
+
+    :return: 0, or 2 (with one line on stderr) for a notebook that is not in solutions/.
+    """
+    parser = argparse.ArgumentParser(
+        prog='ros2nb-solutions',
+        description='Run solutions/*.ipynb in place, in course order, so their stored outputs '
+                    'are fresh; then run make learner-notebooks.')
+    parser.add_argument('notebooks', nargs='*', type=Path, metavar='NOTEBOOK',
+                        help='solution notebooks to run (default: all of solutions/)')
+    given = parser.parse_args(argv)
+    paths = sorted(p.resolve() for p in given.notebooks) or sorted(SOLUTIONS.glob('*.ipynb'))
+    for path in paths:
+        if path.parent != SOLUTIONS.resolve() or not path.is_file():
+            parser.error(f'{path} is not a notebook of {SOLUTIONS}: name one of '
+                         'solutions/*.ipynb')
     scratch = Path(tempfile.mkdtemp(prefix='ros2nb-test-'))
     try:
         for path in paths:
@@ -74,7 +88,6 @@ def main(argv: Optional[list[str]] = None) -> int:
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
     return 0
-
 
 if __name__ == '__main__':
     sys.exit(main())

@@ -103,6 +103,13 @@ def main(argv: Optional[list[str]] = None) -> NoReturn:
     """Prepare the learner's folder, then replace this process with jupyterhub-singleuser."""
     argv = sys.argv[1:] if argv is None else argv
     venv_bin = Path(sys.executable).parent
+    if argv in (['-h'], ['--help']):
+        print('usage: ros2nb-hub-singleuser [--check | JUPYTERHUB_SINGLEUSER_ARGUMENT ...]\n\n'
+              "JupyterHub's spawner command for the course: copy the notebooks the learner's "
+              'folder lacks (never overwriting theirs), then become jupyterhub-singleuser '
+              'with the arguments given.\n  --check  as root, say whether learners can use '
+              'the course (docs/classroom-server.md)')
+        sys.exit(0)
     if argv == ['--check']:
         problem = check_learners_can_use_course(Path(sys.executable)) if os.geteuid() == 0 else None
         sys.exit(problem)
