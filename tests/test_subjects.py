@@ -261,3 +261,39 @@ def test_a_subject_ends_by_itself_and_its_exit_handlers_run(tmp_path):
     process.close()
     assert process.proc.returncode == 0, process.output.text()
     assert marker.exists()
+
+
+#: Fast DDS's default lease of a participant (s): one that vanished without a word stays in
+#: every other participant's graph, its endpoints matched, until it runs out.
+DDS_LEASE_S = 20.0
+
+MAKES_A_NODE = '''
+from rclpy.node import Node
+
+class Leaver(Node):
+    def __init__(self):
+        super().__init__('leaver')
+'''
+
+
+def test_a_subject_the_judge_ends_leaves_its_graph_at_once(session):
+    """A subject the judge ends (``kill_process_group``: a flood, a hang) takes its nodes
+    down on SIGTERM: its participant says it leaves, and the judge's graph drops it at once.
+    Ended by SIGTERM's default action, it stayed there until its lease ran out (20 s), its
+    /clock subscription matched, and the judge's /clock reached the next subjects late:
+    ``test_floods.py``'s topic flood failed so beside four burners, the next subject waiting
+    over 30 s for the judge's time."""
+    from ros2nb.processes import kill_process_group
+    from ros2nb.subject_interface import NewNode
+
+    def load(subject: SubjectProcess) -> None:
+        assert subject.request(ExecCells(sources=[MAKES_A_NODE])).cell_errors == []
+
+    subject = session.subject(('leaver',), load)
+    subject.request(NewNode(cls='Leaver'))
+    graph = session.observer.node.get_node_names_and_namespaces
+    assert wait_until(lambda: ('leaver', '/') in graph()), graph()
+    assert kill_process_group(subject.proc) == -15  # ended by the signal, as asked
+    # Idle time of the judge's own wait: half the lease, which a vanished participant outlives.
+    assert session.observer.wait_until(lambda: ('leaver', '/') not in graph(), DDS_LEASE_S / 2), \
+        f'the ended subject is still in the judge\'s graph: {graph()}'
