@@ -8,8 +8,9 @@ file descriptor IN and reads one JSON reply per command on OUT.  The first comma
 the learner's code (their file imported, or their answer cells run), before anything of the
 command loop exists; then their nodes run here on the judge's clock (the runtime follows the
 judge's ``/clock``, :mod:`ros2nb.subject.judge_time`), with the course's stand-ins in place of
-the parts a check does not grade (:mod:`.stand_ins`).  The judge watches the nodes over ROS
-itself; a reply only tells it how long to wait, or which mistake to name.
+the parts a check does not grade (their code sent by the judge,
+:mod:`ros2nb.judge.stand_ins`).  The judge watches the nodes over ROS itself; a reply only
+tells it how long to wait, or which mistake to name.
 """
 
 from __future__ import annotations
@@ -31,8 +32,8 @@ from ..errors import Ros2nbError
 from ..explain.exceptions import describe_error
 from ..runtime import Runtime, enable_field_checks
 from .judge_time import JudgeTime
-from .out_of_reach import STAND_INS, Answers
 from .replies import decode_argument, encode
+from .seen import STAND_IN_FILE
 from .trials import Trials
 
 #: Exit code when a command could not even be read.
@@ -87,9 +88,10 @@ def load(request: dict) -> tuple[dict, dict]:
 class Subject(Trials):
     """The state of this process: the learner's namespace, their node, the runtime."""
 
-    def __init__(self, namespace: dict[str, Any], answers: Answers) -> None:
+    def __init__(self, namespace: dict[str, Any], sealer: Any = None) -> None:
         self.namespace = namespace
-        self._answers = answers  # hands in the stand-ins; the learner's code never had them
+        self._sealer = sealer  # notebook 07's (:func:`.shown.make_sealer`)
+        self._stand_ins: dict[str, tuple[str, Any]] = {}  # name -> (method, function)
         self.rt: Optional[Runtime] = None
         self.node: Optional[Node] = None
         self.received = 0
@@ -110,6 +112,15 @@ class Subject(Trials):
             except BaseException as error:
                 outputs.append({'error': describe_error(error)})
         return {'ok': True, 'outputs': outputs}
+
+    def stand_ins(self, source: str) -> dict:
+        """Compile the stand-ins the judge sent (:func:`ros2nb.judge.stand_ins.source_of`),
+        once the learner's code is loaded: kept here, on no module and under no name that
+        code imports."""
+        made: dict[str, Any] = {'__name__': 'ros2nb stand-ins'}
+        exec(compile(source, STAND_IN_FILE, 'exec'), made)  # noqa: S102 - the judge's code
+        self._stand_ins = dict(made['STAND_INS'])
+        return {'ok': True}
 
     # ---------------------------------------------------------------- nodes
     def _runtime(self) -> Runtime:
@@ -135,7 +146,7 @@ class Subject(Trials):
 
     def new_node(self, cls: str, stand_ins: list[str], seed: Optional[int],
                  args: Optional[list] = None) -> dict:
-        """Create ``cls(*args)`` with the named stand-ins (:mod:`.stand_ins`) and run it on the
+        """Create ``cls(*args)`` with the named stand-ins (:meth:`stand_ins`) and run it on the
         judge's clock; stop the node made before."""
         rt = self._runtime()
         if self.node is not None:
@@ -147,8 +158,9 @@ class Subject(Trials):
             found = sorted(n for n, v in self.namespace.items()
                            if isinstance(v, type) and issubclass(v, Node) and v is not Node)
             return {'ok': False, 'no_class': True, 'classes': found}
-        if stand_ins:
-            node_class = self._answers.hand_in(STAND_INS).with_stand_ins(node_class, stand_ins)
+        if stand_ins:  # a subclass with the course's parts in place of the learner's
+            methods = dict(self._stand_ins[name] for name in stand_ins)
+            node_class = type(node_class.__name__, (node_class,), methods)
         rt.take_judge_time()
         if seed is not None:
             random.seed(seed)
@@ -243,18 +255,19 @@ class Subject(Trials):
 
 
 
-def serve(commands: Any, replies: Any, namespace: dict[str, Any], answers: Answers) -> None:
+def serve(commands: Any, replies: Any, namespace: dict[str, Any], sealer: Any = None) -> None:
     """Answer one JSON reply per JSON command until ``quit`` or end of input.
 
-    :param answers: the finder that keeps the course's answers from the learner's code
-        (:func:`.out_of_reach.shut`), which hands in the stand-ins.
+    :param sealer: notebook 07's sealer, made before the learner's code was loaded
+        (:func:`.shown.make_sealer`).
     """
-    subject = Subject(namespace, answers)
+    subject = Subject(namespace, sealer)
     handlers: dict[str, Callable[..., dict]] = {
         'call': subject.call, 'new_node': subject.new_node, 'run': subject.run,
         'set_attribute': subject.set_attribute, 'wait_matched': subject.wait_matched,
         'wait_received': subject.wait_received, 'counts': subject.counts,
         'serve': subject.serve, 'worker': subject.worker, 'worker_stop': subject.worker_stop,
+        'worker_release': subject.worker_release, 'stand_ins': subject.stand_ins,
         'plot_shown': subject.plot_shown,
         'room_nodes': subject.room_nodes, 'wait_publishers': subject.wait_publishers,
         'qos_endpoint': subject.qos_endpoint, 'qos_acked': subject.qos_acked,
