@@ -7,8 +7,8 @@
   check that starts a subject afresh is graded on that subject's code).
 - Only the hook's own lines count, and a kind the judge does not know is dropped.
 - A notebook whose added cell writes the course's code into the learner's file has that
-  file refused; the course's solutions and every honest and wrong learner of the corpora
-  have none refused.
+  file graded as its ``%%part`` cells write it; the course's solutions and every honest and
+  wrong learner of the corpora have none rewritten.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import pytest
 from corpora import NOTEBOOKS, Learner, every_learner, learner_workspace
 from ros2nb.errors import CheckFailed
 from ros2nb.judge.reaching import Reached, Reaching, parse_seen
-from ros2nb.judge.written import altered_files
+from ros2nb.judge.written import as_written
 
 
 class Subject:
@@ -103,16 +103,17 @@ path = ros2nb.current_workspace() / FAN
 path.write_text(path.read_text() + '\\n# changed\\n')
 '''),)),
 ], ids=lambda learner: learner.name)
-def test_a_file_another_cell_wrote_is_refused(learner, tmp_path):
+def test_a_file_another_cell_wrote_is_graded_as_the_cells_write_it(learner, tmp_path):
     with learner_workspace(learner, tmp_path) as (ws, nb):
-        altered = altered_files(nb, ws)
-    assert len(altered) == 1, altered
-    assert "is not what your notebook's %%part cells write" in next(iter(altered.values()))
+        rewritten = as_written(nb, ws)
+        (relative, text), = rewritten.items()
+        assert text != (ws / relative).read_text()
+    assert "the course\\'s code" not in text and '# changed' not in text, text
 
 
-def test_no_honest_wrong_or_course_notebook_has_a_file_refused(tmp_path):
+def test_no_honest_wrong_or_course_notebook_has_a_file_rewritten(tmp_path):
     learners = [learner for learner in every_learner().values() if not learner.added]
     learners += [Learner(f'solution {n}', n, {}) for n in sorted(NOTEBOOKS) if n >= '03']
     for index, learner in enumerate(learners):
         with learner_workspace(learner, tmp_path / str(index)) as (ws, nb):
-            assert altered_files(nb, ws) == {}, learner.name
+            assert as_written(nb, ws) == {}, learner.name

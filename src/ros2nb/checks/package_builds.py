@@ -53,7 +53,6 @@ def course_setup_cfg() -> str:
 
 
 def package_source(judge: Judge) -> Path:
-    judge.refuse_altered(f'src/{course.PACKAGE}')  # a file no %%part cell wrote as it is
     source = judge.workspace / 'src' / course.PACKAGE
     if not (source / 'package.xml').is_file():
         raise CheckFailed(f'The package {course.PACKAGE} does not exist in your workspace: create '

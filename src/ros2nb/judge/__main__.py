@@ -63,11 +63,14 @@ def main(argv: list[str]) -> int:
             # Only grading flags code (the flags parse cells with IPython, whose imports
             # every check of a learner's kernel would pay).
             from .flags import notebook_flags
-            from .written import altered_files
+            from .written import REWRITTEN, as_written
             source, submission = (json.loads(Path(p).read_text()) for p in argv[1:])
-            session.altered = altered_files(submission, session.workspace)
+            rewritten = as_written(submission, session.workspace)
+            flags = notebook_flags(submission, session.workspace, source)
+            if rewritten:  # what another cell wrote into the package is never graded
+                session.grade_as_written(rewritten)
             result = {'results': grade(source, submission, session),
-                      'flags': notebook_flags(submission, session.workspace, source)
+                      'flags': flags + [REWRITTEN.format(name=Path(r).name) for r in rewritten]
                       + session.reaching.flags()}
     finally:
         session.close()

@@ -137,7 +137,8 @@ class Reaching:
         for index, (subject, event) in enumerate(self.found):
             if KINDS[event.kind][1] and (index >= self._mark or
                                          any(subject is used for used in self.used)):
-                raise CheckFailed(REFUSED.format(does=KINDS[event.kind][0], what=event.what,
+                what = '/'.join(event.what.split('/')[-2:])  # a file of the course's: its name
+                raise CheckFailed(REFUSED.format(does=KINDS[event.kind][0], what=what,
                                                  where=_short(event.where) or 'in your code'))
 
     def flags(self) -> list[str]:

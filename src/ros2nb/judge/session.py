@@ -6,7 +6,6 @@ Part of the judge (:mod:`ros2nb.judge`).  The checks get the session as their ju
 
 from __future__ import annotations
 
-import contextlib
 import json
 import os
 import shutil
@@ -34,6 +33,7 @@ from ..judge_interface import AnswerRef, learner_error
 from .observer import Observer
 from .reaching import Reaching
 from .stand_ins import source_of
+from .written import workspace_files
 from .subjects import (Output, SubjectHung, SubjectProcess, home_and_tmp, subject_env,
                        subject_prefix, subjects_folder)
 
@@ -72,9 +72,6 @@ class Session:
         #: What the learner's code reached for in the subjects (their audit hooks): flags,
         #: and a failed check where it can only serve cheating (:mod:`.reaching`).
         self.reaching = Reaching(self._subjects)
-        #: Package files the notebook's %%part cells did not write as they are, with the
-        #: line a check that uses one fails with (grading only: :mod:`.written`).
-        self.altered: dict[str, str] = {}
 
     @property
     def observer(self) -> Observer:
@@ -170,7 +167,6 @@ class Session:
         per set of stand-ins, so that no learner's code ever ran beside the course's version
         of the part it is graded on."""
         path = self.workspace / relative
-        self.refuse_altered(relative)
 
         def load(subject: SubjectProcess) -> None:
             reply = subject.request('load_file', path=str(path), module=path.stem)
@@ -186,15 +182,15 @@ class Session:
         return self.subject(('file', relative, *(['+', *stand_ins] if stand_ins else [])),
                             load)
 
-    def refuse_altered(self, relative: str) -> None:
-        """Raise for a package file at or under ``relative`` (a path in the workspace) that
-        the notebook's %%part cells did not write as it is (:attr:`altered`).
-
-        :raises CheckFailed: with its line.
-        """
-        for known, line in self.altered.items():
-            if known == relative or known.startswith(relative.rstrip('/') + '/'):
-                raise CheckFailed(line)
+    def grade_as_written(self, files: dict[str, str]) -> None:
+        """From now on, grade a copy of the workspace in which each of ``files`` (a path in the
+        workspace -> its text) is written so: what the notebook's ``%%part`` cells write,
+        where another cell changed the file (:mod:`.written`).  A workspace too large to copy
+        is graded as it is."""
+        found = workspace_files(self.workspace)
+        if found is not None:
+            found.update({relative: text.encode() for relative, text in files.items()})
+            self.workspace = self.hand_over('as-written-', found)
 
     def answer_subject(self, ref: AnswerRef, workspace: Optional[Path] = None) -> SubjectProcess:
         """A subject with the course's context cells and the learner's answer cells run (in
@@ -254,8 +250,6 @@ class Session:
 
         :return: the process, and its output (stdout and stderr), collected as it comes.
         """
-        with contextlib.suppress(ValueError):  # a path outside the workspace: not the learner's
-            self.refuse_altered(str(path.relative_to(self.workspace)))
         args = [str(path), *([stand_in] if stand_in else [])]
         if subject_prefix():
             return self.start([sys.executable, '-m', 'ros2nb.subject.program', *args],

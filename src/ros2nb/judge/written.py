@@ -8,8 +8,9 @@ kernel, where the course's own code is at hand, and could write a file of the pa
 is not what the notebook shows.  So before grading, the judge compares each file with what
 the submission's ``%%part`` cells say it holds, through the workspace's record of the parts
 (``.ros2nb-parts.json``, which ``write_part`` keeps): a part a cell wrote must be there as the
-cell wrote it, and the file must be its parts joined.  A file that is not is refused to every
-check that would load, run or build it, with one line (:meth:`Session.file_subject`).
+cell wrote it, and the file must be its parts joined.  A file that is not is graded as the
+cells write it: the judge grades a copy of the workspace with that file written so
+(:meth:`ros2nb.judge.session.Session.grade_as_written`), and flags it for the instructor.
 
 A part whose cell still holds the placeholder keeps the working version written before it
 (``write_part`` never replaces one with the placeholder): by an earlier ``%%part`` cell of the
@@ -23,29 +24,24 @@ import json
 import os
 import re
 import shlex
+import stat
 from pathlib import Path
 from typing import Optional
 
 from .. import course, nbmeta
 from ..terminal.files import AUTHOR_MARKERS, PARTS_RECORD, PLACEHOLDER
 
-#: The line of a check that would use a file the notebook's cells did not write as it is.
-ALTERED = ('{name} is not what your notebook\'s %%part cells write (another cell changed it): '
-           'the grader grades what the %%part cells write; run them in order and let no other '
-           'cell write the file.')
-#: Bytes read of one file at most (the package's files are small).
-MAX_BYTES = 1_000_000
+#: The flag of a file the notebook's cells did not write as it is (graded as they write it).
+REWRITTEN = ("{name}: not what the notebook's %%part cells write (another cell changed it); "
+             'graded as they write it')
+#: Bytes read of one file at most (the package's files are small), and files of a workspace.
+MAX_BYTES, MAX_FILES = 1_000_000, 2000
 
 
 def _read(path: Path) -> Optional[str]:
     """A file's text, never through a link; None when it cannot be read."""
-    try:
-        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW)
-    except OSError:
-        return None
-    with os.fdopen(fd, 'rb') as file:
-        data = file.read(MAX_BYTES + 1)
-    return None if len(data) > MAX_BYTES else data.decode('utf-8', 'replace')
+    data = _read_bytes(path)
+    return None if data is None else data.decode('utf-8', 'replace')
 
 
 #: The package files an earlier notebook wrote, by what a notebook needs before it starts.
@@ -96,23 +92,65 @@ def cell_parts(submission: dict) -> dict[str, dict[int, Optional[str]]]:
     return written
 
 
-def altered_files(submission: dict, workspace: Path) -> dict[str, str]:
-    """The package files of ``workspace`` that are not what ``submission``'s ``%%part`` cells
-    write: relative path -> the line a check that uses it fails with."""
+def _record(workspace: Path) -> dict[str, dict[str, str]]:
+    """The workspace's record of the parts ``write_part`` saved (empty when unreadable)."""
     try:
         record = json.loads(_read(workspace / PARTS_RECORD) or '{}')
     except ValueError:
-        record = {}
-    altered = {}
+        return {}
+    return {k: {n: str(t) for n, t in v.items()} for k, v in record.items()
+            if isinstance(v, dict)} if isinstance(record, dict) else {}
+
+
+def _joined(parts: dict[str, str]) -> str:
+    """A file's text from its parts, as ``write_part`` joins them."""
+    return '\n\n'.join(parts[n].rstrip('\n') for n in
+                        sorted(parts, key=lambda n: int(n) if n.isdigit() else 0)) + '\n'
+
+
+def as_written(submission: dict, workspace: Path) -> dict[str, str]:
+    """The package files of ``workspace`` that are not what ``submission``'s ``%%part`` cells
+    write: relative path -> the text those cells write (the record's parts where a
+    placeholder kept an earlier notebook's)."""
+    record, rewritten = _record(workspace), {}
     for relative, parts in cell_parts(submission).items():
-        saved = record.get(relative, {}) if isinstance(record, dict) else {}
-        saved = saved if isinstance(saved, dict) else {}
+        saved = record.get(relative, {})
         text = _read(workspace / relative)
-        joined = '\n\n'.join(str(saved[n]).rstrip('\n') for n in
-                             sorted(saved, key=lambda n: int(n) if n.isdigit() else 0)) + '\n'
         if text is None:
             continue  # a file never written: each check says what is missing
-        if text != joined or any(body is not UNKNOWN and saved.get(str(n)) != body
-                                 for n, body in parts.items()):
-            altered[relative] = ALTERED.format(name=Path(relative).name)
-    return altered
+        written = {**saved, **{str(n): body for n, body in parts.items() if body is not UNKNOWN}}
+        if text != _joined(saved) or written != saved:
+            rewritten[relative] = _joined(written)
+    return rewritten
+
+
+def workspace_files(workspace: Path) -> Optional[dict[str, bytes]]:
+    """Every file of ``workspace`` (a graded snapshot: sources, the parts' record, no build),
+    read without following a link; None when there are more than :data:`MAX_BYTES` times
+    :data:`MAX_FILES` bytes or files."""
+    found: dict[str, bytes] = {}
+    total = 0
+    for folder, _dirs, names in os.walk(workspace):
+        for name in names:
+            path = Path(folder) / name
+            data = _read_bytes(path)
+            if data is None:
+                continue
+            total += len(data)
+            found[str(path.relative_to(workspace))] = data
+            if total > MAX_BYTES * 8 or len(found) > MAX_FILES:
+                return None
+    return found
+
+
+def _read_bytes(path: Path) -> Optional[bytes]:
+    """A regular file's bytes, never through a link (None: not one, or too large)."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+    except OSError:
+        return None
+    with os.fdopen(fd, 'rb') as file:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            return None
+        data = file.read(MAX_BYTES + 1)
+    return None if len(data) > MAX_BYTES else data

@@ -1,6 +1,6 @@
 """What the learner's code reaches for in a subject, seen as it runs (a CPython audit hook).
 
-Part of :mod:`ros2nb.subject`; introduced with grading (``docs/grading.md``).  Before the
+Part of :mod:`ros2nb.subject`; introduced with grading (``docs/instructors.md``).  Before the
 learner's code is loaded, the subject installs an audit hook (PEP 578, ``sys.addaudithook``:
 no Python code can remove it).  The hook watches the events that reach into the course or
 into the process: stack frames, the garbage collector's objects, a function's code, the
