@@ -24,7 +24,7 @@ export UV_SYSTEM_CERTS := 1
 # numpy (rclpy's message types), and none of them does linear algebra (docs/decisions.md).
 export OPENBLAS_NUM_THREADS := 1
 
-.PHONY: image image-tool lab lab-instructor check test setup bytecode sandbox-tool browser-tool graph-tool grading-course solutions learner-notebooks bench grade clean docs
+.PHONY: image image-tool lab lab-instructor check test setup bytecode sandbox-tool browser-tool axe-tool graph-tool grading-course solutions learner-notebooks bench grade clean docs
 
 setup: $(STAMP)
 
@@ -81,6 +81,17 @@ sandbox-tool:
 browser-tool:
 	$(call from_debian,chromium,chromium,the browser tests skip.)
 
+# The browser tests of the website (tests/test_docs_site.py) run axe-core, the accessibility
+# engine, on every page: from npm, pinned, into .cache/node beside the hub's proxy (never
+# globally), so nothing is fetched while a test runs; without npm the axe tests skip, saying why.
+AXE_VERSION := 4.14.1
+AXE_STAMP   := $(HERE)/.cache/node/.installed-axe-core-$(AXE_VERSION)
+
+axe-tool:
+	@test -e $(AXE_STAMP) || { command -v npm >/dev/null || { echo "npm not found (install Node.js with npm): the site's accessibility tests skip."; exit 0; }; \
+	  npm install --prefix $(HERE)/.cache/node --cache $(HERE)/.cache/npm --save-exact --no-audit --no-fund --loglevel=error axe-core@$(AXE_VERSION) && touch $(AXE_STAMP) \
+	  || echo "axe-core not installed (needs npm's registry): the site's accessibility tests skip."; }
+
 # Notebook 06 draws the ROS graph with Graphviz's dot layout (as rqt_graph does).
 graph-tool:
 	$(call from_debian,dot,graphviz,notebook 06 lists the graph as text instead of drawing it.)
@@ -90,11 +101,14 @@ graph-tool:
 image-tool:
 	$(call from_debian,podman runc debootstrap,podman runc debootstrap,the image test skips.)
 
-# The fast lane (docs/developing.md): ruff over the course's Python, then the tests that need
-# only Python (no ROS process, kernel, sandbox, browser, image or hub: tests/conftest.py's
-# lanes), notebook structure and layer rules among them.  Run it while you work.
+# The fast lane (docs/developing.md): ruff over the course's Python, mypy over the seams
+# between the places code runs (pyproject.toml: [tool.mypy]; its cache in .cache/mypy), then
+# the tests that need only Python (no ROS process, kernel, sandbox, browser, image or hub:
+# tests/conftest.py's lanes), notebook structure and layer rules among them.  Run it while
+# you work.
 check: $(STAMP) bytecode
 	@$(VENV)/bin/ruff check --quiet .
+	@$(PY) -m mypy
 	@$(PY) -m pytest --lane check -q
 
 # Everything: the fast lane first (a lint error or a broken rule stops here, in a minute),
@@ -105,7 +119,7 @@ check: $(STAMP) bytecode
 # step by step, and fewer left the cores idle between steps (docs/decisions.md).
 TEST_WORKERS ?= 6
 
-test: check $(STAMP) bytecode sandbox-tool browser-tool graph-tool image-tool grading-course docs
+test: check $(STAMP) bytecode sandbox-tool browser-tool axe-tool graph-tool image-tool grading-course docs
 	@tests/run_steps.sh $(PY) $(TEST_WORKERS)
 
 # The nbgrader course of the current solutions (generate_assignment, kept per version of the
@@ -140,8 +154,8 @@ bench: $(STAMP) bytecode sandbox-tool
 # Grade a class: SUBMISSIONS is a folder of <learner-id>/NN-*.ipynb or a platform .zip.
 # Output goes to grading/ (git-ignored); FORCE=1 replaces an earlier grading/.
 grade: $(STAMP) bytecode sandbox-tool
-	@test -n "$(SUBMISSIONS)" || { echo "Usage: make grade SUBMISSIONS=DIR (DIR/<learner>/NN-title.ipynb) or SUBMISSIONS=class.zip [FORCE=1] [NO_SANDBOX=1] [SEED=N] [SCHEDULER=tcp://host:8786]"; exit 2; }
-	$(VENV)/bin/ros2nb-grade "$(SUBMISSIONS)" $(if $(FORCE),--force) $(if $(NO_SANDBOX),--no-sandbox) $(if $(SEED),--seed $(SEED)) $(if $(SCHEDULER),--scheduler "$(SCHEDULER)")
+	@test -n "$(SUBMISSIONS)" || { echo "Usage: make grade SUBMISSIONS=DIR (DIR/<learner>/NN-title.ipynb) or SUBMISSIONS=class.zip [FORCE=1] [NO_SANDBOX=1] [SEED=N] [SCHEDULER=tcp://host:8786] [SETTINGS=course.toml] [EXPORT=canvas|moodle|csv ROSTER=roster.csv] [LEARNER=name]"; exit 2; }
+	$(VENV)/bin/ros2nb-grade "$(SUBMISSIONS)" $(if $(FORCE),--force) $(if $(NO_SANDBOX),--no-sandbox) $(if $(SEED),--seed $(SEED)) $(if $(SCHEDULER),--scheduler "$(SCHEDULER)") $(if $(SETTINGS),--settings "$(SETTINGS)") $(if $(EXPORT),--export "$(EXPORT)") $(if $(ROSTER),--roster "$(ROSTER)") $(if $(LEARNER),--learner "$(LEARNER)")
 
 clean:
 	rm -rf $(VENV) .cache .jupyter

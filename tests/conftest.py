@@ -18,6 +18,7 @@ from ros2nb import domains
 from ros2nb.judge.session import Session
 
 from browser import module_chromium, page  # noqa: F401 - fixtures for every module
+from docs_site import site  # noqa: F401 - the built website, for its browser tests
 from judging import judge_session
 
 #: The kinds of slow test, each a marker: what the test needs besides Python.

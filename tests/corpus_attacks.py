@@ -7,6 +7,7 @@ subject reports about the learner's objects.
 """
 
 from corpora import Learner
+from corpus_floods import FLOODERS
 from corpus_tables import TABLES
 
 #: 03: no timer; every step of the course's runtime (found among the garbage collector's
@@ -75,10 +76,11 @@ if _frame is not None:
     _handlers = _frame.f_locals['handlers']
     for _name in list(_handlers):
         _real = _handlers[_name]
-        def _forged(*args, _real=_real, **kwargs):
-            reply = _real(*args, **kwargs)
-            reply.update(received=60, redraws=60, ok=True)
-            return reply
+        def _forged(command, _real=_real):
+            import dataclasses
+            reply = _real(command)
+            counted = {'received': 60} if hasattr(reply, 'received') else {}
+            return dataclasses.replace(reply, ok=True, **counted)
         _handlers[_name] = _forged
 '''
 
@@ -370,5 +372,6 @@ def record_hour(bag_path):
 '''}, twin='10 twin: record_hour records nothing'),
 ]
 
-#: Lookup tables of the judge's old fixed inputs, beside their honest-wrong twins.
-ATTACKS += TABLES
+#: Lookup tables of the judge's old fixed inputs, beside their honest-wrong twins; a slow
+#: flood the judge's CPU limit ends.
+ATTACKS += TABLES + FLOODERS

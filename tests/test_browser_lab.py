@@ -8,7 +8,9 @@ by the tests of this module in file order:
    panel, no Validate button) and no news pop-up;
 2. a finished notebook (01, the cheapest) runs to the end with Run All Cells, its check
    passing in its own cell;
-3. Interrupt stops a running spin within 1 s, with one line.
+3. Interrupt stops a running spin within 1 s, with one line;
+4. a learner without a pointer goes through notebook 03 to its first check with the keyboard
+   alone: runs the cells, sees the check fail on the unwritten part, writes it, and passes.
 
 Screenshots go to a temporary folder whose name the tests print (``-s`` shows it).
 """
@@ -16,6 +18,7 @@ Screenshots go to a temporary folder whose name the tests print (``-s`` shows it
 from __future__ import annotations
 
 import os
+import re
 import secrets
 import shutil
 import signal
@@ -79,11 +82,14 @@ class Lab:
     :ivar page: Playwright's page, on notebook 01 in the learner's lab.
     :ivar shots: where the test's screenshots go.
     :ivar work: the learner's work folder (``ROS2NB_WORK``).
+    :ivar url: the lab's address with its token (``http://127.0.0.1:PORT/lab/tree/{}?token=...``,
+        ``{}`` for a notebook's name).
     """
 
     page: Any
     shots: Path
     work: Path
+    url: str
 
 
 @pytest.fixture(scope='module')
@@ -119,11 +125,14 @@ def lab(tmp_path_factory):
         with browser.chromium() as chromium:
             context = chromium.new_context(viewport={'width': 1400, 'height': 900})
             page = context.new_page()
-            page.goto(f'{base}/lab/tree/{NOTEBOOK}?token={token}')
+            # Up to the document's parse, with no time limit: what follows is polled (a busy
+            # machine takes longer than Playwright's 30 s to load the whole lab).
+            page.goto(f'{base}/lab/tree/{NOTEBOOK}?token={token}', wait_until='domcontentloaded',
+                      timeout=0)
             code_cells = sum(c.cell_type == 'code' for c in nbformat.read(work / NOTEBOOK, 4).cells)
             wait_for(lambda: page.evaluate(NOTEBOOK_READY, code_cells), 'the notebook shown',
                      seen=lambda: page.content()[-800:])
-            yield Lab(page, shots, work)
+            yield Lab(page, shots, work, f'{base}/lab/tree/{{}}?token={token}')
             context.close()
     finally:
         os.killpg(server.pid, signal.SIGTERM)
@@ -204,3 +213,76 @@ def test_interrupt_stops_a_spin_with_one_line(lab):
     page.screenshot(path=str(shots / 'learner-lab-01-interrupted.png'))
     assert (lines[0] == 'spinning' and len(lines) == 2
             and lines[1].startswith('Interrupted after ')), lines
+
+
+KEYBOARD_NOTEBOOK = '03-write-the-publisher.ipynb'
+#: The notebook on show (the lab keeps the tabs it hides in the page).
+SHOWN = '.jp-NotebookPanel:not(.lm-mod-hidden) .jp-Notebook'
+#: Notebook 03 shown, its cells all there and its kernel idle.
+SHOWN_READY = ("n => { const nb = document.querySelector('" + SHOWN + "');"
+               " return !!nb && nb.querySelectorAll('.jp-CodeCell').length === n &&"
+               " (document.querySelector('#jp-main-statusbar') || {innerText: ''})"
+               ".innerText.includes('| Idle'); }")
+#: The index of the shown notebook's active cell, and whether the page's focus is in it.
+WHERE = ("() => { const nb = document.querySelector('" + SHOWN + "');"
+         " const cells = [...nb.querySelectorAll('.jp-Cell')];"
+         " return [cells.findIndex(c => c.classList.contains('jp-mod-active')),"
+         " nb.contains(document.activeElement)]; }")
+
+
+def _cell(page, index: int):
+    return page.locator(f'{SHOWN} .jp-Cell').nth(index)
+
+
+def _output(page, index: int) -> str:
+    """The text of cell ``index``'s output, once it ran (its prompt shows a number)."""
+    prompt = _cell(page, index).locator('.jp-InputPrompt').inner_text()
+    return _cell(page, index).locator('.jp-OutputArea').inner_text() \
+        if re.search(r'\[\d+\]', prompt) else ''
+
+
+def _press_until(page, key: str, index: int) -> None:
+    """Press ``key`` until cell ``index`` is the active one, each press moving one cell."""
+    for _ in range(page.locator(f'{SHOWN} .jp-Cell').count()):
+        if page.evaluate(WHERE)[0] == index:
+            return
+        page.keyboard.press(key)
+    assert page.evaluate(WHERE)[0] == index
+
+
+def test_the_first_check_of_03_by_keyboard_alone(lab):
+    """No click from here on: the notebook opened at its address (as a bookmark would), then
+    only keys, each of JupyterLab's own: Shift+Enter runs a cell and moves on, Up selects the
+    cell above, Enter edits it, Ctrl+A selects its text (which the learner's part replaces)."""
+    # The same window: a second one on the same lab would be moved to a workspace of its own.
+    page = lab.page
+    page.goto(lab.url.format(KEYBOARD_NOTEBOOK), wait_until='domcontentloaded', timeout=0)
+    notebook = nbformat.read(lab.work / KEYBOARD_NOTEBOOK, 4)
+    wait_for(lambda: page.evaluate(SHOWN_READY, sum(c.cell_type == 'code'
+                                                    for c in notebook.cells)),
+             'notebook 03 shown', seen=lambda: page.content()[-800:])
+    answer = next(i for i, c in enumerate(notebook.cells)
+                  if c.metadata.get('nbgrader', {}).get('solution'))
+    check = answer + 1
+    assert 'learner-check' in notebook.cells[check].metadata.get('tags', [])
+    wait_for(lambda: page.evaluate(WHERE) == [0, True], 'the first cell active, with the focus',
+             seen=lambda: page.evaluate(WHERE))
+    page.keyboard.press('Escape')  # command mode: keys act on cells
+    _press_until(page, 'Shift+Enter', check + 1)  # everything up to the check, run
+    failed = wait_for(lambda: _output(page, check).strip(), 'the check of the unwritten part',
+                      seen=lambda: _cell(page, check).inner_text())
+    assert not failed.startswith('Check passed') and '\n' not in failed, failed
+
+    solution = nbformat.read(ROOT / 'solutions' / KEYBOARD_NOTEBOOK, 4).cells[answer].source
+    _press_until(page, 'ArrowUp', answer)
+    page.keyboard.press('Enter')  # edit mode, in the learner's cell
+    page.keyboard.press('Control+a')
+    page.keyboard.insert_text(re.sub(r' *### (BEGIN|END) SOLUTION\n?', '', solution))
+    page.keyboard.press('Shift+Enter')  # saves the part; the check is next
+    wait_for(lambda: page.evaluate(WHERE) == [check, True], 'the check cell active',
+             seen=lambda: page.evaluate(WHERE))
+    page.keyboard.press('Shift+Enter')
+    wait_for(lambda: _output(page, check).strip().startswith('Check passed:'), 'the check passed',
+             seen=lambda: _cell(page, check).inner_text())
+    assert page.evaluate(WHERE) == [check + 1, True]
+    page.screenshot(path=str(lab.shots / 'learner-lab-03-by-keyboard.png'))

@@ -5,50 +5,29 @@ The browser tests open the built site (``docs/_build/html``, which ``make test``
 first; built into a temporary folder when it is missing) in Debian's chromium, served by
 Python's http.server on 127.0.0.1: the search finds what learners look for, the lessons'
 pictures load, the exercise blocks show no solution, and no page asks for anything off the
-machine.  Each protection also meets the failure it prevents: a learner page built with a
-solution left in, and a page with an image from the network.  The tests without a marker
-check the lesson pages and the link check as plain Python (``make check``).
+machine, and axe-core (tests/accessibility.py) finds no violation of critical, serious or
+moderate impact and the console no error on any page, in light and dark mode.  Each
+protection also meets the failure it prevents: a learner page built with a solution left in,
+a page with an image from the network, and one with an image without alt and a console
+error.  The tests without a marker check the lesson pages and the link check as plain Python
+(``make check``).
 """
 
 from __future__ import annotations
 
 import functools
-import importlib.util
 import json
-import os
 import re
 import shutil
-import subprocess
-import sys
-import threading
-from contextlib import contextmanager
-from dataclasses import dataclass
-from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from typing import Iterator
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
-SITE_TOOLS = ROOT / 'docs' / 'site'
-BUILT = ROOT / 'docs' / '_build' / 'html'
-LESSONS = sorted(path.name for path in (ROOT / 'solutions').glob('[0-9][0-9]-*.ipynb'))
-#: What a page may ask for besides its own server: pictures stored in the page itself.
-IN_THE_PAGE = ('data:', 'blob:', 'about:')
-#: Building under load (make test runs beside its other steps) is slow, never stuck.
-BUILD_LIMIT_S = 900
-
-
-def _load(name: str):
-    spec = importlib.util.spec_from_file_location(f'docs_site_{name}', SITE_TOOLS / f'{name}.py')
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-site_lessons = _load('lessons')
-site_build = _load('build')
-
+import accessibility
+from docs_site import (BUILD_LIMIT_S, LESSONS, ROOT, build_site, open_page, page_name,
+                       page_text, served, site_build, site_lessons, site_pages,
+                       watch_requests)
 
 # ---- what a lesson's solution looks like, read here from the notebooks, not from lessons.py
 
@@ -104,10 +83,6 @@ def answer_cells(lesson: str) -> int:
                if cell.get('metadata', {}).get('nbgrader', {}).get('solution'))
 
 
-def page_name(lesson: str) -> str:
-    return f'lessons/{lesson.removesuffix(".ipynb")}.html'
-
-
 # ---- the check lane: the lesson pages and the link check, as plain Python
 
 @pytest.mark.parametrize('lesson', LESSONS)
@@ -155,84 +130,6 @@ def test_link_check_names_broken_links_and_network_loads(tmp_path):
 
 
 # ---- the browser lane: the built site in chromium
-
-class _QuietHandler(SimpleHTTPRequestHandler):
-    def log_message(self, format, *args):  # noqa: A002 - http.server's own signature
-        pass
-
-
-@contextmanager
-def served(folder: Path) -> Iterator[str]:
-    """``folder`` served by http.server on 127.0.0.1 and a free port: its base URL."""
-    handler = functools.partial(_QuietHandler, directory=str(folder))
-    server = ThreadingHTTPServer(('127.0.0.1', 0), handler)
-    thread = threading.Thread(target=server.serve_forever, daemon=True)
-    thread.start()
-    try:
-        yield f'http://127.0.0.1:{server.server_address[1]}/'
-    finally:
-        server.shutdown()
-        server.server_close()
-        thread.join()
-
-
-def build_site(out: Path, course: Path = ROOT, *extra: str,
-               env: dict | None = None) -> Path:
-    """The site built by ``docs/site/build.py`` into ``out``: its html folder."""
-    done = subprocess.run([sys.executable, str(SITE_TOOLS / 'build.py'), '--out', str(out),
-                           '--course', str(course), *extra],
-                          capture_output=True, text=True, timeout=BUILD_LIMIT_S,
-                          env={**os.environ, **(env or {})})
-    assert done.returncode == 0, done.stderr[-3000:]
-    return out / 'html'
-
-
-@dataclass(frozen=True)
-class Site:
-    html: Path  #: the built site's folder
-    base: str   #: its URL on this machine's http.server
-
-
-@pytest.fixture(scope='module')
-def site(tmp_path_factory) -> Iterator[Site]:
-    """The built site (``make docs``'s, else built here), served."""
-    html = BUILT if (BUILT / 'index.html').exists() else \
-        build_site(tmp_path_factory.mktemp('docs'))
-    with served(html) as base:
-        yield Site(html, base)
-
-
-def watch_requests(page, base: str) -> list[str]:
-    """Record every request of ``page``; the ones off this machine are listed (and stopped
-    before they leave): the list returned, filled as the page loads."""
-    off_machine: list[str] = []
-
-    def route(route):
-        url = route.request.url
-        if url.startswith(base) or url.startswith(IN_THE_PAGE):
-            route.continue_()
-        else:
-            route.abort()
-
-    def request(request):
-        if not (request.url.startswith(base) or request.url.startswith(IN_THE_PAGE)):
-            off_machine.append(request.url)
-
-    page.route('**/*', route)
-    page.on('request', request)
-    return off_machine
-
-
-def open_page(page, url: str) -> None:
-    """``url`` loaded: its scripts, styles and pictures (``load``) and its fonts."""
-    page.goto(url, wait_until='load')
-    page.evaluate('document.fonts.ready.then(() => true)')
-
-
-def page_text(page) -> str:
-    """All the text of the page, what a collapsed block holds included."""
-    return page.evaluate('document.body.textContent')
-
 
 @pytest.mark.browser
 @pytest.mark.timeout(BUILD_LIMIT_S)
@@ -323,11 +220,6 @@ def test_hub_link_only_where_a_hub_is_set(planted_site, page):
         'http://127.0.0.1:1/hub/lab/tree/04-write-the-subscriber.ipynb'
 
 
-def site_pages(html: Path) -> list[str]:
-    return sorted(str(page.relative_to(html)) for page in html.rglob('*.html')
-                  if page.relative_to(html).parts[0] != '_static')
-
-
 @pytest.mark.browser
 @pytest.mark.timeout(BUILD_LIMIT_S)
 def test_no_page_asks_for_anything_off_the_machine(site, page):
@@ -350,3 +242,92 @@ def test_a_page_asking_the_network_is_caught(site, page, tmp_path):
         off_machine = watch_requests(page, base)
         open_page(page, base + 'lessons/planted.html')
     assert off_machine == ['https://example.com/x.png']
+
+
+# ---- the browser lane: axe-core on every page (tests/accessibility.py)
+
+#: axe's colour-contrast rule takes about a CPU-second on a long page: the pages are checked
+#: in this many tests, so that each stays well inside its time limit on a busy machine.
+AXE_PARTS = 3
+
+
+@pytest.fixture(scope='module')
+def axe_installed() -> None:
+    why = accessibility.problem()
+    if why:
+        pytest.skip(why)
+
+
+def page_problems(page, name: str, console: list[str]) -> tuple[str, list[str]]:
+    """axe's findings on the page ``page`` shows (``name``): its row of the table (rules and
+    elements per impact) and its problems, one line each: a violation of critical, serious
+    or moderate impact, too little contrast where axe left it for review, a console error."""
+    results = accessibility.run(page)
+    counts = accessibility.counts(results)
+    row = f'{name}: ' + ', '.join(f'{impact} {rules} ({nodes})'
+                                  for impact, (rules, nodes) in counts.items())
+    problems = [*accessibility.failures(results), *accessibility.reviewed(page, results),
+                *console, *accessibility.sticking_out(page)]
+    console.clear()
+    return row, [f'{name}: {problem}' for problem in problems]
+
+
+def console_errors(page) -> list[str]:
+    """The page's console errors and uncaught exceptions, filled as they come."""
+    errors: list[str] = []
+    page.on('console', lambda message: errors.append(f'console error: {message.text}')
+            if message.type == 'error' else None)
+    page.on('pageerror', lambda error: errors.append(f'page error: {error}'))
+    return errors
+
+
+@pytest.mark.browser
+@pytest.mark.timeout(BUILD_LIMIT_S)
+@pytest.mark.parametrize('part', range(AXE_PARTS))
+@pytest.mark.parametrize('mode, width', [('light', 1280), ('dark', 400)])
+def test_axe_finds_no_violation_on_any_page(site, module_chromium, axe_installed, mode, width,
+                                            part):
+    """Every page, in the theme's light and dark modes (the reader's system setting picks
+    one), the one at a desktop's width and the other at a phone's: no violation of critical,
+    serious or moderate impact, no console error, and nothing running off the right of the
+    page.  The pages come in :data:`AXE_PARTS` parts, a test each; the table of the pages each
+    ran is printed (pytest -s shows it)."""
+    context = module_chromium.new_context(color_scheme=mode,
+                                          viewport={'width': width, 'height': 900})
+    page = context.new_page()
+    console = console_errors(page)
+    rows, problems = [], []
+    for name in site_pages(site.html)[part::AXE_PARTS]:
+        open_page(page, site.base + name)
+        assert page.evaluate('document.documentElement.dataset.theme') == mode
+        row, found = page_problems(page, name, console)
+        rows.append(row)
+        problems += found
+    context.close()
+    print(f'\naxe {accessibility.version()}, {mode} mode, {width} px wide, {len(rows)} pages:\n'
+          + '\n'.join(rows))
+    assert len(rows) >= len(LESSONS) // AXE_PARTS
+    assert problems == []
+
+
+#: A picture of one pixel, with no text alternative.
+PIXEL = ('data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mNk'
+         '+M9QDwADhgGAWjR9awAAAABJRU5ErkJggg==')
+
+
+@pytest.mark.browser
+@pytest.mark.timeout(BUILD_LIMIT_S)
+def test_an_image_without_alt_and_a_console_error_are_caught(site, page, axe_installed):
+    lesson = page_name('07-live-plot.ipynb')
+    built = page.context.request.get(site.base + lesson).text()
+    planted = built.replace('<article class="bd-article">',
+                            f'<article class="bd-article"><img src="{PIXEL}">'
+                            '<script>console.error("planted")</script>', 1)
+    assert planted != built
+    page.route('**/lessons/planted.html', lambda route: route.fulfill(
+        status=200, content_type='text/html', body=planted))
+    console = console_errors(page)
+    open_page(page, site.base + 'lessons/planted.html')
+    _, problems = page_problems(page, 'planted', console)
+    assert [problem.split(':')[1].strip().split(' (')[0] for problem in problems] == \
+        ['image-alt', 'console error'], problems

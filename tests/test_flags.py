@@ -11,6 +11,7 @@ notebook, and changes no point.
 from __future__ import annotations
 
 import concurrent.futures
+import html
 import json
 
 import nbformat
@@ -110,12 +111,13 @@ def test_a_flag_reaches_the_instructors_note_and_no_point(tmp_path):
               for c in release.cells if c.metadata.get('nbgrader', {}).get('grade')}
     verdict: concurrent.futures.Future = concurrent.futures.Future()
     verdict.set_result(Verdict(graded, None, ('answer cell 02-x line 3: uses sys._getframe',)))
-    learner = ClassLearner('ada', 'ada')
-    learners_module._file(tmp_path, learner, NOTEBOOKS[number].stem, release,
-                          copy_of(release), verdict)
-    note = learner.notes[NOTEBOOKS[number].stem]
+    notebook = NOTEBOOKS[number].stem
+    done = learners_module.judged(notebook, release,
+                                  learners_module.Judging((), copy_of(release), verdict))
+    note = done.notes[notebook]
     assert note.startswith(learners_module.FLAGGED) and 'sys._getframe' in note
-    scored = json.loads((tmp_path / f'{NOTEBOOKS[number].stem}.ipynb').read_text())
+    assert done.flags[notebook] == ('answer cell 02-x line 3: uses sys._getframe',)
+    scored = json.loads(done.filed[notebook])
     shown = [''.join(o.get('text', '')) for c in scored['cells'] for o in c.get('outputs', [])]
     assert sum('Check passed: x' in text for text in shown) == len(graded)
 
@@ -140,17 +142,18 @@ def test_a_copy_of_the_course_is_flagged_on_its_feedback_page(learner: Learner, 
     release = nbformat.read(NOTEBOOKS[learner.notebook], as_version=4)
     verdict: concurrent.futures.Future = concurrent.futures.Future()
     verdict.set_result(Verdict({}, None, tuple(flags)))
-    ada = ClassLearner('ada', 'ada')
-    learners_module._file(tmp_path, ada, notebook, release, copy_of(release), verdict)
+    ada = ClassLearner('ada', 'ada', {notebook: tmp_path / 'handed-in.ipynb'})
+    learners_module.file_graded(tmp_path, ada, learners_module.judged(
+        notebook, release, learners_module.Judging((), copy_of(release), verdict)))
     made = ('<html><head><style>p{color:#000}</style></head><body class="jp-Notebook">'
             '<p>nbgrader\'s page</p></body></html>')
     page = feedback.safe_feedback(made, notebook, ada.flags[notebook])
     assert feedback.FLAGS_HEADING in page and "nbgrader's page" in page
     box = page[page.index('id="flags"'):page.index("nbgrader's page")]
-    assert all(flag in feedback.html.unescape(box) for flag in flags), box
+    assert all(flag in html.unescape(box) for flag in flags), box
     assert feedback.FLAGS_HEADING not in feedback.safe_feedback(made, notebook, ())
     report = write_report(tmp_path, [ada], [notebook], [['ada', notebook, '0', '6']], [])
-    notes = feedback.html.unescape(report.read_text().split('id="notes"', 1)[1])
+    notes = html.unescape(report.read_text().split('id="notes"', 1)[1])
     assert all(flag in notes for flag in flags), notes
 
 

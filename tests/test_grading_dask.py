@@ -1,10 +1,13 @@
 """Grading on a real Dask cluster: ``dask scheduler`` and ``dask worker`` processes on loopback.
 
-The sample class (tests/grading_samples.py) graded through two workers gets the scores a local
-grading gets (tests/test_grading.py holds the local run to the same EXPECTED), although one
-worker is killed (SIGKILL) while it holds a learner: every learner is graded exactly once.  A
-worker of another course version is refused before any learner runs there; a learner whose
-task fails on the workers is that learner's note.
+A small class (one learner per path a learner takes through the cluster: several notebooks on
+one worker, a notebook not attempted, a file that is no notebook, a name nbgrader cannot use,
+a browser's copy, a run that kills its kernel, code the judge flags) is graded twice with one
+seed: here, and through two workers, one of which is killed (SIGKILL) while it holds a learner.
+Both gradings end alike: the same scores, notes and feedback pages, byte for byte (the flags box
+of "Code your instructor will look at" included), every learner graded exactly once.  A worker
+of another course version is refused before any learner runs there; a learner whose task fails
+on the workers is that learner's note.
 """
 
 import csv
@@ -18,15 +21,19 @@ import threading
 from dataclasses import dataclass
 from pathlib import Path
 
+import nbformat
 import pytest
 
 from dask_cluster import kill_when_grading, local_cluster
-from grading_samples import EXPECTED, NB00, NB01, ROOT, SOLUTION, STAGES, build
+from grading_samples import EXPECTED, LEARNER, NB00, NB01, NB02, ROOT, SOLUTION, Case
+from notebook_outputs import sanitize
 from test_grading import CLASS_LIMIT_S, as_text, in_the_csv
 
 from ros2nb_instructor.grading import sandbox
 from ros2nb_instructor.grading.cluster import Cluster
+from ros2nb_instructor.grading.feedback import FLAGS_HEADING
 from ros2nb_instructor.grading.gradebook import set_up_course
+from ros2nb_instructor.grading.learners import FLAGGED
 from ros2nb_instructor.grading.settings import CELL_TIMEOUT_S, NOTEBOOK_TIMEOUT_S, Settings
 from ros2nb_instructor.grading.submissions import find_learners
 
@@ -34,15 +41,66 @@ pytestmark = [pytest.mark.sandbox, pytest.mark.timeout(CLASS_LIMIT_S),
               pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))]
 GRADE = str(Path(sys.executable).with_name('ros2nb-grade'))
 NOTEBOOKS = sorted(SOLUTION)
-#: The learners a local grading meets with a fault planted in the grader's own process
-#: (GRADE_WITH_FAULTS); on a worker nothing is planted, so they are not in this class.
-PLANTED = ('plant-read', *(f'x-{stage}' for stage in STAGES[1:]))
+#: The seed of both gradings' drawn inputs: the judges check both alike.
+SEED = 4242
 #: A progress line, as a local grading prints it.
 PROGRESS = re.compile(r'^\[\d+/\d+ notebooks, \d+/\d+ learners; .* so far, .*\] (.*) graded$')
+#: Notebook 01's answer with a call the judge flags (it reads stack frames), and no point lost.
+REACHING_IN = ("    return Path('~/Documents/ROS2_and_RL_Tutorials').expanduser()",
+               "    import sys\n    sys._getframe(0)\n"
+               "    return Path('~/Documents/ROS2_and_RL_Tutorials').expanduser()")
 
 
-def grade(submissions: Path, out: Path, address: str) -> subprocess.CompletedProcess:
-    return subprocess.run([GRADE, str(submissions), '--out', str(out), '--scheduler', address],
+def _reaches_in() -> str:
+    nb = nbformat.read(SOLUTION[NB01], as_version=4)
+    answer = next(c for c in nb.cells if REACHING_IN[0] in c.source)
+    answer.source = answer.source.replace(*REACHING_IN)
+    return nbformat.writes(nb)
+
+
+def small_class(folder: Path, learners: dict[str, dict[str, str]]) -> Path:
+    """Learners of a few notebooks each: name -> {file name or notebook: the file's text}."""
+    for name, files in learners.items():
+        (folder / name).mkdir(parents=True)
+        for notebook, text in files.items():
+            file = notebook if notebook.endswith('.ipynb') else f'{notebook}.ipynb'
+            (folder / name / file).write_text(text)
+    return folder
+
+
+#: The class: each learner one path through the cluster, with what grading must make of them.
+CLASS = {
+    'complete': Case({n: EXPECTED['complete'].scores[n] for n in (NB00, NB01, NB02)}),
+    'untouched': Case({NB01: 0, NB02: 0}, {}, {NB01: 'not attempted', NB02: 'not attempted'}),
+    'empty-file': EXPECTED['empty-file'],
+    'Lovelace, Ada': EXPECTED['Lovelace, Ada'],
+    'browser-copy': EXPECTED['browser-copy'],
+    'kills-its-kernel': EXPECTED['kills-its-kernel'],
+    'reaches-in': Case({NB01: 1}, {NB01: FLAGS_HEADING},
+                       {NB01: f'{FLAGGED} answer cell {NB01}-challenge-1 line'}),
+}
+
+
+def class_files() -> dict[str, dict[str, str]]:
+    solution = {n: SOLUTION[n].read_text() for n in (NB00, NB01, NB02)}
+    killer = nbformat.read(SOLUTION[NB01], as_version=4)
+    killer.cells.insert(1, nbformat.v4.new_code_cell(
+        'import os, signal\nos.kill(os.getpid(), signal.SIGKILL)'))
+    return {'complete': solution,
+            'untouched': {n: LEARNER[n].read_text() for n in (NB01, NB02)},
+            'empty-file': {NB01: ''},
+            'Lovelace, Ada': {NB01: solution[NB01]},
+            'browser-copy': {f'{NB01} (1).ipynb': solution[NB01]},
+            'kills-its-kernel': {NB01: nbformat.writes(killer)},
+            'reaches-in': {NB01: _reaches_in()}}
+
+
+def grade(submissions: Path, out: Path, address: str = '', seed: int | None = None
+          ) -> subprocess.CompletedProcess:
+    """ros2nb-grade on ``submissions`` (on the Dask scheduler at ``address``, else here)."""
+    where = ['--scheduler', address] if address else []
+    drawn = ['--seed', str(seed)] if seed is not None else []
+    return subprocess.run([GRADE, str(submissions), '--out', str(out), *where, *drawn],
                           capture_output=True, text=True, timeout=CLASS_LIMIT_S)
 
 
@@ -56,33 +114,46 @@ class OnDask:
     out: Path
     done: subprocess.CompletedProcess
     killed: dict  #: the worker killed while it held a learner: address, pid, its keys
+    here: Path  #: the same class graded on this machine
+    done_here: subprocess.CompletedProcess
 
 
 @pytest.fixture(scope='module')
 def on_dask(tmp_path_factory):
-    """The sample class graded once on two workers, one of them killed mid-class (its nanny
-    starts it again, as Kubernetes restarts a pod; the new worker is checked before it grades)."""
+    """The small class graded here, then on two workers, one of them killed while it holds a
+    learner (its nanny starts it again, as Kubernetes restarts a pod; the new worker is
+    checked before it grades)."""
     root = tmp_path_factory.mktemp('dask-grading')
+    submissions = small_class(root / 'class', class_files())
+    here = root / 'grading-here'
+    done_here = grade(submissions, here, seed=SEED)
     out = root / 'grading'
-    decoy = root / 'elsewhere' / 'gradebook.db'
-    decoy.parent.mkdir()
-    decoy.write_bytes(b'SQLite format 3\x00' + b'\x00' * 100)
-    home_file = Path.home() / f'ros2nb-dask-sample-{os.getpid()}'
-    submissions = build(root / 'class', grading_out=out, submissions=root / 'class',
-                        decoy_gradebook=decoy, home_file=home_file,
-                        forged=root / 'forged-after-grading.txt')
-    for learner in PLANTED:
-        shutil.rmtree(submissions / learner)
     killed = {}
     with local_cluster(root / 'cluster') as cluster:
-        # 'complete' runs first (most notebooks) and longest: its worker holds it for minutes.
         killer = threading.Thread(target=lambda: killed.update(
             kill_when_grading(cluster.address, 'w1')), daemon=True)
         killer.start()
-        done = grade(submissions, out, cluster.address)
+        done = grade(submissions, out, cluster.address, seed=SEED)
         killer.join(timeout=1)
-    home_file.unlink(missing_ok=True)
-    yield OnDask(out, done, killed)
+    yield OnDask(out, done, killed, here, done_here)
+
+
+#: A learner's scratch folder, as a cell's output may show it: new for every grading (here
+#: under the grader's temporary folder, on a worker under the worker's).
+SCRATCH = re.compile(r'/tmp/ros2nb-(?:grading|worker)-\w+/(?:scratch/)?learner-\w+/')
+
+
+#: The box of "Code your instructor will look at" on a feedback page.
+FLAGS_BOX = re.compile(r'<div id="flags".*?</ul>', re.S)
+
+
+def pages(out: Path) -> dict[str, str]:
+    """Every feedback page of a grading: its path under feedback/ -> its text, the learner's
+    scratch folder aside, and what nbval sets aside of the notebooks' outputs in ``make test``
+    (tests/sanitize.cfg: a build's seconds, a kernel's domain)."""
+    return {str(p.relative_to(out / 'feedback')): sanitize(SCRATCH.sub('<scratch>/',
+                                                                       p.read_text()))
+            for p in sorted((out / 'feedback').rglob('*.html'))}
 
 
 @pytest.mark.judge
@@ -92,18 +163,41 @@ def test_the_class_on_dask_scores_as_the_local_run(on_dask):
     assert done.returncode == 0, done.stdout + done.stderr
     with open(out / 'grades.csv', newline='') as stream:
         got = {(r['learner'], r['notebook']): float(r['score']) for r in csv.DictReader(stream)}
-    class_ = {learner: case for learner, case in EXPECTED.items() if learner not in PLANTED}
-    for learner, case in class_.items():
+    for learner, case in CLASS.items():
         for notebook in NOTEBOOKS:
             assert got[in_the_csv(learner), notebook] == case.scores.get(notebook, 0), \
                 (learner, notebook)
     notes = json.loads((out / 'notes.json').read_text())['learners']
-    for learner, case in class_.items():
+    for learner, case in CLASS.items():
         for notebook, phrase in case.notes.items():
             if phrase:
                 assert phrase in notes[as_text(learner)].get(notebook, ''), (learner, notes)
-    for made in ('report.html', 'nbgrader/gradebook.db', f'feedback/complete/{NB01}.html'):
+    for learner, case in CLASS.items():
+        for notebook, phrase in case.feedback.items():
+            page = (out / 'feedback' / learner / f'{notebook}.html').read_text()
+            assert phrase in page, (learner, notebook)
+    assert FLAGS_HEADING not in (out / 'feedback' / 'complete' / f'{NB01}.html').read_text()
+    for made in ('report.html', 'nbgrader/gradebook.db'):
         assert (out / made).is_file(), made
+
+
+@pytest.mark.judge
+@pytest.mark.kernel
+def test_a_class_graded_on_dask_ends_as_graded_here(on_dask):
+    """The same feedback pages, byte for byte but for the learner's scratch folder a cell may
+    print and what nbval sets aside (the flags box of a flagged learner too), the same
+    grades.csv and the same notes: what a worker made of a learner came back whole."""
+    assert on_dask.done_here.returncode == 0, on_dask.done_here.stdout + on_dask.done_here.stderr
+    assert on_dask.done.returncode == 0, on_dask.done.stdout + on_dask.done.stderr
+    here, there = pages(on_dask.here), pages(on_dask.out)
+    assert FLAGS_HEADING in here[f'reaches-in/{NB01}.html']  # the box the cluster must carry
+    assert sorted(there) == sorted(here)
+    for page in here:  # the flags box first: a worker that lost the flags fails here, named
+        assert FLAGS_BOX.findall(there[page]) == FLAGS_BOX.findall(here[page]), page
+    for page in here:
+        assert there[page] == here[page], page
+    for made in ('grades.csv', 'notes.json'):
+        assert (on_dask.out / made).read_text() == (on_dask.here / made).read_text(), made
 
 
 @pytest.mark.judge
@@ -114,12 +208,11 @@ def test_a_worker_killed_mid_class_costs_nobody(on_dask):
     out, done, killed = on_dask.out, on_dask.done, on_dask.killed
     assert killed.get('keys'), f'no worker was killed while grading: {done.stdout[-2000:]}'
     assert done.returncode == 0, done.stdout + done.stderr
-    learners = sorted(as_text(name) for name in EXPECTED if name not in PLANTED)
+    learners = sorted(as_text(name) for name in CLASS)
     assert sorted(graded_lines(done.stdout)) == learners
     with open(out / 'grades.csv', newline='') as stream:
         totals = [r['learner'] for r in csv.DictReader(stream) if r['notebook'] == 'TOTAL']
-    assert sorted(totals) == sorted(in_the_csv(name) for name in EXPECTED
-                                    if name not in PLANTED)
+    assert sorted(totals) == sorted(in_the_csv(name) for name in CLASS)
     notes = json.loads((out / 'notes.json').read_text())['learners']
     for key in killed['keys']:
         learner = next(name for name in learners if str(key).endswith(f'-{name}'))
@@ -133,15 +226,6 @@ def other_course(folder: Path) -> Path:
                         ignore=shutil.ignore_patterns('__pycache__'))
     changed = folder / 'solutions' / f'{NB01}.ipynb'
     changed.write_bytes(changed.read_bytes() + b'\n')
-    return folder
-
-
-def small_class(folder: Path, learners: dict[str, dict[str, str]]) -> Path:
-    """Learners of a few notebooks each: name -> {notebook: the notebook's text}."""
-    for name, files in learners.items():
-        (folder / name).mkdir(parents=True)
-        for notebook, text in files.items():
-            (folder / name / f'{notebook}.ipynb').write_text(text)
     return folder
 
 

@@ -113,6 +113,23 @@ def test_malformed_nbgrader_metadata_is_removed_not_fatal():
     assert json.dumps(scored)  # nothing unserialisable left
 
 
+def test_what_a_cell_printed_is_filed_whole_however_the_kernel_cut_it():
+    """The same prints, sent by the kernel in one piece or in three (its flushes fall where a
+    busy machine puts them), file the same notebook: the feedback page is the same."""
+    release = nbformat.read(SOLUTION[NB01], as_version=4)
+    printed = ['average rate: 2.000\n', '\tmin: 0.500s max: 0.500s\n', 'done\n']
+    made = []
+    for pieces in (printed, [''.join(printed)]):
+        executed = nbformat.read(SOLUTION[NB01], as_version=4)
+        cell = next(c for c in executed.cells
+                    if c.cell_type == 'code' and not c.metadata.get('nbgrader', {}).get('grade'))
+        cell.outputs = [*(nbformat.v4.new_output('stream', name='stdout', text=piece)
+                          for piece in pieces),
+                        nbformat.v4.new_output('stream', name='stderr', text='a warning\n')]
+        made.append(nbformat.writes(notebooks.for_scoring(release, executed, {})))
+    assert made[0] == made[1]
+
+
 def test_a_notebook_without_code_of_the_learner_is_not_attempted():
     """Only a notebook whose code cells are the release's, text for text, goes unrun (0 points,
     noted); any code of the learner's, wherever they put it, gets the notebook run."""
@@ -322,7 +339,7 @@ def test_a_copy_of_the_stand_ins_scores_its_twins_score_in_the_sandbox(who, scra
     """The grader's judge, sandboxed with its subjects: notebook 03 built from the course's
     stand-ins through importlib loses what its twin (parts from a module that is not there)
     loses, and only it is flagged.  Before, its subjects imported the stand-ins: full marks."""
-    from corpora import Learner as CorpusLearner, _write_parts, submission
+    from corpora import Learner as CorpusLearner, submission, write_parts
     from corpus_attacks import SENSOR_PARTS, SENSOR_PARTS_TWIN
     monkeypatch.setenv('ROS2NB_WORKSPACE', str(scratch.workspace))
     monkeypatch.setattr(ws_module, '_current', None)
@@ -330,7 +347,7 @@ def test_a_copy_of_the_stand_ins_scores_its_twins_score_in_the_sandbox(who, scra
     cells = SENSOR_PARTS if who == 'attack' else SENSOR_PARTS_TWIN
     nb = submission(CorpusLearner(who, '03', cells))
     course.catch_up(3)
-    _write_parts(nb)
+    write_parts(nb)
     notebook = '03-write-the-publisher'
     results, problem, flags = judge_notebook(scratch, notebook, nbformat.from_dict(nb),
                                              Settings(120, 600, True), scratch.snapshot(notebook))

@@ -145,7 +145,9 @@ def build(out: Path, *, course: Path = ROOT, solutions: bool = False,
     html = out / 'html'
     # -E: every page read again, so that each build repeats every warning (an incremental
     # build only warns about the pages it reads).
+    # schedule_course: the start page's schedule is read from this course's notebooks.
     status = build_main(['-b', 'html', '-W', '--keep-going', '-E', '-q', '-c', str(HERE),
+                         '-D', f'schedule_course={course.resolve()}',
                          '-d', str(out / 'doctrees'), str(source), str(html)])
     if status:
         return [f'sphinx-build failed (exit {status}): its warnings are above']

@@ -9,7 +9,8 @@ nbgrader's hidden-test cells are dropped, the checks' stored verdicts too (they 
 the solution, not on the learner's cell), and so is any other stored output that shows a
 line of the lesson's solutions (a cell that prints the finished file).  With
 ``solutions=True`` (the instructor's site) each exercise block is followed by its solution,
-run, with its outputs.
+run, with its outputs.  Every picture gets its text alternative from the caption line the
+notebook prints with it (:func:`describe_figures`).
 
 Nothing here executes a notebook or writes outside the folder it is given.
 """
@@ -31,6 +32,10 @@ DISTINCTIVE_CHARS = 8
 WIDGET_VIEW = 'application/vnd.jupyter.widget-view+json'
 HIDDEN_OUTPUT_NOTE = ('*This cell shows your finished work once you have written the parts '
                       'above: run it in the notebook.*')
+#: The outputs that are pictures.
+IMAGES = ('image/png', 'image/jpeg', 'image/gif', 'image/svg+xml')
+#: How the line that says what a figure shows begins (``ros2nb.figures.CAPTION_START``).
+CAPTION_START = 'Figure: '
 
 
 def source(cell: dict) -> str:
@@ -100,6 +105,39 @@ def _split_at_last_heading(markdown: str) -> tuple[str, str]:
     return '\n'.join(lines[:last + 1]), '\n'.join(lines[last + 1:]).strip()
 
 
+def figure_caption(cell: dict) -> Optional[str]:
+    """The words of the first line of ``cell``'s outputs that starts with
+    :data:`CAPTION_START` (without it), or None."""
+    for output in cell.get('outputs', []):
+        for line in _output_text(output).splitlines():
+            if line.startswith(CAPTION_START):
+                return line[len(CAPTION_START):].strip()
+    return None
+
+
+def describe_figures(cell: dict, notebook: str) -> None:
+    """Give each picture among ``cell``'s outputs its text alternative: the cell's caption
+    line (:func:`figure_caption`) becomes the ``alt`` of its images (MyST-NB's cell option
+    ``mystnb.image.alt``).  A live figure's stored snapshot is shown as its picture, not as
+    the widget's HTML, whose ``<img>`` has no ``alt`` (and a malformed ``width``).
+
+    :raises ValueError: when the cell shows a picture and no caption line: every figure says
+        in words what it shows (``ros2nb.figures``).
+    """
+    pictures = [output for output in cell.get('outputs', [])
+                if any(mime in output.get('data', {}) for mime in IMAGES)]
+    if not pictures:
+        return
+    for output in pictures:
+        if 'image/png' in output['data']:
+            output['data'].pop('text/html', None)
+    caption = figure_caption(cell)
+    if not caption:
+        raise ValueError(f'{notebook}: cell {cell.get("id")} shows a figure but no line '
+                         f'"{CAPTION_START}..." that says what it shows (ros2nb.figures)')
+    cell.setdefault('metadata', {}).setdefault('mystnb', {})['image'] = {'alt': caption}
+
+
 def _markdown_cell(text: str, cell_id: str) -> dict:
     return {'cell_type': 'markdown', 'id': cell_id, 'metadata': {}, 'source': text}
 
@@ -127,7 +165,8 @@ def learner_page(solution_nb: dict, learner_nb: dict, notebook: str, *,
     :param solutions: show each solution, run, after its exercise block (the instructor's
         site) instead of hiding it.
     :raises ValueError: when an answer cell has no learner version with its id in
-        ``learner_nb`` (``make learner-notebooks`` regenerates them).
+        ``learner_nb`` (``make learner-notebooks`` regenerates them), or a figure has no
+        caption line (:func:`describe_figures`).
     """
     page = copy.deepcopy(solution_nb)
     page['metadata'].pop('widgets', None)
@@ -153,6 +192,8 @@ def learner_page(solution_nb: dict, learner_nb: dict, notebook: str, *,
             cells.append(cell)
             cell = _markdown_cell(HIDDEN_OUTPUT_NOTE, f'{cell.get("id")}-hidden-output')
         cells.append(cell)
+    for cell in cells:
+        describe_figures(cell, notebook)
     _add_launch(cells, notebook)
     page['cells'] = cells
     return page

@@ -3,7 +3,9 @@
 Every process ros2nb starts (a node for ``ros2 run``, colcon, a check's helper process)
 gets a session and process group of its own (``start_new_session=True``), so a signal
 sent to the group reaches whatever it started too.  It is also the one place that decides
-when a process has had long enough (:class:`Patience`).  No mention of ROS here.
+when a process has had long enough (:class:`Patience`).  psutil walks the process trees and
+reads their CPU times; what psutil does not give (a thread's time on the run queue) is read
+from /proc here.  No mention of ROS here.
 """
 
 from __future__ import annotations
@@ -14,7 +16,10 @@ import signal
 import subprocess
 import sys
 import time
-from typing import Any, Callable, NoReturn, Optional, Sequence
+from typing import TYPE_CHECKING, Any, Callable, NoReturn, Optional, Protocol, Sequence
+
+if TYPE_CHECKING:
+    import psutil
 
 #: Seconds a process gets to exit after Ctrl+C (SIGINT) before SIGTERM, then SIGKILL.
 STOP_GRACE_S = 5.0
@@ -26,7 +31,21 @@ KILL_GRACE_S = 1.0
 POLL_S = 0.02
 
 
-def signal_group(proc: subprocess.Popen, sig: int) -> bool:
+class Process(Protocol):
+    """A process the course started in a session of its own: a :class:`subprocess.Popen`, or
+    a child of the fork server (:class:`ros2nb.subject.forked.ForkedProcess`)."""
+
+    pid: int  #: also its process group's id
+    returncode: Optional[int]  #: its exit code once reaped (negative: the signal), else None
+
+    def poll(self) -> Optional[int]:
+        """Its exit code once it ended, else None (it never waits)."""
+
+    def wait(self, timeout: Optional[float] = None) -> int:
+        """Its exit code, waited for ``timeout`` s at most (then subprocess.TimeoutExpired)."""
+
+
+def signal_group(proc: Process, sig: int) -> bool:
     """Send ``sig`` to the process group of ``proc``; return False if it is gone."""
     try:
         os.killpg(proc.pid, sig)
@@ -35,7 +54,7 @@ def signal_group(proc: subprocess.Popen, sig: int) -> bool:
     return True
 
 
-def stop_process_group(proc: subprocess.Popen, *,
+def stop_process_group(proc: Process, *,
                        signals: Sequence[tuple[int, float]] = (
                            (signal.SIGINT, STOP_GRACE_S), (signal.SIGTERM, TERM_GRACE_S),
                            (signal.SIGKILL, TERM_GRACE_S))) -> Optional[int]:
@@ -64,7 +83,7 @@ def stop_process_group(proc: subprocess.Popen, *,
         return None
 
 
-def kill_process_group(proc: subprocess.Popen) -> Optional[int]:
+def kill_process_group(proc: Process) -> Optional[int]:
     """End ``proc`` and its process group now: SIGTERM, and SIGKILL :data:`KILL_GRACE_S`
     later; return the exit code.
 
@@ -79,53 +98,62 @@ def kill_process_group(proc: subprocess.Popen) -> Optional[int]:
 #: A process tree using less than this share of one CPU between two looks, counting the
 #: time its threads stood ready on the run queue, is waiting, not working.
 BUSY_SHARE = 0.05
-#: Seconds between two looks at a process tree's work in /proc (each look reads every
-#: process's stat: milliseconds on a busy machine).
+#: Seconds between two looks at a process tree's work (each look reads every process's
+#: parent from /proc: milliseconds on a busy machine).
 LOOK_S = 0.25
-_TICKS_PER_S = os.sysconf('SC_CLK_TCK')
 
 
-def _processes() -> tuple[dict[int, list[int]], dict[int, float]]:
-    """Every process's children, and the CPU seconds each used (with its reaped children's)."""
-    children: dict[int, list[int]] = {}
-    cpu: dict[int, float] = {}
-    for entry in os.listdir('/proc'):
-        if not entry.isdigit():
+def _psutil() -> Any:
+    """psutil, imported on first use: a process that never looks at a tree (a judge's
+    subject, which only runs nodes) does not pay for its import."""
+    import psutil
+    return psutil
+
+
+def _tree(pids: Sequence[int]) -> list['psutil.Process']:
+    """Each of ``pids`` that is still there and every process under them, once, as
+    :class:`psutil.Process` (psutil walks the tree from every process's parent)."""
+    psutil, found = _psutil(), {}  # pid -> its Process, in the order found
+    for pid in dict.fromkeys(pids):
+        if pid in found:
             continue
         try:
-            with open(f'/proc/{entry}/stat') as stat:
-                fields = stat.read().rsplit(')', 1)[1].split()
-        except OSError:
+            top = psutil.Process(pid)
+            below = top.children(recursive=True)
+        except psutil.Error:  # gone meanwhile
             continue
-        children.setdefault(int(fields[1]), []).append(int(entry))
-        # utime, stime, cutime, cstime: fields 14-17 of proc(5), counted from "state" here
-        cpu[int(entry)] = sum(int(field) for field in fields[11:15]) / _TICKS_PER_S
-    return children, cpu
+        found.update((each.pid, each) for each in [top, *below] if each.pid not in found)
+    return list(found.values())
 
 
-def _children() -> dict[int, list[int]]:
-    """Every process's children, read from /proc."""
-    return _processes()[0]
+def _asked(process: 'psutil.Process', what: str, gone: Any) -> Any:
+    """``process.what()`` (psutil's ``name``, ``status``, ``cpu_times``), or ``gone`` once
+    the process is gone."""
+    try:
+        return getattr(process, what)()
+    except _psutil().Error:
+        return gone
+
+
+def _cpu_seconds(process: 'psutil.Process') -> float:
+    """CPU seconds (user + system) of ``process`` and of its children it reaped; 0 once gone."""
+    times = _asked(process, 'cpu_times', None)
+    return times.user + times.system + times.children_user + times.children_system if times \
+        else 0.0
 
 
 def child_pids(pid: int) -> list[int]:
     """The processes ``pid`` started that are still there (running or not yet reaped)."""
-    return _children().get(pid, [])
-
-
-def _trees(pids: Sequence[int], children: dict[int, list[int]]) -> list[int]:
-    """Each of ``pids`` and every process under them, once."""
-    found, pending = list(dict.fromkeys(pids)), list(dict.fromkeys(pids))
-    while pending:
-        below = [pid for pid in children.get(pending.pop(), []) if pid not in found]
-        found += below
-        pending += below
-    return found
+    psutil = _psutil()
+    try:
+        return [child.pid for child in psutil.Process(pid).children()]
+    except psutil.Error:
+        return []
 
 
 def tree_pids(pid: int) -> list[int]:
-    """``pid`` and every process under it now (read from /proc)."""
-    return _trees([pid], _children())
+    """``pid`` and every process under it now."""
+    return [process.pid for process in _tree([pid])]
 
 
 def tree_cpu_seconds(pid: int) -> float:
@@ -134,8 +162,7 @@ def tree_cpu_seconds(pid: int) -> float:
     Processes of the tree that already ended count when their parent has reaped them.
     A process that is gone counts 0.
     """
-    children, cpu = _processes()
-    return sum(cpu.get(each, 0.0) for each in _trees([pid], children))
+    return sum(_cpu_seconds(process) for process in _tree([pid]))
 
 
 def queued_seconds(pids: Sequence[int]) -> tuple[float, bool]:
@@ -143,7 +170,12 @@ def queued_seconds(pids: Sequence[int]) -> tuple[float, bool]:
     CPU: the seconds the kernel counted (the second field of ``/proc/PID/task/TID/schedstat``,
     brought up to date only when a thread gets a CPU), and whether one of them stands ready
     now (state R).  Gone processes and threads, and a kernel without schedstats, count
-    nothing."""
+    nothing.
+
+    Read from /proc here, not through psutil: psutil gives a thread's CPU times but neither
+    its time on the run queue nor its state, and these two are what tell a program the
+    scheduler starves from one that waits (:class:`Patience`).
+    """
     total, ready = 0.0, False
     for pid in pids:
         try:
@@ -172,10 +204,9 @@ def tree_work(pids: int | Sequence[int]) -> tuple[float, float, bool]:
 
     Introduced in ``03-write-the-publisher.ipynb`` (how long the judge waits for a subject).
     """
-    children, cpu = _processes()
-    trees = _trees([pids] if isinstance(pids, int) else pids, children)
-    queued, ready = queued_seconds(trees)
-    return sum(cpu.get(each, 0.0) for each in trees), queued, ready
+    trees = _tree([pids] if isinstance(pids, int) else pids)
+    queued, ready = queued_seconds([process.pid for process in trees])
+    return sum(_cpu_seconds(process) for process in trees), queued, ready
 
 
 class Patience:
@@ -264,7 +295,7 @@ def wait_for_work(condition: Callable[[], Any], pids: Sequence[int], limit_s: fl
     return True
 
 
-def wait_patiently(proc: subprocess.Popen, limit_s: float) -> Optional[int]:
+def wait_patiently(proc: Process, limit_s: float) -> Optional[int]:
     """Wait for ``proc`` to exit, with :class:`Patience` (``limit_s`` of its tree's work, or
     of its idle waiting): on a busy machine a slow exit is not a hang.
 
@@ -277,25 +308,7 @@ def wait_patiently(proc: subprocess.Popen, limit_s: float) -> Optional[int]:
     return None
 
 
-def _name(pid: int) -> str:
-    try:
-        with open(f'/proc/{pid}/comm') as comm:
-            return comm.read().strip()
-    except OSError:
-        return ''
-
-
-def _state(pid: int) -> str:
-    """A process's state as /proc shows its main thread: R running or ready, S or D waiting,
-    Z ended, ... ('' when it is gone)."""
-    try:
-        with open(f'/proc/{pid}/stat') as stat:
-            return stat.read().rsplit(')', 1)[1].split()[0]
-    except (OSError, IndexError):
-        return ''
-
-
-def until_waiting(proc: subprocess.Popen, limit_s: float) -> bool:
+def until_waiting(proc: Process, limit_s: float) -> bool:
     """Wait until the main thread of every process under ``proc`` (bubblewrap's own aside)
     sits waiting, in two looks in a row: a program idle in its spin, as a person at a
     terminal sees it before pressing Ctrl+C.  Whether a signal lands in the spin's wait or
@@ -309,13 +322,14 @@ def until_waiting(proc: subprocess.Popen, limit_s: float) -> bool:
     while calm < 2:
         if proc.poll() is not None or patience.exhausted():
             return False
-        pids = [pid for pid in tree_pids(proc.pid) if _name(pid) != 'bwrap']
-        calm = calm + 1 if pids and all(_state(pid) in ('S', 'D') for pid in pids) else 0
+        tree = [p for p in _tree([proc.pid]) if _asked(p, 'name', '') != 'bwrap']
+        waiting = ('sleeping', 'disk-sleep')  # psutil's STATUS_SLEEPING, STATUS_DISK_SLEEP
+        calm = calm + 1 if tree and all(_asked(p, 'status', '') in waiting for p in tree) else 0
         time.sleep(POLL_S)
     return True
 
 
-def interrupt(proc: subprocess.Popen, sig: int = signal.SIGINT) -> None:
+def interrupt(proc: Process, sig: int = signal.SIGINT) -> None:
     """Press Ctrl+C for ``proc``: send ``sig`` to its process group, as a terminal does.
 
     A program started inside a sandbox (bubblewrap) is reached past the sandbox's own
@@ -323,21 +337,16 @@ def interrupt(proc: subprocess.Popen, sig: int = signal.SIGINT) -> None:
     program could handle it: ``sig`` goes to every process under ``proc`` that is not
     bubblewrap.
     """
-    if _name(proc.pid) != 'bwrap':
+    tree = _tree([proc.pid])
+    if not tree or _asked(tree[0], 'name', '') != 'bwrap':
         signal_group(proc, sig)
         return
-    children = _children()
-    pending, targets = list(children.get(proc.pid, [])), []
-    while pending:
-        pid = pending.pop()
-        pending.extend(children.get(pid, []))
-        if _name(pid) != 'bwrap':
-            targets.append(pid)
-    for pid in targets:
-        try:
-            os.kill(pid, sig)
-        except ProcessLookupError:
-            pass
+    for process in tree[1:]:
+        if _asked(process, 'name', '') != 'bwrap':
+            try:
+                process.send_signal(sig)
+            except _psutil().Error:
+                pass
 
 
 def end_this_process(code: int) -> NoReturn:

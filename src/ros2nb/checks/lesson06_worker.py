@@ -22,7 +22,9 @@ from rcl_interfaces.srv import GetParameters
 
 from .. import course
 from ..errors import CheckFailed
-from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
+from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, Subject, learner_error
+from ..subject_interface import Worker, WorkerRelease, WorkerStop
+from ..subject_replies import WorkerSpun
 from .base import judged
 from .witnessed import WITNESS_TOPIC, new_nonce, started, told_to
 
@@ -85,14 +87,14 @@ def _servers(judge: Judge, calls: list[_Calls], name: str, namespace: str) -> Op
     return all(node.count_services(c.name) == 1 for c in calls)
 
 
-def _worker_cause(reply: dict) -> str:
+def _worker_cause(reply: WorkerSpun) -> str:
     """Why no heartbeat came during slow_work, from the executor and groups the subject
     says it was given (only to name the cause of what the judge saw)."""
-    groups = {name: (kind, number) for name, kind, number in reply.get('groups', [])}
-    if reply.get('executor') == 'SingleThreadedExecutor':
+    groups = {name: (kind, number) for name, kind, number in reply.groups}
+    if reply.executor == 'SingleThreadedExecutor':
         return ('a SingleThreadedExecutor runs one callback at a time, so slow_work holds up '
                 'heartbeat; return a MultiThreadedExecutor')
-    if reply.get('threads') == 1:
+    if reply.threads == 1:
         return ('a MultiThreadedExecutor with num_threads=1 runs one callback at a time: give '
                 'it num_threads=2')
     if groups.get('slow_work') == groups.get('heartbeat') and \
@@ -103,33 +105,33 @@ def _worker_cause(reply: dict) -> str:
             'group of its own for each timer')
 
 
-def _worker_refused(reply: dict) -> None:
+def _worker_refused(reply: WorkerSpun) -> None:
     """Raise for a worker the subject could not spin (its reply names what it found)."""
-    if reply.get('undefined'):
+    if reply.undefined:
         raise CheckFailed(f'promises.py defines no function {course.WORKER_FUNCTION}: write '
                           'part 4 (and run its cell).')
-    if 'error' in reply:
-        raise learner_error(f'{course.WORKER_FUNCTION}()', reply['error'])
-    if 'returned' in reply:
-        raise CheckFailed(f'{course.WORKER_FUNCTION}() returned {reply["returned"]["value"]}; '
+    if reply.error is not None:
+        raise learner_error(f'{course.WORKER_FUNCTION}()', reply.error)
+    if reply.returned is not None:
+        raise CheckFailed(f'{course.WORKER_FUNCTION}() returned {reply.returned.value}; '
                           'return two things, the Worker node and the executor to spin it: '
                           'return node, executor.')
-    if 'timers' in reply:
-        raise CheckFailed(f'{course.WORKER_FUNCTION}() returned a node with {reply["timers"]} '
+    if reply.timers is not None:
+        raise CheckFailed(f'{course.WORKER_FUNCTION}() returned a node with {reply.timers} '
                           'timer(s): return a Worker (part 3), whose two timers run slow_work '
                           'and heartbeat.')
-    if reply.get('unmatched'):
+    if reply.unmatched:
         raise CheckFailed("The worker's witness never reached the grader: is the machine very "
                           'busy? Run this check again.')
 
 
-def _overlapped(judge: Judge, subject: Any, reply: dict) -> tuple[bool, str]:
+def _overlapped(judge: Judge, subject: Subject, reply: WorkerSpun) -> tuple[bool, str]:
     """Call the slow work, then the heartbeat while it runs; whether the heartbeat's answer
     left the subject first, and what went wrong otherwise (empty when nothing did)."""
     observer, told = judge.observer, told_to(judge)
     slow, beat = calls = [_Calls(judge, name) for name in SERVICES]
     try:
-        where = (judge, calls, reply['name'], reply['namespace'])
+        where = (judge, calls, reply.name or '', reply.namespace or '/')
         if not observer.wait_until(lambda: _servers(*where) is not None, ARRIVAL_TIMEOUT_S):
             return False, 'never'
         if not _servers(*where):
@@ -145,7 +147,7 @@ def _overlapped(judge: Judge, subject: Any, reply: dict) -> tuple[bool, str]:
         beating = beat.send(WARM_UP)
         observer.wait_until(lambda: beat.answered(beating), BEAT_PATIENCE_S)
         one_server = _servers(*where)
-        subject.request('worker_release')
+        subject.request(WorkerRelease())
         observer.wait_until(lambda: slow.answered(working) and beat.answered(beating),
                             ARRIVAL_TIMEOUT_S)
         if one_server is False:
@@ -162,25 +164,25 @@ def _responsive_worker(judge: Judge) -> str:
     subject = judge.file_subject(course.PROMISES_FILE)
     observer, name = judge.observer, 'responsive_worker'
     told_to(judge)  # the judge's subscription exists before the subject looks for it
-    reply = subject.request('worker', name=course.WORKER_FUNCTION, topic=WITNESS_TOPIC,
-                            services=list(SERVICES), seconds=ARRIVAL_TIMEOUT_S,
+    reply = subject.request(Worker(name=course.WORKER_FUNCTION, topic=WITNESS_TOPIC,
+                                   services=list(SERVICES), seconds=ARRIVAL_TIMEOUT_S),
                             timeout=ARRIVAL_TIMEOUT_S + 30)
-    if not reply.get('ok'):
+    if not reply.ok:
         judge.drop(('file', course.PROMISES_FILE))
         _worker_refused(reply)
     try:
         overlap, problem = _overlapped(judge, subject, reply)
         # the name as the graph shows it, while the node runs (the reply only words a failure)
-        named = reply.get('name') == name and \
+        named = reply.name == name and \
             observer.wait_until(lambda: observer.has_node(name), ARRIVAL_TIMEOUT_S)
     finally:
-        stopped = subject.request('worker_stop', timeout=60)
+        stopped = subject.request(WorkerStop(), timeout=60)
         judge.drop(('file', course.PROMISES_FILE))
-    if stopped.get('failure'):
-        raise learner_error(stopped['failure']['callback'], stopped['failure'])
+    if stopped.failure is not None:
+        raise learner_error(stopped.failure.callback, stopped.failure)
     if not named:
         raise CheckFailed(f"{course.WORKER_FUNCTION}() returned a Worker called "
-                          f"{reply.get('name')}; name it '{name}'.")
+                          f"{reply.name}; name it '{name}'.")
     if problem == 'servers':
         raise CheckFailed('Something in your code answers for the Worker: the grader calls '
                           "the Worker's own callbacks, which only your executor runs; return "
@@ -189,7 +191,7 @@ def _responsive_worker(judge: Judge) -> str:
         raise CheckFailed(f'slow_work never ran within {ARRIVAL_TIMEOUT_S:g} s: add the Worker '
                           'to no other executor, and keep both its callback groups.')
     if overlap:
-        return (f'a heartbeat came while slow_work was busy, on a {reply["executor"]}: the two '
+        return (f'a heartbeat came while slow_work was busy, on a {reply.executor}: the two '
                 'timers run side by side.')
     raise CheckFailed(f'No heartbeat came while slow_work was busy: {_worker_cause(reply)}.')
 
@@ -199,9 +201,9 @@ def check_responsive_worker(judge: Judge) -> str:
     """Check part 4 of ``promises.py``: a slow callback no longer holds up the heartbeat.
 
     Calls your ``responsive_worker()`` for its node and executor, puts the course's own
-    callbacks on the Worker's two timers (in the callback groups you chose: a slow one that
-    works 0.45 s, a quick one) and spins your executor on the wall clock.  The course's
-    callbacks tell the grader when each runs: a heartbeat must run while ``slow_work`` is
+    slow work and heartbeat in place of the Worker's two timers (as services, in the
+    callback groups you chose) and spins your executor on the wall clock.  The grader calls
+    them and times the answers itself: a heartbeat must be answered while ``slow_work`` is
     busy.  When none does, the line says why, from the executor and the timers' callback
     groups.
 

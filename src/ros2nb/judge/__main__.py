@@ -2,8 +2,10 @@
 
 The judge's command line (see :mod:`ros2nb.judge`): it opens a :class:`Session`, runs the
 body of each check asked for with it (:func:`ros2nb.checks.run_check`) and prints one JSON
-line with the outcome.  A check draws its inputs from a seed the judge draws itself; only
-the grader gives one (``--seed``, :mod:`ros2nb.checks.drawn`), the learner's kernel never.
+line with the outcome; while grading, also one line per graded cell as soon as it is decided
+(``{"cell": ID, "result": ...}``), which is what a judge stopped at its limits leaves.  A
+check draws its inputs from a seed the judge draws itself; only the grader gives one
+(``--seed``, :mod:`ros2nb.checks.drawn`), the learner's kernel never.
 """
 
 from __future__ import annotations
@@ -69,7 +71,11 @@ def main(argv: list[str]) -> int:
             flags = notebook_flags(submission, session.workspace, source)
             if rewritten:  # what another cell wrote into the package is never graded
                 session.grade_as_written(rewritten)
-            result = {'results': grade(source, submission, session),
+
+            def checked(grade_id: str, outcome: dict[str, Any]) -> None:
+                print(json.dumps({'cell': grade_id, 'result': outcome}), flush=True)
+
+            result = {'results': grade(source, submission, session, checked),
                       'flags': flags + [REWRITTEN.format(name=Path(r).name) for r in rewritten]
                       + session.reaching.flags()}
     finally:

@@ -126,13 +126,15 @@ def _folded(node: ast.AST) -> Optional[str]:
     if isinstance(node, ast.JoinedStr):
         pieces = [_folded(v.value if isinstance(v, ast.FormattedValue) else v)
                   for v in node.values]
-        return None if None in pieces else ''.join(pieces)  # type: ignore[arg-type]
+        known = [piece for piece in pieces if piece is not None]
+        return None if len(known) != len(pieces) else ''.join(known)
     if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and \
             node.func.attr == 'join' and len(node.args) == 1 and \
             isinstance(node.args[0], (ast.List, ast.Tuple)):
         glue = _folded(node.func.value)
         pieces = [_folded(e) for e in node.args[0].elts]
-        return None if glue is None or None in pieces else glue.join(pieces)  # type: ignore
+        known = [piece for piece in pieces if piece is not None]
+        return None if glue is None or len(known) != len(pieces) else glue.join(known)
     return None
 
 

@@ -13,18 +13,19 @@ import contextlib
 import math
 import threading
 import time
-from dataclasses import dataclass
 from typing import Any, Callable, Optional
 
 import rclpy
 from rcl_interfaces.msg import Log
 from rcl_interfaces.srv import ListParameters
 from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.serialization import deserialize_message
 from rclpy.signals import SignalHandlerOptions
 
 from .. import domains
-from ..judge_interface import ARRIVAL_TIMEOUT_S
+from ..judge_interface import ARRIVAL_TIMEOUT_S, Heard, Line
 from ..errors import CheckFailed
 from ..processes import Patience, wait_for_work
 from ..runtime import QUIET_SUBSCRIPTION, node_serving_nothing
@@ -52,34 +53,6 @@ class _GivenUp(Exception):
     """The processes a wait attended to had their patience (:meth:`Observer.spins`)."""
 
 
-@dataclass(frozen=True)
-class Heard:
-    """A message the judge's node received.
-
-    :ivar t_ns: the judge's clock when it arrived (ns of simulated time).
-    :ivar value: what the check keeps of it (e.g. a Float32's ``data``).
-    """
-
-    t_ns: int
-    value: Any
-
-
-@dataclass(frozen=True)
-class Line:
-    """A /rosout line the judge's node received.
-
-    :ivar t_ns: the judge's clock when it arrived (ns of simulated time).
-    :ivar name: the logger's name (a node's name).
-    :ivar level: 10 debug, 20 info, 30 warn, 40 error, 50 fatal.
-    :ivar text: the message.
-    """
-
-    t_ns: int
-    name: str
-    level: int
-    text: str
-
-
 class Observer:
     """The judge's own ROS node on the judge's domain: graph, messages, logs, probes."""
 
@@ -102,30 +75,35 @@ class Observer:
         self.heard: dict[str, list[Heard]] = {}
         #: What the learner's code sends beyond any node of the course, and its one line.
         self.floods = Floods(self)
-        self._quiet: Any = None
+        self._quiet: Optional[Node] = None
         self._stop = False
+        #: Held while a message is taken: by the spin thread, or by :meth:`take_stale`.
+        self._taking = threading.Lock()
         #: The processes whose work the judge waits for (its subjects and the learner's
         #: programs, given by the session): every wait of the judge's lasts while they work.
         self.attending: Callable[[], list[int]] = list
         self._thread = threading.Thread(target=self._spin, name='ros2nb-judge', daemon=True)
         self._thread.start()
-        self.node.create_subscription(Log, '/rosout', self._on_log, ROSOUT_QOS,
-                                      event_callbacks=QUIET_SUBSCRIPTION)
+        #: What the judge hears the learner's code send on: /rosout and the watched topics.
+        on_log: Any = self._on_log  # with the message's info: rclpy passes it to two arguments
+        self._hearing = [self.node.create_subscription(Log, '/rosout', on_log, ROSOUT_QOS,
+                                                       event_callbacks=QUIET_SUBSCRIPTION)]
 
     def _spin(self) -> None:
         """Run the node's callbacks until :meth:`close` (which wakes the wait at once)."""
         while not self._stop:
             with contextlib.suppress(Exception):  # as spin_once: a callback's error is dropped
-                handler, _entity, _node = self.executor.wait_for_ready_callbacks(
-                    timeout_sec=SPIN_WAIT_S, condition=self._stopping)
-                handler()
+                handler = self.executor.wait_for_ready_callbacks(
+                    timeout_sec=SPIN_WAIT_S, condition=self._stopping)[0]
+                with self._taking:  # rcl takes from a subscription in one thread at a time
+                    handler()
 
     def _stopping(self) -> bool:
         return self._stop
 
-    def _on_log(self, msg: Log) -> None:
+    def _on_log(self, msg: Log, info: Any) -> None:
         with self.changed:
-            if self.floods.count('/rosout', msg.name):
+            if self.floods.stale(info) or self.floods.count('/rosout', msg.name):
                 return
             self.logs.append(Line(self.now_ns, msg.name, msg.level, msg.msg))
             self.log_counts[msg.name] += 1
@@ -141,18 +119,36 @@ class Observer:
         if topic not in self.heard:
             self.heard[topic] = store = []
 
-            def note(msg: Any) -> None:
+            def noted(msg: Any, info: Any) -> None:
                 with self.changed:
-                    if self.floods.count(topic, topic):
+                    if self.floods.stale(info) or self.floods.count(topic, topic):
                         return
                     store.append(Heard(self.now_ns, keep(msg)))
                     self.changed.notify_all()
 
-            self.node.create_subscription(msg_type, topic, note, EVERY_MESSAGE,
-                                          event_callbacks=QUIET_SUBSCRIPTION)
+            note: Any = noted  # with the message's info, as on_log
+            self._hearing.append(self.node.create_subscription(
+                msg_type, topic, note, EVERY_MESSAGE, event_callbacks=QUIET_SUBSCRIPTION))
         return self.heard[topic]
 
-    def quiet_node(self) -> Any:
+    def take_stale(self) -> None:
+        """Take what the judge's subscriptions hold that stopped processes sent
+        (:meth:`~ros2nb.judge.floods.Floods.stale`), serialised, until a history holds no
+        more of it: a flood's backlog, gone before the next check, not read in the spin
+        thread beside it.  A message sent since goes to its callback, as the spin thread's do.
+        """
+        for subscription in list(self._hearing):
+            while True:
+                with self._taking, subscription.handle:
+                    taken = subscription.handle.take_message(subscription.msg_type, True)
+                if taken is None:
+                    break
+                raw, info = taken
+                if not self.floods.stale(info):
+                    subscription.callback(deserialize_message(raw, subscription.msg_type), info)
+                    break
+
+    def quiet_node(self) -> Node:
         """A node of the judge's that no thread spins: what its subscriptions receive waits in
         their history until the judge takes it (nothing taken before it asks)."""
         if self._quiet is None:
@@ -192,7 +188,7 @@ class Observer:
         with self.changed:
             return [line.text for line in self.logs[start:] if line.name == logger]
 
-    def endpoints(self, name: str, namespace: str, expected: list[list[str]],
+    def endpoints(self, name: str, namespace: str, expected: list[tuple[str, str, str]],
                   seconds: float = ARRIVAL_TIMEOUT_S) -> list[tuple[str, str, str]]:
         """The node's publishers and subscriptions as the ROS graph shows them.
 
@@ -231,7 +227,7 @@ class Observer:
         empty only when five reads in a row failed so.
         """
         for _attempt in range(5):
-            found = []
+            found: list[tuple[str, str, Any]] = []
             try:
                 for topic, _types in self.node.get_topic_names_and_types():
                     for kind, infos in (

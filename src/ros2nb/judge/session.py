@@ -16,13 +16,14 @@ from importlib import resources
 from pathlib import Path
 from typing import Any, Callable, ContextManager, Optional
 
+from rclpy.publisher import Publisher
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Bool, Float32
 
 from .. import course
 from ..checks.drawn import new_seed
 from ..errors import CheckFailed
-from ..processes import kill_process_group, wait_patiently
+from ..processes import Process, kill_process_group, wait_patiently
 from ..subject.judge_time import JUDGE_TOPICS_ENV
 from ..subject.forked import fork_program
 from ..terminal.files import parts_verdict
@@ -30,6 +31,7 @@ from ..terminal.workspace import WORKSPACE_ENV
 from . import handed
 from .clock import JudgeClock
 from ..judge_interface import AnswerRef, learner_error
+from ..subject_interface import ExecCells, LoadFile, StandIns
 from .observer import Observer
 from .reaching import Reaching
 from .stand_ins import source_of
@@ -65,16 +67,17 @@ class Session:
         self._scratch_fd = os.open(self.scratch, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW)
         self._observer: Optional[Observer] = None
         self._clock: Optional[JudgeClock] = None
-        self._subjects: dict[tuple, SubjectProcess] = {}
-        self._programs: list[Any] = []  # the learner's programs started (start, start_program)
-        self._probe: Any = None
-        self.builds: dict[str, Any] = {}
+        self._subjects: dict[tuple[Any, ...], SubjectProcess] = {}
+        self._programs: list[Process] = []  # the learner's programs (start, start_program)
+        self._probe: Optional[Publisher] = None
+        self.builds: dict[str, Path] = {}
         #: What the learner's code reached for in the subjects (their audit hooks): flags,
         #: and a failed check where it can only serve cheating (:mod:`.reaching`).
         self.reaching = Reaching(self._subjects)
 
     @property
     def observer(self) -> Observer:
+        """The judge's own ROS node (made on first use, hearing the course's topics)."""
         if self._observer is None:
             self._observer = Observer()
             self._observer.attending = self.working_pids
@@ -94,7 +97,7 @@ class Session:
         return self._clock
 
     @property
-    def probe_publisher(self) -> Any:
+    def probe_publisher(self) -> Publisher:
         """The judge's own Float32 publisher on /temperature (it plays the sensor)."""
         if self._probe is None:
             self._probe = self.observer.node.create_publisher(
@@ -102,7 +105,7 @@ class Session:
                 QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE))
         return self._probe
 
-    def subject(self, key: tuple, load: Callable[[SubjectProcess], None],
+    def subject(self, key: tuple[Any, ...], load: Callable[[SubjectProcess], None],
                 workspace: Optional[Path] = None) -> SubjectProcess:
         """A subject for ``key``, started and loaded once per session (in ``workspace``, by
         default the learner's)."""
@@ -134,19 +137,19 @@ class Session:
                                       *self._programs) if proc.poll() is None]
 
     def _end_flood(self) -> None:
-        """End every process that runs the learner's code now (one of them floods), before
-        the flood is raised (:meth:`ros2nb.judge.floods.Floods.raise_any`); what runs next
-        starts its subjects afresh."""
+        """End and reap every process that runs the learner's code now (one of them floods),
+        before the flood is raised (:meth:`ros2nb.judge.floods.Floods.raise_any`); what runs
+        next starts its subjects afresh."""
         for proc in (*(s.proc for s in self._subjects.values()), *self._programs):
             kill_process_group(proc)
 
-    def drop(self, key: tuple) -> None:
+    def drop(self, key: tuple[Any, ...]) -> None:
         """End the subject ``key``, and those of the same file with stand-ins (``key``
         followed by their names)."""
         for known in [k for k in self._subjects if k[:len(key)] == key]:
             self._end(known)
 
-    def _end(self, key: tuple) -> None:
+    def _end(self, key: tuple[Any, ...]) -> None:
         """End the subject ``key``; what its audit hook saw stays with :attr:`reaching`."""
         subject = self._subjects.pop(key)
         subject.close()
@@ -169,15 +172,17 @@ class Session:
         path = self.workspace / relative
 
         def load(subject: SubjectProcess) -> None:
-            reply = subject.request('load_file', path=str(path), module=path.stem)
-            if reply.get('missing'):
+            reply = subject.request(LoadFile(path=str(path), module=path.stem))
+            if reply.missing:
                 raise CheckFailed(f'{path.name} does not exist yet: run the %%part cells that '
                                   'write it, from part 1 on.')
-            if not reply['ok']:
+            if not reply.ok:
                 parts_verdict(self.workspace, relative)  # a part never run explains it best
-                raise learner_error(path.name, reply['error'], context=' on import')
+                if reply.error is not None:
+                    raise learner_error(path.name, reply.error, context=' on import')
+                raise CheckFailed(f'{path.name} could not be imported: run this check again.')
             if stand_ins:
-                subject.request('stand_ins', source=source_of(stand_ins))
+                subject.request(StandIns(source=source_of(stand_ins)))
 
         return self.subject(('file', relative, *(['+', *stand_ins] if stand_ins else [])),
                             load)
@@ -196,7 +201,7 @@ class Session:
         """A subject with the course's context cells and the learner's answer cells run (in
         ``workspace``, by default the learner's)."""
         def load(subject: SubjectProcess) -> None:
-            subject.request('exec_cells', sources=list(ref.sources))
+            subject.request(ExecCells(sources=list(ref.sources)))
 
         return self.subject(('cells', ref.sources, str(workspace)), load, workspace)
 
@@ -222,7 +227,7 @@ class Session:
         return self.hand_over('caught-up-', given)
 
     def start(self, argv: list[str], *, cwd: Path,
-              env: Optional[dict[str, str]] = None) -> tuple[subprocess.Popen, Output]:
+              env: Optional[dict[str, str]] = None) -> tuple[subprocess.Popen[str], Output]:
         """Start a program of the learner's (sandboxed while grading) in a session of its own.
 
         :param env: the program's whole environment (default :func:`subject_env`).  While
@@ -242,7 +247,7 @@ class Session:
         return proc, Output(proc.stdout)
 
     def start_program(self, path: Path, stand_in: Optional[str] = None
-                      ) -> tuple[Any, Output]:
+                      ) -> tuple[Process, Output]:
         """Start the learner's ``main()`` in ``path`` as ``ros2 run`` would, in the learner's
         workspace, as :mod:`ros2nb.subject.program` does it (its node class replaced by the
         course's stand-in ``stand_in`` when given): sandboxed while grading, else forked from

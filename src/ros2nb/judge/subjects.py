@@ -9,6 +9,7 @@ sandbox command (``ROS2NB_SUBJECT_PREFIX``) and cannot see, signal or trace the 
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import itertools
 import json
 import os
@@ -19,13 +20,16 @@ import sys
 import threading
 import time
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any, Optional, TypeVar
 
 from .. import domains
 from ..errors import CheckFailed
 from ..processes import Patience, kill_process_group, stop_process_group
 from ..subject.judge_time import JUDGE_CLOCK_ENV
 from ..subject.forked import SUBJECT_PREFIX_ENV, fork_subject, has_server
+from ..subject_interface import Command, ExecCells, LoadFile, reply_type, wire
+from ..subject_replies import Reply
+from ..typed_json import decoded
 from .reaching import MAX_SEEN, SEEN_PREFIX, Reached, parse_seen
 
 #: The folder the subjects may write (while grading, the only one): their home
@@ -41,6 +45,7 @@ REPLY_TIMEOUT_S = 30.0
 POLL_S = 0.25
 #: Lines of a subject's own output kept for hints.
 KEPT_OUTPUT_LINES = 200
+R = TypeVar('R', bound=Reply)
 #: Subjects this process has started.  Unless sandboxed, they are forked from a server
 #: that has imported ROS (:mod:`ros2nb.subject.forked`): all of them in a judge process,
 #: which forks its server from itself as it starts; elsewhere all but the first, which
@@ -176,18 +181,30 @@ class SubjectProcess:
         #: /rosout lines per logger (set by the session that starts it).
         self.heard_base: tuple[dict[str, int], dict[str, int]] = ({}, {})
 
-    def send(self, op: str, **arguments: Any) -> None:
-        """Send one command (its reply comes later: :meth:`receive`, :meth:`poll_reply`); the
-        first carries :attr:`seal`."""
+    def send(self, command: Command[Any]) -> None:
+        """Send one command (its reply comes later: :meth:`poll_reply`, read with
+        :meth:`reply_to`); the first, which loads the learner's code, carries :attr:`seal`."""
         if not self._sealed:
-            arguments, self._sealed = {**arguments, 'seal': self.seal}, True
+            self._sealed = True
+            if isinstance(command, (LoadFile, ExecCells)):
+                command = dataclasses.replace(command, seal=self.seal)
         try:
-            os.write(self._commands, (json.dumps({'op': op, **arguments}) + '\n').encode())
+            os.write(self._commands, (json.dumps(wire(command)) + '\n').encode())
         except BrokenPipeError:
             raise self._died() from None
 
-    def poll_reply(self, seconds: float) -> Optional[dict]:
-        """The reply, if it has come within ``seconds``; else None.
+    @staticmethod
+    def reply_to(command: Command[R], data: Any) -> R:
+        """A reply as :meth:`poll_reply` read it, as ``command``'s reply type.
+
+        :raises ros2nb.typed_json.Unreadable: when it does not fit that type (the subject
+            runs learner code, which may write anything there): that check fails alone.
+        """
+        reply: R = decoded(reply_type(type(command)), data)
+        return reply
+
+    def poll_reply(self, seconds: float) -> Any:
+        """The reply as JSON, if it has come within ``seconds``; else None.
 
         :raises CheckFailed: when the process ended (its last output line says why).
         """
@@ -245,22 +262,23 @@ class SubjectProcess:
                 self.seen.append(reached)
         return kept
 
-    def request(self, op: str, *, timeout: float = REPLY_TIMEOUT_S, **arguments: Any) -> dict:
-        """Send one command and return its reply.
+    def request(self, command: Command[R], *, timeout: float = REPLY_TIMEOUT_S) -> R:
+        """Send one command and return its reply (``command``'s reply type).
 
         :param timeout: seconds the subject gets: of CPU time while it works, of the wall
             clock while it waits (:class:`~ros2nb.processes.Patience`), so that a busy
             machine never turns slow honest work into a hang.
         :raises SubjectHung: when no reply comes within ``timeout`` seconds, or the
             process died (its last output line is in the message).
+        :raises ros2nb.typed_json.Unreadable: for a reply that does not fit its type.
         """
-        self.send(op, **arguments)
+        self.send(command)
         sent, patience = time.monotonic(), None
         while True:
             reply = self.poll_reply(POLL_S)
             self.take_ack()
             if reply is not None:
-                return reply
+                return self.reply_to(command, reply)
             # No reply within POLL_S: from now on the subject's CPU time counts.  (Most
             # replies come sooner, and reading /proc for each cost the judge more than the
             # reply.)

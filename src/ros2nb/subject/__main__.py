@@ -14,8 +14,10 @@ import sys
 
 from ..explain.plots import guard_pyplot
 from ..processes import end_this_process
+from ..subject_interface import LOADERS, command_of, wire
+from ..typed_json import Unreadable
 from . import judge_time, out_of_reach, seen
-from .commands import LOADERS, PROTOCOL_ERROR, load, serve
+from .commands import PROTOCOL_ERROR, load, serve
 from .shown import make_sealer
 
 
@@ -32,15 +34,18 @@ def main(argv: list[str]) -> int:
         first = commands.readline()
         if not first:
             return 0
-        request = json.loads(first)
-        # notebook 07's seal: its key lives in the sealer's frame alone, before any learner code
-        sealer = make_sealer(str(request.pop('seal', '')))
-        del first
-        if request.get('op') not in LOADERS:
+        try:
+            request = json.loads(first)
+            del first
+            # notebook 07's seal: its key lives in the sealer's frame alone, taken out of the
+            # command before any learner code runs (the command itself keeps none)
+            sealer = make_sealer(str(request.pop('seal', '') if isinstance(request, dict) else ''))
+            command = command_of(request, LOADERS)
+        except (ValueError, Unreadable):
             return PROTOCOL_ERROR
         out_of_reach.shut()  # no answer module importable: the judge sends what stands in
-        namespace, reply = load(request)
-        replies.write(json.dumps(reply) + '\n')
+        namespace, reply = load(command)
+        replies.write(json.dumps(wire(reply)) + '\n')
         replies.flush()
         serve(commands, replies, namespace, sealer)
     return 0

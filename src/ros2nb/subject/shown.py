@@ -100,7 +100,12 @@ def worker_services(node: Node, names: tuple[str, str], groups: tuple[Any, Any],
 
 
 # ------------------------------------------------------------------ notebook 07: the plot
-def make_sealer(key: str) -> Generator[Optional[str], tuple, None]:
+#: Notebook 07's sealer (:func:`make_sealer`): sent ``(what, node)``, it answers a sealed
+#: drawing, ``'bound'``, or None.
+Sealer = Generator[Optional[str], tuple[str, Any], None]
+
+
+def make_sealer(key: str) -> Sealer:
     """The sealer of notebook 07's drawings, made before the learner's code is loaded.
 
     Send it ``('bind', node)`` once (the first node bound is the only one it reads), then
@@ -113,7 +118,7 @@ def make_sealer(key: str) -> Generator[Optional[str], tuple, None]:
     return sealer
 
 
-def _sealing(key: str) -> Generator[Optional[str], tuple, None]:
+def _sealing(key: str) -> Sealer:
     sha, real, is_a, make_float, text, joined = hashlib.sha256, numbers.Real, isinstance, \
         float, repr, ';'.join
     listed, attribute, as_text = list, getattr, str  # none looked up once the code runs
@@ -141,7 +146,7 @@ def _sealing(key: str) -> Generator[Optional[str], tuple, None]:
             answer = None
 
 
-def plot_redraw(shown: Shown, sealer: Generator) -> Callable[[Any], None]:
+def plot_redraw(shown: Shown, sealer: Sealer) -> Callable[[Any], None]:
     """The course's ``PlotFeeder.redraw`` (part 1 of live_plot.py, given), for a feeder
     without a figure: it counts, logs the newest point as part 1 does (so a list holding
     something other than numbers fails as it would there), and tells the judge every point

@@ -25,7 +25,11 @@ from ..endpoints import node_endpoints
 from ..explain.exceptions import describe_error
 from ..explain.ros_settings import zero_depth_refused
 from ..runtime.rates import callback_groups
-from .replies import encode
+from ..subject_interface import (PlotShown, QosAcked, QosEndpoint, RoomNodes, Worker,
+                                 WorkerRelease, WorkerStop)
+from ..subject_replies import (CallbackFailure, PlotWitnessed, QosMade, Reply, RoomsMade,
+                               WorkerSpun, WorkerStopped)
+from .replies import described, encode
 from .shown import Shown, plot_redraw, worker_services
 
 #: The node that makes an endpoint with the learner's QoS profile (notebook 09).
@@ -34,14 +38,15 @@ QOS_NODE = 'qos_answer'
 SPIN_ROUND_S = 0.05
 
 
-def _spin(node: Node, executor: Executor, stop: threading.Event, failures: list) -> None:
+def _spin(node: Node, executor: Executor, stop: threading.Event,
+          failures: list[CallbackFailure]) -> None:
     """Spin the learner's ``executor`` until ``stop``, its first failure kept (notebook 06)."""
     while not stop.is_set():
         try:
             executor.spin_once(timeout_sec=SPIN_ROUND_S)
         except BaseException as error:  # the learner's executor may raise anything
-            failures.append({'callback': f'{type(node).__name__} callback',
-                             **describe_error(error)})
+            failures.append(CallbackFailure(callback=f'{type(node).__name__} callback',
+                                            **describe_error(error)))
             return
 
 
@@ -51,8 +56,8 @@ class Trials:
     namespace: dict[str, Any]
     rooms: list[Node]
     node: Optional[Node]
-    _spun: Optional[tuple[Node, Executor, threading.Thread, threading.Event, list, Shown,
-                          threading.Event]]
+    _spun: Optional[tuple[Node, Executor, threading.Thread, threading.Event,
+                          list[CallbackFailure], Shown, threading.Event]]
     _qos: Optional[tuple[Node, Any]]
     _plot_shown: Optional[Shown] = None
     _sealer: Any = None
@@ -61,67 +66,69 @@ class Trials:
         raise NotImplementedError
 
     # ------------------------------------------------------------ notebook 06
-    def worker(self, name: str, topic: str, services: list[str], seconds: float) -> dict:
+    def worker(self, command: Worker) -> WorkerSpun:
         """Call the learner's ``name()`` for ``(node, executor)``; stop the Worker's two timers
         and put the course's slow work and heartbeat in their place, as the services
         ``services`` in the same callback groups (:func:`.shown.worker_services`, telling
         ``topic``); spin the learner's executor on the wall clock in a thread until
         :meth:`worker_stop`.  The judge calls the services and times the answers itself.
 
-        :param seconds: how long to wait, at most, for the judge's subscription to match.
+        ``seconds``: how long to wait, at most, for the judge's subscription to match.
         """
-        function = self.namespace.get(name)
+        function = self.namespace.get(command.name)
         if not callable(function):
-            return {'ok': False, 'undefined': True}
+            return WorkerSpun(ok=False, undefined=True)
         self._runtime()  # rclpy initialised, on this subject's domain
         try:
             made = function()
         except BaseException as error:
-            return {'ok': False, 'error': describe_error(error)}
+            return WorkerSpun(ok=False, error=described(error))
         if not (isinstance(made, tuple) and len(made) == 2 and isinstance(made[0], Node)
                 and isinstance(made[1], Executor)):
-            return {'ok': False, 'returned': encode(made)}
+            return WorkerSpun(ok=False, returned=encode(made))
         node, executor = made
-        described = {'name': node.get_name(), 'namespace': node.get_namespace(),
-                     'executor': type(executor).__name__,
-                     'threads': getattr(executor, '_num_threads', None),
-                     'groups': callback_groups(node)}
+        facts: dict[str, Any] = {'name': node.get_name(), 'namespace': node.get_namespace(),
+                                 'executor': type(executor).__name__,
+                                 'threads': getattr(executor, '_num_threads', None),
+                                 'groups': callback_groups(node)}
         timers = sorted(node.timers, key=lambda timer: timer.timer_period_ns)
         if len(timers) < 2:
-            return {'ok': False, 'timers': len(timers), **described}
-        shown = Shown(topic)
-        if not shown.reaches_judge(seconds):
+            return WorkerSpun(ok=False, timers=len(timers), **facts)
+        shown = Shown(command.topic)
+        if not shown.reaches_judge(command.seconds):
             shown.close()
-            return {'ok': False, 'unmatched': True, **described}
+            return WorkerSpun(ok=False, unmatched=True, **facts)
         for timer in timers:  # the learner's own callbacks no longer run
             timer.cancel()
-        stop, release, failures = threading.Event(), threading.Event(), []
+        stop, release = threading.Event(), threading.Event()
+        failures: list[CallbackFailure] = []
         thread = threading.Thread(target=_spin, args=(node, executor, stop, failures),
                                   name='ros2nb-subject-worker', daemon=True)
 
-        def dispatching() -> set:
+        def dispatching() -> set[Optional[int]]:
             pool = getattr(getattr(executor, '_executor', None), '_threads', ())
             return {thread.ident, *(worker.ident for worker in list(pool))}
 
         # the slowest timer is slow_work's, the quickest heartbeat's (part 3: 0.5 s, 0.1 s)
-        worker_services(node, (services[0], services[1]),
+        slow, quick = command.services
+        worker_services(node, (slow, quick),
                         (timers[-1].callback_group, timers[0].callback_group), shown,
                         release, dispatching)
         executor.add_node(node)
         self._spun = (node, executor, thread, stop, failures, shown, release)
         thread.start()
-        return {'ok': True, **described}
+        return WorkerSpun(ok=True, **facts)
 
-    def worker_release(self) -> dict:
+    def worker_release(self, command: WorkerRelease) -> Reply:
         """Let the course's slow work end (the judge has seen what it waited for)."""
         if self._spun is not None:
             self._spun[6].set()
-        return {'ok': True}
+        return Reply(ok=True)
 
-    def worker_stop(self) -> dict:
+    def worker_stop(self, command: WorkerStop) -> WorkerStopped:
         """Stop spinning the learner's worker; the first failure of its callbacks, if any."""
         if self._spun is None:
-            return {'ok': True, 'failure': None}
+            return WorkerStopped(ok=True)
         node, executor, thread, stop, failures, shown, release = self._spun
         self._spun = None
         release.set()
@@ -130,32 +137,33 @@ class Trials:
         executor.shutdown(timeout_sec=5)
         node.destroy_node()
         shown.close()
-        return {'ok': True, 'failure': failures[0] if failures else None}
+        return WorkerStopped(ok=True, failure=failures[0] if failures else None)
 
     # ------------------------------------------------------------ notebook 07
-    def plot_shown(self, topic: str, seconds: float) -> dict:
+    def plot_shown(self, command: PlotShown) -> PlotWitnessed:
         """Put the course's ``redraw()`` (:func:`.shown.plot_redraw`, telling ``topic`` what
         the sealer sealed) in place of the given one on the class of the node made last, bind
         the sealer to that node, and wait (at most ``seconds``) for the judge's subscription
         on ``topic`` to match.  ``tampered``: something bound the sealer before."""
         if self.node is None or self._sealer is None:
-            return {'ok': False}
+            return PlotWitnessed(ok=False)
         if self._plot_shown is not None:
             self._plot_shown.close()
-        self._plot_shown = shown = Shown(topic)
+        self._plot_shown = shown = Shown(command.topic)
         if self._sealer.send(('bind', self.node)) is None:
-            return {'ok': False, 'tampered': True}
-        type(self.node).redraw = plot_redraw(shown, self._sealer)  # type: ignore[attr-defined]
-        return {'ok': shown.reaches_judge(seconds), 'shown': shown.told}
+            return PlotWitnessed(ok=False, tampered=True)
+        # the learner's class, not Node
+        setattr(type(self.node), 'redraw', plot_redraw(shown, self._sealer))
+        return PlotWitnessed(ok=shown.reaches_judge(command.seconds), shown=shown.told)
 
-    def room_nodes(self, arguments: list) -> dict:
+    def room_nodes(self, command: RoomNodes) -> RoomsMade:
         """A stand-in sensor and monitor, each started with ``arguments`` (as ``--ros-args``)."""
         self._runtime()
         made: list[Node] = []
         try:
             for name, kind in (('temperature_sensor', 'publisher'),
                                ('temperature_monitor', 'subscription')):
-                node = Node(name, cli_args=[str(a) for a in arguments],
+                node = Node(name, cli_args=[str(a) for a in command.arguments],
                             use_global_arguments=False, start_parameter_services=False)
                 if kind == 'publisher':
                     node.create_publisher(Float32, 'temperature', 10)
@@ -165,29 +173,30 @@ class Trials:
         except BaseException as error:
             for node in made:
                 node.destroy_node()
-            return {'ok': False, 'error': describe_error(error)}
+            return RoomsMade(ok=False, error=described(error))
         self.rooms.extend(made)
-        return {'ok': True, 'nodes': [[n.get_name(), n.get_namespace(), node_endpoints(n)]
-                                      for n in made]}
+        return RoomsMade(ok=True, nodes=[(n.get_name(), n.get_namespace(), node_endpoints(n))
+                                         for n in made])
 
     # ------------------------------------------------------------ notebook 09
-    def qos_endpoint(self, name: str, topic: str, kind: str, numbers: tuple = ()) -> dict:
+    def qos_endpoint(self, command: QosEndpoint) -> QosMade:
         """Make a ``kind`` ('subscription' or 'publisher') of Int32 on ``topic`` with the
         profile the learner's ``name()`` returns, and say its history and depth (discovery
         does not carry them).  A subscription takes nothing; a publisher publishes ``numbers``
         (the judge's) at once."""
-        function = self.namespace.get(name)
+        function = self.namespace.get(command.name)
         if not callable(function):
-            return {'ok': False, 'undefined': True}
+            return QosMade(ok=False, undefined=True)
         self._runtime()
         try:
             with zero_depth_refused():
                 profile = function()
         except BaseException as error:
-            return {'ok': False, 'error': describe_error(error)}
+            return QosMade(ok=False, error=described(error))
         if not isinstance(profile, QoSProfile):
-            return {'ok': False, 'returned': encode(profile)}
+            return QosMade(ok=False, returned=encode(profile))
         node = Node(QOS_NODE, start_parameter_services=False)
+        topic, kind, numbers = command.topic, command.kind, command.numbers
         try:
             if kind == 'subscription':
                 endpoint: Any = node.create_subscription(Int32, topic, lambda msg: None, profile)
@@ -197,18 +206,19 @@ class Trials:
                     endpoint.publish(Int32(data=int(number)))
         except BaseException as error:
             node.destroy_node()
-            return {'ok': False, 'error': describe_error(error)}
+            return QosMade(ok=False, error=described(error))
         self._qos = (node, endpoint)
-        return {'ok': True, 'history': int(profile.history), 'depth': int(profile.depth)}
+        return QosMade(ok=True, history=int(profile.history), depth=int(profile.depth))
 
-    def qos_acked(self, seconds: float) -> dict:
+    def qos_acked(self, command: QosAcked) -> Reply:
         """Wait (at most ``seconds``) until the judge's late joiner matched this publisher and
         acknowledged the burst."""
         if self._qos is None:
-            return {'ok': False}
+            return Reply(ok=False)
         _, publisher = self._qos
-        deadline = time.monotonic() + seconds  # the judge's joiner matched on its side: wait
+        # the judge's joiner matched on its side: wait
+        deadline = time.monotonic() + command.seconds
         while publisher.get_subscription_count() < 1 and time.monotonic() < deadline:
             time.sleep(0.01)  # for this side too, or nothing waits to be acknowledged yet
         left = max(0.0, deadline - time.monotonic())
-        return {'ok': bool(publisher.wait_for_all_acked(Duration(seconds=left)))}
+        return Reply(ok=bool(publisher.wait_for_all_acked(Duration(seconds=left))))

@@ -9,9 +9,11 @@ topics, subscribers right of them, no edge drawn across another when it can be h
 
 from __future__ import annotations
 
-from typing import Any, Iterable, Optional
+import html
+from typing import Iterable, Optional
 
 from ..errors import Ros2nbError
+from ..figures import CAPTION_START
 from ..processes import wait_for_work
 from ..runtime import current_runtime
 from .background import failures, running_pids
@@ -72,22 +74,68 @@ def graph_edges(*, expect: Iterable[str] = (),
     return sorted(found)
 
 
+def graph_caption(edges: Iterable[tuple[str, str, str]], title: str = '') -> str:
+    """The caption line of a graph picture, from its edges: each topic with who publishes it
+    and who subscribes to it (``Figure: the ROS graph, ...: 3 nodes, 2 topics. /temperature:
+    published by /temperature_sensor; subscribed by /temperature_monitor.``).
+
+    Introduced in ``06-five-promises.ipynb``.
+
+    :param edges: from :func:`graph_edges`.
+    :param title: the picture's title, if it has one.
+    """
+    edges = sorted(edges)
+    nodes = sorted({node for node, _, _ in edges})
+    topics = sorted({topic for _, _, topic in edges})
+    what = f'the ROS graph{f", {title}" if title else ""}'
+    if not edges:
+        return f'{CAPTION_START}{what}: no node with a topic.'
+    line = [f'{CAPTION_START}{what}: {len(nodes)} node{"s" * (len(nodes) != 1)}, '
+            f'{len(topics)} topic{"s" * (len(topics) != 1)}.']
+    for topic in topics:
+        ends = {kind: ', '.join(node for node, k, t in edges if t == topic and k == kind) or
+                'nobody' for kind in ('publisher', 'subscription')}
+        line.append(f'{topic}: published by {ends["publisher"]}; subscribed by '
+                    f'{ends["subscription"]}.')
+    return ' '.join(line)
+
+
+class GraphPicture:
+    """A graph's picture (SVG) with its caption: shown in a notebook as the picture, then the
+    caption line under it; ``data`` is the SVG's text, ``caption`` the line.  The SVG is
+    labelled with the caption too (``role="img"``, ``aria-label``), for screen readers."""
+
+    def __init__(self, svg: str, caption: str) -> None:
+        from IPython.display import SVG  # the <svg> element alone, as IPython shows an SVG
+
+        label = html.escape(caption.removeprefix(CAPTION_START), quote=True)
+        self.data = SVG(svg).data.replace('<svg ', f'<svg role="img" aria-label="{label}" ', 1)
+        self.caption = caption
+
+    def _ipython_display_(self) -> None:
+        from IPython.display import display
+        display({'image/svg+xml': self.data, 'text/plain': self.caption}, raw=True)
+        print(self.caption)
+
+
 def graph_picture(edges: Optional[Iterable[tuple[str, str, str]]] = None, *,
-                  title: str = '') -> Any:
-    """Draw the graph as rqt_graph does: nodes as ellipses, topics as boxes, arrows for data.
+                  title: str = '') -> GraphPicture:
+    """Draw the graph as rqt_graph does: nodes as ellipses, topics as boxes, arrows for data,
+    captioned in words (:func:`graph_caption`).
 
     Introduced in ``06-five-promises.ipynb``.
 
     :param edges: from :func:`graph_edges` (``None`` reads the graph now).
     :param title: a caption under the picture.
-    :return: an SVG picture the notebook displays (``IPython.display.SVG``).
+    :return: the picture the notebook displays, followed by its caption line.
     :raises Ros2nbError: when Graphviz's ``dot`` is not installed (``make graph-tool``).
     """
     import graphviz
-    from IPython.display import SVG
 
     edges = sorted(_endpoints_now() if edges is None else edges)
-    graph = graphviz.Digraph(graph_attr={'rankdir': 'LR', 'label': title, 'fontsize': '11',
+    # The graph's name is the SVG's <title>, which a screen reader reads out.
+    graph = graphviz.Digraph(name=title or 'ROS graph',
+                             graph_attr={'rankdir': 'LR', 'label': title, 'fontsize': '11',
                                          'fontname': 'Helvetica', 'bgcolor': 'white'},
                              node_attr={'fontname': 'Helvetica', 'fontsize': '11',
                                         'style': 'filled'})
@@ -101,8 +149,9 @@ def graph_picture(edges: Optional[Iterable[tuple[str, str, str]]] = None, *,
         else:
             graph.edge('topic ' + topic, 'node ' + node)
     try:
-        return SVG(graph.pipe(format='svg'))
+        svg = graph.pipe(format='svg', encoding='utf-8')
     except graphviz.ExecutableNotFound:
         raise Ros2nbError("Graphviz's dot is not installed: run make graph-tool (or sudo "
                           'apt-get install graphviz); graph_edges() lists the same graph as '
                           'text.') from None
+    return GraphPicture(svg, graph_caption(edges, title))

@@ -48,14 +48,15 @@ from typing import TYPE_CHECKING, Optional
 from ros2nb.checks.drawn import SEED_OPTION, new_seed, parse_seed
 from ros2nb.errors import Ros2nbError
 
-from ..paths import ROOT
+from ..paths import ASSIGNMENT, ROOT
 from . import sandbox
 from .gradebook import Scoring, collect_zip, set_up_course, write_results
 from .judging import Judges
-from .learners import grade_learner
+from .learners import file_graded, grade_learner
 from .report import write_report
 from .settings import CELL_TIMEOUT_S, JOBS, NOTEBOOK_CPU_S, NOTEBOOK_TIMEOUT_S, Settings
 from .submissions import Learner, find_learners
+from .term import add_options, export, forget, load_state, read_term, save_state, with_roster
 
 if TYPE_CHECKING:
     from .cluster import Cluster
@@ -69,6 +70,9 @@ def _options(argv: Optional[list[str]]) -> argparse.Namespace:
     parser.add_argument('--notebook-timeout', type=int, default=NOTEBOOK_TIMEOUT_S)
     parser.add_argument('--notebook-cpu', type=int, default=NOTEBOOK_CPU_S,
                         help="CPU seconds one notebook's run may use in its sandbox")
+    parser.add_argument('--judge-cpu', type=int, default=None,
+                        help="CPU seconds one notebook's judge may use with its subjects "
+                             "(default: the course's limit for each notebook)")
     parser.add_argument('--jobs', type=int, default=JOBS)
     parser.add_argument('--force', action='store_true',
                         help='replace an earlier grading/ (and any manual grades in it)')
@@ -79,6 +83,7 @@ def _options(argv: Optional[list[str]]) -> argparse.Namespace:
                              'inputs of an earlier grading (its notes.json); new by default')
     parser.add_argument('--scheduler', metavar='ADDRESS',
                         help='grade on the workers of this Dask scheduler (tcp://host:8786)')
+    add_options(parser)
     return parser.parse_args(argv)
 
 
@@ -99,7 +104,10 @@ def _refusal(submissions: Path, out: Path, args: argparse.Namespace) -> Optional
     if why:
         return (f'No sandbox can be made here ({why}); grading runs learners\' code, so it stops. '
                 'For work you trust, run again with NO_SANDBOX=1 (--no-sandbox).')
-    if out.exists() and any(out.iterdir()) and not args.force:
+    if args.learner and not (out / 'learners.json').is_file():
+        return (f'{out} holds no earlier grading to grade {args.learner} again into: grade the '
+                'class first (without LEARNER).')
+    if out.exists() and any(out.iterdir()) and not args.force and not args.learner:
         return (f'{out} holds an earlier grading (maybe with manual grades): move it away, '
                 'or run again with FORCE=1 to replace it.')
     if submissions.suffix == '.zip' and not zipfile.is_zipfile(submissions):
@@ -108,7 +116,7 @@ def _refusal(submissions: Path, out: Path, args: argparse.Namespace) -> Optional
 
 
 def _grade_all(course: Path, learners: list[Learner], notebooks: list[str],
-               settings: Settings, jobs: int) -> None:
+               settings: Settings, jobs: int, everyone: list[Learner]) -> None:
     """Grade every learner, ``jobs`` at a time, each notebook's judge beside the next run.
 
     nbgrader scores each learner as soon as they are done (with whoever else is done by
@@ -125,7 +133,8 @@ def _grade_all(course: Path, learners: list[Learner], notebooks: list[str],
 
         def grade(learner: Learner) -> None:
             try:
-                grade_learner(course, Path(scratch_root), learner, notebooks, settings, judges)
+                file_graded(course, learner, grade_learner(course, Path(scratch_root), learner,
+                                                           notebooks, settings, judges))
             finally:
                 print(progress.learner_done(learner), flush=True)
 
@@ -138,7 +147,7 @@ def _grade_all(course: Path, learners: list[Learner], notebooks: list[str],
                     waiting = {learner.id for job, learner in jobs_of.items()
                                if job.done()} - scored
                     if waiting:
-                        _score(scoring, learners, waiting)
+                        _score(scoring, everyone, waiting)
                         scored |= waiting
                     else:
                         concurrent.futures.wait([job for job in jobs_of if not job.done()],
@@ -159,7 +168,7 @@ def _not_graded(learner: Learner, error: BaseException) -> None:
 
 
 def _grade_all_on(cluster: 'Cluster', course: Path, learners: list[Learner],
-                  notebooks: list[str]) -> None:
+                  notebooks: list[str], everyone: list[Learner]) -> None:
     """Grade every learner on ``cluster``; nbgrader scores each batch as it comes back, and
     the progress lines are a local grading's."""
     progress = Progress(sum(len(learner.files) for learner in learners), len(learners))
@@ -169,7 +178,7 @@ def _grade_all_on(cluster: 'Cluster', course: Path, learners: list[Learner],
                 if error is not None:
                     _not_graded(learner, error)
                 print(progress.learner_done(learner), flush=True)
-            _score(scoring, learners, {learner.id for learner, _error in batch})
+            _score(scoring, everyone, {learner.id for learner, _error in batch})
 
 
 class Progress:
@@ -217,7 +226,7 @@ def _score(scoring: Scoring, learners: list[Learner], batch: set[str]) -> None:
 
 
 def _report(out: Path, learners: list[Learner], rows: list[list[str]],
-            refused: list[str], seed: int) -> None:
+            refused: list[str], seed: Optional[int]) -> None:
     """notes.json (with the seed that grades again with the same inputs: ``--seed``), and
     one line per learner: their total and what happened."""
     (out / 'notes.json').write_text(json.dumps(
@@ -242,6 +251,8 @@ def main(argv: Optional[list[str]] = None) -> int:
     # grading that stops half-way leaves an earlier grading/ (FORCE=1) as it was.
     out.parent.mkdir(parents=True, exist_ok=True)
     final, out = out, Path(tempfile.mkdtemp(prefix=f'.{out.name}-new-', dir=out.parent))
+    if args.learner:  # the earlier grading, with one learner graded again
+        shutil.copytree(final, out, symlinks=True, dirs_exist_ok=True)
     try:
         code = _grade(args, submissions, out, started)
         if code == 0:
@@ -268,7 +279,7 @@ def _grade(args: argparse.Namespace, submissions: Path, out: Path, started: floa
     grading worked."""
     seed = new_seed() if args.seed is None else args.seed  # one for the class: notes.json
     settings = Settings(args.cell_timeout, args.notebook_timeout, not args.no_sandbox, seed,
-                        args.notebook_cpu)
+                        args.notebook_cpu, args.judge_cpu)
     if not args.scheduler:
         return _grade_with(None, args, submissions, out, started, settings)
     from .cluster import Cluster, ClusterProblem  # Dask is imported for a cluster only
@@ -287,23 +298,50 @@ def _grade_with(cluster: Optional['Cluster'], args: argparse.Namespace, submissi
                 out: Path, started: float, settings: Settings) -> int:
     """Grade into ``out``, here (``cluster`` None) or on ``cluster``; 0 when grading worked."""
     course = out / 'nbgrader'
-    course.mkdir()
-    notebooks = set_up_course(course)
+    if args.learner:
+        notebooks = sorted(p.stem for p in (course / 'source' / ASSIGNMENT).glob('*.ipynb'))
+    else:
+        course.mkdir()
+        notebooks = set_up_course(course)
+    term, mistakes = read_term(args, notebooks)
+    for line in mistakes:
+        print(line)
+    if term is None:
+        return 2
     refused: list[str] = []
+    times: dict = {}
     if submissions.suffix == '.zip':
-        submissions, refused = collect_zip(submissions, course)
+        submissions, refused = collect_zip(submissions, course, times,
+                                           term.deadlines.zip_time_zone)
     learners, not_learners = find_learners(submissions, notebooks)
+    for learner in learners:  # a platform zip's times, where its folder had no timestamp.txt
+        learner.handed_in.update({n: times[learner.name, p.name]
+                                  for n, p in learner.files.items() if n not in learner.handed_in
+                                  and (learner.name, p.name) in times})
     refused += not_learners
     for line in refused:
         print(f'not graded: {line}')
     if not learners:
         print(f'{submissions} has no learner folders (<learner>/NN-title.ipynb).')
         return 2
+    learners = with_roster(learners, term.roster)
+    graded = learners
+    if args.learner:
+        graded = [lr for lr in learners if lr.name == args.learner]
+        if not graded:
+            print(f'{args.learner} has no folder in {submissions}: name a learner who has one.')
+            return 2
+        kept = {learner.name: learner for learner in load_state(out)}
+        graded[0].id = kept[args.learner].id if args.learner in kept else graded[0].id
+        forget(course, graded[0])
+        learners = sorted({**kept, args.learner: graded[0]}.values(), key=lambda lr: lr.name)
     if cluster is None:
-        _grade_all(course, learners, notebooks, settings, args.jobs)
+        _grade_all(course, graded, notebooks, settings, args.jobs, learners)
     else:
-        _grade_all_on(cluster, course, learners, notebooks)
-    rows = write_results(course, out, learners, notebooks)
+        _grade_all_on(cluster, course, graded, notebooks, learners)
+    save_state(out, learners)
+    rows = write_results(course, out, learners, notebooks, term.deadlines)
+    export(term, course, out, learners, notebooks)
     _report(out, learners, rows, refused, settings.seed)
     try:
         write_report(out, learners, notebooks, rows, refused)

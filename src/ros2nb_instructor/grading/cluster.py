@@ -18,10 +18,11 @@ import os
 import time
 import uuid
 from pathlib import Path
-from typing import Iterator, Optional
+from typing import Any, Iterator, Optional
 
 from ..paths import ASSIGNMENT
-from .cluster_task import Graded, Job, accept, course_version, grade_job, resource_name
+from .cluster_task import FromWorker, Job, accept, course_version, grade_job, resource_name
+from .learners import file_graded
 from .settings import Settings
 from .submissions import MAX_SUBMISSION_BYTES, Learner
 
@@ -124,7 +125,7 @@ class Cluster:
             for future in futures:
                 future.cancel()
 
-    def _submit(self, job: Job):
+    def _submit(self, job: Job) -> Any:
         """``job`` as a task only a checked worker runs (it needs their resource)."""
         # The key names the learner (an nbgrader id) for the dashboard, and is new each time.
         return self.client.submit(
@@ -166,9 +167,9 @@ class Cluster:
                     continue
                 taken.add(learner.id)
                 try:
-                    graded = future.result()
-                    _file(course, learner, graded)
-                    self.graded_by[learner.id] = graded.worker
+                    returned: FromWorker = future.result()
+                    file_graded(course, learner, returned.graded)
+                    self.graded_by[learner.id] = returned.worker
                     error = None
                 except Exception as failed:  # noqa: BLE001 - that learner's, in a note
                     error = failed
@@ -181,7 +182,7 @@ class Cluster:
         self.client.close()
 
 
-def _unrunnable_keys(dask_scheduler) -> list:
+def _unrunnable_keys(dask_scheduler: Any) -> list:
     """Run on the scheduler: the keys of the tasks no worker can run now."""
     return [task.key for task in dask_scheduler.unrunnable]
 
@@ -196,14 +197,3 @@ def _handed_in(path: Path) -> Optional[bytes]:
     with os.fdopen(fd, 'rb') as stream:
         return stream.read(MAX_SUBMISSION_BYTES + 1)
 
-
-def _file(course: Path, learner: Learner, graded: Graded) -> None:
-    """Put what a worker made of ``learner`` where a local grading puts it."""
-    target = course / 'submitted' / learner.id / ASSIGNMENT
-    target.mkdir(parents=True, exist_ok=True)
-    for notebook, text in graded.filed.items():
-        if notebook in learner.files:  # only the course's notebooks the learner handed in
-            (target / f'{notebook}.ipynb').write_text(text)
-    for key, text in graded.notes.items():
-        learner.note(key, text)
-    learner.results.update(graded.results)

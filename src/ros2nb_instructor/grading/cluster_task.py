@@ -3,8 +3,9 @@
 Runs on a worker host where the course is installed (the course's image, or a clone with
 ``make setup``), as root while grading, like the grader on one machine.  A learner is graded by
 :func:`.learners.grade_learner`, the function a local grading runs, in the same sandboxes; what
-goes back to the instructor is only what grading made of them: the notebooks filed for nbgrader,
-the notes and the judge's results.  Nothing here decides a point.
+goes back to the instructor is only what grading made of them (:class:`.learners.Graded`, whole:
+the notebooks filed for nbgrader, the notes, the judge's results and flags), and the worker's
+address.  Nothing here decides a point.
 """
 
 from __future__ import annotations
@@ -15,12 +16,12 @@ import sys
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Optional
+from typing import Any, Optional
 
 from ..paths import ASSIGNMENT, ROOT
 from . import sandbox
 from .judging import Judges
-from .learners import grade_learner
+from .learners import Graded, grade_learner
 from .settings import Settings
 from .submissions import Learner
 
@@ -53,7 +54,7 @@ def resource_name(version: str) -> str:
     return f'ros2nb-course-{version}'
 
 
-async def accept(version: str, sandboxed: bool, dask_worker=None) -> Optional[str]:
+async def accept(version: str, sandboxed: bool, dask_worker: Any = None) -> Optional[str]:
     """Run on each worker (``Client.run``): None when it may grade for an instructor whose
     course is ``version`` (it then holds :func:`resource_name`, which every learner's task
     needs, one per thread, and the scheduler knows it), else why not, in words that end the
@@ -95,19 +96,14 @@ class Job:
 
 
 @dataclass(frozen=True)
-class Graded:
-    """What a worker made of one learner: all that travels back.
+class FromWorker:
+    """What travels back from a worker: what it made of one learner, and its address."""
 
-    :ivar filed: notebook -> the notebook filed for nbgrader to score (JSON text).
-    """
-
-    filed: dict[str, str]
-    notes: dict[str, str]
-    results: dict[str, dict]
+    graded: Graded
     worker: str
 
 
-def grade_job(job: Job) -> Graded:
+def grade_job(job: Job) -> FromWorker:
     """Grade one learner on this worker, as :func:`.learners.grade_learner` grades on one
     machine, in a folder of its own that is gone when it returns.
 
@@ -134,13 +130,11 @@ def grade_job(job: Job) -> Graded:
         scratch.chmod(0o711)
         judges = Judges(1)  # a notebook's judge beside the learner's next notebook
         try:
-            grade_learner(top / 'course', scratch, learner, list(job.notebooks), job.settings,
-                          judges)
+            graded = grade_learner(top / 'course', scratch, learner, list(job.notebooks),
+                                   job.settings, judges)
         finally:
             judges.close()
-        filed = top / 'course' / 'submitted' / job.id / ASSIGNMENT
-        return Graded({p.stem: p.read_text() for p in filed.glob('*.ipynb')}, learner.notes,
-                      learner.results, _worker_address())
+        return FromWorker(graded, _worker_address())
 
 
 def _worker_address() -> str:

@@ -6,15 +6,32 @@ module is the second wall: the page's body goes through nh3 (the Ammonia sanitis
 head is rebuilt from the template's own style sheets only (no script, no remote load), and
 a Content-Security-Policy forbids every script and every load but inline styles and
 ``data:`` images.  A page opens the same in the instructor's and the learner's browser.
+The pages' HTML is jinja2's, from ``templates/`` (autoescape on: every value is text unless
+a template says it is HTML the grader made, such as a body nh3 cleaned).
 """
 
 from __future__ import annotations
 
-import html
 import re
-from typing import Sequence
+from typing import TYPE_CHECKING, Any, Mapping, Optional, Sequence
 
+import jinja2
 import nh3
+
+if TYPE_CHECKING:
+    from .deadlines import Lateness
+
+#: The grader's templates (``templates/*.j2``); every value they show is escaped.
+TEMPLATES = jinja2.Environment(loader=jinja2.PackageLoader(__package__, 'templates'),
+                               autoescape=True, undefined=jinja2.StrictUndefined)
+
+
+def render(template: str, **values: Any) -> str:
+    """``templates/<template>`` with ``values`` (escaped, unless the template marks one safe).
+
+    :raises jinja2.UndefinedError: when the template uses a value not given.
+    """
+    return TEMPLATES.get_template(template).render(**values)
 
 #: The page may show inline styles and data: images, and load or run nothing else.
 CSP = ("default-src 'none'; img-src data:; style-src 'unsafe-inline'; font-src data:; "
@@ -46,13 +63,11 @@ def clean_body(body: str) -> str:
                      strip_comments=True)
 
 
-def page(title: str, body: str, styles: list[str] = (), body_class: str = '') -> str:
-    """A whole page: CSP, the title as text, the given style sheets, the body sanitised."""
-    css = ''.join(f'<style>{s}</style>' for s in styles if '</' not in s)
-    return (f'<!DOCTYPE html>\n<html><head><meta charset="utf-8">'
-            f'<meta http-equiv="Content-Security-Policy" content="{CSP}">'
-            f'<title>{html.escape(title)}</title>{css}</head>\n'
-            f'<body class="{html.escape(body_class)}">{clean_body(body)}</body></html>\n')
+def page(title: str, body: str, styles: Sequence[str] = (), body_class: str = '') -> str:
+    """A whole page (``templates/page.html.j2``): CSP, the title as text, the given style
+    sheets (none that could end its ``<style>``), the body sanitised."""
+    return render('page.html.j2', csp=CSP, title=title, body_class=body_class,
+                  styles=[s for s in styles if '</' not in s], body=clean_body(body)) + '\n'
 
 
 #: What the feedback page says above the judge's flags (:mod:`ros2nb.judge.flags`).
@@ -64,20 +79,42 @@ FLAGS_WHY = ('These lines reach past what the lessons use (into the course\'s ow
 
 def flags_html(flags: Sequence[str]) -> str:
     """The judge's flags of one notebook as a box of the feedback page (empty for none);
-    each flag is text, escaped."""
-    if not flags:
+    each flag is text, escaped (``templates/flags.html.j2``)."""
+    return render('flags.html.j2', flags=flags, heading=FLAGS_HEADING, why=FLAGS_WHY)
+
+
+def late_html(late: Optional[Lateness]) -> str:
+    """A notebook's lateness as the box of the feedback page that says when it was due and
+    handed in (both in the due date's time zone), its score before lateness, the penalty and
+    its score (empty when it had no due date)."""
+    if late is None or late.due is None:
         return ''
-    items = ''.join(f'<li><code>{html.escape(flag)}</code></li>' for flag in flags)
-    return (f'<div id="flags" class="flags"><h2>{FLAGS_HEADING}</h2><p>{FLAGS_WHY}</p>'
-            f'<ul>{items}</ul></div>')
+    due, when = late.shown()
+    return render('late.html.j2', late={
+        'due': due, 'handed_in': when or 'the submission says no time', 'raw': f'{late.raw:g}',
+        'penalty': f'{late.penalty:g}', 'final': f'{late.final:g}', 'note': late.note,
+        'cost': late.penalty > 0})
 
 
-def safe_feedback(made: str, title: str, flags: Sequence[str] = ()) -> str:
-    """nbgrader's feedback page ``made`` rebuilt by :func:`page` (its styles kept), with the
-    judge's ``flags`` of the notebook first (:func:`flags_html`)."""
+#: The boxes above nbgrader's feedback (:func:`safe_feedback`): bootstrap's panels, which
+#: nbgrader's page already styles, with room between a table's label and its value.
+ABOVE_STYLE = ('div.above .panel-heading h4{margin:0}'
+               'div.late th{padding:2px 2em 2px 0}div.late td{padding:2px 0}'
+               'div.late p{margin:.8em 0 0}'
+               'div.flags code{white-space:pre-wrap}')
+
+
+def safe_feedback(made: str, title: str, flags: Sequence[str] = (),
+                  late: Optional[Lateness] = None,
+                  progress: Optional[Sequence[Mapping[str, Any]]] = None) -> str:
+    """nbgrader's feedback page ``made`` rebuilt by :func:`page` (its styles kept), headed by
+    the learner's ``progress`` (rows of ``notebook``, ``part``, ``status``, ``points``, from
+    wherever the course keeps it; none: no table), the notebook's lateness
+    (:func:`late_html`) and the judge's ``flags`` (:func:`flags_html`)."""
     head, _, rest = made.partition('<body')
     tag, _, body = rest.partition('>')
-    body = flags_html(flags) + body.rsplit('</body>', 1)[0]
+    boxes = [render('progress.html.j2', progress=progress), late_html(late), flags_html(flags)]
+    body = render('above.html.j2', boxes=boxes) + body.rsplit('</body>', 1)[0]
     styles = re.findall(r'<style[^>]*>(.*?)</style>', head, flags=re.S | re.I)
     found = re.search(r'class="([\w\s-]*)"', tag)
-    return page(title, body, styles, found.group(1) if found else '')
+    return page(title, body, [*styles, ABOVE_STYLE], found.group(1) if found else '')

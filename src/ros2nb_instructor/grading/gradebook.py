@@ -11,7 +11,6 @@ import contextlib
 import csv
 import fcntl
 import hashlib
-import html
 import json
 import os
 import shutil
@@ -20,12 +19,13 @@ import sys
 import tempfile
 from importlib import metadata
 from pathlib import Path
-from typing import Iterable, Optional
+from typing import Any, Iterable, Optional
 
 from nbgrader.api import Gradebook, MissingEntry
 
 from ..paths import ASSIGNMENT, ROOT, SOLUTIONS, gradebook_url
 from . import feedback
+from .deadlines import NO_DEADLINES, CourseSettings, Lateness, assess
 from .submissions import Learner, screen_zip
 
 #: nbgrader's command, from the course's venv (or conda environment).
@@ -118,14 +118,18 @@ def _generate_course(kept: Path) -> None:
         shutil.rmtree(fresh, ignore_errors=True)
 
 
-def collect_zip(archive: Path, course: Path) -> tuple[Path, list[str]]:
+def collect_zip(archive: Path, course: Path, times: Optional[dict] = None,
+                zone: Any = None) -> tuple[Path, list[str]]:
     """nbgrader's ``zip_collect`` on a screened copy of a platform download.
 
+    :param times: filled with the hand-in times the archive says (:func:`.submissions.screen_zip`),
+        a zone-less entry time taken in ``zone`` (default UTC).
     :return: the folder of learner folders, and one line per member refused.
     """
     downloaded = course / 'downloaded' / ASSIGNMENT / 'archive'
     downloaded.mkdir(parents=True)
-    refused = screen_zip(archive, downloaded / archive.name)
+    refused = screen_zip(archive, downloaded / archive.name, times,
+                         *([zone] if zone is not None else []))
     regexp = r'.*/extracted/(?:.*/)?(?P<student_id>[^/]+)/(?P<file_id>[^/]+\.ipynb)$'
     code = nbgrader(course, 'zip_collect', ASSIGNMENT, '--force',
                     f'--FileNameCollectorPlugin.named_regexp={regexp}', log=course / 'grading.log')
@@ -145,46 +149,84 @@ def collect_zip(archive: Path, course: Path) -> tuple[Path, list[str]]:
 
 
 def _not_submitted_page(learner: Learner, notebook: str, points: float) -> str:
-    return feedback.page(notebook, f'<h1>{html.escape(learner.shown)}: {notebook}</h1><p>Not '
-                                   f'submitted: 0 of {points:g} points.</p>')
+    return feedback.page(notebook, feedback.render('not_submitted.html.j2', learner=learner.shown,
+                                                   notebook=notebook, points=f'{points:g}'))
 
 
-def write_results(course: Path, out: Path, learners: list[Learner],
-                  notebooks: list[str]) -> list[list[str]]:
-    """grades.csv from nbgrader's gradebook, and the feedback files; return the CSV rows."""
+#: grades.csv's columns: ``score`` is what the notebook counts (after lateness), ``raw_score``
+#: what nbgrader gave it, ``late_penalty`` the difference (:mod:`.deadlines`).
+CSV_COLUMNS = ['learner', 'notebook', 'score', 'max_score', 'raw_score', 'late_penalty',
+               'handed_in', 'due']
+
+
+def write_results(course: Path, out: Path, learners: list[Learner], notebooks: list[str],
+                  deadlines: CourseSettings = NO_DEADLINES) -> list[list[str]]:
+    """grades.csv from nbgrader's gradebook, and the feedback files; return the CSV rows
+    (:data:`CSV_COLUMNS`; learner's name as shown, then a TOTAL row per learner).
+
+    A handed-in notebook's lateness (:func:`.deadlines.assess`) goes into the learner's
+    ``late`` and notes, and into nbgrader's gradebook as its late submission penalty (so
+    ``nbgrader export`` and the formgrader show it too)."""
     rows = []
     with Gradebook(gradebook_url(course)) as gb:
         maxima = {nb.name: nb.max_score for nb in gb.find_assignment(ASSIGNMENT).notebooks}
         for learner in learners:
-            total = 0.0
+            total = raw_total = 0.0
             folder = out / 'feedback' / learner.name
             folder.mkdir(parents=True, exist_ok=True)
             for notebook in notebooks:
                 try:
-                    score = gb.find_submission_notebook(notebook, ASSIGNMENT, learner.id).score
+                    scored = gb.find_submission_notebook(notebook, ASSIGNMENT, learner.id)
                 except MissingEntry:
-                    score = 0.0
-                total += score
-                rows.append([learner.shown, notebook, f'{score:g}', f'{maxima[notebook]:g}'])
-                made = course / 'feedback' / learner.id / ASSIGNMENT / f'{notebook}.html'
-                page = folder / f'{notebook}.html'
-                try:
-                    if notebook in learner.files and made.is_file():
-                        page.write_text(feedback.safe_feedback(made.read_text(), notebook,
-                                                           learner.flags.get(notebook, ())))
-                    else:
-                        page.write_text(_not_submitted_page(learner, notebook, maxima[notebook]))
-                except Exception as error:  # noqa: BLE001 - that page's problem, in a note
-                    why = (f'its feedback page could not be written ({type(error).__name__}: '
-                           f'{str(error)[:200]}); the score stands')
-                    learner.note(notebook, why)
-                    page.write_text(feedback.page(notebook, f'<p>{html.escape(why)}</p>'))
-            rows.append([learner.shown, 'TOTAL', f'{total:g}', f'{sum(maxima.values()):g}'])
+                    scored = None
+                raw = scored.score if scored is not None else 0.0
+                late = None
+                if notebook in learner.files:
+                    late = assess(deadlines, notebook, raw, learner.handed_in.get(notebook))
+                    learner.late[notebook] = late
+                    if late.note:
+                        learner.note(notebook, late.note)
+                    if scored is not None:
+                        scored.late_submission_penalty = late.penalty or None
+                score = late.final if late else raw
+                total, raw_total = total + score, raw_total + raw
+                rows.append([learner.shown, notebook, f'{score:g}', f'{maxima[notebook]:g}',
+                             f'{raw:g}', f'{raw - score:g}', _time(late, 'handed_in'),
+                             _time(late, 'due')])
+                _feedback_page(course, folder, learner, notebook, maxima[notebook])
+            rows.append([learner.shown, 'TOTAL', f'{total:g}', f'{sum(maxima.values()):g}',
+                         f'{raw_total:g}', f'{raw_total - total:g}', '', ''])
+        gb.db.commit()
     with open(out / 'grades.csv', 'w', newline='') as stream:
         writer = csv.writer(stream)
-        writer.writerow(['learner', 'notebook', 'score', 'max_score'])
+        writer.writerow(CSV_COLUMNS)
         writer.writerows([spreadsheet_safe(row[0]), *row[1:]] for row in rows)
     return rows
+
+
+def _time(late: Optional[Lateness], which: str) -> str:
+    when = getattr(late, which, None) if late else None
+    return when.isoformat() if when else ''
+
+
+def _feedback_page(course: Path, folder: Path, learner: Learner, notebook: str,
+                   points: float) -> None:
+    """The learner's feedback page of ``notebook`` (nbgrader's, made safe, headed by its
+    lateness and the judge's flags), or one saying it was not submitted."""
+    made = course / 'feedback' / learner.id / ASSIGNMENT / f'{notebook}.html'
+    page = folder / f'{notebook}.html'
+    try:
+        if notebook in learner.files and made.is_file():
+            page.write_text(feedback.safe_feedback(made.read_text(), notebook,
+                                                   learner.flags.get(notebook, ()),
+                                                   learner.late.get(notebook)))
+        else:
+            page.write_text(_not_submitted_page(learner, notebook, points))
+    except Exception as error:  # noqa: BLE001 - that page's problem, in a note
+        why = (f'its feedback page could not be written ({type(error).__name__}: '
+               f'{str(error)[:200]}); the score stands')
+        learner.note(notebook, why)
+        page.write_text(feedback.page(notebook, feedback.render('paragraph.html.j2', text=why)))
 
 
 #: What makes a spreadsheet read a cell as a formula (OWASP, "CSV Injection").
@@ -250,6 +292,6 @@ class Scoring:
         process, self._process = self._process, None
         if process is not None:
             with contextlib.suppress(OSError):
-                process.stdin.close()  # type: ignore[union-attr]
+                process.stdin.close()  # type: ignore[union-attr]  # started with a pipe
             process.wait()
-            process.stdout.close()  # type: ignore[union-attr]
+            process.stdout.close()  # type: ignore[union-attr]  # started with a pipe

@@ -16,6 +16,7 @@ import re
 from typing import Any, Optional
 
 import nbformat
+from nbconvert.preprocessors import CoalesceStreamsPreprocessor
 from ros2nb.nbmeta import nbgrader_metadata as nbgrader
 
 #: What the learner's kernel runs in place of a graded cell.
@@ -37,7 +38,7 @@ def _grade_id(cell: Any) -> Optional[str]:
 
 
 def _by_grade_id(nb: nbformat.NotebookNode) -> dict[str, Any]:
-    return {_grade_id(c): c for c in nb.cells if _grade_id(c)}
+    return {grade_id: c for c in nb.cells if (grade_id := _grade_id(c))}
 
 
 def _clean(cell: Any) -> None:
@@ -99,6 +100,7 @@ def for_the_run(release: nbformat.NotebookNode,
     course = _by_grade_id(release)
     for cell in _course_cells(nb, course):
         grade_id = _grade_id(cell)
+        assert grade_id is not None  # _course_cells gives the course's graded cells only
         original = course[grade_id]
         if nbgrader(original).get('locked'):
             cell.source, cell.cell_type = original.source, original.cell_type
@@ -227,7 +229,10 @@ def for_scoring(release: nbformat.NotebookNode, executed: nbformat.NotebookNode,
     :param results: ``{grade_id: result}`` from ros2nb.judge.
     :param problem: why nothing could be checked, if so (every graded cell shows it).
     """
-    nb = copy.deepcopy(executed)
+    # A kernel sends what a cell prints in as many pieces as its flushes happened to make
+    # (more of them on a busy machine): merged, as JupyterLab shows them, the feedback of a
+    # notebook is the same wherever and whenever it ran.
+    nb, _ = CoalesceStreamsPreprocessor().preprocess(copy.deepcopy(executed), {})
     course_cells = {c.get('id'): c for c in release.cells}
     present = {_grade_id(c): c for c in _course_cells(nb, _by_grade_id(release))}
     previous = None

@@ -7,13 +7,15 @@ graded or named in a note; nothing is skipped without a word.
 
 from __future__ import annotations
 
+import datetime
 import os
 import re
 import stat
+import struct
 import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
-from typing import Optional
+from typing import Any, Optional
 
 import nbformat
 
@@ -38,6 +40,10 @@ class Learner:
     :ivar results: notebook -> the judge's results (grade id -> ``passed``, ``message``).
     :ivar flags: notebook -> the judge's flags (code that reaches into the course,
         :mod:`ros2nb.judge.flags`), shown on the feedback page and in the report's notes.
+    :ivar handed_in: notebook -> when the submission says it was handed in (aware), and
+        where that comes from (:data:`TIMESTAMP`, :data:`ZIP_ENTRY`).
+    :ivar late: notebook -> its raw score, late penalty and why (:mod:`.deadlines`), once
+        nbgrader scored it.
     """
 
     name: str
@@ -46,6 +52,8 @@ class Learner:
     notes: dict[str, str] = field(default_factory=dict)
     results: dict[str, dict] = field(default_factory=dict)
     flags: dict[str, list[str]] = field(default_factory=dict)
+    handed_in: dict[str, tuple[datetime.datetime, str]] = field(default_factory=dict)
+    late: dict[str, Any] = field(default_factory=dict)
 
     @property
     def shown(self) -> str:
@@ -101,12 +109,41 @@ def notebook_for(filename: str, notebooks: list[str]) -> Optional[str]:
     return match.group('stem') if match and match.group('stem') in notebooks else None
 
 
+#: The file nbgrader's exchange writes beside a submission: when it was handed in (UTC).
+TIMESTAMP = 'timestamp.txt'
+#: Where a hand-in time read from a platform zip's entry comes from.
+ZIP_ENTRY = 'zip entry'
+
+
+def read_timestamp(text: str) -> Optional[datetime.datetime]:
+    """An nbgrader ``timestamp.txt``'s time, aware (nbgrader's own parser: a time without a
+    zone is UTC, as nbgrader writes it); None when it is no time."""
+    from nbgrader.utils import parse_utc
+    try:
+        return parse_utc(text.strip()).replace(tzinfo=datetime.timezone.utc)
+    except (ValueError, OverflowError, TypeError):
+        return None
+
+
+def _timestamp(entry: Path, learner: 'Learner', notebooks: list[str]) -> None:
+    """The hand-in time of ``entry``'s nbgrader timestamp.txt, for all the learner's notebooks."""
+    path = entry / TIMESTAMP
+    if path.is_symlink() or not path.is_file():
+        return
+    when = read_timestamp(path.read_text(errors='replace')[:200])
+    if when is None:
+        learner.note('_folder', f'{TIMESTAMP} holds no time nbgrader reads: no hand-in time')
+        return
+    learner.handed_in.update({n: (when, TIMESTAMP) for n in notebooks})
+
+
 def find_learners(folder: Path, notebooks: list[str]) -> tuple[list[Learner], list[str]]:
     """One Learner per learner folder; also the lines about entries that are not graded.
+    A folder's nbgrader ``timestamp.txt`` is when all its notebooks were handed in.
 
     :return: the learners (sorted by name) and one line per entry refused.
     """
-    learners, refused, taken = [], [], set()
+    learners, refused, taken = [], [], set[str]()
     for number, entry in enumerate(sorted(folder.iterdir(), key=lambda p: p.name), start=1):
         if entry.is_symlink():
             refused.append(f'"{shown(entry.name)}": a link, not a learner folder (links are '
@@ -125,7 +162,10 @@ def find_learners(folder: Path, notebooks: list[str]) -> tuple[list[Learner], li
             learner.note('_folder', f'graded under the id {learner.id} (nbgrader cannot use '
                                     f'the folder name {learner.shown} itself)')
         candidates: dict[str, list[Path]] = {}
+        _timestamp(entry, learner, notebooks)
         for path in sorted(entry.iterdir()):
+            if path.name == TIMESTAMP:
+                continue
             if path.is_symlink():
                 learner.note('_folder', f'{shown(path.name)} is a link (links are not followed: '
                                         'hand in the notebook itself); not graded')
@@ -167,7 +207,21 @@ def _learner_paths(members: list[zipfile.ZipInfo]) -> list[tuple[zipfile.ZipInfo
     return paths
 
 
-def screen_zip(archive: Path, cleaned: Path) -> list[str]:
+def entry_time(member: zipfile.ZipInfo, zone: datetime.tzinfo) -> datetime.datetime:
+    """When a zip entry was last written: its UTC time where the zip's maker added one (the
+    extended timestamp field, 0x5455), else its local time, taken in ``zone``."""
+    extra, at = member.extra, 0
+    while at + 4 <= len(extra):
+        tag, size = struct.unpack('<HH', extra[at:at + 4])
+        if tag == 0x5455 and size >= 5 and extra[at + 4] & 1:
+            seconds = struct.unpack('<I', extra[at + 5:at + 9])[0]
+            return datetime.datetime.fromtimestamp(seconds, datetime.timezone.utc)
+        at += 4 + size
+    return datetime.datetime(*member.date_time, tzinfo=zone)
+
+
+def screen_zip(archive: Path, cleaned: Path, times: Optional[dict] = None,
+               zone: datetime.tzinfo = datetime.timezone.utc) -> list[str]:
     """Copy the members of a platform's .zip that may be graded into ``cleaned``.
 
     A learner is a folder at the archive's top level (below one export folder, if all is
@@ -177,9 +231,13 @@ def screen_zip(archive: Path, cleaned: Path) -> list[str]:
     each: archives inside the archive (never unpacked), files outside any learner's folder,
     and a second copy of a notebook in one learner's folder (the shallowest is graded).
 
+    :param times: filled with (learner's folder, file name) -> (when it was handed in, where
+        that comes from): a ``timestamp.txt`` in the learner's folder, else the entry's time
+        (:func:`entry_time`, a zone-less time taken in ``zone``).
     :return: one line per refusal.
     :raises zipfile.BadZipFile: when ``archive`` is not a zip file.
     """
+    stamped: dict[str, datetime.datetime] = {}
     lines = []
     with zipfile.ZipFile(archive) as source, zipfile.ZipFile(cleaned, 'w') as out:
         members = [m for m in source.infolist() if not m.is_dir()]
@@ -188,7 +246,11 @@ def screen_zip(archive: Path, cleaned: Path) -> list[str]:
                                     key=lambda mp: (len(mp[1]), mp[1])):
             with source.open(member) as stream:
                 head = stream.read(8)
-            if _is_archive(parts[-1], head):
+            if parts[-1] == TIMESTAMP and len(parts) >= 2:
+                when = read_timestamp(source.read(member)[:200].decode('utf-8', 'replace'))
+                if when is not None:
+                    stamped.setdefault(parts[0], when)
+            elif _is_archive(parts[-1], head):
                 lines.append(f'{member.filename}: an archive inside the archive is not '
                              'unpacked; hand in the notebooks themselves')
             elif len(parts) < 2 or legal_name(parts[0]):
@@ -201,6 +263,10 @@ def screen_zip(archive: Path, cleaned: Path) -> list[str]:
             else:
                 chosen[parts[0], parts[-1]] = member
                 out.writestr(f'{parts[0]}/{parts[-1]}', source.read(member))
+    if times is not None:
+        for (learner, name), member in chosen.items():
+            times[learner, name] = ((stamped[learner], TIMESTAMP) if learner in stamped
+                                    else (entry_time(member, zone), ZIP_ENTRY))
     return lines
 
 
@@ -216,7 +282,7 @@ def readable(path: Path) -> tuple[Optional[nbformat.NotebookNode], Optional[str]
     try:
         fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
     except OSError as error:
-        return None, f'the file could not be read ({os.strerror(error.errno)})'
+        return None, f'the file could not be read ({error.strerror})'
     with os.fdopen(fd, 'rb') as stream:
         size = os.fstat(stream.fileno()).st_size
         if not stat.S_ISREG(os.fstat(stream.fileno()).st_mode):

@@ -1,0 +1,135 @@
+"""What a term adds to grading a class: due dates, the roster, an export, one learner again.
+
+Runs on the instructor's host, for ``ros2nb-grade`` (:mod:`.cli`): ``--settings`` (the course's
+``course.toml``, :mod:`.deadlines`), ``--export canvas|moodle|csv`` with ``--roster`` (:mod:`.lms`),
+and ``--learner NAME``: that learner graded again into an earlier grading, the others kept as
+they were (``learners.json``, what grading made of each learner before nbgrader scored them).
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import json
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Optional
+
+from nbgrader.api import Gradebook, MissingEntry
+
+from ..paths import ASSIGNMENT, ROOT, gradebook_url
+from .deadlines import CourseSettings, SettingsProblem, read_settings
+from .lms import EXPORTS, RosterProblem, read_roster
+from .submissions import Learner
+
+#: The course's settings file, where the instructor keeps due dates and the late policy.
+SETTINGS = ROOT / 'course.toml'
+#: What grading made of each learner before nbgrader scored them, kept for ``--learner``.
+STATE = 'learners.json'
+
+
+def add_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument('--settings', type=Path, default=SETTINGS,
+                        help='the course settings file: due dates and the late policy')
+    parser.add_argument('--export', choices=sorted(EXPORTS),
+                        help='also write grading/export/<choice>.csv for a learning platform')
+    parser.add_argument('--roster', type=Path,
+                        help='CSV mapping learner names to the platform\'s ids (for --export)')
+    parser.add_argument('--learner', metavar='NAME',
+                        help='grade this learner again into the earlier grading in --out')
+
+
+@dataclass(frozen=True)
+class Term:
+    """The term's settings for one grading: due dates, and the roster of an export."""
+
+    deadlines: CourseSettings
+    export: Optional[str]
+    roster: Optional[dict[str, dict[str, str]]]
+
+
+def read_term(args: argparse.Namespace, notebooks: list[str]) -> tuple[Optional[Term], list[str]]:
+    """The settings file and roster ``args`` name, or the lines that say what is wrong."""
+    lines = []
+    try:
+        deadlines = read_settings(args.settings, notebooks)
+    except SettingsProblem as problem:
+        deadlines, lines = CourseSettings({}, {}), list(problem.lines)
+    roster = None
+    if args.roster is not None:
+        try:
+            roster = read_roster(args.roster, args.export or 'csv')
+        except RosterProblem as problem:
+            lines += problem.lines
+    elif args.export in ('canvas', 'moodle'):
+        lines.append(f'EXPORT={args.export} needs a roster of the platform\'s ids: '
+                     'ROSTER=roster.csv (docs/instructors.md, "A term, step by step")')
+    return (None, lines) if lines else (Term(deadlines, args.export, roster), [])
+
+
+def with_roster(learners: list[Learner], roster: Optional[dict]) -> list[Learner]:
+    """``learners`` and, for each roster learner with no folder, a learner with nothing handed
+    in (0 on every notebook, and a note saying so)."""
+    if not roster:
+        return learners
+    taken = {learner.id for learner in learners}
+    found = {learner.name for learner in learners}
+    for number, name in enumerate(sorted(set(roster) - found), start=1):
+        absent = Learner(name, name if name not in taken and name.isidentifier()
+                         else f'roster-{number:03d}')
+        absent.note('_folder', 'in the roster, nothing handed in: 0 points')
+        learners.append(absent)
+    return sorted(learners, key=lambda learner: learner.name)
+
+
+def export(term: Term, course: Path, out: Path, learners: list[Learner],
+           notebooks: list[str]) -> None:
+    """``out/export/<platform>.csv`` through the platform's nbgrader export plugin."""
+    if term.export is None:
+        return
+    folder = out / 'export'
+    folder.mkdir(exist_ok=True)
+    plugin = EXPORTS[term.export](to=str(folder / f'{term.export}.csv'), roster=term.roster,
+                                  names={lr.id: lr.shown for lr in learners},
+                                  notebooks=notebooks)
+    with Gradebook(gradebook_url(course)) as gradebook:
+        plugin.export(gradebook)
+    for line in plugin.said:
+        print(f'export: {line}')
+
+
+def save_state(out: Path, learners: list[Learner]) -> None:
+    """``learners.json``: each learner's files, notes, results, flags and hand-in times, as
+    grading left them before nbgrader scored them (``--learner`` starts from it).  JSON's
+    ASCII escapes keep a folder name that is not UTF-8 (a Windows zip's) exactly as it is."""
+    (out / STATE).write_text(json.dumps({learner.name: {
+        'id': learner.id, 'files': {n: str(p) for n, p in learner.files.items()},
+        'notes': learner.notes, 'results': learner.results, 'flags': learner.flags,
+        'handed_in': {n: [t.isoformat(), s] for n, (t, s) in learner.handed_in.items()}}
+        for learner in learners}, indent=1) + '\n')
+
+
+def load_state(out: Path) -> list[Learner]:
+    """The learners ``learners.json`` kept (:func:`save_state`)."""
+    kept = json.loads((out / STATE).read_text())
+    learners = []
+    for name, state in kept.items():
+        learner = Learner(name, state['id'], {n: Path(p) for n, p in state['files'].items()},
+                          dict(state['notes']), dict(state['results']), dict(state['flags']))
+        learner.handed_in = {n: (datetime.datetime.fromisoformat(t), s)
+                             for n, (t, s) in state['handed_in'].items()}
+        learners.append(learner)
+    return learners
+
+
+def forget(course: Path, learner: Learner) -> None:
+    """Remove what nbgrader holds of ``learner`` (their submission, its scores and feedback)
+    from ``course``, to grade them again."""
+    with Gradebook(gradebook_url(course)) as gradebook:
+        try:
+            gradebook.remove_submission(ASSIGNMENT, learner.id)
+        except MissingEntry:
+            pass
+    for step in ('submitted', 'autograded', 'feedback'):
+        shutil.rmtree(course / step / learner.id, ignore_errors=True)
