@@ -60,8 +60,9 @@ class _Calls:
                 header, response = self.client.handle.take_response(GetParameters.Response)
                 if header is None:
                     break
-                self.answers[header.request_id.sequence_number] = (header.source_timestamp,
-                                                                   response)
+                # the first answer to a request is its answer (a second server's comes later)
+                self.answers.setdefault(header.request_id.sequence_number,
+                                        (header.source_timestamp, response))
         return sequence in self.answers
 
     def close(self) -> None:
