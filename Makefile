@@ -24,7 +24,7 @@ export UV_SYSTEM_CERTS := 1
 # numpy (rclpy's message types), and none of them does linear algebra (docs/decisions.md).
 export OPENBLAS_NUM_THREADS := 1
 
-.PHONY: image image-tool lab lab-instructor check test setup bytecode sandbox-tool browser-tool axe-tool graph-tool grading-course solutions learner-notebooks bench grade clean docs
+.PHONY: image image-tool lab lab-instructor check test setup bytecode sandbox-tool browser-tool axe-tool graph-tool grading-course solutions learner-notebooks bench grade clean docs mistakes
 
 setup: $(STAMP)
 
@@ -63,23 +63,26 @@ lab: $(STAMP) bytecode graph-tool
 lab-instructor: $(STAMP) bytecode graph-tool
 	$(VENV)/bin/ros2nb-lab --instructor
 
-# The Debian tools some tests and grading use: installed by make when it runs as root; else it
-# says the one apt line, and what goes without them (their tests skip, saying why).
-# $(call from_debian,COMMANDS,PACKAGES,WITHOUT): installs PACKAGES when a command is missing.
+# The Debian tools the lab (graphviz), some tests and grading use: installed by make when it
+# runs as root, saying so first (README); else it says the one apt line, and what goes without
+# them (their tests skip, saying why).
+# $(call from_debian,COMMANDS,PACKAGES,WITHOUT,FOR): installs PACKAGES when a command is missing.
 have_all = for command in $(1); do command -v $$command >/dev/null || exit 1; done
 define from_debian
-	@( $(call have_all,$(1)) ) || [ "$$(id -u)" != 0 ] || apt-get install -y -q $(2) >/dev/null 2>&1 \
-	  || { apt-get update -q >/dev/null 2>&1 && apt-get install -y -q $(2) >/dev/null 2>&1; } || true
+	@( $(call have_all,$(1)) ) || [ "$$(id -u)" != 0 ] || { \
+	  echo "Installing $(2) from Debian with apt-get (make runs as root): $(4)"; \
+	  apt-get install -y -q $(2) >/dev/null 2>&1 \
+	  || { apt-get update -q >/dev/null 2>&1 && apt-get install -y -q $(2) >/dev/null 2>&1; } || true; }
 	@( $(call have_all,$(1)) ) || echo "$(firstword $(2)) is not installed (sudo apt-get install $(2)): $(3)"
 endef
 
 # Grading runs learners' code in bubblewrap sandboxes.
 sandbox-tool:
-	$(call from_debian,bwrap,bubblewrap,grading refuses to run and its tests skip.)
+	$(call from_debian,bwrap,bubblewrap,grading refuses to run and its tests skip.,grading runs learners' code in its sandboxes.)
 
 # Browser tests (Playwright) drive Debian's chromium; Playwright's own download is unreachable.
 browser-tool:
-	$(call from_debian,chromium,chromium,the browser tests skip.)
+	$(call from_debian,chromium,chromium,the browser tests skip.,the browser tests drive it.)
 
 # The browser tests of the website (tests/test_docs_site.py) run axe-core, the accessibility
 # engine, on every page: from npm, pinned, into .cache/node beside the hub's proxy (never
@@ -94,12 +97,12 @@ axe-tool:
 
 # Notebook 06 draws the ROS graph with Graphviz's dot layout (as rqt_graph does).
 graph-tool:
-	$(call from_debian,dot,graphviz,notebook 06 lists the graph as text instead of drawing it.)
+	$(call from_debian,dot,graphviz,notebook 06 lists the graph as text instead of drawing it.,notebook 06 draws the ROS graph with it.)
 
 # The image test (tests/test_image.py) builds the course's image with podman and runc on a base
 # debootstrap makes.
 image-tool:
-	$(call from_debian,podman runc debootstrap,podman runc debootstrap,the image test skips.)
+	$(call from_debian,podman runc debootstrap,podman runc debootstrap,the image test skips.,the image test builds the course's image with them.)
 
 # The fast lane (docs/developing.md): ruff over the course's Python, mypy over the seams
 # between the places code runs (pyproject.toml: [tool.mypy]; its cache in .cache/mypy), then
@@ -150,6 +153,13 @@ learner-notebooks: $(STAMP)
 # ros2nb against bare rclpy, and grading seconds per notebook (benchmarks/bench.py).
 bench: $(STAMP) bytecode sandbox-tool
 	$(PY) benchmarks/bench.py $(BENCH_ARGS)
+
+# The mutation test of the checks (benchmarks/mistakes.py): every answer cell of solutions/
+# mutated by a fixed set of operators, each mutant run in a real kernel and through the
+# grader's path, each answer judged; the report goes to mistakes/report.md (git-ignored).
+# MISTAKES_ARGS='--notebooks 03,04 --workers 3' narrows or widens it; fails on a bad answer.
+mistakes: $(STAMP) bytecode
+	$(PY) benchmarks/mistakes.py $(MISTAKES_ARGS)
 
 # Grade a class: SUBMISSIONS is a folder of <learner-id>/NN-*.ipynb or a platform .zip.
 # Output goes to grading/ (git-ignored); FORCE=1 replaces an earlier grading/.

@@ -6,8 +6,9 @@
   Fast DDS profile (ros2nb.domains.DISCOVERY_PROFILE).
 - The course workspace goes to a temporary folder removed at the end, so tests never
   touch a learner's ``workspace/``.  So do the files every kernel writes (IPython's
-  history, Jupyter's connection files): tests run side by side (pytest-xdist, one
-  process per worker, each with this set-up of its own), and while one of them checks
+  history, Jupyter's connection files, the learner's progress): tests run side by side
+  (pytest-xdist, one process per worker, each with this set-up of its own), and while one
+  of them checks
   that grading leaves the repository byte-identical no other may write into it.
 - Cells tagged ``learner-check`` (a Challenge's check) must raise ``CheckFailed`` with its
   friendly message in ``notebooks/`` (the challenge is unsolved there) and must pass in
@@ -39,6 +40,7 @@ _SCRATCH = Path(tempfile.mkdtemp(prefix='ros2nb-test-'))
 os.environ['ROS2NB_WORKSPACE'] = str(_SCRATCH / 'ROS2_and_RL_Tutorials')
 os.environ['IPYTHONDIR'] = str(_SCRATCH / 'ipython')
 os.environ['JUPYTER_RUNTIME_DIR'] = str(_SCRATCH / 'jupyter-runtime')
+os.environ['ROS2NB_PROGRESS'] = str(_SCRATCH / 'progress.json')  # never in the notebooks' folder
 
 LEARNER_CHECK_TAG = 'learner-check'
 
@@ -74,6 +76,7 @@ def pytest_runtest_call(item):
 #: make test passes --no-loadscope-reorder: xdist otherwise sorts files by their number of
 #: tests, whatever this order says.
 LONGEST_FIRST = ('test_grading.py', 'test_corpus_honest.py', 'test_corpus_wrong.py',
+                 'test_mutants.py',
                  'test_jupyterhub.py', 'test_checks_forged.py', 'test_image.py',
                  'test_checks.py', 'test_lessons_06_07.py', 'test_corpora.py',
                  'test_checks_parameters.py',

@@ -255,6 +255,24 @@ def test_feedback_and_notes_say_what_happened(graded, learner):
         assert 'longer than' not in notes[NB01]  # a dead kernel is not a slow one
 
 
+@pytest.mark.parametrize('learner', ['complete', 'untouched', 'solved-only-04'])
+def test_every_feedback_page_is_headed_by_the_learners_table_from_the_graders_results(
+        graded, learner):
+    """The table of the learner's progress (issue 69), on every page of theirs: each
+    notebook's points as the grader scored them, and the notebooks not handed in as such."""
+    case = EXPECTED[learner]
+    for page in NOTEBOOKS:
+        text = shown(graded.out / 'feedback' / learner / f'{page}.html')
+        assert text.startswith('Every notebook, as the grader found it: '
+                               f'{sum(case.scores.values()):g} of {sum(FULL.values()):g} points '
+                               'passed'), (learner, page, text[:200])
+        for notebook in NOTEBOOKS:
+            row = re.search(rf'{notebook} (\S+) of (\S+) (.*?)(?= \d\d-|$)', text)
+            assert row is not None, (notebook, text[:2000])
+            assert row.group(1, 2) == (f'{case.scores.get(notebook, 0):g}', f'{FULL[notebook]:g}')
+            assert (' not handed in' in row.group(3)) == (notebook not in case.scores), row.group(0)
+
+
 def test_learners_content_is_text_in_the_feedback(graded):
     out = graded.out
     for page in (out / 'feedback').rglob('*.html'):

@@ -37,6 +37,7 @@ def test_launcher_gives_each_learner_a_workspace_in_their_folder(tmp_path):
     launcher.learner_environment(env, tmp_path / 'ros2-course', Path('/course/.venv/bin'))
     assert env['ROS2NB_WORKSPACE'] == str(tmp_path / 'ros2-course' / 'workspace' /
                                           'ROS2_and_RL_Tutorials')
+    assert env['ROS2NB_WORK'] == str(tmp_path / 'ros2-course' / 'notebooks')  # their progress
     assert env['PATH'].split(os.pathsep) == ['/course/.venv/bin', '/usr/bin']
     assert 'ROS_DOMAIN_ID' not in env
     assert env['JUPYTER_CONFIG_PATH'] == str(ROOT / 'environment' / 'jupyter-learner')

@@ -31,7 +31,8 @@ from .terminal.workspace import create_workspace, current_workspace, tree
 #: Loaded on first use (PEP 562): a process that only runs nodes, such as a judge's subject,
 #: never pays for importing the notebooks' checks or rosbags (docs/decisions.md), and never
 #: holds the course's rules (an answer) unless asked.
-_ON_FIRST_USE = {'checks': 'checks', 'rules': 'rules', 'figures': 'figures',
+_ON_FIRST_USE = {'checks': 'checks', 'progress': 'checks', 'rules': 'rules',
+                 'figures': 'figures',
                  'Recording': 'terminal.bag',
                  'bag_info': 'terminal.bag', 'bag_play': 'terminal.bag',
                  'bag_record': 'terminal.bag'}
@@ -52,7 +53,8 @@ __all__ = [
     'callback_groups', 'checks', 'colcon_build', 'course', 'create_workspace',
     'current_runtime', 'current_workspace', 'domains', 'figures', 'find_executable', 'graph_edges',
     'graph_picture', 'import_file', 'message_type', 'node_list', 'param_describe',
-    'param_dump', 'param_get', 'param_list', 'param_set', 'pkg_create', 'qos', 'record', 'rules',
+    'param_dump', 'param_get', 'param_list', 'param_set', 'pkg_create', 'progress', 'qos',
+    'record', 'rules',
     'ros2_run', 'ros2_start', 'run_and_interrupt', 'shutdown', 'source_workspace', 'spin',
     'start', 'stop', 'stop_all', 'timer_runs', 'topic_echo', 'topic_hz', 'topic_info',
     'topic_list', 'tree', 'unmatched_topics', 'write_file', 'write_part',

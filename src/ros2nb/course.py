@@ -5,8 +5,9 @@ itself is an answer, in :mod:`ros2nb.rules`.  No ROS import.  The node files
 the learner writes (and ``ros2nb/reference/``) are standalone ROS programs, so they carry
 the same numbers as literals in their constants part; a test keeps them equal to these.
 
-Also :func:`catch_up`, so any notebook can be run on its own.  Introduced in
-``01-create-a-workspace.ipynb``.
+Also :func:`catch_up`, so any notebook can be run on its own, and :func:`unfinished_line`,
+the one line that names what an earlier notebook left unwritten in a node file a later one
+uses.  Introduced in ``01-create-a-workspace.ipynb``.
 """
 
 from __future__ import annotations
@@ -14,10 +15,13 @@ from __future__ import annotations
 import contextlib
 import io
 import os
+import re
 from importlib import resources
 from pathlib import Path
+from typing import Optional, Sequence
 
 from .terminal.files import write_file
+from . import unfinished
 from .terminal.pkg_create import pkg_create
 from .terminal.workspace import create_workspace, default_workspace, shown
 
@@ -96,6 +100,20 @@ STEPS = {1: (), 2: ('workspace',), 3: ('workspace', 'package'),
          7: ('workspace', 'package', 'publisher', 'subscriber'),
          8: ('workspace', 'package', 'publisher', 'subscriber', 'entry_points'),
          10: ('workspace', 'package', 'publisher', 'subscriber', 'entry_points')}
+#: Where each part of the two node files later notebooks use is written: file -> its class,
+#: and each name (the class, a method, ``main``, a parameter the class declares) -> the
+#: (notebook, part) cells that write it; notebook 08 writes some parts again, its way.
+WRITTEN_IN: dict[str, tuple[str, dict[str, tuple[tuple[int, int], ...]]]] = {
+    PUBLISHER_FILE: (SENSOR_CLASS, {
+        SENSOR_CLASS: ((3, 3), (8, 3)), 'publish_temperature': ((3, 4),), 'main': ((3, 5),),
+        PERIOD_PARAMETER: ((8, 3),), START_PARAMETER: ((8, 3),)}),
+    SUBSCRIBER_FILE: (MONITOR_CLASS, {
+        MONITOR_CLASS: ((4, 3), (8, 3)), 'temperature_callback': ((4, 4), (8, 4)),
+        'main': ((4, 5),), 'on_set_thresholds': ((8, 4),), HIGH_PARAMETER: ((8, 3),),
+        LOW_PARAMETER: ((8, 3),)}),
+}
+#: Notebooks that start the node files as programs (``ros2 run``): their ``main()`` counts.
+RUN_AS_PROGRAMS = (5, 6, 8)
 
 
 def reference_source(name: str) -> str | None:
@@ -135,23 +153,82 @@ def _write_entry_points(package: Path) -> None:
     write_file(setup_py, text)
 
 
-def catch_up(notebook: int) -> Path:
-    """Create whatever earlier notebooks would have made, if it is missing.
+def _where(parts: list[tuple[int, int]]) -> str:
+    """``notebook 08, part 4`` (``notebook 08, parts 3 and 4``; notebooks joined by ``;``)."""
+    by_notebook: dict[int, list[int]] = {}
+    for notebook, part in sorted(set(parts)):
+        by_notebook.setdefault(notebook, []).append(part)
+    return '; '.join(f'notebook {notebook:02d}, part{"s" if len(numbers) > 1 else ""} '
+                     f'{" and ".join(map(str, numbers))}'
+                     for notebook, numbers in by_notebook.items())
 
-    Each step creates only what is missing and never changes a file you wrote.  The
-    nodes it writes are the course's reference code (the tutorial's, with its mistakes
-    fixed); while grading it writes none, so only your own nodes are graded.
+
+def unfinished_line(workspace: Path, relative: str, notebook: int) -> Optional[str]:
+    """The one line naming what earlier notebooks left unwritten in a node file, or None.
+
+    Read from the file's text (:func:`ros2nb.unfinished.missing`), never run; what it names
+    and where each part is written come from :data:`WRITTEN_IN`.  It also says how to take
+    the course's version instead (:func:`catch_up`), except while grading.
+
+    Introduced in ``04-write-the-subscriber.ipynb``.
+
+    :param workspace: the learner's workspace.
+    :param relative: a node file of :data:`WRITTEN_IN`, relative to the workspace.
+    :param notebook: the notebook about to use it (its number, as for :func:`catch_up`).
+    """
+    class_name, parts = WRITTEN_IN[relative]
+    name = Path(relative).name
+    take = ('' if reference_source(name) is None else
+            f', or take the course\'s version with ros2nb.course.catch_up({notebook}, '
+            f'take=[\'{name}\']) (yours is kept as {name}.bak)')
+    try:
+        text = (workspace / relative).read_text()
+        found = unfinished.missing(text, class_name, parts, programs=notebook in RUN_AS_PROGRAMS)
+    except (OSError, UnicodeDecodeError, ValueError):
+        return None  # missing (catch_up writes it) or unreadable: its own use says why
+    except SyntaxError as error:
+        return (f'{name} does not load (line {error.lineno}: {error.msg}): fix the %%part cell '
+                f'that wrote that line and run it again{take}.')
+    if not found:
+        return None
+    whats = [what for _names, what in found]
+    listed = '; '.join(whats)
+    # The file is at the newest notebook whose own names it holds: a part that notebook
+    # writes again is to be written there (08's temperature_callback, not 04's).
+    words = set(re.findall(r'\w+', text))
+    newest = max((places[0][0] for part, places in parts.items() if part in words), default=0)
+    names = [part for names, _what in found for part in names]
+    where = [max((p for p in parts[part] if p[0] <= newest), default=parts[part][0])
+             for part in names]
+    return (f'{name} is not finished: it lacks {listed} ({_where(where)}): write '
+            f'{"them" if len(names) > 1 else "it"} there and run '
+            f'{"those cells" if len(set(where)) > 1 else "that cell"}{take}.')
+
+
+def catch_up(notebook: int, *, take: Sequence[str] = ()) -> Path:
+    """Create whatever earlier notebooks would have made, if it is missing, and say in one
+    line per file what earlier notebooks left unwritten in the nodes this one uses
+    (:func:`unfinished_line`).
+
+    Each step creates only what is missing and never changes a file you wrote, unless you
+    name it in ``take``.  The nodes it writes are the course's reference code (the
+    tutorial's, with its mistakes fixed); while grading it writes none, so only your own
+    nodes are graded.
 
     Introduced in ``01-create-a-workspace.ipynb``.
 
     :param notebook: the number of the notebook about to run (1-8, 10).
+    :param take: node files to replace with the course's version now, e.g.
+        ``['temperature_subscriber.py']``; yours is kept beside it as ``<name>.bak``.
     :return: the workspace path.
-    :raises ValueError: for a notebook number without steps.
+    :raises ValueError: for a notebook number without steps, or a file ``take`` cannot give.
     """
     if notebook not in STEPS:
         raise ValueError(f'notebook must be one of {sorted(STEPS)} (got {notebook}).')
     steps = STEPS[notebook]
     done, missing = [], []
+    for name in take:
+        done.append(_take_course_file(name))
     if 'workspace' in steps and not default_workspace().is_dir():
         done.append(shown(default_workspace()))
     ws = create_workspace()  # also re-creates any missing sub-folder, like mkdir -p
@@ -185,4 +262,31 @@ def catch_up(notebook: int) -> Path:
     if missing:
         print(f'Not created: {", ".join(missing)} (only your own nodes count here); the '
               'cells that use them will fail until you write them.')
+    _say_unfinished(ws, notebook, steps)
     return ws
+
+
+def _say_unfinished(ws: Path, notebook: int, steps: tuple[str, ...]) -> None:
+    """One line for each node file among ``steps`` that earlier notebooks left unfinished."""
+    for step, relative in (('publisher', PUBLISHER_FILE), ('subscriber', SUBSCRIBER_FILE)):
+        line = unfinished_line(ws, relative, notebook) if step in steps else None
+        if line:
+            print(line)
+
+
+def _take_course_file(name: str) -> str:
+    """Replace a node file with the course's version (yours kept as ``.bak``); its name shown.
+
+    :raises ValueError: for a name that is not a node file of the course's, or while grading.
+    """
+    relative = {Path(r).name: r for r in WRITTEN_IN}.get(Path(name).name)
+    text = reference_source(Path(name).name) if relative else None
+    if text is None:
+        raise ValueError(f'take= names the course\'s node files, '
+                         f'{" or ".join(repr(Path(r).name) for r in WRITTEN_IN)} (got {name!r}); '
+                         'the course gives none while grading.')
+    target = create_workspace() / relative
+    write_file(target, text, overwrite=True)
+    target.chmod(0o755)
+    return shown(target) + ' (the course\'s version)'
+

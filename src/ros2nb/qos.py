@@ -36,7 +36,8 @@ from .errors import Ros2nbError
 from .qos_profiles import describe, endpoint_lines, incompatibility, policy_name
 from .runtime import node_serving_nothing
 
-#: ``describe`` is the notebook's (09) way to print a profile; the checks name the others.
+#: ``describe`` and ``policy_name`` are the notebook's (09) ways to print a profile and the
+#: policy an incompatible-QoS event names; the checks name the others.
 __all__ = ['Deliveries', 'burst', 'burst_while_spinning', 'describe', 'discovered',
            'endpoint_lines', 'incompatibility', 'late_joiner', 'pair', 'policy_name']
 

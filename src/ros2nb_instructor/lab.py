@@ -16,6 +16,7 @@ Runs on the learner's machine (``make lab``), on the classroom server as the lea
 
 from __future__ import annotations
 
+import argparse
 import hashlib
 import json
 import os
@@ -24,12 +25,12 @@ import sys
 from pathlib import Path
 from typing import MutableMapping, NoReturn, Optional
 
+from ros2nb.graded_parts import WORK_ENV
+
 from .paths import NOTEBOOKS, ROOT
 
 #: The learner's working folder for ``make lab`` (git ignores it); ``$ROS2NB_WORK`` moves it.
 WORK = ROOT / 'work'
-#: Environment variable that moves the working folder (tests point it at a temp dir).
-WORK_ENV = 'ROS2NB_WORK'
 #: The Jupyter configuration of a learner's server (labconfig/page_config.json and the
 #: server's extensions); put on ``JUPYTER_CONFIG_PATH``.
 LEARNER_CONFIG = ROOT / 'environment' / 'jupyter-learner'
@@ -105,9 +106,15 @@ def main(argv: Optional[list[str]] = None) -> NoReturn:
     ``--instructor`` (``make lab-instructor``): the course folder, every tool on.
     Any other argument is passed to ``jupyter lab``.
     """
-    args = sys.argv[1:] if argv is None else list(argv)
-    if '--instructor' in args:
-        args.remove('--instructor')
+    parser = argparse.ArgumentParser(
+        prog='ros2nb-lab', allow_abbrev=False,
+        description='make lab: copy the notebooks the working folder lacks (never '
+        'overwriting yours), then start JupyterLab on it.',
+        epilog='Any other argument goes to jupyter lab (e.g. --ServerApp.ip=0.0.0.0).')
+    parser.add_argument('--instructor', action='store_true',
+                        help='the course folder itself, every tool on (make lab-instructor)')
+    given, args = parser.parse_known_args(sys.argv[1:] if argv is None else list(argv))
+    if given.instructor:
         root, default_url = ROOT, '/lab/tree/notebooks'
     else:
         root = Path(os.environ.get(WORK_ENV) or WORK).resolve()
@@ -116,6 +123,7 @@ def main(argv: Optional[list[str]] = None) -> NoReturn:
         print(f'Your notebooks are in {root} (the course never overwrites them); keep each '
               'notebook open in one tab only.', file=sys.stderr)
         learner_environment(os.environ)
+        os.environ[WORK_ENV] = str(root)  # the kernels keep the learner's progress there
         default_url = '/lab'
     # Localhost unless told otherwise (the course's image listens on every interface of its
     # container: `make lab LAB_ARGS=--ServerApp.ip=0.0.0.0`); traitlets refuses two values.

@@ -23,10 +23,13 @@ runs one with :func:`run_check`.
 
 from __future__ import annotations
 
+import contextlib
+import io
 import sys
 from typing import Any, Optional
 
-from ..errors import CheckFailed
+from .. import graded_parts, working
+from ..errors import CheckFailed, Ros2nbError
 from ..judge_interface import Judge
 from ..on_first_use import loader
 
@@ -96,4 +99,47 @@ def run_check(name: str, judge: Optional[Judge], *args: Any, **kwargs: Any) -> N
     observer.floods.raise_any()
     passed(message)
 
-__all__ = ['CheckFailed', *sorted(_MODULE_OF)]
+#: Checks that ``progress(check=True)`` leaves out although they need no argument: each
+#: builds the package with colcon (tens of seconds on a busy machine).
+NOT_QUICK = ('check_entry_points', 'check_setup_cfg', 'check_package_runs')
+
+
+def progress(check: bool = False) -> None:
+    """Show your progress: every graded part of the 11 notebooks, passed, failed or not yet,
+    with its points, from the checks you ran in this lab (kept in your work folder,
+    :mod:`ros2nb.graded_parts`).  Only a guide: the grader runs every check itself.
+
+    Introduced in ``00-setup-and-the-pubsub-idea.ipynb``.
+
+    :param check: first run again the quick checks of your files (those that need no
+        argument and build nothing; a check that takes your function runs in its own
+        notebook), so the table says how your files stand now.  Each takes a few seconds.
+    :raises OSError: when the course's notebooks cannot be read (ros2nb outside the course).
+    """
+    from . import base
+    all_parts = graded_parts.parts()
+    if check:
+        calls = {}
+        for part in all_parts:
+            if part.check in _MODULE_OF and part.check not in NOT_QUICK:
+                try:
+                    calls[part] = getattr(sys.modules[__name__], part.check)
+                except ImportError:  # a lesson whose library this Python lacks (rosbags)
+                    continue
+        quick = [part for part in calls if part.check in base.JUDGED]
+        with working.shown('progress(check=True)') as work:
+            for index, part in enumerate(quick, start=1):
+                work.say(f'{part.number} · {part.label} ({index} of {len(quick)})')
+                with contextlib.redirect_stdout(io.StringIO()):
+                    try:
+                        calls[part]()
+                    except (CheckFailed, Ros2nbError):  # its line is kept with its outcome
+                        pass
+    recorded = graded_parts.outcomes()
+    table = graded_parts.rows(all_parts, {p.grade_id: graded_parts.state(p, recorded)
+                                          for p in all_parts})
+    graded_parts.show_table(table, 'Your progress in this lab (the grader runs every check '
+                                   'itself)')
+
+
+__all__ = ['CheckFailed', *sorted(_MODULE_OF), 'progress']

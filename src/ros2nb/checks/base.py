@@ -17,15 +17,23 @@ session, once: no check is called twice or dispatched again.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import inspect
-from typing import Any, Callable
+import io
+import os
+import sys
+import traceback
+from pathlib import Path
+from typing import Any, Callable, Iterator
 
+from .. import course, graded_parts, working
 from ..errors import CheckFailed, Ros2nbError
 from ..explain.exceptions import describe_error
 from ..judge_interface import learner_error
 from ..subject_replies import LearnerError
-from .dispatch import ask_judge
+from ..terminal.workspace import current_workspace
+from .dispatch import INTERRUPTED, ask_judge
 
 #: A check's body: ``body(judge, *learner_things) -> the passed sentence``.
 Body = Callable[..., str]
@@ -33,6 +41,54 @@ Body = Callable[..., str]
 
 #: The body of every check of the lessons loaded so far, by the check's name.
 CHECKS: dict[str, Body] = {}
+#: The notebook of the direct check running in the kernel (for the line of an unfinished file).
+_running: list[int] = []
+#: The names of the checks that run in a judge (loaded so far).
+JUDGED: set[str] = set()
+
+
+@contextlib.contextmanager
+def _progress_kept(check: str) -> Iterator[None]:
+    """In the kernel: keep the check's outcome in the learner's progress
+    (:mod:`ros2nb.graded_parts`), and end with its line there.  A check that could not run,
+    or was interrupted, keeps nothing; while grading nothing is kept."""
+    if os.environ.get(course.GRADING_ENV):
+        yield
+        return
+    out = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(_Tee(out)):
+            yield
+    except CheckFailed as failure:
+        if not str(failure).startswith(INTERRUPTED):
+            _kept(check, False, str(failure))
+        raise
+    lines = out.getvalue().strip().splitlines()
+    _kept(check, True, lines[-1] if lines else '')
+
+
+def _kept(check: str, ok: bool, line: str) -> None:
+    graded_parts.remember(check, ok, line)
+    try:
+        said = graded_parts.outcome_line(check, ok, graded_parts.parts())
+    except OSError:  # the course's notebooks are not beside ros2nb: no table to point at
+        said = None
+    if said:
+        print(said)
+
+
+class _Tee(io.TextIOBase):
+    """Writes to the current stdout and keeps a copy (the check's passed line)."""
+
+    def __init__(self, copy: io.StringIO) -> None:
+        self._copy, self._out = copy, sys.stdout
+
+    def write(self, text: str) -> int:
+        self._copy.write(text)
+        return self._out.write(text)
+
+    def flush(self) -> None:
+        self._out.flush()
 
 
 def _register(body: Body, call: Callable[..., None]) -> Callable[..., None]:
@@ -55,7 +111,10 @@ def judged(body: Body) -> Callable[[], None]:
     """Register ``body(judge)`` as a check that runs only in a judge; return the notebook's
     function, which asks a judge process to run it by name."""
     def call() -> None:
-        ask_judge(body.__name__)
+        with _progress_kept(body.__name__):
+            ask_judge(body.__name__)
+
+    JUDGED.add(body.__name__)
 
     return _register(body, call)
 
@@ -63,8 +122,17 @@ def judged(body: Body) -> Callable[[], None]:
 def direct(body: Body) -> Callable[..., None]:
     """Register ``body(judge, *args)`` as a check that runs where it is called; return the
     notebook's function, which runs it in the kernel (no judge) and prints its line."""
+    notebook = int(body.__module__.rpartition('lesson')[2][:2] or 0)
+
     def call(*args: Any, **kwargs: Any) -> None:
-        passed(body(None, *args, **kwargs))
+        _running.append(notebook)
+        try:
+            with _progress_kept(body.__name__):
+                with working.shown(body.__name__):
+                    message = body(None, *args, **kwargs)
+                passed(message)
+        finally:
+            _running.pop()
 
     return _register(body, call)
 
@@ -83,12 +151,35 @@ def call_learner(function: Callable[..., Any], *args: Any) -> Any:
     """
     try:
         return function(*args)
-    except NotImplementedError:
-        raise CheckFailed(f'{function.__name__}() still raises NotImplementedError: replace '
-                          '"raise NotImplementedError()" with your code and run its cell '
-                          'again.') from None
     except (CheckFailed, Ros2nbError):  # ros2nb's own line, raised in their code's call
         raise
-    except Exception as error:  # their frames only, or the one line of a known mistake
+    except Exception as error:
+        _unfinished_file(error)  # raised in a node file an earlier notebook left unfinished
+        if isinstance(error, NotImplementedError):
+            raise CheckFailed(f'{function.__name__}() still raises NotImplementedError: '
+                              'replace "raise NotImplementedError()" with your code and run its '
+                              'cell again.') from None
+        # their frames only, or the one line of a known mistake
         raise learner_error(f'{function.__name__}()', LearnerError(**describe_error(error))
                             ) from None
+
+
+#: What a part an earlier notebook left unwritten raises where it is used.
+UNWRITTEN_SIGNS = ('AttributeError', 'NameError', 'NotImplementedError',
+                   'ParameterNotDeclaredException')
+
+
+def _unfinished_file(error: BaseException) -> None:
+    """Raise the one line of a node file an earlier notebook left unfinished
+    (:func:`ros2nb.course.unfinished_line`) when ``error`` came through it and is what an
+    unwritten part raises (:data:`UNWRITTEN_SIGNS`)."""
+    if type(error).__name__ not in UNWRITTEN_SIGNS:
+        return
+    workspace = current_workspace().resolve()
+    files = {Path(frame.f_code.co_filename).resolve() for frame, _line in
+             traceback.walk_tb(error.__traceback__)}
+    for relative in course.WRITTEN_IN:
+        if workspace / relative in files:
+            line = course.unfinished_line(workspace, relative, _running[-1] if _running else 10)
+            if line:
+                raise CheckFailed(line) from None

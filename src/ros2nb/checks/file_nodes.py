@@ -59,10 +59,11 @@ def raised(what: str, error: Optional[LearnerError]) -> CheckFailed:
 
 
 def started_log_verdict(judge: Judge, info: NodeMade, mark: int, cls: str) -> None:
-    """Raise unless the node ``info`` logged a line while it started."""
+    """Raise when the node ``info`` logged nothing while it was made (after ``mark``)."""
     if info.started_lines == 0 or not lines_logged(judge, info, mark, info.started_lines):
+        words = ''.join(f' {c}' if c.isupper() else c for c in cls).strip()
         raise CheckFailed(f'{cls} logged nothing when it started: log a line such as '
-                          f"'{cls[:11]} {cls[11:]} Node Started' with the node's logger.")
+                          f"'{words} Node Started' with the node's logger.")
 
 
 def lines_logged(judge: Judge, info: NodeMade, mark: int, lines: int) -> list[str]:

@@ -18,14 +18,15 @@ from std_msgs.msg import Bool
 
 from .. import course, rules
 from ..errors import CheckFailed
-from ..explain.ros_settings import ros_arguments_mistake
+from ..explain.ros_settings import ros_arguments_mistake, without_c_location
 from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, Subject
 from ..subject_interface import Call, RoomNodes, WaitMatched
 from ..subject_replies import Counts
 from .base import judged
 from .drawn import chooser
 from .mains import run_main
-from .file_nodes import announced, feed, lines_logged, new_node, raised, reach
+from .file_nodes import (announced, feed, lines_logged, new_node, raised, reach,
+                         started_log_verdict)
 from .verdicts import endpoint_verdict, node_name_verdict
 
 #: Readings the fan check sends (°C): both sides of the High threshold; then drawn ones.
@@ -58,12 +59,14 @@ def _fan_readings(judge: Judge) -> list[float]:
 def _fan_controller(judge: Judge) -> str:
     judge.drop(('file', course.PROMISES_FILE))  # the fan is the only subscription here
     commands = judge.observer.watch('/' + course.FAN_TOPIC, Bool, lambda m: bool(m.data))
+    mark = len(judge.observer.logs)
     subject, info = new_node(judge, course.FAN_FILE, course.FAN_CLASS)
     node_name_verdict(info, course.FAN_NODE)
     found = judge.observer.endpoints(info.name, info.namespace, info.endpoints)
     endpoint_verdict(info.name, found, 'subscription', '/' + course.TOPIC, course.MESSAGE_TYPE)
     endpoint_verdict(info.name, found, 'publisher', '/' + course.FAN_TOPIC,
                      course.FAN_MESSAGE_TYPE)
+    started_log_verdict(judge, info, mark, course.FAN_CLASS)  # the task's third step
     if not subject.request(WaitMatched(topic='/' + course.FAN_TOPIC,
                                        seconds=ARRIVAL_TIMEOUT_S)).ok:
         raise CheckFailed(f'The fan controller\'s publisher never reached the grader\'s '
@@ -173,8 +176,8 @@ def _counting_monitor(judge: Judge) -> str:
                               'with the count.')
         if index not in numbers:
             raise CheckFailed(f'After {index} reading{"s" if index > 1 else ""} {name} logged '
-                              f'"{lines[0]}": add one to self.received for every message, and '
-                              'log the new count.')
+                              f'"{lines[0]}"; the count is {index}: start self.received at 0 '
+                              'in __init__, add one for every message, and log the new count.')
     _named_as_told(judge, f'monitor_{chooser(judge, "06 counting name").randrange(10, 1000)}')
     return (f"{course.COUNTING_CLASS}('{name}') is called {name} and counted "
             f'{COUNTED_READINGS} of {COUNTED_READINGS} readings, as its lines on /rosout say.')
@@ -241,7 +244,7 @@ def _rooms(judge: Judge) -> str:
                 raise raised(f"rooms started with {course.ROOMS_FUNCTION}('{room}')", None)
             kind, text = reply.error.type, reply.error.message
             why = ros_arguments_mistake(kind, text) or \
-                f'{kind}: {(text.splitlines() or [""])[0][:160]}'
+                f'{kind}: {without_c_location((text.splitlines() or [""])[0])[:160]}'
             raise CheckFailed(f"rclpy refused the arguments {course.ROOMS_FUNCTION}('{room}') "
                               f'returned, {arguments}: {why}')
         for name, namespace, endpoints in reply.nodes:

@@ -140,7 +140,8 @@ def _recording(judge: Optional[Judge], record_hour: Any) -> str:
     label = f'{record_hour.__name__}(bag_path)'
     with fresh_path(judge, 'hour') as path:
         with witnessing(judge) as seen:
-            _call(judge, record_hour, label, path, spin_s=course.RECORD_S)
+            _call(judge, record_hour, label, path, spin_s=course.RECORD_S,
+                  stops=course.SENSOR_NODE)  # the task ends the hour with ros2nb.stop()
         if not path.is_dir():
             _bag_verdict(path, label)  # the line for "no bag at all"
         with read_back(judge, path) as copy:
@@ -334,8 +335,9 @@ def _readings_in(judge: Optional[Judge], path: Path, read_temperatures: Any,
                           f'first reading, [0.0, 1.0, 2.0, ...]: (stamp - first stamp) / 1e9.')
     if not all(isinstance(v, (int, float)) and abs(v - w) < 1e-4
                for v, w in zip(values, readings)):
-        raise CheckFailed(f'{name} returned readings {values[:3]}...; expected the messages\' '
-                          f'data, {readings[:3]}...: deserialize each message.')
+        said = 'messages, not their data;' if 'data' in repr(values[:1]) else f'{values[:3]}...;'
+        raise CheckFailed(f'{name} returned readings {said} expected the messages\' data, '
+                          f'{readings[:3]}...: deserialize each message and take its field, .data.')
     return f'{name} returns the {sent} readings of the bag, with their times from 0 s.'
 
 

@@ -18,7 +18,9 @@ import subprocess
 from pathlib import Path
 from typing import Optional
 
+from .. import working
 from ..errors import CheckFailed
+from ..explain.programs import read_explained
 from ..processes import Process, interrupt, kill_process_group, until_waiting, wait_patiently
 from ..judge_interface import Judge, Observer, ProgramOutput
 from .source import TEXT
@@ -47,6 +49,8 @@ STOPPING_SIGNALS = {signal.SIGINT: 'Ctrl+C',
                     signal.SIGTERM: 'a shutdown from outside (SIGTERM)'}
 STOP_EXCEPTIONS = {signal.SIGINT: 'KeyboardInterrupt',
                    signal.SIGTERM: 'ExternalShutdownException'}
+#: What a stop itself raises in a main(): its line is the stop's, not an error of the code's.
+STOP_KINDS = ('KeyboardInterrupt', 'ExternalShutdownException', 'RCLError')
 #: On Jazzy Ctrl+C shuts rclpy down itself; then, depending on where the signal lands, the spin
 #: ends with ExternalShutdownException or a later rclpy.shutdown() fails. One race, one cause:
 #: the learner is told the cause, in the same words whichever way the race went.
@@ -129,8 +133,9 @@ def _watch_stop(observer: Observer, path: Path, node_name: str, part: int, proc:
                           'start it): main() should bring rclpy up, create the node and spin it '
                           'until Ctrl+C.')
     until_waiting(proc, START_PATIENCE_S)  # the node idle in its spin, its call answered
-    interrupt(proc, sig)
     pressed = STOPPING_SIGNALS[sig]
+    working.say(f'{pressed} for {node_name}')
+    interrupt(proc, sig)
     code = _wait_for_exit(observer, proc, node_name, sig)
     if code is None:
         raise CheckFailed(f'{path.name} did not stop within {EXIT_AFTER_CTRL_C_S:g} s of '
@@ -143,10 +148,13 @@ def _watch_stop(observer: Observer, path: Path, node_name: str, part: int, proc:
                           'constructor or callback: repeat work with a timer (create_timer) '
                           'and let main() spin.')
     if not spinning:  # the node was there but never answered: main() did not spin it
-        raise CheckFailed(f'{path.name} created its node {node_name} but never spun it (it did '
-                          'not answer the grader): main() should spin it with rclpy.spin(node) '
-                          'until Ctrl+C.')
+        raise _crashed(path, text) or CheckFailed(_NOT_SPUN.format(file=path.name))
     if code != 0 or 'Traceback' in text:
+        facts = read_explained(text)  # an error of the learner's code, not of the stop
+        if facts and facts.get('explanation') and facts.get('type') not in STOP_KINDS:
+            where = f' ({facts["where"]})' if facts.get('where') else ''
+            raise CheckFailed(f'{path.name} exited with code {code} after {pressed}: '
+                              f'{facts["explanation"]}{where}')
         last = _error_line(text)
         if all(mark in last for mark in RACE_MARKS):
             raise _ShutdownRace(f'{path.name} exited with code {code} after {pressed}: rclpy '
@@ -187,11 +195,32 @@ def _ended_early(path: Path, part: int, text: str, code: int) -> CheckFailed:
     if 'NotImplementedError' in text:
         return CheckFailed(f'main() still raises NotImplementedError: write part {part} where '
                            'it says YOUR CODE HERE.')
+    crashed = _crashed(path, text)
+    if crashed is not None:
+        return crashed
     if 'Traceback' in text:
         return CheckFailed(f'{path.name} crashed before Ctrl+C{_crash_place(text, path)} '
                            f'({_error_line(text)}): fix that line, then run this check again.')
+    if code == 0:  # as when its node was seen, not spinning: how busy the machine is decides
+        return CheckFailed(_NOT_SPUN.format(file=path.name))
     return CheckFailed(f'{path.name} ended by itself before Ctrl+C (exit code {code}); main() '
                        'should spin until Ctrl+C.')
+
+
+#: A main() that never spins, whether the judge saw its node before it ended or not.
+_NOT_SPUN = ('{file} did not spin its node until Ctrl+C (it ended by itself, or did not answer '
+             'the grader): main() should spin it with rclpy.spin(node) until Ctrl+C.')
+
+
+def _crashed(path: Path, text: str) -> Optional[CheckFailed]:
+    """The line for an error of the learner's code that ended the program by itself (its
+    explained line, :mod:`ros2nb.explain.programs`), or None: whether the judge pressed
+    Ctrl+C before it was reaped or not, as a busy machine decides."""
+    facts = read_explained(text)
+    if facts is None or not facts.get('explanation') or facts.get('type') in STOP_KINDS:
+        return None
+    where = f' ({facts["where"]})' if facts.get('where') else ''
+    return CheckFailed(f'{path.name} crashed before Ctrl+C: {facts["explanation"]}{where}')
 
 
 def _caught(main: ast.FunctionDef) -> set[str]:

@@ -86,6 +86,12 @@ def samples_verdict(samples: list[float], *, seconds: float,
         raise CheckFailed(f'{len(samples)} readings in {seconds:g} s; expected one every '
                           f'{course.PUBLISH_PERIOD_S} s: check the timer period.')
     if samples and abs(samples[0] - start_c) > course.MAX_STEP_C + FLOAT32_TOLERANCE_C:
+        if start_c != course.START_TEMPERATURE_C:  # a probe of the clamp, set by the grader
+            raise CheckFailed(f'The grader set self.temperature to {start_c} °C, just inside '
+                              f'the limits, and the next reading was {samples[0]:.2f} °C, more '
+                              f'than one step of ±{course.MAX_STEP_C} °C away: clamp each new '
+                              f'reading into [{low}, {high}] (MIN_TEMPERATURE_C to '
+                              'MAX_TEMPERATURE_C), no narrower.')
         raise CheckFailed(f'The first reading is {samples[0]:.2f} °C, but self.temperature was '
                           f'{start_c} °C: each reading is the previous self.temperature plus one '
                           f'step of at most ±{course.MAX_STEP_C} °C.')

@@ -21,9 +21,12 @@ from rclpy.exceptions import NameValidationException, NotInitializedException
 
 from ..errors import SHUT_DOWN_MESSAGE
 from .bag_reading import bag_reading_mistake
+from .everyday import cause_place, everyday_explanation
+from .names import made_where
 from .frames import frames_of, is_library_file, learner_entry, learner_frame, raised_in
 from .plain_python import python_mistake
 from .plots import plot_in_callback
+from .ros_calls import wrong_arguments
 from .ros_settings import qos_setting, settings_mistake
 
 
@@ -60,19 +63,21 @@ def learner_traceback(exc: BaseException) -> list[str]:
 
 def describe_error(error: BaseException) -> dict:
     """The learner-facing facts of an exception: ``type``, ``message`` (at most 500
-    characters), ``explanation`` (the one line of a known mistake, or None), ``traceback``
+    characters), ``explanation`` (the one line of a known mistake, else of Python's error
+    with what to do, :mod:`.everyday`; None when no frame is the learner's), ``traceback``
     (their own frames, :func:`learner_traceback`) and ``where`` (:func:`learner_line`).
 
     What a check makes of an error in the learner's code, in a subject or in the kernel
-    (``ros2nb.judge_interface.learner_error``); introduced in ``03-write-the-publisher.ipynb``.
+    (``ros2nb.judge_interface.learner_error``): one line at the learner's line, never a
+    traceback; introduced in ``03-write-the-publisher.ipynb``.
     """
     try:
-        explanation = explain_exception(error)
+        explanation = explain_exception(error) or everyday_explanation(error)
     except Exception:  # explaining must never hide the original error
         explanation = None
     return {'type': type(error).__name__, 'message': str(error)[:500],
             'explanation': explanation, 'traceback': learner_traceback(error),
-            'where': learner_line(error)}
+            'where': cause_place(error) or learner_line(error)}
 
 
 def _called_code(exc: BaseException) -> Any:
@@ -107,6 +112,10 @@ def _field_type(exc: AssertionError) -> Optional[str]:
     fix = _NUMBERS.get(wanted, f'a {wanted}')
     if wanted == 'float' and isinstance(value, int) and not isinstance(value, bool):
         fix = f'{value}.0 or float(...)'
+    if isinstance(value, bool) and wanted != 'bool':  # a yes/no: another message type meant
+        return (f"{owner}'s field '{field}' takes {fix}, not bool {value!r}: True or False "
+                f'goes into a Bool message; make this message a Bool, not a {owner}'
+                f'{made_where(exc, message)}.')
     return (f"{owner}'s field '{field}' takes {fix}, not {type(value).__name__} {value!r}: "
             'convert the value before you put it into the message.')
 
@@ -170,6 +179,9 @@ def explain_exception(exc: BaseException, *, ros_started: bool = False) -> Optio
         traceback is then the best explanation).
     """
     text = str(exc)
+    found = wrong_arguments(exc)  # an rclpy call given its arguments out of order
+    if found:
+        return found
     if isinstance(exc, NameValidationException):
         return _invalid_name(exc)
     if _called_code(exc) is not None:
@@ -195,12 +207,10 @@ def explain_exception(exc: BaseException, *, ros_started: bool = False) -> Optio
         return ('rclpy.init() was called, but ros2nb.start() already brought ROS 2 up in this '
                 'kernel: remove that call; to run a node here hand it to ros2nb.add(node) '
                 '(main() is for `ros2 run`, notebook 05).')
-    python = python_mistake(exc, text) or bag_reading_mistake(exc, text)
-    if python:
-        return python
-    parameter = settings_mistake(exc, text, list(frames_of(exc))) or plot_in_callback(exc, text)
-    if parameter:
-        return parameter
+    found = (python_mistake(exc, text) or bag_reading_mistake(exc, text)
+             or settings_mistake(exc, text, list(frames_of(exc))) or plot_in_callback(exc, text))
+    if found:
+        return found
     if type(exc).__name__ == 'InvalidQoSProfileException':
         return ('a QoSProfile needs its history depth: QoSProfile(depth=10), or pass just the '
                 'depth, 10.')

@@ -57,13 +57,15 @@ def python_mistake(exc: BaseException, text: str) -> Optional[str]:
 
 
 def _method_without_self(frame: Any, text: str) -> Optional[str]:
+    """A method or an attribute of the node named without ``self.`` inside the class."""
     undefined = _UNDEFINED.match(text)
     owner = frame.f_locals.get('self')
-    if undefined and owner is not None and callable(getattr(owner, undefined.group(1), None)):
-        name = undefined.group(1)
-        return (f'{name} is a method of {type(owner).__name__}: inside the class, name it '
-                f'self.{name}.')
-    return None
+    if not undefined or owner is None or not hasattr(owner, undefined.group(1)):
+        return None
+    name = undefined.group(1)
+    kind = 'a method' if callable(getattr(owner, name)) else 'kept on the node as an attribute'
+    return (f'{name} is {kind} of {type(owner).__name__}: inside the class, name it '
+            f'self.{name}.')
 
 
 def _attribute_without_self(frame: Any, text: str) -> Optional[str]:
@@ -73,6 +75,9 @@ def _attribute_without_self(frame: Any, text: str) -> Optional[str]:
     if unset is None or owner is None:
         return None
     name = unset.group(1)
+    source = linecache.getline(frame.f_code.co_filename, frame.f_lineno)
+    if not hasattr(owner, name) and not re.search(rf'\b{name}\s*[-+*/]=', source):
+        return None  # no count: another local used before it is set (everyday.py says so)
     kept = (f'the node keeps it as self.{name}' if hasattr(owner, name) else
             f'keep it on the node: self.{name} = 0 in __init__')
     return (f'{name} here is a new local name of this method, not the node\'s count ({kept}): '
@@ -104,7 +109,9 @@ def _callback_called(frame: Any, text: str) -> Optional[str]:
     if missing is None:
         return None
     argument = missing.group(2)
-    source = linecache.getline(frame.f_code.co_filename, frame.f_lineno)
+    # the call may run over lines: the callback's line and the two before it
+    source = ' '.join(linecache.getline(frame.f_code.co_filename, line).strip()
+                      for line in range(max(1, frame.f_lineno - 2), frame.f_lineno + 1))
     taker = next((name for name in _TAKES_A_CALLBACK if f'{name}(' in source), None)
     # the method as the learner's line names it (what raised may be wrapped, or renamed)
     called = re.search(rf'{taker}\(.*?\bself\.(\w+)\(\s*\)', source) if taker else None

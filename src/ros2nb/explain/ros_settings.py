@@ -78,6 +78,11 @@ _NO_DEFAULT = ('Cannot declare a statically typed parameter with default value o
                'PARAMETER_NOT_SET')
 
 
+def without_c_location(text: str) -> str:
+    """rcl's message without the C source location it ends with (``, at /.../x.c:384``)."""
+    return re.sub(r',? at /\S+\.c:\d+\s*$', '', text.strip())
+
+
 def settings_mistake(exc: BaseException, text: str, frames: list[Any]) -> Optional[str]:
     """The line for any mistake of this module's kinds (parameters, ``-r``/``-p`` rules, a
     depth of 0), or None.
@@ -160,6 +165,13 @@ def ros_arguments_mistake(kind: str, text: str) -> Optional[str]:
         arguments, ``RCLError`` for ``rclpy.init``'s (a program's command line).
     :param text: its message.
     """
+    if kind == 'UnknownROSArgsError':  # rules ROS found outside any flag
+        return (f'ROS did not read {text.strip()}: every rule goes right after its flag, '
+                "after '--ros-args': ['--ros-args', '-r', '__ns:=/kitchen'].")
+    trailing = re.search(r"trailing (-[rp]) flag", text)
+    if trailing and kind in ('RCLInvalidROSArgsError', 'RCLError'):
+        return (f'the {trailing.group(1)} at the end of the arguments has no rule after it: '
+                "write each rule right after its flag: ['--ros-args', '-r', '__ns:=/kitchen'].")
     found = _ROS_RULE.search(text) if kind in ('RCLInvalidROSArgsError', 'RCLError') else None
     if found is None:
         return None

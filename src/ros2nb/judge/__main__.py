@@ -16,6 +16,7 @@ import sys
 from pathlib import Path
 from typing import Any, Optional
 
+from .. import working
 from ..processes import end_this_process
 from ..subject.forked import SUBJECT_PREFIX_ENV, serve_from_here
 
@@ -44,6 +45,7 @@ def arguments(argv: list[str]) -> tuple[list[str], Optional[int]]:
 
 def main(argv: list[str]) -> int:
     """Run one check, or grade one notebook; print the outcome as one JSON line."""
+    working.tell_on_stderr()  # what it does, for the kernel that waits (none of its children)
     if not os.environ.get(SUBJECT_PREFIX_ENV):  # subjects not sandboxed: forked from here,
         serve_from_here()  # before ROS starts and before any answer is imported
     from .. import checks

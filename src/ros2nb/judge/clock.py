@@ -18,6 +18,7 @@ from typing import Any, Optional, TypeVar
 
 from rosgraph_msgs.msg import Clock
 
+from .. import working
 from ..judge_interface import ARRIVAL_TIMEOUT_S, learner_error
 from ..errors import CheckFailed
 from ..processes import Patience, kill_process_group
@@ -116,7 +117,8 @@ class JudgeClock:
     def _drive(self, subject: SubjectProcess, command: Command[Any], steps: tuple[float, float],
                limit_s: float, timeout: float, what: str) -> Any:
         step_ns, probe_ns = round(steps[0] * 1e9), round(steps[1] * 1e9)
-        limit_ns, whole_ns = self.now_ns + round(limit_s * 1e9), self.now_ns + step_ns
+        began_ns = self.now_ns
+        limit_ns, whole_ns = began_ns + round(limit_s * 1e9), began_ns + step_ns
         subject.send(command)
         # Patience reads /proc: it starts only once the subject has been quiet for
         # PATIENCE_LOOK_S (an hour of steps would otherwise read it 7200 times), and looks
@@ -148,6 +150,8 @@ class JudgeClock:
                 else:
                     self.step_to(whole_ns)
                     whole_ns += step_ns
+                working.say(f'running {what} on the grader\'s clock: '
+                            f'{(self.now_ns - began_ns) / 1e9:.0f} simulated s', often=True)
                 patience, quiet_since = None, time.monotonic()
             elif time.monotonic() - max(quiet_since, looked) < PATIENCE_LOOK_S:
                 continue

@@ -20,7 +20,7 @@ from rclpy.publisher import Publisher
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Bool, Float32
 
-from .. import course
+from .. import course, working
 from ..checks.drawn import new_seed
 from ..errors import CheckFailed
 from ..processes import Process, kill_process_group, wait_patiently
@@ -172,6 +172,7 @@ class Session:
         path = self.workspace / relative
 
         def load(subject: SubjectProcess) -> None:
+            working.say(f'loading {path.name} in a process of its own')
             reply = subject.request(LoadFile(path=str(path), module=path.stem))
             if reply.missing:
                 raise CheckFailed(f'{path.name} does not exist yet: run the %%part cells that '
@@ -201,6 +202,7 @@ class Session:
         """A subject with the course's context cells and the learner's answer cells run (in
         ``workspace``, by default the learner's)."""
         def load(subject: SubjectProcess) -> None:
+            working.say('running your answer cells in a process of its own')
             subject.request(ExecCells(sources=list(ref.sources)))
 
         return self.subject(('cells', ref.sources, str(workspace)), load, workspace)
@@ -236,6 +238,7 @@ class Session:
             load the program that sandboxes theirs.
         :return: the process, and its output (stdout and stderr), collected as it comes.
         """
+        working.say(f'starting {Path(argv[0]).name}')
         prefix = subject_prefix()
         if prefix and env is not None:
             argv = [sys.executable, '-I', '-c', SET_ENV_AND_EXEC, json.dumps(env), *argv]
@@ -256,6 +259,7 @@ class Session:
         :return: the process, and its output (stdout and stderr), collected as it comes.
         """
         args = [str(path), *([stand_in] if stand_in else [])]
+        working.say(f'starting main() of {path.name}, as ros2 run does')
         if subject_prefix():
             return self.start([sys.executable, '-m', 'ros2nb.subject.program', *args],
                               cwd=self.workspace)
@@ -273,6 +277,7 @@ class Session:
         :raises SubjectHung: when it had them and still runs.
         """
         proc, output = self.start(argv, cwd=cwd, env=env)
+        working.say(f'running {what or Path(argv[0]).name}')
         code = wait_patiently(proc, seconds)
         if code is None:
             kill_process_group(proc)

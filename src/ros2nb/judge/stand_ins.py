@@ -22,7 +22,9 @@ from __future__ import annotations
 
 import inspect
 import random
-from typing import Any, Callable
+import sys
+import types
+from typing import Any, Callable, Optional
 
 from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor, SetParametersResult
 from rclpy.node import Node
@@ -33,17 +35,33 @@ from ..rules import monitor_status
 
 
 def _publisher_on(node: Node, topic: str) -> Any:
-    """The node's publisher on ``topic`` (relative to its namespace), whatever its attribute."""
+    """The node's publisher on ``topic`` (relative to its namespace), whatever its attribute;
+    an AttributeError for ``publisher_`` (the task's name) when no attribute keeps it."""
     full = node.resolve_topic_name(topic)
     found = [p for p in node.publishers if p.topic_name == full]
     if not found:
         raise AttributeError(f'{node.get_name()} has no publisher on {full}')
+    kept = [name for name, value in vars(node).items()
+            if value is found[-1] and not name.startswith('_')]
+    if not kept:  # made in a local name: the learner's own callback could never reach it
+        raise AttributeError(f"'{type(node).__name__}' object has no attribute 'publisher_'",
+                             name='publisher_', obj=node)
     return found[-1]
 
 
 #: The learner's node class a stand-in method is put on: a Node subclass with attributes of
 #: its own (``publisher_``, ``temperature``, ...), which no type declares.
 LearnersNode = Any
+
+
+def _constructing(node: Node) -> bool:
+    """Whether ``node``'s own ``__init__`` is running further up this thread's stack."""
+    frame: Optional[types.FrameType] = sys._getframe(1)
+    while frame is not None:
+        if frame.f_code.co_name == '__init__' and frame.f_locals.get('self') is node:
+            return True
+        frame = frame.f_back
+    return False
 
 
 # ------------------------------------------------------------------ notebook 03: the sensor
@@ -59,11 +77,14 @@ def sensor_init(self: LearnersNode) -> None:
 def sensor_callback(self: LearnersNode) -> None:
     """Part 4 of temperature_publisher.py: one step of the walk, clamped, published, logged.
 
-    Does nothing on a node without ``temperature`` (a constructor that calls it before it
-    sets the walk's start, or keeps the walk under another name): the learner's own
-    callback is then tried instead.
+    On a node without ``temperature`` (a constructor that keeps the walk in a local name, or
+    under another name) it raises the AttributeError of reading it: the check names the
+    constructor's line (:mod:`ros2nb.explain.everyday`), and tries the learner's own
+    callback with it.  Called by the constructor itself (``self.publish_temperature()``
+    where the method should be passed), before the walk's start is set, it does nothing, as
+    a call of a part not written yet would: the check then names the call.
     """
-    if not hasattr(self, 'temperature'):
+    if not hasattr(self, 'temperature') and _constructing(self):
         return
     step = random.uniform(-course.MAX_STEP_C, course.MAX_STEP_C)
     self.temperature = max(course.MIN_TEMPERATURE_C,
@@ -152,11 +173,14 @@ STAND_INS: dict[str, tuple[str, Callable[..., Any]]] = {
 }
 #: What a stand-in's code uses besides :data:`PREAMBLE`'s names.
 HELPERS: dict[str, tuple[Callable[..., Any], ...]] = {
-    'sensor_callback': (_publisher_on,), 'fan_callback': (_publisher_on,),
+    'sensor_callback': (_publisher_on, _constructing), 'fan_callback': (_publisher_on,),
     'monitor_callback': (monitor_status,)}
 #: The names every stand-in's code may use, imported in the subject (no answer among them).
 PREAMBLE = """\
 import random
+import sys
+import types
+from typing import Any, Optional
 from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor, SetParametersResult
 from rclpy.node import Node
 from std_msgs.msg import Bool, Float32

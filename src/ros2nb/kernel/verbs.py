@@ -20,7 +20,7 @@ from typing import Callable, Optional
 import rclpy
 from rclpy.node import Node
 
-from .. import domains
+from .. import domains, working
 from ..errors import Ros2nbError, UsageError
 from ..explain.guards import guard_endpoint_types
 from ..explain.plots import guard_pyplot
@@ -242,6 +242,7 @@ def spin(seconds: float, *, sim_time: Optional[bool] = None, show_logs: bool = T
     def flush_held() -> None:
         with contextlib.redirect_stdout(held.stdout), contextlib.redirect_stderr(held.stderr):
             flush()
+        working.say(f'{(rt.sim_now_ns - started_ns) / 1e9:.0f} of {seconds:g} simulated s')
 
     rt.begin_spin()
     flush()
@@ -249,7 +250,7 @@ def spin(seconds: float, *, sim_time: Optional[bool] = None, show_logs: bool = T
     try:
         # The Stop button is acted on between callbacks and between two looks at the log
         # lines, never inside rclpy or the kernel's output stream (ros2nb.runtime.stop_button).
-        with rt.stop_button.held(), rt.clock(use_sim):
+        with rt.stop_button.held(), rt.clock(use_sim), working.shown('spinning the nodes'):
             if use_sim:
                 ran = rt.advance_sim_time(seconds, on_step=flush_held)
                 held.replay()

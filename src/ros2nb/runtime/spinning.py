@@ -19,6 +19,7 @@ from rclpy.executors import (ConditionReachedException, ExternalShutdownExceptio
 from rclpy.node import Node
 
 from ..errors import Ros2nbError
+from ..explain.everyday import everyday_explanation
 from ..explain.exceptions import explain_exception, learner_line, learner_traceback
 from . import current
 from .logs import CallbackFailure
@@ -109,7 +110,11 @@ class Spinning:
 
     def _callback_failed(self, node: Node, label: str, error: BaseException) -> None:
         """Report a callback that raised; stop its node unless it is ros2nb's own."""
-        explained = explain_exception(error, ros_started=current.kernel_runtime() is self)
+        in_kernel = current.kernel_runtime() is self
+        # in a check's subject, Python's own errors get their line too (a kernel shows the
+        # learner's traceback, theirs to read; a check answers in one line)
+        explained = explain_exception(error, ros_started=in_kernel) or (
+            None if in_kernel else everyday_explanation(error))
         self._report_failure(CallbackFailure(
             node=node.get_fully_qualified_name(), callback=label,
             error=explained or f'{type(error).__name__}: {error}',

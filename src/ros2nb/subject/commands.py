@@ -17,9 +17,11 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import linecache
 import random
 import sys
 import time
+import types
 from pathlib import Path
 from types import ModuleType
 from typing import Any, Callable, Optional
@@ -53,6 +55,16 @@ def _without_magics(source: str) -> str:
                      for line in source.splitlines())
 
 
+def _named(function: Callable[..., Any], name: str, qualname: str) -> Callable[..., Any]:
+    """A copy of a stand-in ``function`` named as the method it stands in for (``qualname``
+    in a report): an error is reported as the course's method of the learner's class, never
+    as a function of ours."""
+    named = types.FunctionType(function.__code__, function.__globals__, name,
+                               function.__defaults__, function.__closure__)
+    named.__qualname__ = qualname
+    return named
+
+
 # ------------------------------------------------------------------ loading (first command)
 def load(command: Command[Any]) -> tuple[dict[str, Any], Reply]:
     """Run the first command (:data:`~ros2nb.subject_interface.LOADERS`), which loads the
@@ -80,8 +92,11 @@ def load(command: Command[Any]) -> tuple[dict[str, Any], Reply]:
     assert isinstance(command, ExecCells)  # the only other loader
     errors = []
     for index, source in enumerate(command.sources):
+        text, name = _without_magics(source), f'<cell {index + 1}>'
+        # its lines for tracebacks and explanations, as a kernel keeps a cell's
+        linecache.cache[name] = (len(text), None, text.splitlines(keepends=True), name)
         try:
-            exec(compile(_without_magics(source), f'<cell {index + 1}>', 'exec'), namespace)
+            exec(compile(text, name, 'exec'), namespace)
         except BaseException as error:  # the learner's cell may raise anything
             errors.append(described(error))
     return namespace, CellsRun(ok=True, cell_errors=errors)
@@ -163,7 +178,9 @@ class Subject(Trials):
                            if isinstance(v, type) and issubclass(v, Node) and v is not Node)
             return NodeMade(ok=False, no_class=True, classes=found)
         if stand_ins:  # a subclass with the course's parts in place of the learner's
-            methods = dict(self._stand_ins[name] for name in stand_ins)
+            methods = {method: _named(function, method,
+                                      f"the course's {node_class.__name__}.{method}")
+                       for method, function in (self._stand_ins[name] for name in stand_ins)}
             node_class = type(node_class.__name__, (node_class,), methods)
         rt.take_judge_time()
         if seed is not None:

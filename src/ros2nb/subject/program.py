@@ -19,6 +19,7 @@ import sys
 from rclpy.node import Node
 
 from .. import course
+from ..explain.programs import explained_line
 from . import out_of_reach
 
 #: Exit code when the file has no ``main()`` to call.
@@ -49,14 +50,18 @@ def main(argv: list[str]) -> int:
         return 2
     sys.argv = [argv[0]]
     out_of_reach.shut()
-    module = runpy.run_path(argv[0], run_name='__ros2nb_program__')
-    entry = module.get('main')
-    if not callable(entry):
-        print(f'{argv[0]} has no main() function.', file=sys.stderr)
-        return NO_MAIN
-    if len(argv) == 2:  # what main() looks up when it runs: its module's globals
-        getattr(entry, '__globals__', module)[argv[1]] = stand_in_node(argv[1])
-    result = entry()
+    try:
+        module = runpy.run_path(argv[0], run_name='__ros2nb_program__')
+        entry = module.get('main')
+        if not callable(entry):
+            print(f'{argv[0]} has no main() function.', file=sys.stderr)
+            return NO_MAIN
+        if len(argv) == 2:  # what main() looks up when it runs: its module's globals
+            getattr(entry, '__globals__', module)[argv[1]] = stand_in_node(argv[1])
+        result = entry()
+    except Exception as error:  # its line for the check, then Python's traceback as usual
+        print(explained_line(error), file=sys.stderr, flush=True)
+        raise
     return result if isinstance(result, int) else 0
 
 

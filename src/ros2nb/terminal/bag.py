@@ -41,6 +41,7 @@ if sys.version_info >= (3, 11):  # rosbags' apsw has no wheel for 3.10
 else:  # pragma: no cover - Python 3.10: every verb says it needs 3.11
     rosbag2 = typesys = None
 
+from .. import working
 from ..errors import Ros2nbError, UsageError
 from ..runtime import QUIET_SUBSCRIPTION, current_runtime
 from .echo import message_type
@@ -288,7 +289,7 @@ def bag_play(name: Any, *, rate: float = 1.0, topics: Optional[Sequence[str]] = 
         subprocess.run([_real_ros2(), 'bag', 'play', str(path), '--clock', '--rate', str(rate),
                         *args], check=False, env=node_process_env(os.environ))
         return {}
-    with _reader(path) as reader:
+    with _reader(path) as reader, working.shown(f'playing {path.name}'):
         return _play(rt, reader, path, rate, topics, show_logs)
 
 
@@ -332,6 +333,8 @@ def _play(rt: Any, reader: Any, path: Path, rate: float, topics: Optional[Sequen
                     publishers[connection.topic].publish(data)
                     rt.drain()
                 counts[connection.topic] += 1
+                working.say(f'{sum(counts.values())} messages played, '
+                            f'{(rt.sim_now_ns - sim0) / 1e9:.0f} simulated s')
     finally:
         for publisher in publishers.values():  # the last messages reach every subscription
             publisher.wait_for_all_acked(Duration(seconds=MATCH_WAIT_S))

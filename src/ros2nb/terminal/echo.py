@@ -15,6 +15,7 @@ from typing import Any, Optional
 
 from rclpy.qos import DurabilityPolicy, QoSPresetProfiles, QoSProfile, ReliabilityPolicy
 
+from .. import working
 from ..errors import Ros2nbError, UsageError
 from ..runtime import QUIET_SUBSCRIPTION, current_runtime
 from .topic import did_you_mean, graph_topics, resolve
@@ -223,6 +224,7 @@ def record(topic: str, seconds: float, msg_type: Optional[str] = None, *, field:
         now = rt.sim_now_ns / 1e9 if use_sim else time.monotonic()
         times.append(now - start_s)
         values.append(getattr(msg, field))
+        working.say(f'{len(values)} messages in {now - start_s:.0f} of {seconds:g} s')
 
     name = resolve(topic)
     cls = _topic_type(name, msg_type)
@@ -230,6 +232,7 @@ def record(topic: str, seconds: float, msg_type: Optional[str] = None, *, field:
     if field not in fields:  # checked here: raised in the callback it would only be logged
         raise Ros2nbError(f'{cls.__name__} has no field {field!r}; its fields are '
                           f'{", ".join(fields)}.')
-    _collect(name, cls, 2 ** 62, seconds, use_sim, keep, show_logs=False)
+    with working.shown(f'recording {name}'):
+        _collect(name, cls, 2 ** 62, seconds, use_sim, keep, show_logs=False)
     print(f'Recorded {len(values)} messages from {name} over {seconds:g} s.')
     return times, values

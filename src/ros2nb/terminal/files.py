@@ -93,26 +93,64 @@ def remember_written(path: PathLike) -> None:
 
 
 def import_file(path: PathLike, module_name: Optional[str] = None) -> ModuleType:
-    """Import a Python file afresh (re-running the cell picks up your latest edits).
+    """Import a Python file as a module that follows the file: whenever the file changed
+    since (a ``%%part`` cell run again, here or in another notebook), the next use of a name
+    in it imports it afresh, so no cell ever runs an old version of your code.
+
+    Nodes made from an older version keep running it until you replace them.
 
     Introduced in ``03-write-the-publisher.ipynb``.
 
     :param path: the ``.py`` file; relative paths are relative to the current workspace.
     :param module_name: name to register in ``sys.modules``; default the file's stem.
-    :return: the module.
+    :return: the module (a :class:`FreshModule`).
     :raises Ros2nbError: if the file does not exist.
-    :raises SyntaxError: (and anything the file raises at import) unchanged, with its line.
+    :raises SyntaxError: (and anything the file raises at import) unchanged, with its line;
+        also later, on the use that imports a changed file afresh.
     """
     path = workspace_file(path)
     if not path.is_file():
         raise Ros2nbError(f'{shown(path)} does not exist: run the cells that write it first.')
-    name = module_name or path.stem
-    spec = importlib.util.spec_from_file_location(name, path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
-    spec.loader.exec_module(module)
-    return module
+    return FreshModule(path, module_name or path.stem)
+
+
+class FreshModule(ModuleType):
+    """A learner's file as a module, imported afresh on the first use after the file changed.
+
+    Each import makes a new module (registered in ``sys.modules``); this one forwards every
+    name to the newest, so a name looked up in a cell is always the file's current one, while
+    nodes made earlier keep the module they were made from (nothing is changed under them).
+    """
+
+    def __init__(self, path: Path, name: str) -> None:
+        super().__init__(name)
+        self.__dict__['_ros2nb_file'] = (path, name)
+        self.__dict__['_ros2nb_loaded'] = (b'', None)
+        self._ros2nb_current()
+
+    def _ros2nb_current(self) -> ModuleType:
+        """The module of the file as it is now (imported again when its text changed)."""
+        path, name = self.__dict__['_ros2nb_file']
+        digest, module = self.__dict__['_ros2nb_loaded']
+        text = path.read_bytes() if path.is_file() else None
+        now = hashlib.sha256(text).digest() if text is not None else digest
+        if module is None or now != digest:
+            spec = importlib.util.spec_from_file_location(name, path)
+            assert spec is not None and spec.loader is not None
+            module = importlib.util.module_from_spec(spec)
+            sys.modules[name] = module
+            spec.loader.exec_module(module)
+            self.__dict__['_ros2nb_loaded'] = (now, module)
+            self.__dict__['__file__'], self.__dict__['__doc__'] = module.__file__, module.__doc__
+        return module
+
+    def __getattr__(self, attribute: str) -> object:
+        if attribute.startswith('__') and attribute.endswith('__'):
+            raise AttributeError(attribute)
+        return getattr(self._ros2nb_current(), attribute)
+
+    def __dir__(self) -> list[str]:
+        return dir(self._ros2nb_current())
 
 
 _parts_outside: dict[str, dict[int, str]] = {}  # files outside the workspace: this kernel only

@@ -13,7 +13,7 @@ a template says it is HTML the grader made, such as a body nh3 cleaned).
 from __future__ import annotations
 
 import re
-from typing import TYPE_CHECKING, Any, Mapping, Optional, Sequence
+from typing import TYPE_CHECKING, Any, Optional, Sequence
 
 import jinja2
 import nh3
@@ -104,16 +104,20 @@ ABOVE_STYLE = ('div.above .panel-heading h4{margin:0}'
                'div.flags code{white-space:pre-wrap}')
 
 
+def standing_html(table: str) -> str:
+    """The learner's table of every notebook's parts (:func:`ros2nb.graded_parts.table_html`,
+    from the grader's results) as the box that heads each feedback page."""
+    return f'<div id="standing" class="standing">{table}</div>'
+
+
 def safe_feedback(made: str, title: str, flags: Sequence[str] = (),
-                  late: Optional[Lateness] = None,
-                  progress: Optional[Sequence[Mapping[str, Any]]] = None) -> str:
+                  late: Optional[Lateness] = None, standing: str = '') -> str:
     """nbgrader's feedback page ``made`` rebuilt by :func:`page` (its styles kept), headed by
-    the learner's ``progress`` (rows of ``notebook``, ``part``, ``status``, ``points``, from
-    wherever the course keeps it; none: no table), the notebook's lateness
-    (:func:`late_html`) and the judge's ``flags`` (:func:`flags_html`)."""
+    the learner's ``standing`` in every notebook (:func:`standing_html`; '' for none), the
+    notebook's lateness (:func:`late_html`) and the judge's ``flags`` (:func:`flags_html`)."""
     head, _, rest = made.partition('<body')
     tag, _, body = rest.partition('>')
-    boxes = [render('progress.html.j2', progress=progress), late_html(late), flags_html(flags)]
+    boxes = [standing, late_html(late), flags_html(flags)]
     body = render('above.html.j2', boxes=boxes) + body.rsplit('</body>', 1)[0]
     styles = re.findall(r'<style[^>]*>(.*?)</style>', head, flags=re.S | re.I)
     found = re.search(r'class="([\w\s-]*)"', tag)

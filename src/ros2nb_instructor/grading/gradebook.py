@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any, Iterable, Optional
 
 from nbgrader.api import Gradebook, MissingEntry
+from ros2nb import graded_parts
 
 from ..paths import ASSIGNMENT, ROOT, SOLUTIONS, gradebook_url
 from . import feedback
@@ -148,9 +149,24 @@ def collect_zip(archive: Path, course: Path, times: Optional[dict] = None,
     return collected, refused
 
 
-def _not_submitted_page(learner: Learner, notebook: str, points: float) -> str:
-    return feedback.page(notebook, feedback.render('not_submitted.html.j2', learner=learner.shown,
-                                                   notebook=notebook, points=f'{points:g}'))
+def _not_submitted_page(learner: Learner, notebook: str, points: float, standing: str) -> str:
+    return feedback.page(notebook, standing + feedback.render(
+        'not_submitted.html.j2', learner=learner.shown, notebook=notebook, points=f'{points:g}'))
+
+
+def standing_table(learner: Learner) -> str:
+    """The learner's table of every graded part of the course (:mod:`ros2nb.graded_parts`),
+    from this grading's own results (the judge's, never the learner's record of their lab):
+    passed, failed, or not handed in, with its points."""
+    parts = graded_parts.parts(SOLUTIONS)
+    states = {}
+    for part in parts:
+        result = learner.results.get(part.notebook, {}).get(part.grade_id, {})
+        states[part.grade_id] = (graded_parts.NOT_HANDED_IN if part.notebook not in learner.files
+                                 else graded_parts.PASSED if result.get('passed') is True
+                                 else graded_parts.FAILED)
+    return graded_parts.table_html(graded_parts.rows(parts, states),
+                                   'Every notebook, as the grader found it')
 
 
 #: grades.csv's columns: ``score`` is what the notebook counts (after lateness), ``raw_score``
@@ -172,6 +188,7 @@ def write_results(course: Path, out: Path, learners: list[Learner], notebooks: l
         maxima = {nb.name: nb.max_score for nb in gb.find_assignment(ASSIGNMENT).notebooks}
         for learner in learners:
             total = raw_total = 0.0
+            standing = feedback.standing_html(standing_table(learner))
             folder = out / 'feedback' / learner.name
             folder.mkdir(parents=True, exist_ok=True)
             for notebook in notebooks:
@@ -193,7 +210,7 @@ def write_results(course: Path, out: Path, learners: list[Learner], notebooks: l
                 rows.append([learner.shown, notebook, f'{score:g}', f'{maxima[notebook]:g}',
                              f'{raw:g}', f'{raw - score:g}', _time(late, 'handed_in'),
                              _time(late, 'due')])
-                _feedback_page(course, folder, learner, notebook, maxima[notebook])
+                _feedback_page(course, folder, learner, notebook, maxima[notebook], standing)
             rows.append([learner.shown, 'TOTAL', f'{total:g}', f'{sum(maxima.values()):g}',
                          f'{raw_total:g}', f'{raw_total - total:g}', '', ''])
         gb.db.commit()
@@ -210,18 +227,19 @@ def _time(late: Optional[Lateness], which: str) -> str:
 
 
 def _feedback_page(course: Path, folder: Path, learner: Learner, notebook: str,
-                   points: float) -> None:
-    """The learner's feedback page of ``notebook`` (nbgrader's, made safe, headed by its
-    lateness and the judge's flags), or one saying it was not submitted."""
+                   points: float, standing: str) -> None:
+    """The learner's feedback page of ``notebook`` (nbgrader's, made safe, headed by the
+    learner's ``standing`` in every notebook, its lateness and the judge's flags), or one
+    saying it was not submitted (headed by ``standing`` too)."""
     made = course / 'feedback' / learner.id / ASSIGNMENT / f'{notebook}.html'
     page = folder / f'{notebook}.html'
     try:
         if notebook in learner.files and made.is_file():
             page.write_text(feedback.safe_feedback(made.read_text(), notebook,
                                                    learner.flags.get(notebook, ()),
-                                                   learner.late.get(notebook)))
+                                                   learner.late.get(notebook), standing))
         else:
-            page.write_text(_not_submitted_page(learner, notebook, points))
+            page.write_text(_not_submitted_page(learner, notebook, points, standing))
     except Exception as error:  # noqa: BLE001 - that page's problem, in a note
         why = (f'its feedback page could not be written ({type(error).__name__}: '
                f'{str(error)[:200]}); the score stands')

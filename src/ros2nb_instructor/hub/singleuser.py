@@ -63,9 +63,10 @@ def copy_missing_notebooks(source: Path, folder: Path) -> list[str]:
 
 
 def learner_environment(env: MutableMapping[str, str], folder: Path, venv_bin: Path) -> None:
-    """Give the learner their own ROS workspace, the course's venv first on ``PATH``,
-    the learner's lab."""
+    """Give the learner their own ROS workspace and work folder, the course's venv first on
+    ``PATH``, the learner's lab."""
     env.setdefault('ROS2NB_WORKSPACE', str(folder / 'workspace' / WORKSPACE_NAME))
+    env.setdefault(lab.WORK_ENV, str(folder / 'notebooks'))  # where their progress is kept
     env['PATH'] = os.pathsep.join([str(venv_bin), env.get('PATH', os.defpath)])
     env['VIRTUAL_ENV'] = str(venv_bin.parent)
     lab.learner_environment(env)  # nbgrader's instructor tools, news and Extension Manager off
@@ -102,6 +103,13 @@ def main(argv: Optional[list[str]] = None) -> NoReturn:
     """Prepare the learner's folder, then replace this process with jupyterhub-singleuser."""
     argv = sys.argv[1:] if argv is None else argv
     venv_bin = Path(sys.executable).parent
+    if argv in (['-h'], ['--help']):
+        print('usage: ros2nb-hub-singleuser [--check | JUPYTERHUB_SINGLEUSER_ARGUMENT ...]\n\n'
+              "JupyterHub's spawner command for the course: copy the notebooks the learner's "
+              'folder lacks (never overwriting theirs), then become jupyterhub-singleuser '
+              'with the arguments given.\n  --check  as root, say whether learners can use '
+              'the course (docs/classroom-server.md)')
+        sys.exit(0)
     if argv == ['--check']:
         problem = check_learners_can_use_course(Path(sys.executable)) if os.geteuid() == 0 else None
         sys.exit(problem)

@@ -1,0 +1,243 @@
+"""One line for Python's everyday errors in the learner's code: the name they meant, the
+attribute never set on the node, the argument a class does not take.
+
+Part of :mod:`ros2nb.explain`; what a check says when the learner's code raised an error no
+other explanation knows (:func:`~ros2nb.explain.exceptions.describe_error`): the error,
+what it means here and what to do, where a traceback would have shown the learner's frames.
+Runs wherever a check runs learner code: the kernel (a check of the learner's objects) and a
+judge's subject.  Introduced in ``03-write-the-publisher.ipynb``.
+"""
+
+from __future__ import annotations
+
+import builtins
+import inspect
+import linecache
+import re
+from types import FrameType
+from typing import Any, Optional
+
+from ..errors import Ros2nbError, UsageError
+from .frames import frames_of, learner_frame
+from .names import (declared, import_of, learners_functions, place, raising_text,
+                    similar, stored)
+
+_CONSTRUCTOR_ARGUMENTS = re.compile(r'Invalid arguments passed to constructor: '
+                                    r'(?:dict_keys\(\[(?P<keys>[^\]]*)\]\)|(?P<names>.+))')
+#: Python's refusal of two values an operator cannot take together.
+_OPERANDS = re.compile(r"(?:not supported between instances of|unsupported operand type\(s\) "
+                       r"for \S+:) '(\w+)' and '(\w+)'")
+
+
+def _first_line(exc: BaseException) -> str:
+    return (str(exc).splitlines() or [''])[0][:200]
+
+
+def _unset_attribute(obj: Any, name: str, owner: str) -> Optional[str]:
+    """``self.name`` read on the learner's node, where no method of theirs keeps it: a local
+    of that name (``temperature = ...``), an attribute of a name a typo away, one set only
+    later, or none at all."""
+    methods = list(learners_functions(type(obj)))
+    if not methods:
+        return None
+    for code in methods:
+        line = stored(code, name, 'STORE_FAST')
+        if line is not None:
+            return (f'{owner} has no attribute {name}: {code.co_name} sets a local name '
+                    f'{name} ({place(code, line)}), which is gone when it returns: write '
+                    f'self.{name} = ... there, so that the node keeps it.')
+    kept = similar(name, [key for key in vars(obj) if not key.startswith('_')])
+    if kept:
+        return (f'{owner} has no attribute {name}, but it has {kept}: names must match '
+                f'exactly where they are set and where they are used (self.{name}).')
+    if any(stored(code, name, 'STORE_ATTR') for code in methods):
+        return (f'{owner} has no attribute {name} yet: it is read before any method sets it: '
+                f'set self.{name} in __init__.')
+    meant = similar(name, dir(obj))
+    if meant:
+        return (f'{owner} has no attribute {name}: did you mean self.{meant}? Names must '
+                'match exactly.')
+    return (f'{owner} has no attribute {name}: no method of the class sets self.{name}, and '
+            f'none is called {name}: set self.{name} in __init__ (or write the method).')
+
+
+def _attribute(exc: AttributeError) -> Optional[str]:
+    name, obj = getattr(exc, 'name', None), getattr(exc, 'obj', None)
+    if not name or obj is None:
+        return None
+    owner = obj.__name__ if isinstance(obj, type) or hasattr(obj, '__file__') and hasattr(
+        obj, '__name__') else type(obj).__name__
+    if not isinstance(obj, type) and not hasattr(obj, '__file__'):
+        unset = _unset_attribute(obj, name, owner)
+        if unset:
+            return unset
+    meant = similar(name, dir(obj))
+    if meant:
+        return f"{owner} has no attribute {name}: did you mean {meant}? Names must match exactly."
+    return f'{owner} has no attribute {name}: check the name against what {owner} offers.'
+
+
+def _name(exc: NameError, frame: FrameType) -> str:
+    name = getattr(exc, 'name', None)
+    if not name:
+        quoted = re.match(r"name '(\w+)'", _first_line(exc))
+        name = quoted.group(1) if quoted else '?'
+    visible = {*frame.f_locals, *frame.f_globals, *vars(builtins)}
+    if name == 'self':  # self.NAME in a plain function: the notebook's own names are plain
+        used = re.search(r'\bself\.(\w+)', linecache.getline(frame.f_code.co_filename,
+                                                             frame.f_lineno))
+        plain = used.group(1) if used else 'the name'
+        return (f"name 'self' is not defined: {frame.f_code.co_name}() is a function, not a "
+                f'method of a node, so there is no self: write {plain}, not self.{plain}.')
+    meant = similar(name, visible)
+    if meant:
+        return (f"name '{name}' is not defined: did you mean {meant}? Names must match "
+                'exactly.')
+    imported = import_of(name)
+    if imported:
+        return (f"name '{name}' is not defined: import it at the top of the file (or cell), "
+                f'{imported}.')
+    return (f"name '{name}' is not defined where this line runs: define it (or import it) "
+            'before, or check its spelling.')
+
+
+def _constructor_arguments(exc: AssertionError) -> Optional[str]:
+    """rclpy's and the messages' ``Invalid arguments passed to constructor``: which argument
+    the class does not take, and the one meant."""
+    found = _CONSTRUCTOR_ARGUMENTS.search(str(exc))
+    frames = list(frames_of(exc))
+    made = frames[-1].f_locals.get('self') if frames else None
+    if not found or made is None:
+        return None
+    takes = [slot.lstrip('_') for slot in getattr(type(made), '__slots__', ())]
+    given = [name.strip(" '") for name in (found['keys'] or found['names']).split(',')]
+    unknown = [name for name in given if name not in takes]
+    if not unknown:
+        return None
+    cls = type(made).__name__
+    meant = similar(unknown[0], takes)
+    hint = f': did you mean {meant}?' if meant else ''
+    return (f'{cls}() takes no argument {unknown[0]}{hint} (it takes '
+            f'{", ".join(t for t in takes if not t.startswith("check"))}).')
+
+
+def _unset_local(exc: UnboundLocalError, frame: FrameType) -> str:
+    """A name the function sets (which makes it local everywhere in it) used before that."""
+    quoted = re.search(r"'(\w+)'", _first_line(exc))
+    name = quoted.group(1) if quoted else '?'
+    line = stored(frame.f_code, name, 'STORE_FAST')
+    where = f' ({place(frame.f_code, line)})' if line is not None else ''
+    return (f'{name} is used before {frame.f_code.co_name} sets it{where}: a name the '
+            f'function sets is its own local name everywhere in it; set it first, or, for an '
+            f'import, import it at the top of the file.')
+
+
+_MISSING = re.compile(r"^(?P<called>[\w.]+)\(\) missing \d+ required positional "
+                      r"arguments?: (?P<names>.+)$")
+
+
+def _missing_arguments(exc: TypeError, frame: FrameType) -> Optional[str]:
+    """``create_publisher(Float32)``: which arguments the call still needs, in its order."""
+    found = _MISSING.match(_first_line(exc))
+    if found is None:
+        return None
+    called = found['called'].removesuffix('.__init__').rpartition('.')[2]
+    names = ', '.join(re.findall(r"'(\w+)'", found['names']))
+    return (f'{called}() was called without {names}: give it every argument it needs, in '
+            f'its order.')
+
+
+_UNEXPECTED_KEYWORD = re.compile(r"^(?P<called>[\w.]+)\(\) got an unexpected keyword argument "
+                                 r"'(?P<name>\w+)'")
+
+
+def _unexpected_keyword(exc: TypeError, frame: FrameType) -> Optional[str]:
+    """``Worker(heartbat_group=...)``: the keyword the callable takes that was meant."""
+    found = _UNEXPECTED_KEYWORD.match(_first_line(exc))
+    if found is None:
+        return None
+    called = found['called'].removesuffix('.__init__')
+    line = linecache.getline(frame.f_code.co_filename, frame.f_lineno)
+    written = re.search(rf'([\w.]*\b{re.escape(called.split(".")[-1])})\(', line)
+    path = written.group(1) if written else called  # ros2nb.spin, as the line calls it
+    target = {**frame.f_globals, **frame.f_locals}.get(path.split('.')[0])
+    for part in path.split('.')[1:]:
+        target = getattr(target, part, None)
+    try:
+        takes = [p for p in inspect.signature(target).parameters if p not in ('self', 'args',
+                                                                               'kwargs')]
+    except (TypeError, ValueError):
+        return None
+    meant = similar(found['name'], takes)
+    hint = f': did you mean {meant}?' if meant else ''
+    return (f'{called}() takes no argument {found["name"]}{hint} (it takes '
+            f'{", ".join(takes) or "none"}).')
+
+
+def _operands(text: str, frame: FrameType, kinds: set[str]) -> str:
+    """``low_c >= high_c`` with a str on one side: which names on the line hold what."""
+    line = linecache.getline(frame.f_code.co_filename, frame.f_lineno)
+    held = [f'{name} is {value!r} ({type(value).__name__})'
+            for name, value in frame.f_locals.items()
+            if re.search(rf'\b{name}\b', line) and type(value).__name__ in kinds
+            and len(repr(value)) <= 40]
+    shown = f': here {", ".join(held)}' if held else ''
+    return (f'TypeError: {text}{shown}: find where the value of the wrong kind comes from, '
+            'and give the line two values it can take together.')
+
+
+def cause_place(exc: BaseException) -> Optional[str]:
+    """``FILE line N: source`` of the learner's line that caused ``exc`` where that is not
+    the line that raised it, or None.  A parameter's value of the wrong kind (None: declared
+    without a default) fails where it is used, perhaps in a line the course gave: the cause
+    is the learner's ``declare_parameter`` of it."""
+    frame = learner_frame(exc)
+    if frame is None or not isinstance(exc, (TypeError, ValueError)):
+        return None
+    used = re.search(r"get_parameter\(\s*'(\w+)'", raising_text(exc))
+    owner = frame.f_locals.get('self')
+    if used is None or owner is None:
+        return None
+    for code in learners_functions(type(owner)):
+        line = declared(code, used.group(1))
+        if line is not None:
+            return place(code, line)
+    return None
+
+
+def everyday_explanation(exc: BaseException) -> Optional[str]:
+    """The line for an error of Python's own that the learner's code raised, with what to do,
+    or None when it is not theirs to fix: no frame of the error is the learner's, and it is
+    no attribute missing on an object of a class of theirs (the course's code standing in
+    for a part reads what their constructor should have set)."""
+    frame = learner_frame(exc)
+    if isinstance(exc, (Ros2nbError, UsageError)):
+        return str(exc)  # ros2nb's own line, which says what to do
+    if isinstance(exc, AttributeError):
+        obj = getattr(exc, 'obj', None)
+        if frame is not None or any(True for _ in learners_functions(type(obj))):
+            found = _attribute(exc)
+            if found:
+                return found
+    if frame is None:
+        return None
+    text = _first_line(exc)
+    if isinstance(exc, UnboundLocalError):
+        return _unset_local(exc, frame)
+    if isinstance(exc, NameError):
+        return _name(exc, frame)
+    if isinstance(exc, AssertionError):
+        found = _constructor_arguments(exc)
+        if found:
+            return found
+    if isinstance(exc, TypeError):
+        found = _unexpected_keyword(exc, frame) or _missing_arguments(exc, frame)
+        if found:
+            return found
+    operands = _OPERANDS.search(text) if isinstance(exc, TypeError) else None
+    if operands:
+        return _operands(text, frame, set(operands.groups()))
+    if isinstance(exc, KeyError):
+        return (f'KeyError: {text}: the line reads a key that is not there: check its '
+                'spelling, or read it with .get(key, default).')
+    return f'{type(exc).__name__}: {text}: this line of yours raised it; fix it, then check again.'

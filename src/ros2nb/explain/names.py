@@ -1,0 +1,137 @@
+"""Where a learner's name came from: the name meant, the import left out, the line that set it.
+
+Part of :mod:`ros2nb.explain`, for :mod:`.everyday`: what a learner's error needs looked up
+besides its message: the names visible where it was raised (a typo away, but not a mere
+change of case), the module that defines a name they did not import, and, through
+:mod:`dis`, the line of theirs that stored a name or declared a parameter.
+"""
+
+from __future__ import annotations
+
+import difflib
+import dis
+import linecache
+import sys
+from pathlib import Path
+from types import CodeType
+from typing import Any, Iterator, Optional
+
+from .frames import is_library_file, learner_entry, learner_frame
+
+#: Names a learner uses without importing them, by the import that brings each.
+IMPORTS = {name: f'from std_msgs.msg import {name}' for name in
+           ('Float32', 'Float64', 'Bool', 'String', 'Int32', 'Int64')}
+IMPORTS.update({'Node': 'from rclpy.node import Node', 'rclpy': 'import rclpy',
+                'random': 'import random', 'Path': 'from pathlib import Path',
+                'ExternalShutdownException':
+                    'from rclpy.executors import ExternalShutdownException'})
+
+
+def similar(name: str, candidates: Any) -> Optional[str]:
+    """The candidate ``name`` was most likely meant to be (a typo away), or None; never one
+    that differs only in case from a lower-case name (``node`` is no typo of ``Node``)."""
+    names = sorted({c for c in candidates if isinstance(c, str) and not c.startswith('__')
+                    and not (name.islower() and c.lower() == name)})
+    near = [c for c in names if len(name) > 2 and one_edit_apart(name, c)]  # msg, mgs
+    found = near or difflib.get_close_matches(name, names, n=1, cutoff=0.75)
+    return found[0] if found else None
+
+
+def one_edit_apart(a: str, b: str) -> bool:
+    """Whether ``b`` is ``a`` with one letter left out, added, changed, or two swapped."""
+    if a == b or abs(len(a) - len(b)) > 1:
+        return False
+    if len(a) == len(b):
+        differ = [i for i in range(len(a)) if a[i] != b[i]]
+        return len(differ) == 1 or (len(differ) == 2 and differ[1] == differ[0] + 1
+                                    and a[differ[0]] == b[differ[1]]
+                                    and a[differ[1]] == b[differ[0]])
+    short, long_ = sorted((a, b), key=len)
+    return any(long_[:i] + long_[i + 1:] == short for i in range(len(long_)))
+
+
+#: Where an import the learner left out is looked for, in this order (what the course uses).
+_PACKAGES = ('std_msgs.msg', 'rclpy', 'rcl_interfaces.msg', 'pathlib', 'random')
+
+
+def import_of(name: str) -> Optional[str]:
+    """``from MODULE import name`` for a name a module of the course's packages defines
+    (the shortest public module among those loaded), or None."""
+    if name in IMPORTS:
+        return IMPORTS[name]
+    found = sorted((module_name for module_name, module in list(sys.modules.items())
+                    if module_name.startswith(_PACKAGES) and '._' not in module_name
+                    and isinstance(getattr(module, name, None), type)), key=len)
+    if not found:
+        return None
+    defined = getattr(sys.modules[found[0]], name).__module__  # where the class is written
+    return f'from {defined if defined in found else found[0]} import {name}'
+
+
+def place(code: CodeType, line: int) -> str:
+    """``FILE line N: source`` of a line of the learner's (``cell line N`` for a cell)."""
+    name = Path(code.co_filename)
+    place = name.name if name.is_file() and 'ipykernel' not in code.co_filename else 'cell'
+    return f'{place} line {line}: {linecache.getline(code.co_filename, line).strip()}'
+
+
+def learners_functions(cls: type) -> Iterator[CodeType]:
+    """The code of every method the learner wrote in ``cls`` and its bases (not ROS's)."""
+    for klass in cls.__mro__:
+        for value in vars(klass).values():
+            code = getattr(getattr(value, '__func__', value), '__code__', None)
+            if isinstance(code, CodeType) and not is_library_file(code.co_filename):
+                yield code
+
+
+def stored(code: CodeType, name: str, opname: str) -> Optional[int]:
+    """The line where ``code`` stores ``name`` with ``opname`` (STORE_FAST: a local;
+    STORE_ATTR: an attribute), or None."""
+    line = None
+    for instruction in dis.get_instructions(code):
+        if instruction.starts_line is not None:
+            line = instruction.starts_line
+        if instruction.opname == opname and instruction.argval == name:
+            return line
+    return None
+
+
+def made_where(exc: BaseException, obj: Any) -> str:
+    """`` (FILE line N: name = ...)``: where the learner's code put ``obj`` in the local name
+    it goes by where ``exc`` was raised (a message made of the wrong type), or ''."""
+    frame = learner_frame(exc)
+    if frame is None:
+        return ''
+    for name, value in frame.f_locals.items():
+        line = stored(frame.f_code, name, 'STORE_FAST') if value is obj else None
+        if line is not None:
+            return f' ({place(frame.f_code, line)})'
+    return ''
+
+
+def declared(code: CodeType, name: str) -> Optional[int]:
+    """The line where ``code`` calls ``declare_parameter`` with ``name``, or None."""
+    line, method = None, False
+    for instruction in dis.get_instructions(code):
+        if instruction.starts_line is not None:
+            line, method = instruction.starts_line, False
+        if instruction.argval == 'declare_parameter':
+            method = True
+        elif method and instruction.opname == 'LOAD_CONST' and instruction.argval == name:
+            return line
+    return None
+
+
+def raising_text(exc: BaseException) -> str:
+    """The source of the learner's lines that the instruction raising ``exc`` spans (one
+    line of a statement that runs over several: the f-string's line, not the call's first)."""
+    entry = learner_entry(exc)
+    if entry is None:
+        return ''
+    code = entry.tb_frame.f_code
+    positions = list(code.co_positions())
+    first, last = positions[entry.tb_lasti // 2][:2] if entry.tb_lasti // 2 < len(
+        positions) else (entry.tb_lineno, entry.tb_lineno)
+    first, last = first or entry.tb_lineno, last or first or entry.tb_lineno
+    return ''.join(linecache.getline(code.co_filename, line) for line in range(first, last + 1))
+

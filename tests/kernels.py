@@ -1,0 +1,129 @@
+"""A real Jupyter kernel for a test, and what one of its cells sent: every output message.
+
+The tests of what a learner sees in a cell (a check's lines, the line long work updates, the
+progress table, the mutation tests' ``mutation_runs.py``) read the kernel's own messages, as
+JupyterLab gets them.  The wait for a cell counts the kernel's work, not the wall clock
+(tests/waiting.py).
+"""
+
+from __future__ import annotations
+
+import os
+import queue
+import re
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Optional
+
+from jupyter_client.manager import start_new_kernel
+
+from waiting import wait_until
+
+#: The messages of a cell's output (the rest, status and the echo of its code, are left out).
+OUTPUTS = ('stream', 'error', 'display_data', 'update_display_data', 'execute_result')
+
+
+@dataclass
+class Cell:
+    """What one cell sent, in order, and the wall seconds it took.
+
+    :ivar messages: ``(kind, content)`` of each output message.
+    """
+
+    messages: list[tuple[str, dict]] = field(default_factory=list)
+    seconds: float = 0.0
+
+    @property
+    def stdout(self) -> str:
+        return ''.join(content['text'] for kind, content in self.messages
+                       if kind == 'stream' and content['name'] == 'stdout')
+
+    @property
+    def stderr(self) -> str:
+        return ''.join(content['text'] for kind, content in self.messages
+                       if kind == 'stream' and content['name'] == 'stderr')
+
+    @property
+    def error(self) -> Optional[tuple[str, list[str]]]:
+        """The error's name and its traceback lines as shown (colours removed), or None."""
+        for kind, content in self.messages:
+            if kind == 'error':
+                return content['ename'], [re.sub(r'\x1b\[[0-9;]*m', '', line)
+                                          for line in content['traceback']]
+        return None
+
+    @property
+    def html(self) -> list[str]:
+        return [c['data']['text/html'] for k, c in self.messages
+                if k == 'display_data' and 'text/html' in c['data']]
+
+
+class CellHung(AssertionError):
+    """A cell that neither finished nor worked for the seconds it was given."""
+
+
+class Kernel:
+    """A real ``python3`` kernel with the test process's environment (no ROS domain of its
+    own: the kernel claims one), the given workspace and ``env`` on top."""
+
+    def __init__(self, workspace: Optional[Path | str] = None, **env: str) -> None:
+        environment = {k: v for k, v in os.environ.items() if k != 'ROS_DOMAIN_ID'}
+        if workspace is not None:
+            environment['ROS2NB_WORKSPACE'] = str(workspace)
+        environment.update(env)
+        self.manager, self.client = start_new_kernel(kernel_name='python3', env=environment)
+
+    def run(self, code: str, seconds: float = 600) -> Cell:
+        """Run a cell; what it sent.
+
+        :param seconds: for the whole cell (a node may print for ever): of the kernel's work,
+            or of its idle waiting.
+        :raises CellHung: when the cell had them and had not finished.
+        """
+        msg_id, began, cell = self.client.execute(code), time.monotonic(), Cell()
+
+        def finished() -> bool:
+            try:
+                msg = self.client.get_iopub_msg(timeout=0.25)
+            except queue.Empty:
+                return False
+            if msg['parent_header'].get('msg_id') != msg_id:
+                return False
+            kind, content = msg['msg_type'], msg['content']
+            if kind in OUTPUTS:
+                cell.messages.append((kind, content))
+            return kind == 'status' and content['execution_state'] == 'idle'
+
+        if not wait_until(finished, seconds, interval=0):
+            raise CellHung(f'the cell did not finish within {seconds} s: {code!r}')
+        cell.seconds = time.monotonic() - began
+        return cell
+
+    def one_line(self, code: str, *fragments: str) -> str:
+        """Run a cell that must fail; check it shows one line with every fragment."""
+        cell = self.run(code)
+        assert cell.error is not None, f'no error for {code!r}: {cell.messages}'
+        shown = cell.error[1]
+        assert len(shown) == 1, shown
+        for fragment in fragments:
+            assert fragment in shown[0], (fragment, shown[0])
+        return shown[0]
+
+    def restart(self) -> None:
+        self.manager.restart_kernel(now=True)
+        self.client.wait_for_ready(timeout=120)
+
+    def close(self) -> None:
+        self.client.stop_channels()
+        self.manager.shutdown_kernel(now=True)
+
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def solution_cells(notebook: str) -> dict[str, str]:
+    """A solution notebook's cells' sources by id (``'10-record-and-replay'``)."""
+    import json
+    data = json.loads((ROOT / 'solutions' / f'{notebook}.ipynb').read_text())
+    return {c['id']: ''.join(c['source']) for c in data['cells']}
