@@ -110,9 +110,11 @@ MISTAKES = [
      "super().__init__('counting_monitor')", checks.check_counting_monitor,
      r"CountingMonitor\('monitor_7'\) made a node called counting_monitor: pass the name"),
     ('counting: never counts', PROMISES, 'self.received += 1', 'pass',
-     checks.check_counting_monitor, r'logged "received 0": add one to self.received'),
+     checks.check_counting_monitor,
+     r'logged "received 0"; the count is 1: start self.received at 0 in __init__'),
     ('counting: no attribute', PROMISES, '        self.received = 0\n', '',
-     checks.check_counting_monitor, r"object has no attribute 'received'"),
+     checks.check_counting_monitor,
+     r'has no attribute received yet: it is read before any method sets it'),
     ('worker: single-threaded', PROMISES, 'executor = MultiThreadedExecutor(num_threads=2)',
      'from rclpy.executors import SingleThreadedExecutor\n    executor = SingleThreadedExecutor()',
      checks.check_responsive_worker, r'No heartbeat came while slow_work was busy: a '
@@ -260,7 +262,7 @@ def test_a_count_reported_by_a_forged_subject(session, monkeypatch):
     blind(session, monkeypatch)
     fails_forged(session, PROMISES, 'self.received += 1', 'pass', FORGED_COUNT,
                  checks.check_counting_monitor,
-                 r'logged "received 0": add one to self.received')
+                 r'logged "received 0"; the count is 1: start self.received at 0 in __init__')
 
 
 def test_a_count_through_a_lambda_passes(session, capsys):
