@@ -24,7 +24,8 @@ from typing import Any, Optional, TypeVar
 
 from .. import domains
 from ..errors import CheckFailed
-from ..processes import Patience, kill_process_group, stop_process_group
+from ..patience import Patience
+from ..processes import kill_process_group, stop_process_group
 from ..subject.judge_time import JUDGE_CLOCK_ENV
 from ..subject.forked import SUBJECT_PREFIX_ENV, fork_subject, has_server
 from ..subject_interface import Command, ExecCells, LoadFile, reply_type, wire
@@ -39,7 +40,7 @@ from .reaching import MAX_SEEN, SEEN_PREFIX, Reached, parse_seen
 #: the judge's home and the session uses a temporary folder.
 SUBJECTS_FOLDER_ENV = 'ROS2NB_SUBJECTS_FOLDER'
 #: Seconds a subject may take to answer one command before it counts as hanging: CPU
-#: seconds while it works, wall-clock seconds while it waits (ros2nb.processes.Patience).
+#: seconds while it works, wall-clock seconds while it waits (ros2nb.patience.Patience).
 REPLY_TIMEOUT_S = 30.0
 #: Seconds between two looks at a subject that has not answered yet.
 POLL_S = 0.25
@@ -266,7 +267,7 @@ class SubjectProcess:
         """Send one command and return its reply (``command``'s reply type).
 
         :param timeout: seconds the subject gets: of CPU time while it works, of the wall
-            clock while it waits (:class:`~ros2nb.processes.Patience`), so that a busy
+            clock while it waits (:class:`~ros2nb.patience.Patience`), so that a busy
             machine never turns slow honest work into a hang.
         :raises SubjectHung: when no reply comes within ``timeout`` seconds, or the
             process died (its last output line is in the message).
