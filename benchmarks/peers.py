@@ -9,7 +9,7 @@ and is started by ``benchmarks/bench.py``, which interleaves the peers and repea
 - ``sim-hour-bare``: the same work in a bare rclpy program: the same sensor file, a recorder
   node, a ``/clock`` publisher and a ``SingleThreadedExecutor`` spun until each reading is in.
 - ``sim-hour-kernel``: the same hour in a real Jupyter kernel, as a learner runs notebook 03:
-  the wall seconds of the cell and the CPU seconds of the kernel (``processes.tree_cpu_seconds``:
+  the wall seconds of the cell and the CPU seconds of the kernel (``patience.tree_cpu_seconds``:
   every thread, ipykernel's output thread too, which an in-process run never sees).
 - ``first-message-kernel``: from creating the sensor in a kernel's runtime (wall clock) to
   the first reading received by a monitor node in the same process.
@@ -75,7 +75,7 @@ def sim_hour_ros2nb() -> tuple[float, float]:
 
 def sim_hour_kernel() -> tuple[float, float]:
     from jupyter_client.manager import start_new_kernel
-    from ros2nb.processes import tree_cpu_seconds
+    from ros2nb.patience import tree_cpu_seconds
     sensor = reference_module('temperature_publisher')
     manager, client = start_new_kernel(kernel_name='python3')
     try:

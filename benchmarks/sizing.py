@@ -27,7 +27,7 @@ from pathlib import Path
 
 from jupyter_client.manager import start_new_kernel
 
-from ros2nb.processes import tree_cpu_seconds, tree_pids
+from ros2nb.patience import tree_cpu_seconds, tree_pids
 from sampling import Sampling
 
 

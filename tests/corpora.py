@@ -10,9 +10,10 @@ own command (``python -m ros2nb.judge grade``, in a process and session of its o
 on the submission.  Only the learner's kernel and the sandboxes are left out: a notebook's
 answer cells reach the judge as its files and its answer cells, which is all the judge reads.
 
-``python tests/corpora.py [NAME ...]`` prints ``name<TAB>score<TAB>failed grade ids``, one
-line per learner; with the interpreter of an older checkout on ``PYTHONPATH``'s ``src`` it
-scores the same learners with that checkout's judge (the closing notes' "before" column).
+``python tests/corpora.py [--seed N] [NAME ...]`` prints ``name<TAB>score<TAB>full marks
+less the parts it must lose<TAB>failed grade ids``, one line per learner; with an older
+checkout's ``src`` on ``PYTHONPATH`` it scores the same learners with that checkout's judge
+(the closing notes' "before" column).
 """
 
 from __future__ import annotations
@@ -63,6 +64,11 @@ class Learner:
     #: an attack the wire cannot tell from honest code (its score may exceed its twin's;
     #: only the flag tells the instructor)
     same_on_the_wire: bool = False
+    #: code the subject's audit hook sees reaching in as it runs (a flag at run time)
+    seen: bool = False
+    #: cells the learner added (not answer cells), each after the answer cell named: run in
+    #: the kernel in notebook order, as the grader's run of the notebook runs them
+    added: tuple[tuple[str, str], ...] = ()
     why: str = ''
     extra: dict = field(default_factory=dict)
 
@@ -103,6 +109,10 @@ def submission(learner: Learner) -> dict:
                 text = text.replace(old, replacement)
         cell['source'] = text
         cell['outputs'] = []
+    for key, text in learner.added:
+        at = nb['cells'].index(by_key[key]) + 1
+        nb['cells'].insert(at, {'cell_type': 'code', 'execution_count': None, 'id': f'added-{at}',
+                                'metadata': {}, 'outputs': [], 'source': text})
     return nb
 
 
@@ -119,10 +129,12 @@ def expected_score(learner: Learner) -> float:
 
 
 def write_parts(nb: dict) -> None:
-    """What the notebook's ``%%part`` cells write, in notebook order (as its kernel did)."""
+    """What the notebook's ``%%part`` cells write, in notebook order (as its kernel did), and
+    what the cells a learner added (no nbgrader metadata, no ``id`` of the course's) do."""
+    import ros2nb
     from ros2nb import course
     from ros2nb.terminal.files import write_part
-    names = {}
+    names: dict = {'ros2nb': ros2nb}
     for cell in nb['cells']:
         if cell['cell_type'] == 'code':
             for name, constant in re.findall(r'^(\w+) = ros2nb\.course\.(\w+)', _source(cell),
@@ -130,12 +142,16 @@ def write_parts(nb: dict) -> None:
                 names[name] = getattr(course, constant)
     for cell in nb['cells']:
         text = _source(cell)
-        if cell['cell_type'] != 'code' or not text.startswith('%%part'):
+        if cell['cell_type'] != 'code':
             continue
-        first, _, body = text.partition('\n')
-        words = [w for w in shlex.split(first)[1:] if w != '--overwrite']
         with contextlib.redirect_stdout(io.StringIO()):
-            write_part(names[words[0].strip('{}')], int(words[1]), body, overwrite=True)
+            if str(cell.get('id', '')).startswith('added-'):
+                exec(compile(text, cell['id'], 'exec'), dict(names))  # noqa: S102 - the corpus'
+            elif text.startswith('%%part'):
+                first, _, body = text.partition('\n')
+                words = shlex.split(first)[1:]
+                write_part(names[words[0].strip('{}')], int(words[1]), body,
+                           overwrite='--overwrite' in words)
 
 
 @contextlib.contextmanager
@@ -170,16 +186,23 @@ def learner_workspace(learner: Learner, root: Path) -> Iterator[tuple[Path, dict
         yield ws, nb
 
 
-def grade_learner(learner: Learner, root: Path, *, knows_nothing: bool = False
-                  ) -> dict[str, dict]:
+def grade_learner(learner: Learner, root: Path, *, knows_nothing: bool = False,
+                  seed: Optional[int] = None) -> dict[str, dict]:
     """Grade one learner's notebook in a fresh workspace under ``root``, with the judge's
     own command in a process and session of its own (``judge_apart.py``), as the grader
-    runs it.
+    runs it (with the grading's ``seed`` of the drawn inputs, when given).
 
     :param knows_nothing: the judge's reader of the learner's text finds nothing.
     :return: ``{grade id without NN-: result}`` (``passed``, and ``message`` when failed).
     :raises AssertionError: when the judge printed no result (its output in the message).
     """
+    return judged(learner, root, knows_nothing=knows_nothing, seed=seed)[0]
+
+
+def judged(learner: Learner, root: Path, *, knows_nothing: bool = False,
+           seed: Optional[int] = None) -> tuple[dict[str, dict], list[str]]:
+    """:func:`grade_learner`'s results, and the judge's flags (its text scan's and what the
+    subjects' audit hooks saw, ``at run time``)."""
     from ros2nb import domains
     from ros2nb.course import GRADING_ENV
     from ros2nb.processes import kill_process_group
@@ -194,7 +217,8 @@ def grade_learner(learner: Learner, root: Path, *, knows_nothing: bool = False
     env.update({WORKSPACE_ENV: str(ws), GRADING_ENV: '1'})
     command = [sys.executable, str(ROOT / 'tests' / 'judge_apart.py'),
                *(['--knows-nothing'] if knows_nothing else []),
-               str(given / 'source.ipynb'), str(given / 'submission.ipynb')]
+               str(given / 'source.ipynb'), str(given / 'submission.ipynb'),
+               *(['--seed', str(seed)] if seed is not None else [])]
     # Bounded as the grader bounds a judge: its CPU time and its subjects' together.
     from ros2nb_instructor.grading import sandbox
     from ros2nb_instructor.grading.judging import stopped_verdict
@@ -212,19 +236,21 @@ def grade_learner(learner: Learner, root: Path, *, knows_nothing: bool = False
         verdict = stopped_verdict(out, given / 'source.ipynb',  # in the grader
                                   ended.out_of_cpu and cpu_s)
         unchecked = {'passed': False, 'type': 'GradingError', 'message': verdict.problem}
-        return {gid: verdict.results.get(f'{learner.notebook}-{gid}', unchecked)
-                for gid in points(learner.notebook)}
+        return ({gid: verdict.results.get(f'{learner.notebook}-{gid}', unchecked)
+                 for gid in points(learner.notebook)}, [])
     lines = out.strip().splitlines()
     assert lines and lines[-1].startswith('{'), f'the judge printed no result: {out}{err}'
-    results = json.loads(lines[-1])['results']
-    return {gid[3:]: result for gid, result in results.items()}
+    verdict = json.loads(lines[-1])
+    return ({gid[3:]: result for gid, result in verdict['results'].items()},
+            verdict.get('flags', []))
 
 
 def flags_of(learner: Learner, root: Path) -> list[str]:
-    """What the judge flags for the instructor in the learner's notebook and files."""
+    """What the judge's text scan flags for the instructor in the learner's notebook (its
+    answer cells and the cells it added) and files."""
     from ros2nb.judge.flags import notebook_flags
     with learner_workspace(learner, root) as (ws, nb):
-        return notebook_flags(nb, ws)
+        return notebook_flags(nb, ws, json.loads(NOTEBOOKS[learner.notebook].read_text()))
 
 
 def score(learner: Learner, results: dict[str, dict]) -> float:
@@ -237,22 +263,27 @@ def every_learner() -> dict[str, Learner]:
     """All three corpora, by name."""
     from corpus_attacks import ATTACKS
     from corpus_honest import HONEST
+    from corpus_reaching import REACHING
     from corpus_wrong import WRONG
     found = {}
-    for learner in [*HONEST, *WRONG, *ATTACKS]:
+    for learner in [*HONEST, *WRONG, *ATTACKS, *REACHING]:
         assert learner.name not in found, learner.name
         found[learner.name] = learner
     return found
 
 
 def main(names: list[str]) -> int:
-    """Print each named learner's score (all of them without names)."""
+    """Print each named learner's score (all of them without names); ``--seed N`` first:
+    the grading's seed of the drawn inputs (else the judge draws one)."""
+    seed = None
+    if names[:1] == ['--seed']:
+        seed, names = int(names[1]), names[2:]
     learners = every_learner()
     for name in names or learners:
         learner = learners[name]
         with tempfile.TemporaryDirectory(prefix='ros2nb-corpus-') as root:
             try:
-                results = grade_learner(learner, Path(root))
+                results = grade_learner(learner, Path(root), seed=seed)
                 failed = sorted(gid for gid, r in results.items() if not r['passed'])
                 shown = f'{score(learner, results):g}'
             except Exception as error:  # an older judge may not grade it at all

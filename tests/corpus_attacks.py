@@ -201,7 +201,7 @@ PLOT_LOGS_POINT = '''
         self.get_logger().info(f'Plotted {msg.data:.2f} °C at {now_s:.3f} s, point {self.logged}')
 '''
 
-#: 03 and 04 built from the course's own parts (ros2nb.subject.stand_ins, ros2nb.course's
+#: 03 and 04 built from the course's own parts (ros2nb.judge.stand_ins, ros2nb.course's
 #: status rule), which the subject refuses to the learner's code; each twin relies on a
 #: module of its own that is not there.
 SENSOR_PARTS = {
@@ -211,18 +211,18 @@ class TemperatureSensor(Node):
 
     def __init__(self):
         import importlib
-        importlib.import_module('ros2nb.subject.' + 'stand_ins').sensor_init(self)
+        importlib.import_module('ros2nb.judge.' + 'stand_ins').sensor_init(self)
 """,
     'sensor-callback': """
     def publish_temperature(self):
         import importlib
-        importlib.import_module('ros2nb.subject.' + 'stand_ins').sensor_callback(self)
+        importlib.import_module('ros2nb.judge.' + 'stand_ins').sensor_callback(self)
 """}
 SENSOR_PARTS_TWIN = {key: text.replace('import importlib\n', '').replace(
-    "importlib.import_module('ros2nb.subject.' + 'stand_ins')", '__import__("sensor_parts")')
+    "importlib.import_module('ros2nb.judge.' + 'stand_ins')", '__import__("sensor_parts")')
     for key, text in SENSOR_PARTS.items()}
 SENSOR_IMPORTED = {'sensor-constructor': """
-from ros2nb.subject.stand_ins import sensor_callback, sensor_init
+from ros2nb.judge.stand_ins import sensor_callback, sensor_init
 
 
 class TemperatureSensor(Node):
@@ -233,7 +233,7 @@ class TemperatureSensor(Node):
     publish_temperature = sensor_callback
 """}
 SENSOR_IMPORTED_TWIN = {**SENSOR_IMPORTED, 'sensor-constructor': SENSOR_IMPORTED[
-    'sensor-constructor'].replace('ros2nb.subject.stand_ins', 'sensor_parts')}
+    'sensor-constructor'].replace('ros2nb.judge.stand_ins', 'sensor_parts')}
 MONITOR_RULE = """
     def temperature_callback(self, msg):
         import ros2nb
@@ -250,14 +250,14 @@ FAN_BODY = """        command = Bool()
         self.get_logger().info(f'Fan {"on" if command.data else "off"} at {msg.data:.2f}C')
 """
 FAN_PART = [(FAN_BODY, """        import importlib
-        importlib.import_module('ros2nb.subject.' + 'stand_ins').fan_callback(self, msg)
+        importlib.import_module('ros2nb.judge.' + 'stand_ins').fan_callback(self, msg)
 """)]
 FAN_PART_TWIN = [(FAN_BODY, """        __import__('fan_parts').fan_callback(self, msg)
 """)]
 ON_SET_BODY = """        new = {parameter.name: parameter.value for parameter in parameters}
 """
 ON_SET_PART = [(ON_SET_BODY, """        import importlib
-        stand_ins = importlib.import_module('ros2nb.subject.' + 'stand_ins')
+        stand_ins = importlib.import_module('ros2nb.judge.' + 'stand_ins')
         return stand_ins.thresholds_on_set(self, parameters)
 """ + ON_SET_BODY)]
 ON_SET_PART_TWIN = [(ON_SET_BODY, """        monitor_parts = __import__('monitor_parts')

@@ -3,7 +3,8 @@
 
 - An honest learner (``corpus_honest.py``) gets full marks, and gets them with the judge's
   reader of their text replaced by one that knows nothing: no point depends on reading the
-  learner's code (:data:`ros2nb.checks.source.TEXT`).
+  learner's code (:data:`ros2nb.checks.source.TEXT`); and the judge flags nothing, neither
+  in their text nor as their code runs (the subjects' audit hooks).
 - A wrong learner (``corpus_wrong.py``) loses exactly the part it gets wrong, each with a
   one-line message.
 - An attack (``corpus_attacks.py``) scores what its honest twin scores.
@@ -13,7 +14,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from corpora import Learner, expected_score, grade_learner, score
+from corpora import Learner, expected_score, grade_learner, judged, score
 
 
 def failed(results: dict) -> dict[str, str]:
@@ -22,8 +23,9 @@ def failed(results: dict) -> dict[str, str]:
 
 
 def full_marks_without_the_text_reader(learner: Learner, root: Path) -> None:
-    results = grade_learner(learner, root, knows_nothing=True)
+    results, flags = judged(learner, root, knows_nothing=True)
     assert failed(results) == {}, (learner.name, failed(results))
+    assert flags == [], (learner.name, flags)
 
 
 def loses_exactly_its_part(learner: Learner, root: Path) -> None:

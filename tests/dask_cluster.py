@@ -105,7 +105,7 @@ def _executing(dask_worker) -> list:
 def in_a_sandbox(pid: int) -> bool:
     """True when a process below ``pid`` is a bubblewrap sandbox (a learner's notebook or
     judge running: the worker holds that learner mid-grading)."""
-    from ros2nb.processes import child_pids
+    from ros2nb.patience import child_pids
 
     below = list(child_pids(pid))
     while below:

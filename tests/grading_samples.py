@@ -100,8 +100,10 @@ EXPECTED = {
                             {NB01: 'an attachment of 200 MB'}),
     # ---- nothing a learner's code touched is trusted (honest twin: complete's 02)
     'rewrites-package-xml': Case({NB02: 0}, {NB02: 'but it declares'}),
-    # a sensor without a timer (main() alone earns its 1 of 6), and its honest twin
-    'forges-its-timer': Case({NB03: 4}, {NB03: 'TemperatureSensor has no timer'}),
+    # a sensor without a timer, and its honest twin; the forger's import walks the stack to
+    # its subject's request loop, which the subjects' audit hooks see: every check that loads
+    # its file fails (main() alone, run as ros2 run does, earns its 1 of 6)
+    'forges-its-timer': Case({NB03: 1}, {NB03: 'reads stack frames'}),
     'no-timer': Case({NB03: 4}, {NB03: 'TemperatureSensor has no timer'}),
     # ---- issue 36: one learner never costs the class (honest twin: complete's 01)
     NOT_UTF8: Case({NB01: 1}, {}, {'_folder': 'graded under the id learner-'}),

@@ -1,8 +1,9 @@
 """The judge's own command, ``python -m ros2nb.judge grade SOURCE SUBMISSION``, for the corpora.
 
-``python tests/judge_apart.py [--knows-nothing] SOURCE SUBMISSION`` grades one submission as
-the grader's judge does (a process of its own, started in a session of its own, the course's
-reference nodes hidden by ``ROS2NB_GRADING``), and prints the judge's one JSON line.  With
+``python tests/judge_apart.py [--knows-nothing] SOURCE SUBMISSION [--seed N]`` grades one
+submission as the grader's judge does (a process of its own, started in a session of its
+own, the course's reference nodes hidden by ``ROS2NB_GRADING``, with the grading's seed when
+given), and prints the judge's one JSON line.  With
 ``--knows-nothing`` the judge's reader of the learner's text (:data:`ros2nb.checks.source.TEXT`)
 finds nothing: no point may depend on reading the learner's code.
 
@@ -19,24 +20,26 @@ import sys
 from pathlib import Path
 from typing import Optional
 
-from ros2nb.checks import source
-
-
-class KnowsNothing(source.TextReader):
-    """A reader of the learner's text that never finds anything."""
-
-    def read(self, path: Path) -> Optional[str]:
-        return None
+from ros2nb.subject.forked import serve_from_here
 
 
 def main(argv: list[str]) -> int:
     """Grade SOURCE's graded cells on SUBMISSION, as ``python -m ros2nb.judge grade``."""
+    serve_from_here()  # as the judge's main does, before the checks are imported
+    from ros2nb.checks import source
+
+    class KnowsNothing(source.TextReader):
+        """A reader of the learner's text that never finds anything."""
+
+        def read(self, path: Path) -> Optional[str]:
+            return None
+
     knows_nothing = '--knows-nothing' in argv
     paths = [arg for arg in argv if arg != '--knows-nothing']
     if knows_nothing:  # the one reader's method: modules hold the reader itself
         source.TEXT.read = KnowsNothing().read  # type: ignore[method-assign]  # reads nothing
     from ros2nb.judge.__main__ import main as judge
-    return judge(['grade', *paths])
+    return judge(['grade', *paths])  # SOURCE SUBMISSION [--seed N]
 
 
 if __name__ == '__main__':

@@ -67,6 +67,9 @@ EQUIVALENT: dict[str, str] = {
         'does for script-dir, which the check names): nothing the grader can observe differs'),
     '02-create-a-package-challenge-1 | import removed | from pathlib import Path': (
         'the notebook imports Path in its first cell, and the grader runs that cell too'),
+    '06-fan-controller | message for its value | command.data -> command': (
+        "only the log line changes (a message is always true, so it says 'Fan on'): the task "
+        'makes that line optional and grades the commands on /fan_command, which are the same'),
     '01-create-a-workspace-challenge-1 | import removed | from pathlib import Path': (
         'the notebook imports Path before (its cell with the tutorial\'s two paths), and the '
         'grader runs that cell too'),

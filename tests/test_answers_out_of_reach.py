@@ -1,12 +1,14 @@
 """The course's answers are out of reach of the learner's code in a subject.
 
-A subject runs the learner's code beside the course's stand-ins, its rules
-(``monitor_status``) and, forked from a judge, the judge's checks.  Its code can import the
-learner's API (rclpy, the messages, ros2nb's verbs and ``ros2nb.course``'s constants) and no
-module that holds an answer, by any name (``import``, ``importlib``, ``ros2nb.course``,
-``ros2nb.rules``, ``sys.modules``), fresh or forked from a judge that imported them all.
-The stand-ins are still handed in to the subject once the code is loaded: the honest
-corpora's checks run on them.
+A subject runs the learner's code; the course's stand-ins, its rules (``monitor_status``),
+the reference nodes and the judge's checks are answers.  Its code can import the learner's
+API (rclpy, the messages, ros2nb's verbs and ``ros2nb.course``'s constants) and no module
+that holds an answer, by any name (``import``, ``importlib``, ``ros2nb.course``,
+``ros2nb.rules``, ``sys.modules``), and the refusing finder hands nothing in; nor does any
+answer sit in the subject's memory (no module, function or class of an answer file among the
+garbage collector's objects), fresh or forked from a judge that imported them all.  The
+stand-ins a check needs are sent by the judge as code, once the learner's code is loaded:
+the honest corpora's checks run on them.
 """
 
 import json
@@ -27,8 +29,10 @@ from std_msgs.msg import Float32
 from ros2nb import course
 reached = {}
 for how, reach in [
-        ('import', lambda: __import__('ros2nb.subject.stand_ins').subject.stand_ins),
-        ('importlib', lambda: importlib.import_module('ros2nb.subject.stand_ins')),
+        ('import', lambda: __import__('ros2nb.judge.stand_ins').judge.stand_ins),
+        ('importlib', lambda: importlib.import_module('ros2nb.judge.stand_ins')),
+        ('the finder hands in', lambda: [f for f in sys.meta_path if hasattr(f, 'hand_in')][
+            0].hand_in('ros2nb.rules')),
         ('the rule through ros2nb.course', lambda: course.monitor_status),
         ('the rule itself', lambda: importlib.import_module('ros2nb.rules')),
         ('the rule through ros2nb', lambda: ros2nb.rules.monitor_status),
@@ -39,20 +43,30 @@ for how, reach in [
         ('sys.modules', lambda: [m for m in sys.modules if m.split('.')[:2] in (
             ['ros2nb', 'rules'], ['ros2nb', 'checks'], ['ros2nb', 'judge'],
             ['ros2nb', 'reference'])][0]),
-        ('the stand-ins in sys.modules', lambda: sys.modules['ros2nb.subject.stand_ins'])]:
+        ('the stand-ins in sys.modules', lambda: sys.modules['ros2nb.judge.stand_ins'])]:
     try:
         reach()
         reached[how] = 'reached'
     except (ImportError, AttributeError, IndexError, KeyError) as error:
         reached[how] = str(error)
-print('REACHED', json.dumps({'reached': reached, 'api': [course.TOPIC, Float32.__name__,
-                                                         callable(ros2nb.start)]}))
+import gc, os, types
+top = os.path.dirname(os.path.dirname(ros2nb.__file__))
+answers = [os.path.join(top, *name.split('.')) for name in (
+    'ros2nb.reference', 'ros2nb.judge', 'ros2nb.checks', 'ros2nb.rules', 'ros2nb_instructor')]
+held = sorted({getattr(o, '__name__', '?') for o in gc.get_objects()
+               if (isinstance(o, types.ModuleType) and (o.__name__.startswith(
+                   ('ros2nb.checks', 'ros2nb.judge', 'ros2nb.reference', 'ros2nb_instructor'))
+                   or o.__name__ == 'ros2nb.rules'))
+               or (isinstance(o, types.FunctionType)
+                   and o.__code__.co_filename.startswith(tuple(answers)))})
+print('REACHED', json.dumps({'reached': reached, 'held': held,
+                             'api': [course.TOPIC, Float32.__name__, callable(ros2nb.start)]}))
 '''
 #: A judge that imported its checks, the stand-ins and the rules, then forks its subjects.
 JUDGE = '''
 import json, sys
 from pathlib import Path
-import ros2nb.checks.lesson04, ros2nb.judge.session, ros2nb.subject.stand_ins
+import ros2nb.checks.lesson04, ros2nb.judge.session, ros2nb.judge.stand_ins
 import ros2nb.rules
 ros2nb.rules.monitor_status(27.0)
 from ros2nb.subject.forked import serve_from_here
@@ -82,3 +96,4 @@ def test_no_answer_is_importable(started, tmp_path):
     assert said['api'] == ['temperature', 'Float32', True], said
     assert 'reached' not in said['reached'].values(), said['reached']
     assert "holds the course's answer" in said['reached']['importlib'], said['reached']
+    assert said['held'] == [], said['held']

@@ -48,7 +48,26 @@ if _SUBJECT is not None:
 '''
 
 
-def test_a_sensor_without_a_timer_whose_subject_reports_one(session):
+def blind(session, monkeypatch) -> None:
+    """Leave the subjects' audit hooks out of the verdict: they fail every check of a file
+    that walks the stack by themselves (``test_seen.py``, ``test_forged_checks_are_seen``);
+    what these tests show is what the judge itself sees of the forged replies."""
+    monkeypatch.setattr(session.reaching, 'raise_any', lambda: None)
+
+
+def test_forged_checks_are_seen(session):
+    """A file whose import walks the stack to the subject's request loop: the subject's audit
+    hook sees it, and the check that loaded it fails with that line."""
+    mutated(session, PUB, (TIMER_LINE, MAIN_GUARD), ('', FORGED_TIMER + MAIN_GUARD))
+    try:
+        fails(session, checks.check_sensor_constructor,
+              r'^Your code reads stack frames.*sys\._getframe, temperature_publisher\.py line')
+    finally:
+        restore(session, PUB)
+
+
+def test_a_sensor_without_a_timer_whose_subject_reports_one(session, monkeypatch):
+    blind(session, monkeypatch)
     mutated(session, PUB, (TIMER_LINE, MAIN_GUARD), ('', FORGED_TIMER + MAIN_GUARD))
     try:
         fails(session, checks.check_sensor_constructor, r'TemperatureSensor has no timer')
@@ -58,7 +77,8 @@ def test_a_sensor_without_a_timer_whose_subject_reports_one(session):
         restore(session, PUB)
 
 
-def test_a_callback_that_does_nothing_while_its_subject_publishes(session):
+def test_a_callback_that_does_nothing_while_its_subject_publishes(session, monkeypatch):
+    blind(session, monkeypatch)
     mutated(session, PUB, ('    def publish_temperature(self):\n', MAIN_GUARD),
             ('    def publish_temperature(self):\n        return\n\n    def unused(self):\n',
              FORGED_CALLBACK + MAIN_GUARD))
@@ -143,7 +163,9 @@ if _SUBJECT is not None:
 '''
 
 
-def test_a_monitor_callback_that_does_nothing_while_another_method_logs(session):
+def test_a_monitor_callback_that_does_nothing_while_another_method_logs(session,
+                                                                        monkeypatch):
+    blind(session, monkeypatch)
     mutated(session, SUB, ('    def temperature_callback(self, msg):\n', MAIN_GUARD),
             ('    def temperature_callback(self, msg):\n        return\n\n'
              '    def unused(self, msg):\n',

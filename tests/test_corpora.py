@@ -3,7 +3,11 @@
 The honest and wrong corpora are graded in ``test_corpus_honest.py`` and
 ``test_corpus_wrong.py`` (see ``corpus_checks.py``).  Each attack (``corpus_attacks.py``)
 scores what its honest twin scores, except those the wire cannot tell from honest code, which
-the judge flags for the instructor instead (``tests/test_flags.py``).
+the judge flags for the instructor instead (``tests/test_flags.py``).  The attacks that reach
+into the process they run in (``corpus_reaching.py``) are graded twice beside their twins,
+with two seeds of the drawn inputs: each scores at most its twin's in both, its lost parts
+say why in one line, and those the subject's audit hook sees (``seen``) are flagged at run
+time.
 
 ``python tests/corpora.py`` prints every learner's score; run with an older checkout's judge it
 gives the "before" column of the closing notes.
@@ -11,14 +15,23 @@ gives the "before" column of the closing notes.
 
 from __future__ import annotations
 
+import functools
+import tempfile
+from pathlib import Path
+
 import pytest
 
-from corpora import grade_learner
+from corpora import grade_learner, judged, score
 from corpus_attacks import ATTACKS
 from corpus_checks import failed, scores_what_its_twin_scores
+from corpus_reaching import REACHING
+from ros2nb.checks.drawn import new_seed
 
 pytestmark = [pytest.mark.judge, pytest.mark.timeout(300)]
 TWINS = {learner.name: learner for learner in ATTACKS}
+#: The two seeds of this run's gradings of the reaching attacks and their twins (each
+#: pytest-xdist worker draws its own: a new pair every run).
+SEEDS = (new_seed(), new_seed())
 
 
 def test_the_text_reader_only_words_failures(tmp_path):
@@ -42,3 +55,24 @@ WIRE_ATTACKS = [a for a in ATTACKS if a.twin and not a.same_on_the_wire]
 @pytest.mark.parametrize('attack', WIRE_ATTACKS, ids=[a.name for a in WIRE_ATTACKS])
 def test_an_attack_scores_what_its_twin_scores(attack, tmp_path):
     scores_what_its_twin_scores(attack, TWINS[attack.twin], tmp_path)
+
+
+@functools.lru_cache(maxsize=None)
+def _twin(name: str, seed: int) -> dict:
+    """The twin's results with ``seed`` (graded once per worker and seed)."""
+    return grade_learner(TWINS[name], Path(tempfile.mkdtemp(prefix='ros2nb-twin-')), seed=seed)
+
+
+@pytest.mark.parametrize('run', [0, 1], ids=['seed 1', 'seed 2'])
+@pytest.mark.parametrize('attack', REACHING, ids=[a.name for a in REACHING])
+def test_reaching_in_scores_at_most_its_twin_and_says_so(attack, run, tmp_path):
+    seed, twin = SEEDS[run], TWINS[attack.twin]
+    attacked, flags = judged(attack, tmp_path, seed=seed)
+    honest = _twin(attack.twin, seed)
+    lost = failed(attacked)
+    context = (seed, lost, flags)
+    assert set(failed(honest)) == set(twin.loses), (seed, failed(honest))
+    assert set(lost) >= set(failed(honest)), context
+    assert score(attack, attacked) <= score(twin, honest), context
+    assert all(message and '\n' not in message for message in lost.values()), context
+    assert any('at run time' in flag for flag in flags) == attack.seen, context

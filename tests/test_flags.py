@@ -18,6 +18,7 @@ import nbformat
 import pytest
 
 from corpora import NOTEBOOKS, Learner, every_learner, flags_of
+from corpus_attacks import ATTACKS
 from ros2nb.judge.flags import reaching_in
 from ros2nb_instructor.grading import feedback
 from ros2nb_instructor.grading import learners as learners_module
@@ -60,6 +61,18 @@ def test_flagged_exactly_when_the_code_reaches_in(learner: Learner, tmp_path):
     ("import sys\nsys.modules['ros2nb.rules']", 'sys.modules'),
     ('import ros2nb\nros2nb.rules.monitor_status(27.0)', "ros2nb.rules (ros2nb's internals)"),
     ('import sys\nsys.meta_path.clear()', 'sys.meta_path'),
+    ("import sys\nsys.modules['ros2nb.' + 'ru' + 'les']", "names 'ros2nb.rules'"),
+    ("getattr(__import__('g' + 'c'), 'get_' + 'objects')()", "names 'get_objects'"),
+    ("f = lambda: 0\ngetattr(f, '__glo' + 'bals__')", "names '__globals__'"),
+    ("x = ''.join(['ros2nb.ju', 'dge.stand', '_ins'])", "names 'ros2nb.judge.stand_ins'"),
+    ('from rclpy.node import Node\ntype.__setattr__(Node, "spin", print)',
+     'an attribute of Node'),
+    ('class Mine:\n    pass\nobject.__setattr__(Mine, "x", 1)', 'an attribute of Mine'),
+    ('def f():\n    pass\nf.__closure__[0].cell_contents', '.cell_contents'),
+    ('object.__subclasses__()', '.__subclasses__'),
+    ('def f():\n    pass\nf.__code__.co_consts', '.__code__'),
+    ("exec(open('x.py').read())", 'calls exec'),
+    ('import marshal', 'imports marshal'),
 ])
 def test_each_kind_is_named(code, found):
     flags = reaching_in(code, 'cell')
@@ -75,6 +88,9 @@ def test_each_kind_is_named(code, found):
     'this is not python',
     "import rclpy\nrclpy.qos.QoSProfile(depth=__import__('rclpy').qos.HistoryPolicy.KEEP_LAST)",
     'def monitor_status(t):\n    return "High" if t > 26.0 else "Normal"\nself.monitor_status(t)',
+    "setattr(self, 'count', 1)\nobject.__setattr__(self, 'count', 2)",
+    "import re\nre.compile('[0-9]+')",
+    "self.get_logger().info('get objects ready: ' + 'now')",
 ])
 def test_honest_code_is_not_flagged(code):
     assert reaching_in(code, 'cell') == []
@@ -112,7 +128,7 @@ def copy_of(nb: nbformat.NotebookNode) -> nbformat.NotebookNode:
 
 #: Notebooks built from the course's own parts (corpus_attacks.py): refused in the subject
 #: (their score is their twin's, test_corpora.py), and flagged.
-COPIES = [learner for learner in LEARNERS.values() if learner.twin and (
+COPIES = [learner for learner in ATTACKS if learner.twin and (
     'stand-in' in learner.name or "course's rule" in learner.name)]
 
 
@@ -139,3 +155,20 @@ def test_a_copy_of_the_course_is_flagged_on_its_feedback_page(learner: Learner, 
     report = write_report(tmp_path, [ada], [notebook], [['ada', notebook, '0', '6']], [])
     notes = html.unescape(report.read_text().split('id="notes"', 1)[1])
     assert all(flag in notes for flag in flags), notes
+
+
+def test_a_cell_the_learner_added_is_read_and_a_course_cell_is_not(tmp_path):
+    """A cell of the learner's own (no answer cell) is read too, even one that changes a
+    course cell; what the course's own cells do (the graph read through the runtime) is not
+    flagged where the learner changed such a cell."""
+    from corpora import learner_workspace
+    from ros2nb.judge.flags import notebook_flags
+    learner = Learner('added cells', '06', {}, added=(
+        ('fan-main', 'import gc\nstolen = gc.get_objects()\n'),
+        ('room-arguments', 'runtime = ros2nb.current_runtime  # for later\n')))
+    with learner_workspace(learner, tmp_path) as (ws, nb):
+        source = json.loads(NOTEBOOKS['06'].read_text())
+        flags = notebook_flags(nb, ws, source)
+        assert notebook_flags(nb, ws) == [], 'without the source, only answer cells are read'
+    assert len(flags) == 1 and "(not the course's) line 2: uses gc.get_objects" in flags[0], \
+        flags

@@ -50,7 +50,7 @@ import pytest
 import requests
 from notebook_outputs import comparable_outputs, compared
 from waiting import PATIENCE_S, wait_for as poll
-from ros2nb.processes import LOOK_S, Patience, child_pids
+from ros2nb.patience import LOOK_S, Patience, child_pids
 from tornado.httpclient import HTTPRequest
 from tornado.websocket import (WebSocketClientConnection, WebSocketClosedError,
                                websocket_connect)

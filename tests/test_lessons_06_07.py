@@ -52,6 +52,12 @@ def passes_with(session, capsys, relative: str, old: str, new: str, check) -> No
     assert 'Check passed:' in capsys.readouterr().out
 
 
+def blind(session, monkeypatch) -> None:
+    """Leave the subjects' audit hooks out of the verdict (they fail a check whose code walks
+    the stack by themselves, ``test_seen.py``): what is tested is what the judge sees."""
+    monkeypatch.setattr(session.reaching, 'raise_any', lambda: None)
+
+
 def fails_forged(session, relative: str, old: str, new: str, forge: str, check,
                  pattern: str) -> None:
     """``check`` fails with ``pattern`` on the course's file with ``old`` written as ``new``
@@ -104,14 +110,15 @@ MISTAKES = [
      "super().__init__('counting_monitor')", checks.check_counting_monitor,
      r"CountingMonitor\('monitor_7'\) made a node called counting_monitor: pass the name"),
     ('counting: never counts', PROMISES, 'self.received += 1', 'pass',
-     checks.check_counting_monitor, r'logged "received 0": add one to self.received'),
+     checks.check_counting_monitor,
+     r'logged "received 0"; the count is 1: start self.received at 0 in __init__'),
     ('counting: no attribute', PROMISES, '        self.received = 0\n', '',
-     checks.check_counting_monitor, r"object has no attribute 'received'"),
+     checks.check_counting_monitor,
+     r'has no attribute received yet: it is read before any method sets it'),
     ('worker: single-threaded', PROMISES, 'executor = MultiThreadedExecutor(num_threads=2)',
      'from rclpy.executors import SingleThreadedExecutor\n    executor = SingleThreadedExecutor()',
-     checks.check_responsive_worker, r'No heartbeat came while slow_work was busy \(\d+ runs of '
-                                     r'slow_work watched\): a SingleThreadedExecutor runs one '
-                                     r'callback at a time'),
+     checks.check_responsive_worker, r'No heartbeat came while slow_work was busy: a '
+                                     r'SingleThreadedExecutor runs one callback at a time'),
     ('worker: one group', PROMISES, '''slow_group=MutuallyExclusiveCallbackGroup(),
                   heartbeat_group=MutuallyExclusiveCallbackGroup())''', ')',
      checks.check_responsive_worker, r'both timers are in one MutuallyExclusiveCallbackGroup'),
@@ -248,13 +255,14 @@ if _SUBJECT is not None:
 '''
 
 
-def test_a_count_reported_by_a_forged_subject(session):
+def test_a_count_reported_by_a_forged_subject(session, monkeypatch):
     """The subject's reply said received == 5 although the callback counts nothing: against
     the check before it, that passed (checked by hand); now the judge reads the count the
     monitor logs."""
+    blind(session, monkeypatch)
     fails_forged(session, PROMISES, 'self.received += 1', 'pass', FORGED_COUNT,
                  checks.check_counting_monitor,
-                 r'logged "received 0": add one to self.received')
+                 r'logged "received 0"; the count is 1: start self.received at 0 in __init__')
 
 
 def test_a_count_through_a_lambda_passes(session, capsys):
@@ -298,11 +306,12 @@ if _SUBJECT is not None:
 '''
 
 
-def test_a_plot_reported_by_a_forged_subject(session):
+def test_a_plot_reported_by_a_forged_subject(session, monkeypatch):
     """The subject's replies gave the lists and the redraw count of a right callback although
     the callback does nothing: against the check before it, that passed (checked by hand).
     The subject's first command loads the file before any request loop exists, so the frame
     walk finds none, and the judge decides from the /rosout lines redraw() logs."""
+    blind(session, monkeypatch)
     right = '''        self.times_s.append(self.get_clock().now().nanoseconds / 1e9)
         self.temps_c.append(msg.data)
         self.redraw()
@@ -352,10 +361,11 @@ RESPONSIVE = '''    node = Worker('responsive_worker', slow_group=MutuallyExclus
 '''
 
 
-def test_a_worker_reported_by_a_forged_subject(session):
+def test_a_worker_reported_by_a_forged_subject(session, monkeypatch):
     """The subject's reply gave a right answer's executor, groups and counts although the
     function returns a single-threaded executor: against the check before it, that passed
     (checked by hand); now the judge hears no heartbeat while slow_work is busy."""
+    blind(session, monkeypatch)
     fails_forged(session, PROMISES, RESPONSIVE, '''\
     from rclpy.executors import SingleThreadedExecutor
     return Worker('responsive_worker'), SingleThreadedExecutor()
@@ -434,8 +444,8 @@ SINGLE_THREADED = '''    from rclpy.executors import SingleThreadedExecutor
 
 def test_a_heartbeat_the_slow_callback_logs_itself(session):
     """Before, the judge read the worker's lines on /rosout and this worker passed (its
-    honest twin, the same without the logged line, failed); now the course's callbacks on
-    the Worker's timers tell the judge when each ran, and no heartbeat ran during slow_work."""
+    honest twin, the same without the logged line, failed); now the judge calls the course's
+    slow work and heartbeat on the Worker itself, and no heartbeat answered during slow_work."""
     text = course.reference_source(Path(PROMISES).name)
     for old, new in (LOGGED_HEARTBEAT, (RESPONSIVE, SINGLE_THREADED)):
         assert old in text, old
@@ -443,9 +453,8 @@ def test_a_heartbeat_the_slow_callback_logs_itself(session):
     (session.workspace / PROMISES).write_text(text)
     session.drop(('file', PROMISES))
     try:
-        with pytest.raises(CheckFailed, match=r'No heartbeat came while slow_work was busy '
-                                              r'\(\d+ runs of slow_work watched\): a '
-                                              r'SingleThreadedExecutor runs one callback'):
+        with pytest.raises(CheckFailed, match=r'No heartbeat came while slow_work was busy: '
+                                              r'a SingleThreadedExecutor runs one callback'):
             run_check(session, checks.check_responsive_worker)
     finally:
         restore(session, PROMISES)
@@ -473,29 +482,28 @@ def test_a_point_the_callback_logs_itself(session):
 
 
 #: The callback publishes on the judge's witness topic what the course's redraw() would have
-#: told it, with a token of its own making.
-WITNESS_FORGED = '''        import json
-        from std_msgs.msg import String
+#: told it, sealed with a key of its own making.
+WITNESS_FORGED = '''        from std_msgs.msg import String
         if not hasattr(self, 'forger'):
             self.forger = self.create_publisher(String, '/ros2nb/witness', 10)
             self.points = []
         self.points.append(self.get_clock().now().nanoseconds / 1e9)
-        self.forger.publish(String(data=json.dumps({
-            'token': 'guessed', 'event': 'drawn', 'times_s': self.points,
-            'temps_c': [21.5, 26.25, 19.75, 23.0][:len(self.points)]})))
+        times = ','.join(repr(t) for t in self.points)
+        temps = ','.join(repr(t) for t in [21.5, 26.25, 19.75, 23.0][:len(self.points)])
+        self.forger.publish(String(data=f'drawn {len(self.points)};{times};{temps};guessed'))
 '''
 
 
-def test_a_witness_message_without_the_token_counts_for_nothing(session, capsys, monkeypatch):
-    """Only messages with the token the judge drew for this check run count: one the
-    learner's code publishes on the witness topic itself is not taken for the course's.
-    With every message taken whatever its token, the same callback passes."""
+def test_a_drawing_without_the_seal_counts_for_nothing(session, capsys, monkeypatch):
+    """Only drawings sealed with the subject's key count: one the learner's code publishes on
+    the witness topic itself is not taken for the course's.  With every seal taken, the
+    same callback passes."""
     fails_forged(session, PLOT, RIGHT_PLOT, WITNESS_FORGED, '', checks.check_plot_callback,
                  r'For the reading 21\.5 °C nothing was plotted')
-    from ros2nb.checks import lesson07, witnessed
-    monkeypatch.setattr(lesson07, 'told', lambda heard, start, token: [
-        fact for fact in witnessed.told(heard, start, 'guessed')])
+    from ros2nb.checks import witnessed
+    monkeypatch.setattr(witnessed.hmac, 'compare_digest', lambda mac, good: True)
     # the subject counts only what the course's redraw() told: wait for one message each
+    from ros2nb.checks import lesson07
     real_feed = lesson07.feed
 
     def feed_counting_nothing(*args, **kwargs):
@@ -504,3 +512,62 @@ def test_a_witness_message_without_the_token_counts_for_nothing(session, capsys,
 
     monkeypatch.setattr(lesson07, 'feed', feed_counting_nothing)
     passes_with(session, capsys, PLOT, RIGHT_PLOT, WITNESS_FORGED, checks.check_plot_callback)
+
+
+def test_a_heartbeat_answered_after_slow_work_counts_for_nothing(session, monkeypatch):
+    """The single-threaded worker answers the heartbeat too, once slow_work has ended: only
+    an answer that left the subject first (the answers' own timestamps) shows the two ran
+    side by side.  Counting any answer, the same worker passes."""
+    text = course.reference_source(Path(PROMISES).name).replace(RESPONSIVE, SINGLE_THREADED)
+    (session.workspace / PROMISES).write_text(text)
+    session.drop(('file', PROMISES))
+    try:
+        with pytest.raises(CheckFailed, match=r'No heartbeat came while slow_work was busy'):
+            run_check(session, checks.check_responsive_worker)
+        from ros2nb.checks import lesson06_worker
+        monkeypatch.setattr(lesson06_worker, '_beat_first', lambda slow, beat: True)
+        session.drop(('file', PROMISES))
+        run_check(session, checks.check_responsive_worker)
+    finally:
+        restore(session, PROMISES)
+
+
+#: The single-threaded worker's file also serves the course's heartbeat from a node of its
+#: own, spun in a thread of its own: it answers at once, as the course's heartbeat would.
+OWN_SERVER = '''
+def _answer_for_the_worker():
+    import threading
+    from rcl_interfaces.msg import ParameterType, ParameterValue
+    from rclpy.executors import SingleThreadedExecutor
+
+    def beat(request, response):
+        response.values = [ParameterValue(type=ParameterType.PARAMETER_STRING,
+                                          string_value='beat')]
+        return response
+
+    helper = Node('heartbeat_helper')
+    helper.create_service(GetParameters, '/ros2nb_worker/heartbeat', beat)
+    executor = SingleThreadedExecutor()
+    executor.add_node(helper)
+    threading.Thread(target=executor.spin, daemon=True).start()
+'''
+
+
+def test_a_heartbeat_a_node_of_its_own_answers_counts_for_nothing(session, monkeypatch):
+    """The graph shows two servers of the heartbeat: the check fails with one line.  Taking
+    any server's answer, the single-threaded worker passes."""
+    text = course.reference_source(Path(PROMISES).name).replace(
+        RESPONSIVE, '    _answer_for_the_worker()\n' + SINGLE_THREADED)
+    text = text.replace('from std_msgs.msg import Float32\n', 'from std_msgs.msg import Float32\n'
+                        'from rcl_interfaces.srv import GetParameters\n') + OWN_SERVER
+    (session.workspace / PROMISES).write_text(text)
+    session.drop(('file', PROMISES))
+    try:
+        with pytest.raises(CheckFailed, match=r'^Something in your code answers for the Worker'):
+            run_check(session, checks.check_responsive_worker)
+        from ros2nb.checks import lesson06_worker
+        monkeypatch.setattr(lesson06_worker, '_servers', lambda *args: True)
+        session.drop(('file', PROMISES))
+        run_check(session, checks.check_responsive_worker)
+    finally:
+        restore(session, PROMISES)

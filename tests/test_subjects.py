@@ -18,7 +18,7 @@ from ros2nb.judge import observer
 from ros2nb.judge.subjects import SubjectHung, SubjectProcess
 from ros2nb.subject_interface import Call, ExecCells
 from ros2nb.subject_replies import Called, Encoded, Output
-from ros2nb.processes import BUSY_SHARE, Patience, tree_cpu_seconds, wait_for_work
+from ros2nb.patience import BUSY_SHARE, Patience, tree_cpu_seconds, wait_for_work
 from waiting import PATIENCE_S, run_to_end, wait_until
 
 pytestmark = pytest.mark.judge
@@ -165,7 +165,7 @@ def test_a_wait_lasts_while_its_program_works_and_counts_only_its_idle_time():
 
 WATCHER = """
 import subprocess, sys, threading, time, zlib
-from ros2nb.processes import Patience
+from ros2nb.patience import Patience
 
 def compress_for_ever(data=bytes(range(256)) * 4096):
     while True:

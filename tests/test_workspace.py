@@ -338,7 +338,7 @@ except KeyboardInterrupt:
 
 @pytest.mark.ros
 def test_a_slow_exit_after_ctrl_c_is_waited_for_while_it_works(capsys, monkeypatch):
-    """After Ctrl+C a program that works on its way out is waited for (processes.Patience),
+    """After Ctrl+C a program that works on its way out is waited for (patience.Patience),
     not pressed again: with a fixed grace on the wall clock (here 1 s), the second Ctrl+C
     landed in its clean-up, and it printed a traceback and another exit code."""
     monkeypatch.setattr(run_module, 'STOP_GRACE_S', 1.0)

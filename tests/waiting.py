@@ -2,7 +2,7 @@
 
 Every wait in ``tests/`` ends as soon as its state is there.  When the state never comes, the
 test fails and says what it last saw, once the processes the test started had
-:data:`PATIENCE_S` as the judge counts it (:func:`ros2nb.processes.wait_for_work`): seconds
+:data:`PATIENCE_S` as the judge counts it (:func:`ros2nb.patience.wait_for_work`): seconds
 of their work while they work or stand in the queue for a CPU, of the wall clock while they
 sit idle.  So a busy machine makes a test slower, never wrong; and a slow machine needs one
 knob, not thirty.
@@ -15,7 +15,9 @@ import subprocess
 import time
 from typing import Any, Callable, Optional, Sequence
 
-from ros2nb.processes import child_pids, kill_process_group, wait_for_work
+from ros2nb.patience import child_pids, wait_for_work
+
+from ros2nb.processes import kill_process_group
 
 #: The longest a test waits for a state that should come (s): of the work of the processes
 #: the test started, or of their idle waiting.  Generous: a bound matters only when the

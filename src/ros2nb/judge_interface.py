@@ -81,6 +81,11 @@ class Line:
 class Subject(Protocol):
     """A process of the judge's that runs the learner's code (:mod:`ros2nb.subject`)."""
 
+    @property
+    def seal(self) -> str:
+        """The key this subject seals notebook 07's drawings with (sent with its first
+        command, before any learner code ran there; :mod:`ros2nb.checks.witnessed`)."""
+
     def request(self, command: Command[R], *, timeout: float = ...) -> R:
         """Send ``command`` (:mod:`ros2nb.subject_interface`) and return its typed reply.
 
@@ -204,8 +209,10 @@ class Judge(Protocol):
     def probe_publisher(self) -> Publisher:
         """The judge's reliable Float32 publisher on /temperature (it plays the sensor)."""
 
-    def file_subject(self, relative: str) -> Subject:
-        """A subject with the learner's file (``relative`` to the workspace) imported.
+    def file_subject(self, relative: str, stand_ins: tuple[str, ...] = ()) -> Subject:
+        """A subject with the learner's file (``relative`` to the workspace) imported, and
+        the course's ``stand_ins`` (:mod:`ros2nb.judge.stand_ins`, by name) sent to it once
+        it is: one subject per set of stand-ins.
 
         :raises CheckFailed: when it is missing, or its import raised.
         """
@@ -219,7 +226,8 @@ class Judge(Protocol):
         ``steps`` (:data:`ros2nb.course.STEPS`) are missing."""
 
     def drop(self, key: tuple[Any, ...]) -> None:
-        """End the subject of ``key`` (``('file', relative)``), if one runs."""
+        """End the subject of ``key`` (``('file', relative)``), if one runs, and those of the
+        same file with stand-ins."""
 
     def drop_all(self) -> None:
         """End every subject (their nodes leave the graph)."""

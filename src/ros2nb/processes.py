@@ -2,10 +2,8 @@
 
 Every process ros2nb starts (a node for ``ros2 run``, colcon, a check's helper process)
 gets a session and process group of its own (``start_new_session=True``), so a signal
-sent to the group reaches whatever it started too.  It is also the one place that decides
-when a process has had long enough (:class:`Patience`).  psutil walks the process trees and
-reads their CPU times; what psutil does not give (a thread's time on the run queue) is read
-from /proc here.  No mention of ROS here.
+sent to the group reaches whatever it started too.  How long a process may take is
+:mod:`ros2nb.patience`'s to decide.  No mention of ROS here.
 """
 
 from __future__ import annotations
@@ -16,10 +14,9 @@ import signal
 import subprocess
 import sys
 import time
-from typing import TYPE_CHECKING, Any, Callable, NoReturn, Optional, Protocol, Sequence
+from typing import NoReturn, Optional, Protocol, Sequence
 
-if TYPE_CHECKING:
-    import psutil
+from .patience import POLL_S, Patience, asked, process_tree, psutil_module, wait_for_work
 
 #: Seconds a process gets to exit after Ctrl+C (SIGINT) before SIGTERM, then SIGKILL.
 STOP_GRACE_S = 5.0
@@ -27,8 +24,6 @@ STOP_GRACE_S = 5.0
 TERM_GRACE_S = 2.0
 #: Seconds a process ended at once (kill_process_group) gets between SIGTERM and SIGKILL.
 KILL_GRACE_S = 1.0
-#: Seconds between two looks at a condition while waiting for it.
-POLL_S = 0.02
 
 
 class Process(Protocol):
@@ -95,206 +90,6 @@ def kill_process_group(proc: Process) -> Optional[int]:
                                              (signal.SIGKILL, TERM_GRACE_S)))
 
 
-#: A process tree using less than this share of one CPU between two looks, counting the
-#: time its threads stood ready on the run queue, is waiting, not working.
-BUSY_SHARE = 0.05
-#: Seconds between two looks at a process tree's work (each look reads every process's
-#: parent from /proc: milliseconds on a busy machine).
-LOOK_S = 0.25
-
-
-def _psutil() -> Any:
-    """psutil, imported on first use: a process that never looks at a tree (a judge's
-    subject, which only runs nodes) does not pay for its import."""
-    import psutil
-    return psutil
-
-
-def _tree(pids: Sequence[int]) -> list['psutil.Process']:
-    """Each of ``pids`` that is still there and every process under them, once, as
-    :class:`psutil.Process` (psutil walks the tree from every process's parent)."""
-    psutil, found = _psutil(), {}  # pid -> its Process, in the order found
-    for pid in dict.fromkeys(pids):
-        if pid in found:
-            continue
-        try:
-            top = psutil.Process(pid)
-            below = top.children(recursive=True)
-        except psutil.Error:  # gone meanwhile
-            continue
-        found.update((each.pid, each) for each in [top, *below] if each.pid not in found)
-    return list(found.values())
-
-
-def _asked(process: 'psutil.Process', what: str, gone: Any) -> Any:
-    """``process.what()`` (psutil's ``name``, ``status``, ``cpu_times``), or ``gone`` once
-    the process is gone."""
-    try:
-        return getattr(process, what)()
-    except _psutil().Error:
-        return gone
-
-
-def _cpu_seconds(process: 'psutil.Process') -> float:
-    """CPU seconds (user + system) of ``process`` and of its children it reaped; 0 once gone."""
-    times = _asked(process, 'cpu_times', None)
-    return times.user + times.system + times.children_user + times.children_system if times \
-        else 0.0
-
-
-def child_pids(pid: int) -> list[int]:
-    """The processes ``pid`` started that are still there (running or not yet reaped)."""
-    psutil = _psutil()
-    try:
-        return [child.pid for child in psutil.Process(pid).children()]
-    except psutil.Error:
-        return []
-
-
-def tree_pids(pid: int) -> list[int]:
-    """``pid`` and every process under it now."""
-    return [process.pid for process in _tree([pid])]
-
-
-def tree_cpu_seconds(pid: int) -> float:
-    """CPU seconds (user + system) used so far by ``pid`` and every process under it.
-
-    Processes of the tree that already ended count when their parent has reaped them.
-    A process that is gone counts 0.
-    """
-    return sum(_cpu_seconds(process) for process in _tree([pid]))
-
-
-def queued_seconds(pids: Sequence[int]) -> tuple[float, bool]:
-    """How much the threads of ``pids`` stood ready to run, waiting on the run queue for a
-    CPU: the seconds the kernel counted (the second field of ``/proc/PID/task/TID/schedstat``,
-    brought up to date only when a thread gets a CPU), and whether one of them stands ready
-    now (state R).  Gone processes and threads, and a kernel without schedstats, count
-    nothing.
-
-    Read from /proc here, not through psutil: psutil gives a thread's CPU times but neither
-    its time on the run queue nor its state, and these two are what tell a program the
-    scheduler starves from one that waits (:class:`Patience`).
-    """
-    total, ready = 0.0, False
-    for pid in pids:
-        try:
-            tasks = os.listdir(f'/proc/{pid}/task')
-        except OSError:
-            continue
-        for task in tasks:
-            try:
-                with open(f'/proc/{pid}/task/{task}/stat') as stat:
-                    ready = ready or stat.read().rsplit(')', 1)[1].split()[0] == 'R'
-                with open(f'/proc/{pid}/task/{task}/schedstat') as schedstat:
-                    total += int(schedstat.read().split()[1]) / 1e9
-            except (OSError, IndexError, ValueError):
-                continue
-    return total, ready
-
-
-def tree_work(pids: int | Sequence[int]) -> tuple[float, float, bool]:
-    """What process trees have done, as the kernel counts it: the CPU seconds of ``pids``
-    and every process under them; the seconds their threads stood ready on the run queue
-    for a CPU (:func:`queued_seconds`); and whether one of them stands ready now.
-
-    Only the trees count, not the process that watches them: a judge at work beside its
-    watch (its executor and Fast DDS threads, busy with other subjects) would make every
-    program it waits on look busy.
-
-    Introduced in ``03-write-the-publisher.ipynb`` (how long the judge waits for a subject).
-    """
-    trees = _tree([pids] if isinstance(pids, int) else pids)
-    queued, ready = queued_seconds([process.pid for process in trees])
-    return sum(_cpu_seconds(process) for process in trees), queued, ready
-
-
-class Patience:
-    """Whether process trees asked to do something have had long enough to do it.
-
-    A limit on the wall clock alone cuts honest work short on a busy machine, where a
-    process gets a fraction of a CPU.  So the limit counts what the
-    trees do: they have had long enough once they used ``limit_s`` CPU seconds (an endless
-    loop), or once they sat idle, waiting for an event, for ``limit_s`` seconds on the wall
-    clock.  Between two looks they sat idle when they used less than :data:`BUSY_SHARE` of
-    a CPU, counting the time their threads stood ready on the run queue, and none of their
-    threads stands ready at the look (the kernel brings the time on the run queue up to
-    date only when a thread runs).  A program the scheduler starves is working, not
-    waiting, however long that takes: what bounds a machine that never runs it is outside
-    (a test's time limit, a sandbox's wall time, the learner's stop button).
-
-    Introduced in ``03-write-the-publisher.ipynb`` (how long the judge waits for a subject).
-
-    :param pids: the process (or processes) at the top of the trees (a sandbox's own
-        process is fine).
-    :param limit_s: seconds of CPU time, or of idle waiting, the trees are given.
-    :param started: when the trees were asked (``time.monotonic()``; default now); the time
-        since then counts as waiting.  CPU time counts from now: a caller whose answers
-        mostly come at once starts measuring late, and spares /proc meanwhile.
-    """
-
-    def __init__(self, pids: int | Sequence[int], limit_s: float,
-                 started: Optional[float] = None) -> None:
-        self.pids = [pids] if isinstance(pids, int) else list(pids)
-        self.limit_s = limit_s
-        now = time.monotonic()
-        self.started = now if started is None else started
-        self.cpu_at_start, queued, _ready = tree_work(self.pids)
-        #: Seconds on the wall clock the trees sat idle so far.
-        self.idle_s = now - self.started
-        self._look = (now, self.cpu_at_start + queued)
-        self._verdict = False
-
-    def exhausted(self) -> bool:
-        """True once the trees have had their limit (call it every fraction of a second: it
-        reads /proc once every :data:`LOOK_S`)."""
-        now = time.monotonic()
-        then, busy_then = self._look
-        if self._verdict or now - then < LOOK_S:
-            return self._verdict
-        cpu, queued, ready = tree_work(self.pids)
-        if not ready and cpu + queued - busy_then < BUSY_SHARE * (now - then):
-            self.idle_s += now - then
-        self._look = (now, cpu + queued)
-        self._verdict = cpu - self.cpu_at_start >= self.limit_s or self.idle_s >= self.limit_s
-        return self._verdict
-
-
-def poll(condition: Callable[[], Any], seconds: float) -> bool:
-    """Look at ``condition()`` every few milliseconds for ``seconds``; whether it held."""
-    deadline = time.monotonic() + seconds
-    while not condition():
-        if time.monotonic() >= deadline:
-            return False
-        time.sleep(POLL_S)
-    return True
-
-
-def wait_for_work(condition: Callable[[], Any], pids: Sequence[int], limit_s: float, *,
-                  look: Callable[[Callable[[], Any], float], bool] = poll) -> bool:
-    """Wait until ``condition()`` holds, while the process trees of ``pids`` work towards it.
-
-    The one wait for what processes do (a start, an exit, a line, a message, discovery):
-    it ends when the condition holds (True), or when the trees had ``limit_s``
-    (:class:`Patience`: of CPU time, or of sitting idle on the wall clock; False), so a busy
-    machine never decides it.  With no process to watch, ``limit_s`` is wall-clock time.
-    /proc is read only once the condition has kept the caller waiting for :data:`LOOK_S`.
-
-    Introduced in ``03-write-the-publisher.ipynb`` (the judge waits for a ``main()``).
-
-    :param look: how to wait for the condition at most a given number of seconds (default
-        :func:`poll`); the judge's node passes one that wakes when a message arrives.
-    """
-    began = time.monotonic()
-    if look(condition, min(LOOK_S, limit_s)):
-        return True
-    patience = Patience(pids, limit_s, started=began) if pids else None
-    while not look(condition, LOOK_S):
-        if patience.exhausted() if patience else time.monotonic() - began >= limit_s:
-            return False
-    return True
-
-
 def wait_patiently(proc: Process, limit_s: float) -> Optional[int]:
     """Wait for ``proc`` to exit, with :class:`Patience` (``limit_s`` of its tree's work, or
     of its idle waiting): on a busy machine a slow exit is not a hang.
@@ -322,9 +117,9 @@ def until_waiting(proc: Process, limit_s: float) -> bool:
     while calm < 2:
         if proc.poll() is not None or patience.exhausted():
             return False
-        tree = [p for p in _tree([proc.pid]) if _asked(p, 'name', '') != 'bwrap']
+        tree = [p for p in process_tree([proc.pid]) if asked(p, 'name', '') != 'bwrap']
         waiting = ('sleeping', 'disk-sleep')  # psutil's STATUS_SLEEPING, STATUS_DISK_SLEEP
-        calm = calm + 1 if tree and all(_asked(p, 'status', '') in waiting for p in tree) else 0
+        calm = calm + 1 if tree and all(asked(p, 'status', '') in waiting for p in tree) else 0
         time.sleep(POLL_S)
     return True
 
@@ -337,15 +132,15 @@ def interrupt(proc: Process, sig: int = signal.SIGINT) -> None:
     program could handle it: ``sig`` goes to every process under ``proc`` that is not
     bubblewrap.
     """
-    tree = _tree([proc.pid])
-    if not tree or _asked(tree[0], 'name', '') != 'bwrap':
+    tree = process_tree([proc.pid])
+    if not tree or asked(tree[0], 'name', '') != 'bwrap':
         signal_group(proc, sig)
         return
     for process in tree[1:]:
-        if _asked(process, 'name', '') != 'bwrap':
+        if asked(process, 'name', '') != 'bwrap':
             try:
                 process.send_signal(sig)
-            except _psutil().Error:
+            except psutil_module().Error:
                 pass
 
 

@@ -44,11 +44,17 @@ class Command(Generic[R]):
 
 @dataclass(frozen=True)
 class LoadFile(Command[Loaded]):
-    """The first command: import the learner's file ``path`` as module ``module``."""
+    """The first command: import the learner's file ``path`` as module ``module``.
+
+    ``seal``: the key notebook 07's drawings are sealed with (:attr:`ros2nb.judge.subjects.
+    SubjectProcess.seal`), taken out before the learner's code is loaded
+    (:func:`ros2nb.subject.shown.make_sealer`); every first command carries one.
+    """
 
     op: ClassVar[str] = 'load_file'
     path: str
     module: str
+    seal: str = field(default='', kw_only=True)
 
 
 @dataclass(frozen=True)
@@ -57,6 +63,17 @@ class ExecCells(Command[CellsRun]):
 
     op: ClassVar[str] = 'exec_cells'
     sources: list[str]
+    seal: str = field(default='', kw_only=True)  # as :class:`LoadFile`'s
+
+
+@dataclass(frozen=True)
+class StandIns(Command[Reply]):
+    """Compile the course's stand-ins the judge sends as code (``source``:
+    :func:`ros2nb.judge.stand_ins.source_of`), once the learner's code is loaded; kept in
+    the subject under no name that code imports."""
+
+    op: ClassVar[str] = 'stand_ins'
+    source: str
 
 
 @dataclass(frozen=True)
@@ -71,7 +88,8 @@ class Call(Command[Called]):
 
 @dataclass(frozen=True)
 class NewNode(Command[NodeMade]):
-    """Make ``cls(*args)`` with the course's ``stand_ins`` on the judge's clock (``seed``:
+    """Make ``cls(*args)`` with the course's ``stand_ins`` (compiled by :class:`StandIns`,
+    by name) on the judge's clock (``seed``:
     of ``random``, when given); the node made before is stopped."""
 
     op: ClassVar[str] = 'new_node'
@@ -146,16 +164,24 @@ class Serve(Command[Counts]):
 
 @dataclass(frozen=True)
 class Worker(Command[WorkerSpun]):
-    """Notebook 06: spin the executor of the learner's ``name()`` with the course's
-    callbacks (working ``work_s``), told on ``topic`` with ``token``; wait ``seconds`` at
-    most for the judge's subscription."""
+    """Notebook 06: spin the executor of the learner's ``name()`` with the course's slow
+    work and heartbeat in place of its two timers' callbacks, as the services ``services``
+    (slow, quick) in the same callback groups, the slow one telling ``topic`` when it
+    starts; wait ``seconds`` at most for the judge's subscription.  The judge calls the
+    services and times the answers itself (:mod:`ros2nb.checks.lesson06_worker`)."""
 
     op: ClassVar[str] = 'worker'
     name: str
     topic: str
-    token: str
-    work_s: float
+    services: list[str]
     seconds: float
+
+
+@dataclass(frozen=True)
+class WorkerRelease(Command[Reply]):
+    """Let the course's slow work end (the judge saw what it waited for)."""
+
+    op: ClassVar[str] = 'worker_release'
 
 
 @dataclass(frozen=True)
@@ -167,12 +193,12 @@ class WorkerStop(Command[WorkerStopped]):
 
 @dataclass(frozen=True)
 class PlotShown(Command[PlotWitnessed]):
-    """Notebook 07: the course's ``redraw()`` on the node's class, told on ``topic`` with
-    ``token``; wait ``seconds`` at most for the judge's subscription."""
+    """Notebook 07: the course's ``redraw()`` on the node's class, telling ``topic`` each
+    drawing sealed with the first command's ``seal``; wait ``seconds`` at most for the
+    judge's subscription."""
 
     op: ClassVar[str] = 'plot_shown'
     topic: str
-    token: str
     seconds: float
 
 
@@ -209,14 +235,16 @@ class QosAcked(Command[Reply]):
 LOADERS: dict[str, type[Command[Any]]] = {LoadFile.op: LoadFile, ExecCells.op: ExecCells}
 #: Every command the command loop serves, by its ``op``.
 COMMANDS: dict[str, type[Command[Any]]] = {command.op: command for command in (
-    Call, NewNode, GetCounts, Run, SetAttribute, WaitMatched, WaitPublishers, WaitReceived,
-    Serve, Worker, WorkerStop, PlotShown, RoomNodes, QosEndpoint, QosAcked)}
+    StandIns, Call, NewNode, GetCounts, Run, SetAttribute, WaitMatched, WaitPublishers,
+    WaitReceived, Serve, Worker, WorkerRelease, WorkerStop, PlotShown, RoomNodes,
+    QosEndpoint, QosAcked)}
 
 
 class Serves(Protocol):
     """What a subject serves: one method per command of :data:`COMMANDS`, named by its
     ``op`` (:class:`ros2nb.subject.commands.Subject` is checked against it)."""
 
+    def stand_ins(self, command: StandIns) -> Reply: ...
     def call(self, command: Call) -> Called: ...
     def new_node(self, command: NewNode) -> NodeMade: ...
     def counts(self, command: GetCounts) -> Counts: ...
@@ -227,6 +255,7 @@ class Serves(Protocol):
     def wait_received(self, command: WaitReceived) -> Counts: ...
     def serve(self, command: Serve) -> Counts: ...
     def worker(self, command: Worker) -> WorkerSpun: ...
+    def worker_release(self, command: WorkerRelease) -> Reply: ...
     def worker_stop(self, command: WorkerStop) -> WorkerStopped: ...
     def plot_shown(self, command: PlotShown) -> PlotWitnessed: ...
     def room_nodes(self, command: RoomNodes) -> RoomsMade: ...

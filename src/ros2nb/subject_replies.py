@@ -149,8 +149,9 @@ class WorkerSpun(Reply):
     :ivar undefined: no such function; ``error``: what it raised; ``returned``: what it
         returned instead of ``(node, executor)``; ``timers``: the node's timers, fewer than
         two; ``unmatched``: the witness never reached the judge.
-    :ivar name: the node's name; ``executor``: its class name; ``threads``: a
-        MultiThreadedExecutor's; ``groups``: ``(callback, group class, group number)``.
+    :ivar name: the node's name; ``namespace``: its namespace (where the judge finds its
+        services); ``executor``: its class name; ``threads``: a MultiThreadedExecutor's;
+        ``groups``: ``(callback, group class, group number)``.
     """
 
     undefined: bool = False
@@ -158,6 +159,7 @@ class WorkerSpun(Reply):
     timers: Optional[int] = None
     unmatched: bool = False
     name: Optional[str] = None
+    namespace: Optional[str] = None
     executor: Optional[str] = None
     threads: Optional[int] = None
     groups: list[tuple[str, str, int]] = field(default_factory=list)
@@ -173,9 +175,10 @@ class WorkerStopped(Reply):
 @dataclass(frozen=True, kw_only=True)
 class PlotWitnessed(Reply):
     """:class:`PlotShown`'s reply: ``ok`` once the witness reached the judge; ``shown``
-    counts what it told."""
+    counts what it told; ``tampered``: something bound the sealer before the subject did."""
 
     shown: Optional[int] = None
+    tampered: bool = False
 
 
 @dataclass(frozen=True, kw_only=True)

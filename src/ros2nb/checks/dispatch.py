@@ -19,11 +19,12 @@ import sys
 from .. import domains, working
 from ..errors import CheckFailed, Ros2nbError
 from ..judge_interface import show_result
-from ..processes import LOOK_S, Patience, kill_process_group
+from ..patience import LOOK_S, Patience
+from ..processes import kill_process_group
 from ..terminal.workspace import WORKSPACE_ENV, current_workspace
 
 #: Seconds one check may take in all when the kernel runs it: of its judge's work while it
-#: works, of the wall clock while it waits (:class:`~ros2nb.processes.Patience`).
+#: works, of the wall clock while it waits (:class:`~ros2nb.patience.Patience`).
 CHECK_TIMEOUT_S = 300.0
 #: How the line of a check stopped with the Stop button starts.
 INTERRUPTED = 'Check interrupted'

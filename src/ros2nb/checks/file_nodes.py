@@ -22,14 +22,14 @@ def new_node(judge: Judge, relative: str, cls: str, *, stand_ins: tuple[str, ...
              seed: Optional[int] = None, args: tuple[Any, ...] = ()
              ) -> tuple[Subject, NodeMade]:
     """Create the learner's node ``cls(*args)`` from their file in a subject, on the judge's
-    clock, with the course's stand-ins (:mod:`ros2nb.subject.stand_ins`) for the parts the
-    check does not grade; raise for what went wrong.
+    clock, with the course's stand-ins (:mod:`ros2nb.judge.stand_ins`) for the parts the
+    check does not grade (in a subject of their own); raise for what went wrong.
 
     Returns once the judge has the lines the node logged while it started (over /rosout):
     a start-up line arriving late would otherwise be taken for one of the next lines.
     """
     mark = len(judge.observer.logs)
-    subject = judge.file_subject(relative)
+    subject = judge.file_subject(relative, stand_ins)
     reply = subject.request(NewNode(cls=cls, stand_ins=list(stand_ins), seed=seed,
                                     args=list(args)))
     file = Path(relative).name

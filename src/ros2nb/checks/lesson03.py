@@ -5,7 +5,7 @@ subject, runs it on the judge's own clock (:mod:`ros2nb.judge.clock`) and decide
 reaches its own node over ROS: the graph, each reading on ``/temperature`` with the
 judge's time of its arrival, and the lines on ``/rosout``.  Each part is graded on its own:
 while one part is checked, the course's stand-in may take the place of another
-(:mod:`ros2nb.subject.stand_ins`).  The file, read as text, only picks the words of a
+(:mod:`ros2nb.judge.stand_ins`).  The file, read as text, only picks the words of a
 failure the judge has already seen.
 """
 

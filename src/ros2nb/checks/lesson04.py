@@ -3,7 +3,7 @@
 Part of :mod:`ros2nb.checks`.  The judge creates the learner's ``TemperatureMonitor`` in a
 subject, publishes readings to it from its own node and reads its log lines on ``/rosout``.
 Each part is graded on its own: while one part is checked, the course's stand-in may take
-the place of another (:mod:`ros2nb.subject.stand_ins`).
+the place of another (:mod:`ros2nb.judge.stand_ins`).
 """
 
 from __future__ import annotations

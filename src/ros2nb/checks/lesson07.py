@@ -2,7 +2,8 @@
 
 Part of :mod:`ros2nb.checks`.  The judge creates the learner's ``PlotFeeder`` (from
 ``live_plot.py``) in a subject, with the course's own ``redraw()`` in place of the given one
-(part 1): it tells the judge every point it drew (:mod:`.witnessed`).  The judge moves its own
+(part 1): it tells the judge every point it drew, as the node's lists held them, sealed with
+a key only the judge and the subject's sealer know (:mod:`.witnessed`).  The judge moves its own
 clock on between readings it publishes from its own node, so it knows, for every reading it
 sent, whether the plot was redrawn, and with which times and values.  A line the node logs
 decides nothing (any code can print one); the file, read as text, only picks the words of a
@@ -25,7 +26,7 @@ from .drawn import chooser
 from .file_nodes import feed, new_node, reach
 from .source import ClassSource
 from .verdicts import endpoint_verdict, node_name_verdict
-from .witnessed import WITNESS_TOPIC, new_token, told, told_to
+from .witnessed import WITNESS_TOPIC, sealed, told_to
 
 #: Readings the check publishes (°C); exact in Float32.
 PLOT_READINGS_C = (21.5, 26.25, 19.75, 23.0)
@@ -45,31 +46,32 @@ def _gaps_s(judge: Judge) -> list[int]:
             for k in range(len(PLOT_READINGS_C))]
 
 
-def _drawn(judge: Judge, subject: Subject, info: NodeMade, value: float, counts: Counts,
-           token: str) -> tuple[Counts, list[dict[str, Any]]]:
+def _drawn(judge: Judge, subject: Subject, info: NodeMade, value: float, counts: Counts
+           ) -> tuple[Counts, list[dict[str, Any]]]:
     """Feed one reading and return the subject's counts after it and what the course's
-    redraw() drew meanwhile (each redraw: its ``times_s`` and ``temps_c``)."""
+    redraw() drew meanwhile (each sealed redraw: its ``times_s`` and ``temps_c``)."""
     heard = told_to(judge)
     mark, before = len(heard), counts.shown
     counts, _lines = feed(judge, subject, info, value, counts, 'temperature_callback.')
     after = counts.shown
-    # as many redraws as the subject says it told (none: no wait; it says nothing: one)
+    # as many messages as the subject says it told (none: no wait; it says nothing: one)
     expected = 1 if before is None or after is None else after - before
-    judge.observer.wait_until(lambda: len(told(heard, mark, token)) >= expected,
-                              ARRIVAL_TIMEOUT_S)
-    return counts, [fact for fact in told(heard, mark, token) if fact['event'] == 'drawn']
+    judge.observer.wait_until(lambda: len(heard) - mark >= expected, ARRIVAL_TIMEOUT_S)
+    return counts, sealed(heard, mark, subject.seal)
 
 
 def _plot_callback(judge: Judge) -> str:
     observer = judge.observer
-    token = new_token()
     told_to(judge)  # the judge's subscription exists before the subject looks for it
     subject, info = new_node(judge, course.LIVE_PLOT_FILE, course.PLOT_CLASS)
     node_name_verdict(info, course.PLOT_NODE)
     found = observer.endpoints(info.name, info.namespace, info.endpoints)
     endpoint_verdict(info.name, found, 'subscription', '/' + course.TOPIC, course.MESSAGE_TYPE)
-    shown = subject.request(PlotShown(topic=WITNESS_TOPIC, token=token,
-                                      seconds=ARRIVAL_TIMEOUT_S), timeout=ARRIVAL_TIMEOUT_S + 30)
+    shown = subject.request(PlotShown(topic=WITNESS_TOPIC, seconds=ARRIVAL_TIMEOUT_S),
+                            timeout=ARRIVAL_TIMEOUT_S + 30)
+    if shown.tampered:
+        raise CheckFailed("Something in your code used the grader's sealer before the grader "
+                          'did: feed the plot only from temperature_callback, with redraw().')
     if not shown.ok:
         raise CheckFailed("The plot's witness never reached the grader: is the machine very "
                           'busy? Run this check again.')
@@ -80,7 +82,7 @@ def _plot_callback(judge: Judge) -> str:
         judge.clock.drive(subject, Run(seconds=gap_s), step_s=READING_GAP_S,
                           limit_s=gap_s, what=course.PLOT_CLASS)
         sent.append((judge.clock.now_s, value))
-        counts, drawn = _drawn(judge, subject, info, value, counts, token)
+        counts, drawn = _drawn(judge, subject, info, value, counts)
         _point_verdict(judge, sent, drawn)
     return (f'each of {len(PLOT_READINGS_C)} readings was plotted once, at the time it arrived '
             'on the node\'s clock (the grader\'s simulated time), with its value.')

@@ -7,7 +7,7 @@ gets and describes the parameters, and sets values.  A parameter counts by its e
 each change the judge publishes a reading from its own node and reads, on ``/rosout``, the
 status the monitor gives it, so a threshold that was declared but is not used, or a change
 answered but not made, shows.  Each part is graded on its own: the course's stand-in takes
-the place of the other part (:mod:`ros2nb.subject.stand_ins`) when needed.
+the place of the other part (:mod:`ros2nb.judge.stand_ins`) when needed.
 """
 
 from __future__ import annotations

@@ -11,23 +11,19 @@ check draws its inputs from a seed the judge draws itself; only the grader gives
 from __future__ import annotations
 
 import json
+import os
 import sys
 from pathlib import Path
 from typing import Any, Optional
 
-from .. import checks, working
-from ..checks.drawn import SEED_OPTION, parse_seed
-from ..errors import Ros2nbError
+from .. import working
 from ..processes import end_this_process
-from ..subject.forked import serve_from_here
-from ..terminal.workspace import default_workspace
-from .graded_cells import grade
-from ..judge_interface import captured
-from .session import Session
-from .subjects import subject_prefix
+from ..subject.forked import SUBJECT_PREFIX_ENV, serve_from_here
 
-
-USAGE = f'Usage: python -m ros2nb.judge check NAME | grade SOURCE SUBMISSION [{SEED_OPTION} N]'
+# Nothing of the checks, the judge's session or the course's answers is imported yet: the
+# fork server forks every subject from this process as it is now (main()), and a subject
+# must hold no answer in its memory (ros2nb.subject.out_of_reach).
+USAGE = 'Usage: python -m ros2nb.judge check NAME | grade SOURCE SUBMISSION [--seed N]'
 
 
 def arguments(argv: list[str]) -> tuple[list[str], Optional[int]]:
@@ -37,6 +33,8 @@ def arguments(argv: list[str]) -> tuple[list[str], Optional[int]]:
 
     :raises Ros2nbError: with the usage, or with what is wrong with the seed.
     """
+    from ..checks.drawn import SEED_OPTION, parse_seed
+    from ..errors import Ros2nbError
     seed = None
     if argv[:1] == ['grade'] and len(argv) == 5 and argv[3] == SEED_OPTION:
         argv, seed = argv[:3], parse_seed(argv[4])
@@ -47,14 +45,20 @@ def arguments(argv: list[str]) -> tuple[list[str], Optional[int]]:
 
 def main(argv: list[str]) -> int:
     """Run one check, or grade one notebook; print the outcome as one JSON line."""
+    working.tell_on_stderr()  # what it does, for the kernel that waits (none of its children)
+    if not os.environ.get(SUBJECT_PREFIX_ENV):  # subjects not sandboxed: forked from here,
+        serve_from_here()  # before ROS starts and before any answer is imported
+    from .. import checks
+    from ..errors import Ros2nbError
+    from ..judge_interface import captured
+    from ..terminal.workspace import default_workspace
+    from .graded_cells import grade
+    from .session import Session
     try:
         argv, seed = arguments(argv)
     except Ros2nbError as problem:
         print(problem, file=sys.stderr)
         return 2
-    working.tell_on_stderr()  # what it does, for the kernel that waits (none of its children)
-    if not subject_prefix():  # subjects not sandboxed: forked from here, before ROS starts
-        serve_from_here()
     session = Session(default_workspace(), seed)
     try:
         if argv[0] == 'check':
@@ -63,12 +67,19 @@ def main(argv: list[str]) -> int:
             # Only grading flags code (the flags parse cells with IPython, whose imports
             # every check of a learner's kernel would pay).
             from .flags import notebook_flags
+            from .written import REWRITTEN, as_written
             source, submission = (json.loads(Path(p).read_text()) for p in argv[1:])
-            def checked(grade_id: str, outcome: dict) -> None:
+            rewritten = as_written(submission, session.workspace)
+            flags = notebook_flags(submission, session.workspace, source)
+            if rewritten:  # what another cell wrote into the package is never graded
+                session.grade_as_written(rewritten)
+
+            def checked(grade_id: str, outcome: dict[str, Any]) -> None:
                 print(json.dumps({'cell': grade_id, 'result': outcome}), flush=True)
 
             result = {'results': grade(source, submission, session, checked),
-                      'flags': notebook_flags(submission, session.workspace)}
+                      'flags': flags + [REWRITTEN.format(name=Path(r).name) for r in rewritten]
+                      + session.reaching.flags()}
     finally:
         session.close()
     print(json.dumps(result))

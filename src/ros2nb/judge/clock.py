@@ -21,7 +21,8 @@ from rosgraph_msgs.msg import Clock
 from .. import working
 from ..judge_interface import ARRIVAL_TIMEOUT_S, learner_error
 from ..errors import CheckFailed
-from ..processes import Patience, kill_process_group
+from ..patience import Patience
+from ..processes import kill_process_group
 from ..subject.judge_time import JUDGE_CLOCK_QOS
 from ..runtime.core import QUIET_PUBLISHER
 from ..subject_interface import Command
@@ -35,7 +36,7 @@ R = TypeVar('R', bound=Reply)
 #: Seconds between two looks at a subject that is neither answering nor acknowledging.
 POLL_S = 0.05
 #: Seconds a subject is quiet before its work is read from /proc, and between two reads
-#: (:class:`~ros2nb.processes.Patience`: every process's stat, milliseconds on a busy
+#: (:class:`~ros2nb.patience.Patience`: every process's stat, milliseconds on a busy
 #: machine, where a step often takes longer than POLL_S).
 PATIENCE_LOOK_S = 0.25
 #: Where the judge's clock starts (ns): rcl takes a ROS time of 0 for a clock not yet set,

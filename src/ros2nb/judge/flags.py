@@ -36,14 +36,26 @@ REACHING_CALLS = {
     'gc.get_objects': "walks every object of the process, the course's too",
     'gc.get_referrers': "walks other code's objects",
     'gc.get_referents': "walks other code's objects",
+    'sys._current_frames': "reads every thread's stack frames",
 }
 #: Attributes that lead from a frame or traceback into another function's variables.
 FRAME_ATTRIBUTES = {'f_back', 'f_locals', 'f_globals', 'tb_frame', 'gi_frame', 'cr_frame'}
+#: Attributes that lead from an object to code and objects that are not its own: a
+#: function's code, globals and closure, a class's subclasses.
+REACHING_ATTRIBUTES = {'__code__': "a function's compiled code", '__globals__':
+                       "a function's module", '__closure__': "a function's closure",
+                       'cell_contents': "a function's closure", '__subclasses__':
+                       "every class made from a class, the course's among them"}
+#: Calls that set an attribute of an object named as their first argument.
+SETTING_CALLS = {'setattr', 'type.__setattr__', 'object.__setattr__'}
 #: Modules a lesson's answer never needs that reach below Python's objects, or import
 #: modules by a name computed as the code runs (how the course's answers were reached).
 RAW_MODULES = {'ctypes': 'reads or writes memory directly',
                'importlib': 'imports modules by a name it computes',
-               'runpy': 'runs modules by a name it computes'}
+               'runpy': 'runs modules by a name it computes',
+               'marshal': 'loads compiled code'}
+#: Builtins that run code built as text at run time.
+RUNNING_TEXT = {'exec', 'eval', 'compile'}
 #: The process's own import machinery: the modules it imported (the course's too) and its finders.
 REACHING_CALLS.update({
     'sys.modules': "reads the modules the process imported, the course's answers too",
@@ -103,27 +115,76 @@ def _answer(name: str) -> bool:
     return any(part in name for part in ANSWER_NAMES)
 
 
+def _folded(node: ast.AST) -> Optional[str]:
+    """The text a string expression made of constant pieces stands for (``'a.' + 'b'``,
+    ``f'{"a"}b'``, ``''.join(['a', 'b'])``), else None."""
+    if isinstance(node, ast.Constant) and isinstance(node.value, str):
+        return node.value
+    if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Add):
+        left, right = _folded(node.left), _folded(node.right)
+        return None if left is None or right is None else left + right
+    if isinstance(node, ast.JoinedStr):
+        pieces = [_folded(v.value if isinstance(v, ast.FormattedValue) else v)
+                  for v in node.values]
+        known = [piece for piece in pieces if piece is not None]
+        return None if len(known) != len(pieces) else ''.join(known)
+    if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and \
+            node.func.attr == 'join' and len(node.args) == 1 and \
+            isinstance(node.args[0], (ast.List, ast.Tuple)):
+        glue = _folded(node.func.value)
+        pieces = [_folded(e) for e in node.args[0].elts]
+        known = [piece for piece in pieces if piece is not None]
+        return None if glue is None or len(known) != len(pieces) else glue.join(known)
+    return None
+
+
+def _named(text: str) -> Optional[str]:
+    """What a string names that reaches in: one of the course's answers, or an attribute
+    or function that leads into other code (``getattr(f, '__glo' + 'bals__')``)."""
+    if _answer(text):
+        return f"names {text[:60]!r} (the course's answer, refused to graded code)"
+    last = text.rsplit('.', 1)[-1]
+    if last in REACHING_ATTRIBUTES or last in FRAME_ATTRIBUTES:
+        return f'names {last!r} in a string (reads {REACHING_ATTRIBUTES.get(last, "a frame")})'
+    if text in REACHING_CALLS or any(call.endswith('.' + text) for call in REACHING_CALLS
+                                     if text.startswith(('_get', 'get_'))):
+        return f'names {text!r} in a string (reads other code\'s frames and objects)'
+    return None
+
+
+def _import_why(node: ast.Import | ast.ImportFrom) -> Optional[str]:
+    """What an import statement reaches for, or None."""
+    names = [a.name for a in node.names] if isinstance(node, ast.Import) else \
+        [f'{node.module}.{a.name}' for a in node.names] if node.module else []
+    for name in names:
+        if name.split('.')[0] in RAW_MODULES:
+            return f'imports {name} ({RAW_MODULES[name.split(".")[0]]})'
+        if _internal(name):
+            return f"imports {name} (ros2nb's internals)"
+        if name.startswith('ros2nb.') and _answer(name):
+            return f"imports {name} (the course's answer, refused to graded code)"
+    return None
+
+
 def _why(node: ast.AST, modules: dict[str, str], setup_py: bool) -> Optional[str]:
     """What ``node`` reaches for, or None."""
-    if isinstance(node, ast.Constant) and isinstance(node.value, str) and _answer(node.value):
-        return f'names {node.value[:60]!r} (the course\'s answer, refused to graded code)'
+    if isinstance(node, (ast.Constant, ast.BinOp, ast.JoinedStr, ast.Call)):
+        text = _folded(node)
+        if text is not None and _named(text):
+            return _named(text)
+    if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and \
+            node.func.id in RUNNING_TEXT:
+        return f'calls {node.func.id} (runs code it builds at run time)'
     if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and \
             node.func.id == '__import__' and not (
                 node.args and isinstance(node.args[0], ast.Constant)):
         return 'calls __import__ with a name it computes (imports modules by a computed name)'
     if isinstance(node, (ast.Import, ast.ImportFrom)):
-        names = [a.name for a in node.names] if isinstance(node, ast.Import) else \
-            [f'{node.module}.{a.name}' for a in node.names] if node.module else []
-        for name in names:
-            if name.split('.')[0] in RAW_MODULES:
-                return f'imports {name} ({RAW_MODULES[name.split(".")[0]]})'
-            if _internal(name):
-                return f"imports {name} (ros2nb's internals)"
-            if name.startswith('ros2nb.') and _answer(name):
-                return f"imports {name} (the course's answer, refused to graded code)"
-        return None
+        return _import_why(node)
     if isinstance(node, ast.Attribute) and node.attr in FRAME_ATTRIBUTES:
         return f'reads .{node.attr} (another function\'s frame)'
+    if isinstance(node, ast.Attribute) and node.attr in REACHING_ATTRIBUTES:
+        return f'reads .{node.attr} ({REACHING_ATTRIBUTES[node.attr]})'
     if isinstance(node, (ast.Attribute, ast.Name)):
         dotted = _dotted(node)
         if dotted is not None:
@@ -151,8 +212,9 @@ def _why(node: ast.AST, modules: dict[str, str], setup_py: bool) -> Optional[str
     if isinstance(node, ast.Call):
         name = _dotted(node.func) or (node.func.attr if isinstance(node.func, ast.Attribute)
                                       else '')
-        owner = _dotted(node.args[0]) if name == 'setattr' and node.args else None
-        if owner is not None and owner.split('.')[0] in PATCHED_OWNERS | set(modules):
+        owner = _dotted(node.args[0]) if name in SETTING_CALLS and node.args else None
+        if owner is not None and (owner.split('.')[0] in PATCHED_OWNERS | set(modules) or (
+                name != 'setattr' and owner not in ('self', 'cls'))):
             return f'replaces an attribute of {owner} (patches code that is not its own)'
         if setup_py and (name.rsplit('.', 1)[-1] in WRITING_CALLS or (
                 name == 'open' and any(isinstance(a, ast.Constant) and isinstance(a.value, str)
@@ -183,32 +245,51 @@ def reaching_in(text: str, where: str, setup_py: bool = False) -> list[str]:
     return [f'{where} line {line}: {why}' for line, why in sorted(found)]
 
 
-def _python_of_cell(text: str) -> Optional[str]:
-    """An answer cell as Python (IPython's own transformation), or None for a ``%%`` cell
-    (a ``%%part`` cell's text is checked in the file it wrote)."""
+def _python_of_cell(text: str, parts: bool) -> Optional[str]:
+    """A code cell as Python (IPython's own transformation; with ``parts``, a ``%%part``
+    cell's body), or None for a cell magic or text IPython cannot read (an answer's
+    ``%%part`` cell is read in the file it wrote)."""
     if text.lstrip().startswith('%%'):
-        return None
+        first, _, body = text.lstrip().partition('\n')
+        return body if parts and first.startswith('%%part') else None
     try:
         return TransformerManager().transform_cell(text)
     except Exception:  # noqa: BLE001 - IPython could not read it: nothing to flag
         return None
 
 
-def notebook_flags(submission: dict, workspace: Path) -> list[str]:
-    """Every flag of a submitted notebook: its answer cells, and the package files its
-    ``%%part`` cells write in ``workspace``.
+def notebook_flags(submission: dict, workspace: Path, source: Optional[dict] = None
+                   ) -> list[str]:
+    """Every flag of a submitted notebook: its answer cells, every code cell the learner
+    added or changed (one the course's ``source`` notebook does not have; a graded cell may
+    lack its hidden tests), and the package files its ``%%part`` cells write in
+    ``workspace``.  What a cell of the course's
+    own does (``ros2nb.current_runtime()`` in a cell that shows the graph) is not flagged in
+    a cell the learner changed.
 
     :param submission: the learner's notebook (nbformat JSON).
     :param workspace: the learner's workspace (``src/sensor_simulator`` is read).
+    :param source: the course's notebook (nbformat JSON); None: only the answer cells.
     :return: flags as :func:`reaching_in` words them (empty for honest code).
     """
+    given = {nbmeta.text(cell): nbmeta.nbgrader_metadata(cell).get('grade_id')
+             for cell in nbmeta.cells(source or {}) if cell.get('cell_type') == 'code'}
+    lines_of = {grade_id: set(text.splitlines()) for text, grade_id in given.items() if grade_id}
+    course_does = {flag.partition(': ')[2] for text in given
+                   for flag in reaching_in(_python_of_cell(text, parts=True) or '', '')}
     flags = []
-    for cell in nbmeta.cells(submission):
-        meta = nbmeta.nbgrader_metadata(cell)
-        if meta.get('solution') and cell.get('cell_type') == 'code':
-            python = _python_of_cell(nbmeta.text(cell))
-            if python is not None:
-                flags += reaching_in(python, f'answer cell {meta.get("grade_id", "?")}')
+    for index, cell in enumerate(nbmeta.cells(submission)):
+        meta, text = nbmeta.nbgrader_metadata(cell), nbmeta.text(cell)
+        if cell.get('cell_type') != 'code':
+            continue
+        if meta.get('solution'):
+            flags += reaching_in(_python_of_cell(text, parts=False) or '',
+                                 f'answer cell {meta.get("grade_id", "?")}')
+        elif source is not None and text not in given and not (  # a graded cell, tests hidden
+                set(text.splitlines()) <= lines_of.get(meta.get('grade_id'), set())):
+            found = reaching_in(_python_of_cell(text, parts=True) or '',
+                                f"cell {index + 1} (not the course's)")
+            flags += [flag for flag in found if flag.partition(': ')[2] not in course_does]
     flags += package_flags(workspace)
     return flags
 

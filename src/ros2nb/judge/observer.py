@@ -27,7 +27,7 @@ from rclpy.signals import SignalHandlerOptions
 from .. import domains
 from ..judge_interface import ARRIVAL_TIMEOUT_S, Heard, Line
 from ..errors import CheckFailed
-from ..processes import Patience, wait_for_work
+from ..patience import Patience, wait_for_work
 from ..runtime import QUIET_SUBSCRIPTION, node_serving_nothing
 from ..runtime.services import call_until_answered
 from .floods import Floods
@@ -163,7 +163,7 @@ class Observer:
     def wait_until(self, condition: Callable[[], bool], seconds: float) -> bool:
         """Wait until ``condition()`` holds (looked at whenever something arrives), while the
         processes the judge attends to work towards it: False once they had ``seconds``
-        (:func:`~ros2nb.processes.wait_for_work`: of their work, or of their idle waiting).
+        (:func:`~ros2nb.patience.wait_for_work`: of their work, or of their idle waiting).
 
         :raises Flooded: when a flood was found (:class:`~ros2nb.judge.floods.Floods`), at once.
         """

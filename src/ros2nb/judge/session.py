@@ -6,18 +6,15 @@ Part of the judge (:mod:`ros2nb.judge`).  The checks get the session as their ju
 
 from __future__ import annotations
 
-import contextlib
 import json
 import os
-import secrets
 import shutil
-import stat
 import subprocess
 import sys
 import tempfile
 from importlib import resources
 from pathlib import Path
-from typing import Any, Callable, Iterator, Optional
+from typing import Any, Callable, ContextManager, Optional
 
 from rclpy.publisher import Publisher
 from rclpy.qos import QoSProfile, ReliabilityPolicy
@@ -31,10 +28,14 @@ from ..subject.judge_time import JUDGE_TOPICS_ENV
 from ..subject.forked import fork_program
 from ..terminal.files import parts_verdict
 from ..terminal.workspace import WORKSPACE_ENV
+from . import handed
 from .clock import JudgeClock
 from ..judge_interface import AnswerRef, learner_error
-from ..subject_interface import ExecCells, LoadFile
+from ..subject_interface import ExecCells, LoadFile, StandIns
 from .observer import Observer
+from .reaching import Reaching
+from .stand_ins import source_of
+from .written import workspace_files
 from .subjects import (Output, SubjectHung, SubjectProcess, home_and_tmp, subject_env,
                        subject_prefix, subjects_folder)
 
@@ -48,8 +49,6 @@ SET_ENV_AND_EXEC = ('import json, os, sys; env = json.loads(sys.argv[1]); '
 #: The course's reference node files (the judge's to read; a subject sees only the copies
 #: :meth:`Session.answers_workspace` hands it).
 reference_files = resources.files('ros2nb.reference')
-#: Most bytes :meth:`Session.taken_back` copies out of one folder (an hour's bag is < 1 MiB).
-MAX_TAKEN_BACK_BYTES = 64 << 20
 
 
 class Session:
@@ -72,6 +71,9 @@ class Session:
         self._programs: list[Process] = []  # the learner's programs (start, start_program)
         self._probe: Optional[Publisher] = None
         self.builds: dict[str, Path] = {}
+        #: What the learner's code reached for in the subjects (their audit hooks): flags,
+        #: and a failed check where it can only serve cheating (:mod:`.reaching`).
+        self.reaching = Reaching(self._subjects)
 
     @property
     def observer(self) -> Observer:
@@ -109,6 +111,8 @@ class Session:
         default the learner's)."""
         subject = self._subjects.get(key)
         if subject is None or subject.proc.poll() is not None:
+            if subject is not None:  # it ended: what it saw stays (reaching)
+                self._end(key)
             _ = self.clock  # published before any subject runs: it starts on the judge's time
             where = workspace or self.workspace
             heard = self.observer.counts()
@@ -116,11 +120,13 @@ class Session:
                 WORKSPACE_ENV: str(where), JUDGE_TOPICS_ENV: json.dumps(sorted(heard[0]))}))
             subject.heard_base = heard
             self._subjects[key] = subject
+            self.reaching.use(subject)
             try:
                 load(subject)
             except BaseException:
-                self.drop(key)
+                self._end(key)
                 raise
+        self.reaching.use(subject)
         return subject
 
     def working_pids(self) -> list[int]:
@@ -138,10 +144,16 @@ class Session:
             kill_process_group(proc)
 
     def drop(self, key: tuple[Any, ...]) -> None:
-        """End the subject of ``key``, if one runs."""
-        subject = self._subjects.pop(key, None)
-        if subject is not None:
-            subject.close()
+        """End the subject ``key``, and those of the same file with stand-ins (``key``
+        followed by their names)."""
+        for known in [k for k in self._subjects if k[:len(key)] == key]:
+            self._end(known)
+
+    def _end(self, key: tuple[Any, ...]) -> None:
+        """End the subject ``key``; what its audit hook saw stays with :attr:`reaching`."""
+        subject = self._subjects.pop(key)
+        subject.close()
+        self.reaching.keep(subject)
 
     def drop_all(self) -> None:
         """End every subject of this session (their nodes leave the graph)."""
@@ -152,8 +164,11 @@ class Session:
         """The environment of a subject of this judge (its domain, plain logs, field checks)."""
         return subject_env()
 
-    def file_subject(self, relative: str) -> SubjectProcess:
-        """A subject with the learner's file imported (``relative`` to the workspace)."""
+    def file_subject(self, relative: str, stand_ins: tuple[str, ...] = ()) -> SubjectProcess:
+        """A subject with the learner's file imported (``relative`` to the workspace), and the
+        course's ``stand_ins`` (:mod:`.stand_ins`) compiled in it once the file is: one subject
+        per set of stand-ins, so that no learner's code ever ran beside the course's version
+        of the part it is graded on."""
         path = self.workspace / relative
 
         def load(subject: SubjectProcess) -> None:
@@ -167,8 +182,21 @@ class Session:
                 if reply.error is not None:
                     raise learner_error(path.name, reply.error, context=' on import')
                 raise CheckFailed(f'{path.name} could not be imported: run this check again.')
+            if stand_ins:
+                subject.request(StandIns(source=source_of(stand_ins)))
 
-        return self.subject(('file', relative), load)
+        return self.subject(('file', relative, *(['+', *stand_ins] if stand_ins else [])),
+                            load)
+
+    def grade_as_written(self, files: dict[str, str]) -> None:
+        """From now on, grade a copy of the workspace in which each of ``files`` (a path in the
+        workspace -> its text) is written so: what the notebook's ``%%part`` cells write,
+        where another cell changed the file (:mod:`.written`).  A workspace too large to copy
+        is graded as it is."""
+        found = workspace_files(self.workspace)
+        if found is not None:
+            found.update({relative: text.encode() for relative, text in files.items()})
+            self.workspace = self.hand_over('as-written-', found)
 
     def answer_subject(self, ref: AnswerRef, workspace: Optional[Path] = None) -> SubjectProcess:
         """A subject with the course's context cells and the learner's answer cells run (in
@@ -258,94 +286,21 @@ class Session:
 
     def hand_over(self, prefix: str, files: dict[str, bytes]) -> Path:
         """A new folder in the scratch folder with ``files`` (a relative path, ``a/b.xml``, to
-        its bytes) that the learner's code may read: the check's own inputs.
+        its bytes) that the learner's code may read: the check's own inputs
+        (:func:`.handed.hand_over`).
 
-        Subjects may write the scratch folder, and a learner's thread may swap a name there for
-        a link the moment it appears.  So every folder and file is made relative to the
-        descriptor of a folder made here, opened without following links, and never over an
-        entry that exists: the judge writes only into folders it made, whatever is at the path.
-
-        :param prefix: the start of the new folder's name (a random part follows).
-        :return: the new folder's path (what the learner's code is given).
-        :raises CheckFailed: when a name the judge was making was taken over meanwhile (only
-            the learner's own code, running beside the check, can do that).
+        :raises CheckFailed: when a name the judge was making was taken over meanwhile.
         """
-        name = f'{prefix}{secrets.token_hex(6)}'
-        made: dict[tuple[str, ...], int] = {}  # folder (as parts) -> its descriptor
+        return handed.hand_over(self.scratch, self._scratch_fd, prefix, files)
 
-        def folder(parts: tuple[str, ...]) -> int:
-            if parts not in made:
-                parent = folder(parts[:-1]) if len(parts) > 1 else self._scratch_fd
-                os.mkdir(parts[-1], 0o755, dir_fd=parent)
-                made[parts] = os.open(parts[-1], os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW,
-                                      dir_fd=parent)
-            return made[parts]
-
-        try:
-            for relative, data in files.items():
-                *parents, leaf = Path(relative).parts
-                where = folder((name, *parents))
-                fd = os.open(leaf, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o644,
-                             dir_fd=where)
-                with os.fdopen(fd, 'wb') as out:
-                    out.write(data)
-        except OSError as error:
-            raise CheckFailed(f"The check's own folder {self.scratch / name} changed while the "
-                              f'grader wrote it ({error.strerror}): something in your code '
-                              'writes there; leave files you did not make alone.') from None
-        finally:
-            for fd in made.values():
-                os.close(fd)
-        return self.scratch / name
-
-    @contextlib.contextmanager
-    def taken_back(self, folder: Path) -> Iterator[Path]:
-        """A copy, in a temporary folder of the judge's own (no subject sees it), of the files
-        the learner's code left in ``folder``, a folder of the scratch folder: what the check
-        then reads is what was there, never a file a link points to.
-
-        Every step goes from the scratch folder's descriptor, without following links, and
-        only regular files are copied (one level: a bag folder), at most
-        :data:`MAX_TAKEN_BACK_BYTES` in all.
+    def taken_back(self, folder: Path) -> ContextManager[Path]:
+        """A copy, in a temporary folder of the judge's own, of the files the learner's code
+        left in ``folder``, a folder of the scratch folder (:func:`.handed.taken_back`).
 
         :raises CheckFailed: for a link, a folder or anything else that is not a file, or for
             too many bytes.
         """
-        relative = folder.relative_to(self.scratch)
-        opened: list[int] = []
-        private = Path(tempfile.mkdtemp(prefix='ros2nb-taken-back-'))
-        try:
-            where = self._scratch_fd
-            for part in relative.parts:
-                try:
-                    where = os.open(part, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW,
-                                    dir_fd=where)
-                except OSError as error:
-                    raise CheckFailed(f'{folder} is not a folder ({error.strerror}): write '
-                                      'your files there, not links.') from None
-                opened.append(where)
-            total = 0
-            for name in sorted(os.listdir(where)):
-                try:
-                    fd = os.open(name, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK, dir_fd=where)
-                except OSError as error:
-                    raise CheckFailed(f'{folder / name} cannot be read ({error.strerror}): '
-                                      'the grader reads files there, not links.') from None
-                with os.fdopen(fd, 'rb') as source:
-                    if not stat.S_ISREG(os.fstat(fd).st_mode):
-                        raise CheckFailed(f'{folder / name} is not a file: the grader reads '
-                                          'only the files you wrote there.')
-                    data = source.read(MAX_TAKEN_BACK_BYTES - total + 1)
-                total += len(data)
-                if total > MAX_TAKEN_BACK_BYTES:
-                    raise CheckFailed(f'{folder} holds more than {MAX_TAKEN_BACK_BYTES >> 20} '
-                                      'MiB: the grader reads no more than that.')
-                (private / name).write_bytes(data)
-            yield private
-        finally:
-            for fd in opened:
-                os.close(fd)
-            shutil.rmtree(private, ignore_errors=True)
+        return handed.taken_back(self.scratch, self._scratch_fd, folder)
 
     def close(self) -> None:
         self.drop_all()

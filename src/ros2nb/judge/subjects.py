@@ -9,9 +9,11 @@ sandbox command (``ROS2NB_SUBJECT_PREFIX``) and cannot see, signal or trace the 
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import itertools
 import json
 import os
+import secrets
 import select
 import subprocess
 import sys
@@ -22,15 +24,15 @@ from typing import Any, Optional, TypeVar
 
 from .. import domains
 from ..errors import CheckFailed
-from ..processes import Patience, kill_process_group, stop_process_group
+from ..patience import Patience
+from ..processes import kill_process_group, stop_process_group
 from ..subject.judge_time import JUDGE_CLOCK_ENV
-from ..subject.forked import fork_subject, has_server
-from ..subject_interface import Command, reply_type, wire
+from ..subject.forked import SUBJECT_PREFIX_ENV, fork_subject, has_server
+from ..subject_interface import Command, ExecCells, LoadFile, reply_type, wire
 from ..subject_replies import Reply
 from ..typed_json import decoded
+from .reaching import MAX_SEEN, SEEN_PREFIX, Reached, parse_seen
 
-#: JSON list put in front of every subject's command (the grader's sandbox).
-SUBJECT_PREFIX_ENV = 'ROS2NB_SUBJECT_PREFIX'
 #: The folder the subjects may write (while grading, the only one): their home
 #: (``home/``), their temporary files (``tmp/``), and what the session shares with them
 #: (builds, bags, files it feeds to the learner's functions).  The judge's own cwd, home
@@ -38,7 +40,7 @@ SUBJECT_PREFIX_ENV = 'ROS2NB_SUBJECT_PREFIX'
 #: the judge's home and the session uses a temporary folder.
 SUBJECTS_FOLDER_ENV = 'ROS2NB_SUBJECTS_FOLDER'
 #: Seconds a subject may take to answer one command before it counts as hanging: CPU
-#: seconds while it works, wall-clock seconds while it waits (ros2nb.processes.Patience).
+#: seconds while it works, wall-clock seconds while it waits (ros2nb.patience.Patience).
 REPLY_TIMEOUT_S = 30.0
 #: Seconds between two looks at a subject that has not answered yet.
 POLL_S = 0.25
@@ -169,13 +171,24 @@ class SubjectProcess:
         self._ack_buffer = b''
         #: The newest well-formed acknowledgement of a step (None before the first).
         self.last_ack: Optional[dict] = None
+        #: The key the subject seals notebook 07's drawings with (:mod:`ros2nb.subject.shown`),
+        #: sent with the first command, before any learner code runs there.
+        self.seal = secrets.token_hex(32)
+        self._sealed = False
+        #: What the learner's code reached for, as the subject's audit hook wrote it on the
+        #: same pipe (:mod:`ros2nb.judge.reaching`), in order.
+        self.seen: list[Reached] = []
         #: What the judge had heard when this process started: messages per watched topic,
         #: /rosout lines per logger (set by the session that starts it).
         self.heard_base: tuple[dict[str, int], dict[str, int]] = ({}, {})
 
     def send(self, command: Command[Any]) -> None:
         """Send one command (its reply comes later: :meth:`poll_reply`, read with
-        :meth:`reply_to`)."""
+        :meth:`reply_to`); the first, which loads the learner's code, carries :attr:`seal`."""
+        if not self._sealed:
+            self._sealed = True
+            if isinstance(command, (LoadFile, ExecCells)):
+                command = dataclasses.replace(command, seal=self.seal)
         try:
             os.write(self._commands, (json.dumps(wire(command)) + '\n').encode())
         except BrokenPipeError:
@@ -213,16 +226,10 @@ class SubjectProcess:
 
         Lines that are not well formed are skipped: the process runs learner code, which may
         write anything there; what it says only tells the judge when to step and what to
-        wait for.
+        wait for.  What the subject's audit hook wrote there goes to :attr:`seen`.
         """
-        try:
-            while chunk := os.read(self._acks, 65536):
-                self._ack_buffer += chunk
-        except BlockingIOError:
-            pass
         newest = None
-        *lines, self._ack_buffer = self._ack_buffer.split(b'\n')
-        for line in lines:
+        for line in self._pipe_lines():
             ack = _well_formed_ack(line)
             if ack is not None:
                 newest = ack
@@ -230,11 +237,37 @@ class SubjectProcess:
             self.last_ack = newest
         return newest
 
+    def take_seen(self) -> list[Reached]:
+        """Everything the subject's audit hook wrote so far (:attr:`seen`), read without taking
+        an acknowledgement: those stay for the clock (:meth:`take_ack`)."""
+        kept = self._pipe_lines()
+        self._ack_buffer = b''.join(line + b'\n' for line in kept) + self._ack_buffer
+        return self.seen
+
+    def _pipe_lines(self) -> list[bytes]:
+        """The whole lines that came on the pipe since the last call, but the audit hook's
+        (which go to :attr:`seen`)."""
+        try:
+            while chunk := os.read(self._acks, 65536):
+                self._ack_buffer += chunk
+        except (BlockingIOError, OSError):
+            pass
+        *lines, self._ack_buffer = self._ack_buffer.split(b'\n')
+        kept = []
+        for line in lines:
+            if not line.startswith(SEEN_PREFIX):
+                kept.append(line)
+                continue
+            reached = parse_seen(line)
+            if reached is not None and len(self.seen) < MAX_SEEN:
+                self.seen.append(reached)
+        return kept
+
     def request(self, command: Command[R], *, timeout: float = REPLY_TIMEOUT_S) -> R:
         """Send one command and return its reply (``command``'s reply type).
 
         :param timeout: seconds the subject gets: of CPU time while it works, of the wall
-            clock while it waits (:class:`~ros2nb.processes.Patience`), so that a busy
+            clock while it waits (:class:`~ros2nb.patience.Patience`), so that a busy
             machine never turns slow honest work into a hang.
         :raises SubjectHung: when no reply comes within ``timeout`` seconds, or the
             process died (its last output line is in the message).
@@ -279,6 +312,7 @@ class SubjectProcess:
         except subprocess.TimeoutExpired:
             pass
         stop_process_group(self.proc)
+        self.take_seen()  # what its audit hook wrote last
         for fd in (self._replies, self._acks):
             with contextlib.suppress(OSError):
                 os.close(fd)

@@ -2,8 +2,8 @@
 
 Started by the judge (:mod:`ros2nb.judge.subjects`), sandboxed while grading.  The first
 command loads the learner's code (:func:`ros2nb.subject.commands.load`) before the command
-loop exists, with the course's answers out of its reach (:mod:`.out_of_reach`); the loop
-answers the rest.
+loop exists, with the course's answers out of its reach (:mod:`.out_of_reach`) and what it
+reaches for seen as it runs (:mod:`.seen`); the loop answers the rest.
 """
 
 from __future__ import annotations
@@ -16,13 +16,15 @@ from ..explain.plots import guard_pyplot
 from ..processes import end_this_process
 from ..subject_interface import LOADERS, command_of, wire
 from ..typed_json import Unreadable
-from . import judge_time, out_of_reach
+from . import judge_time, out_of_reach, seen
 from .commands import PROTOCOL_ERROR, load, serve
+from .shown import make_sealer
 
 
 def main(argv: list[str]) -> int:
     """Entry point: ``python -m ros2nb.subject IN_FD OUT_FD``."""
     judge_time.install()  # the judge's pipe and time: this process's alone, never a child's
+    seen.install(judge_time.JudgeTime.pipe())  # before anything of the learner's runs
     guard_pyplot()  # plt.pause / plt.show in a callback: the learner's one line
     if len(argv) != 2:
         print('Usage: python -m ros2nb.subject IN_FD OUT_FD (started by ros2nb.judge).',
@@ -33,14 +35,19 @@ def main(argv: list[str]) -> int:
         if not first:
             return 0
         try:
-            command = command_of(json.loads(first), LOADERS)
+            request = json.loads(first)
+            del first
+            # notebook 07's seal: its key lives in the sealer's frame alone, taken out of the
+            # command before any learner code runs (the command itself keeps none)
+            sealer = make_sealer(str(request.pop('seal', '') if isinstance(request, dict) else ''))
+            command = command_of(request, LOADERS)
         except (ValueError, Unreadable):
             return PROTOCOL_ERROR
-        refusing = out_of_reach.shut()  # the stand-ins are handed in only once the code is loaded
+        out_of_reach.shut()  # no answer module importable: the judge sends what stands in
         namespace, reply = load(command)
         replies.write(json.dumps(wire(reply)) + '\n')
         replies.flush()
-        serve(commands, replies, namespace, refusing)
+        serve(commands, replies, namespace, sealer)
     return 0
 
 

@@ -8,8 +8,9 @@ file descriptor IN and reads one JSON reply per command on OUT.  The first comma
 the learner's code (their file imported, or their answer cells run), before anything of the
 command loop exists; then their nodes run here on the judge's clock (the runtime follows the
 judge's ``/clock``, :mod:`ros2nb.subject.judge_time`), with the course's stand-ins in place of
-the parts a check does not grade (:mod:`.stand_ins`).  The judge watches the nodes over ROS
-itself; a reply only tells it how long to wait, or which mistake to name.
+the parts a check does not grade (their code sent by the judge,
+:mod:`ros2nb.judge.stand_ins`).  The judge watches the nodes over ROS itself; a reply only
+tells it how long to wait, or which mistake to name.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ import random
 import signal
 import sys
 import time
+import types
 from pathlib import Path
 from types import ModuleType
 from typing import Any, Callable, Optional
@@ -33,14 +35,14 @@ from ..endpoints import node_endpoints
 from ..errors import Ros2nbError
 from ..runtime import Runtime, enable_field_checks
 from ..subject_interface import (COMMANDS, Call, Command, ExecCells, GetCounts, LoadFile,
-                                 NewNode, Run, Serve, Serves, SetAttribute, WaitMatched,
-                                 WaitPublishers, WaitReceived, command_of, wire)
+                                 NewNode, Run, Serve, Serves, SetAttribute, StandIns,
+                                 WaitMatched, WaitPublishers, WaitReceived, command_of, wire)
 from ..explain.exceptions import describe_error
 from ..subject_replies import (CallbackFailure, Called, CellsRun, Counts, Loaded, NodeMade,
                                Output, Reply)
 from .judge_time import JudgeTime
-from .out_of_reach import STAND_INS, Answers
 from .replies import decode_argument, described, encode
+from .seen import STAND_IN_FILE
 from .trials import Trials
 
 #: Exit code when a command could not even be read.
@@ -53,6 +55,16 @@ def _without_magics(source: str) -> str:
         return ''
     return '\n'.join('# ' + line if line.lstrip().startswith(('%', '!')) else line
                      for line in source.splitlines())
+
+
+def _named(function: Callable[..., Any], name: str, qualname: str) -> Callable[..., Any]:
+    """A copy of a stand-in ``function`` named as the method it stands in for (``qualname``
+    in a report): an error is reported as the course's method of the learner's class, never
+    as a function of ours."""
+    named = types.FunctionType(function.__code__, function.__globals__, name,
+                               function.__defaults__, function.__closure__)
+    named.__qualname__ = qualname
+    return named
 
 
 # ------------------------------------------------------------------ loading (first command)
@@ -95,9 +107,10 @@ def load(command: Command[Any]) -> tuple[dict[str, Any], Reply]:
 class Subject(Trials):
     """The state of this process: the learner's namespace, their node, the runtime."""
 
-    def __init__(self, namespace: dict[str, Any], answers: Answers) -> None:
+    def __init__(self, namespace: dict[str, Any], sealer: Any = None) -> None:
         self.namespace = namespace
-        self._answers = answers  # hands in the stand-ins; the learner's code never had them
+        self._sealer = sealer  # notebook 07's (:func:`.shown.make_sealer`)
+        self._stand_ins: dict[str, tuple[str, Any]] = {}  # name -> (method, function)
         self.rt: Optional[Runtime] = None
         self.node: Optional[Node] = None
         self.received = 0
@@ -119,6 +132,15 @@ class Subject(Trials):
             except BaseException as error:
                 outputs.append(Output(error=described(error)))
         return Called(ok=True, outputs=outputs)
+
+    def stand_ins(self, command: StandIns) -> Reply:
+        """Compile the stand-ins the judge sent (:func:`ros2nb.judge.stand_ins.source_of`),
+        once the learner's code is loaded: kept here, on no module and under no name that
+        code imports."""
+        made: dict[str, Any] = {'__name__': 'ros2nb stand-ins'}
+        exec(compile(command.source, STAND_IN_FILE, 'exec'), made)  # noqa: S102 - the judge's
+        self._stand_ins = dict(made['STAND_INS'])
+        return Reply(ok=True)
 
     # ---------------------------------------------------------------- nodes
     def _runtime(self) -> Runtime:
@@ -144,7 +166,7 @@ class Subject(Trials):
         subscription.callback = counted
 
     def new_node(self, command: NewNode) -> NodeMade:
-        """Create ``cls(*args)`` with the named stand-ins (:mod:`.stand_ins`) and run it on the
+        """Create ``cls(*args)`` with the named stand-ins (:meth:`stand_ins`) and run it on the
         judge's clock; stop the node made before."""
         cls, stand_ins, seed, args = command.cls, command.stand_ins, command.seed, command.args
         rt = self._runtime()
@@ -157,8 +179,11 @@ class Subject(Trials):
             found = sorted(n for n, v in self.namespace.items()
                            if isinstance(v, type) and issubclass(v, Node) and v is not Node)
             return NodeMade(ok=False, no_class=True, classes=found)
-        if stand_ins:
-            node_class = self._answers.hand_in(STAND_INS).with_stand_ins(node_class, stand_ins)
+        if stand_ins:  # a subclass with the course's parts in place of the learner's
+            methods = {method: _named(function, method,
+                                      f"the course's {node_class.__name__}.{method}")
+                       for method, function in (self._stand_ins[name] for name in stand_ins)}
+            node_class = type(node_class.__name__, (node_class,), methods)
         rt.take_judge_time()
         if seed is not None:
             random.seed(seed)
@@ -264,7 +289,7 @@ def _on_sigterm(signum: int, _frame: Any) -> None:
     raise Ended
 
 
-def serve(commands: Any, replies: Any, namespace: dict[str, Any], answers: Answers) -> None:
+def serve(commands: Any, replies: Any, namespace: dict[str, Any], sealer: Any = None) -> None:
     """Answer one JSON reply per JSON command until ``quit`` or end of input; then, or on
     SIGTERM, take the runtime's nodes down, so that the process's DDS participant tells the
     judge it leaves.
@@ -276,10 +301,10 @@ def serve(commands: Any, replies: Any, namespace: dict[str, Any], answers: Answe
     learner's code that swallows the signal (a bare ``except``) is ended by the SIGKILL that
     follows, as before.
 
-    :param answers: the finder that keeps the course's answers from the learner's code
-        (:func:`.out_of_reach.shut`), which hands in the stand-ins.
+    :param sealer: notebook 07's sealer, made before the learner's code was loaded
+        (:func:`.shown.make_sealer`).
     """
-    subject = Subject(namespace, answers)
+    subject = Subject(namespace, sealer)
     served: Serves = subject  # the type checker holds every command's method to its types
     handlers: dict[str, Callable[[Any], Reply]] = {op: getattr(served, op) for op in COMMANDS}
     ended = False

@@ -38,7 +38,11 @@ import time
 from typing import IO, Optional
 
 from . import fork_server
+from .out_of_reach import answers_loaded
 
+#: JSON list put in front of every subject's command while grading (the grader's sandbox):
+#: a sandboxed subject is started afresh, since a fork cannot enter a sandbox.
+SUBJECT_PREFIX_ENV = 'ROS2NB_SUBJECT_PREFIX'
 #: Seconds a forked child gets to become the leader of its own session.
 SESSION_WAIT_S = 5.0
 
@@ -141,10 +145,13 @@ def serve_from_here() -> None:
 
     Call it first thing in a process whose imports are a subject's (the judge's main),
     before ROS or any thread starts: the fork costs milliseconds and every subject of this
-    process is then forked, the first too.  Never in a process with threads.
+    process is then forked, the first too.  Never in a process with threads, nor in one that
+    imported a course answer (the checks, the rules, ...): every subject would hold it in its
+    memory (:mod:`.out_of_reach`); such a process's subjects come from a server started
+    afresh.
     """
     global _server
-    if threading.active_count() > 1:
+    if _server is not None or threading.active_count() > 1 or answers_loaded():
         return  # a fork would hold only this thread, and any lock another one held
     parent_end, server_end = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
     if os.fork() == 0:

@@ -84,6 +84,11 @@ class JudgeTime:
         cls.topics = cls.topics or frozenset(t for t in topics if isinstance(t, str))
 
     @classmethod
+    def pipe(cls) -> Optional[int]:
+        """The judge's pipe of this process (:meth:`claim`), or None when it has none."""
+        return cls._claimed
+
+    @classmethod
     def published(cls) -> Optional[dict[str, int]]:
         """Messages this process has published so far, per topic; None when nothing is
         counted here (no judge's time was made in this process)."""

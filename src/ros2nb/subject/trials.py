@@ -26,16 +26,28 @@ from ..explain.exceptions import describe_error
 from ..explain.ros_settings import zero_depth_refused
 from ..runtime.rates import callback_groups
 from ..subject_interface import (PlotShown, QosAcked, QosEndpoint, RoomNodes, Worker,
-                                 WorkerStop)
+                                 WorkerRelease, WorkerStop)
 from ..subject_replies import (CallbackFailure, PlotWitnessed, QosMade, Reply, RoomsMade,
                                WorkerSpun, WorkerStopped)
 from .replies import described, encode
-from .shown import Shown, plot_redraw, worker_callbacks
+from .shown import Shown, plot_redraw, worker_services
 
 #: The node that makes an endpoint with the learner's QoS profile (notebook 09).
 QOS_NODE = 'qos_answer'
 #: Wall-clock seconds one spin of the learner's executor waits for work (notebook 06).
 SPIN_ROUND_S = 0.05
+
+
+def _spin(node: Node, executor: Executor, stop: threading.Event,
+          failures: list[CallbackFailure]) -> None:
+    """Spin the learner's ``executor`` until ``stop``, its first failure kept (notebook 06)."""
+    while not stop.is_set():
+        try:
+            executor.spin_once(timeout_sec=SPIN_ROUND_S)
+        except BaseException as error:  # the learner's executor may raise anything
+            failures.append(CallbackFailure(callback=f'{type(node).__name__} callback',
+                                            **describe_error(error)))
+            return
 
 
 class Trials:
@@ -45,22 +57,23 @@ class Trials:
     rooms: list[Node]
     node: Optional[Node]
     _spun: Optional[tuple[Node, Executor, threading.Thread, threading.Event,
-                          list[CallbackFailure], Shown]]
+                          list[CallbackFailure], Shown, threading.Event]]
     _qos: Optional[tuple[Node, Any]]
     _plot_shown: Optional[Shown] = None
+    _sealer: Any = None
 
     def _runtime(self) -> Any:  # provided by Subject
         raise NotImplementedError
 
     # ------------------------------------------------------------ notebook 06
     def worker(self, command: Worker) -> WorkerSpun:
-        """Call the learner's ``name()`` for ``(node, executor)``, put the course's callbacks
-        (:func:`.shown.worker_callbacks`, telling ``topic`` with ``token``) on the Worker's two
-        timers, in the callback groups the learner chose, and spin the learner's executor on the
-        wall clock in a thread until :meth:`worker_stop`; the judge watches ``topic``.
+        """Call the learner's ``name()`` for ``(node, executor)``; stop the Worker's two timers
+        and put the course's slow work and heartbeat in their place, as the services
+        ``services`` in the same callback groups (:func:`.shown.worker_services`, telling
+        ``topic``); spin the learner's executor on the wall clock in a thread until
+        :meth:`worker_stop`.  The judge calls the services and times the answers itself.
 
-        ``work_s``: how long the course's slow callback works (s, wall clock); ``seconds``:
-        how long to wait, at most, for the judge's subscription to match.
+        ``seconds``: how long to wait, at most, for the judge's subscription to match.
         """
         function = self.namespace.get(command.name)
         if not callable(function):
@@ -74,42 +87,51 @@ class Trials:
                 and isinstance(made[1], Executor)):
             return WorkerSpun(ok=False, returned=encode(made))
         node, executor = made
-        facts: dict[str, Any] = {'name': node.get_name(), 'executor': type(executor).__name__,
+        facts: dict[str, Any] = {'name': node.get_name(), 'namespace': node.get_namespace(),
+                                 'executor': type(executor).__name__,
                                  'threads': getattr(executor, '_num_threads', None),
                                  'groups': callback_groups(node)}
         timers = sorted(node.timers, key=lambda timer: timer.timer_period_ns)
         if len(timers) < 2:
             return WorkerSpun(ok=False, timers=len(timers), **facts)
-        shown = Shown(command.topic, command.token)
+        shown = Shown(command.topic)
         if not shown.reaches_judge(command.seconds):
             shown.close()
             return WorkerSpun(ok=False, unmatched=True, **facts)
-        # the slowest timer is slow_work's, the quickest heartbeat's (part 3: 0.5 s, 0.1 s)
-        timers[-1].callback, timers[0].callback = worker_callbacks(shown, command.work_s)
-        executor.add_node(node)
-        stop = threading.Event()
+        for timer in timers:  # the learner's own callbacks no longer run
+            timer.cancel()
+        stop, release = threading.Event(), threading.Event()
         failures: list[CallbackFailure] = []
+        thread = threading.Thread(target=_spin, args=(node, executor, stop, failures),
+                                  name='ros2nb-subject-worker', daemon=True)
 
-        def spin() -> None:
-            while not stop.is_set():
-                try:
-                    executor.spin_once(timeout_sec=SPIN_ROUND_S)
-                except BaseException as error:  # the learner's executor may raise anything
-                    failures.append(CallbackFailure(callback=f'{type(node).__name__} callback',
-                                                    **describe_error(error)))
-                    return
+        def dispatching() -> set[Optional[int]]:
+            pool = getattr(getattr(executor, '_executor', None), '_threads', ())
+            return {thread.ident, *(worker.ident for worker in list(pool))}
 
-        thread = threading.Thread(target=spin, name='ros2nb-subject-worker', daemon=True)
-        self._spun = (node, executor, thread, stop, failures, shown)
+        # the slowest timer is slow_work's, the quickest heartbeat's (part 3: 0.5 s, 0.1 s)
+        slow, quick = command.services
+        worker_services(node, (slow, quick),
+                        (timers[-1].callback_group, timers[0].callback_group), shown,
+                        release, dispatching)
+        executor.add_node(node)
+        self._spun = (node, executor, thread, stop, failures, shown, release)
         thread.start()
         return WorkerSpun(ok=True, **facts)
+
+    def worker_release(self, command: WorkerRelease) -> Reply:
+        """Let the course's slow work end (the judge has seen what it waited for)."""
+        if self._spun is not None:
+            self._spun[6].set()
+        return Reply(ok=True)
 
     def worker_stop(self, command: WorkerStop) -> WorkerStopped:
         """Stop spinning the learner's worker; the first failure of its callbacks, if any."""
         if self._spun is None:
             return WorkerStopped(ok=True)
-        node, executor, thread, stop, failures, shown = self._spun
+        node, executor, thread, stop, failures, shown, release = self._spun
         self._spun = None
+        release.set()
         stop.set()
         thread.join()
         executor.shutdown(timeout_sec=5)
@@ -119,15 +141,19 @@ class Trials:
 
     # ------------------------------------------------------------ notebook 07
     def plot_shown(self, command: PlotShown) -> PlotWitnessed:
-        """Put the course's ``redraw()`` (:func:`.shown.plot_redraw`, telling ``topic`` with
-        ``token``) in place of the given one on the class of the node made last, and wait (at
-        most ``seconds``) for the judge's subscription on ``topic`` to match."""
-        if self.node is None:
+        """Put the course's ``redraw()`` (:func:`.shown.plot_redraw`, telling ``topic`` what
+        the sealer sealed) in place of the given one on the class of the node made last, bind
+        the sealer to that node, and wait (at most ``seconds``) for the judge's subscription
+        on ``topic`` to match.  ``tampered``: something bound the sealer before."""
+        if self.node is None or self._sealer is None:
             return PlotWitnessed(ok=False)
         if self._plot_shown is not None:
             self._plot_shown.close()
-        self._plot_shown = shown = Shown(command.topic, command.token)
-        setattr(type(self.node), 'redraw', plot_redraw(shown))  # the learner's class, not Node
+        self._plot_shown = shown = Shown(command.topic)
+        if self._sealer.send(('bind', self.node)) is None:
+            return PlotWitnessed(ok=False, tampered=True)
+        # the learner's class, not Node
+        setattr(type(self.node), 'redraw', plot_redraw(shown, self._sealer))
         return PlotWitnessed(ok=shown.reaches_judge(command.seconds), shown=shown.told)
 
     def room_nodes(self, command: RoomNodes) -> RoomsMade:

@@ -18,7 +18,8 @@ from typing import Optional
 
 from ..errors import UsageError
 from ..explain.ros_settings import output_mistake
-from ..processes import stop_process_group, wait_for_work
+from ..patience import wait_for_work
+from ..processes import stop_process_group
 from .colcon import source_workspace
 from .run import _command, node_process_env
 from .workspace import PathLike, workspace_or_current
@@ -81,7 +82,7 @@ class NodeProcess:
     def wait_for(self, text: str, *, count: int = 1, timeout: float = 60.0) -> bool:
         """Wait until ``count`` of its lines contain ``text``, while the background processes
         work towards it (``timeout``: seconds of their work, or of their idle waiting, as
-        :class:`~ros2nb.processes.Patience` counts: a busy machine is slow, not wrong).
+        :class:`~ros2nb.patience.Patience` counts: a busy machine is slow, not wrong).
 
         :return: True when they did; False on timeout or when the process ended first.
         """

@@ -14,7 +14,7 @@ from typing import Iterable, Optional
 
 from ..errors import Ros2nbError
 from ..figures import CAPTION_START
-from ..processes import wait_for_work
+from ..patience import wait_for_work
 from ..runtime import current_runtime
 from .background import failures, running_pids
 from .topic import INFRASTRUCTURE_TOPICS, hidden
@@ -53,7 +53,7 @@ def graph_edges(*, expect: Iterable[str] = (),
 
     :param expect: full node names to wait for, e.g. ``['/temperature_sensor']``.
     :param timeout: seconds to wait for them at most: of the background processes' work
-        while they work, of the wall clock while they wait (:class:`~ros2nb.processes.Patience`).
+        while they work, of the wall clock while they wait (:class:`~ros2nb.patience.Patience`).
     :raises Ros2nbError: if ROS is not up, or an expected node did not appear in time.
     """
     want = set(expect)

@@ -23,12 +23,13 @@ from ament_index_python.packages import PackageNotFoundError, get_package_prefix
 from .. import domains, runtime
 from ..errors import Ros2nbError, UsageError
 from ..explain.ros_settings import output_mistake
-from ..processes import STOP_GRACE_S, Patience, signal_group, stop_process_group
+from ..patience import Patience
+from ..processes import STOP_GRACE_S, signal_group, stop_process_group
 from .colcon import source_workspace
 from .workspace import PathLike, workspace_or_current
 
 #: Seconds a process may take to print its first line before Ctrl+C's countdown starts anyway:
-#: of its work while it works, of the wall clock while it waits (processes.Patience).
+#: of its work while it works, of the wall clock while it waits (patience.Patience).
 START_UP_S = 60.0
 #: Console format for processes started by ros2nb (timestamps removed, as in the kernel).
 CONSOLE_FORMAT = '[{severity}] [{name}]: {message}'
@@ -215,7 +216,7 @@ def _relay(procs: list[subprocess.Popen], lines: queue.Queue, seconds: float,
     The countdown starts when every process has printed a line (or ended), as a person at
     a terminal waits for a program to start before timing it, so a busy machine does not
     decide whether Ctrl+C lands in the start-up; a program that prints nothing gets
-    :data:`START_UP_S` (:class:`~ros2nb.processes.Patience`: of its work while it works, of
+    :data:`START_UP_S` (:class:`~ros2nb.patience.Patience`: of its work while it works, of
     the wall clock while it waits).  The kernel's own nodes keep running meanwhile
     (:class:`_KernelNodes`).  Returns when every process has closed its output, or once they
     had :data:`STOP_GRACE_S` after Ctrl+C (patiently too: a slow exit is not a hang).

@@ -30,10 +30,13 @@ from .settings import JUDGE_TIMEOUT_S, Settings
 
 
 #: What the subjects never see: the course's reference nodes, the checks and the judge (their
-#: expectations), the grader.  The stand-ins and rules stay, refused to the learner's code
-#: and handed in to the subject once it is loaded (ros2nb.subject.out_of_reach).
+#: expectations, the stand-ins), the rules, the grader, each with its compiled forms (a
+#: subject needs none: the judge sends the stand-ins it runs, ros2nb.subject.out_of_reach).
 ANSWER_FOLDERS = [ROOT / 'src' / 'ros2nb' / 'reference', ROOT / 'src' / 'ros2nb' / 'checks',
-                  ROOT / 'src' / 'ros2nb' / 'judge', ROOT / 'src' / 'ros2nb_instructor']
+                  ROOT / 'src' / 'ros2nb' / 'judge', ROOT / 'src' / 'ros2nb_instructor',
+                  ROOT / 'src' / 'ros2nb' / 'rules.py',
+                  *(ROOT / 'src' / 'ros2nb' / '__pycache__').glob('rules.*'),
+                  *(ROOT / 'src' / 'ros2nb' / 'subject' / '__pycache__').glob('stand_ins.*')]
 #: Flags of one notebook kept for the instructor's notes (each cut to 300 characters).
 MAX_FLAGS = 20
 

@@ -1,14 +1,17 @@
 """The course's own version of each part a check does not grade, put in place of the learner's.
 
 Introduced in ``03-write-the-publisher.ipynb``.  A check grades one part of a node: the
-constructor, or the callback, or ``main()``.  So that a mistake in one part costs only
-that part's points, the judge may run the learner's class with another part replaced by
-the one here (``new_node(..., stand_ins=[...])``, :mod:`ros2nb.subject.commands`), or
-``main()`` with a whole stand-in node (:mod:`ros2nb.subject.program`).  A stand-in never
+constructor, or the callback.  So that a mistake in one part costs only that part's points,
+the judge may run the learner's class with another part replaced by the one here
+(``new_node(..., stand_ins=[...])``, :mod:`ros2nb.subject.commands`).  A stand-in never
 counts for the learner: it only makes room for their own part to be seen.
 
-This module is an answer: the subject refuses it to the learner's code and imports it only
-after that code is loaded, and keeps it out of ``sys.modules`` (:mod:`.out_of_reach`).
+This module is an answer and the judge's alone: no subject imports it (and while grading its
+file is not on a subject's disk).  A subject that needs stand-ins gets the code of just those
+(:func:`source_of`), sent after the learner's code is loaded, in a subject that runs no other
+stand-ins (:meth:`ros2nb.judge.session.Session.file_subject`): what the learner's code there
+can reach is the course's version of the parts that subject does not grade, never of the
+part it grades.
 
 Each function is written for a class of the learner's (no ``super()``: the class it ends up
 in is made on the fly).  The callbacks find the node's publisher by its topic, so a
@@ -17,6 +20,7 @@ learner's constructor that names its attribute differently still works with them
 
 from __future__ import annotations
 
+import inspect
 import random
 import sys
 import types
@@ -167,37 +171,33 @@ STAND_INS: dict[str, tuple[str, Callable[..., Any]]] = {
     'thresholds_on_set': ('on_set_thresholds', thresholds_on_set),
     'thresholds_callback': ('temperature_callback', thresholds_callback),
 }
-#: Whole nodes for a ``main()`` graded alone: the class main() creates, by class name.
-STAND_IN_NODES = {
-    course.SENSOR_CLASS: ('sensor_init', 'sensor_callback'),
-    course.MONITOR_CLASS: ('monitor_init', 'monitor_callback'),
-    course.FAN_CLASS: ('fan_init', 'fan_callback'),
-}
+#: What a stand-in's code uses besides :data:`PREAMBLE`'s names.
+HELPERS: dict[str, tuple[Callable[..., Any], ...]] = {
+    'sensor_callback': (_publisher_on, _constructing), 'fan_callback': (_publisher_on,),
+    'monitor_callback': (monitor_status,)}
+#: The names every stand-in's code may use, imported in the subject (no answer among them).
+PREAMBLE = """\
+import random
+import sys
+import types
+from typing import Any, Optional
+from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor, SetParametersResult
+from rclpy.node import Node
+from std_msgs.msg import Bool, Float32
+from ros2nb import course
+from ros2nb.course import HIGH_ABOVE_C, LOW_BELOW_C
+"""
 
 
-def with_stand_ins(cls: type, names: list[str]) -> type:
-    """A subclass of ``cls`` with the named stand-ins in place of its own methods.
+def source_of(names: tuple[str, ...]) -> str:
+    """The code of the stand-ins ``names`` and of what they use, as a module's text that
+    ends in ``STAND_INS = {name: (method, function)}``: what a subject compiles.
 
     :raises KeyError: for a name that is no stand-in (a mistake of the course's).
     """
-    methods = {method: _named(function, method, f"the course's {cls.__name__}.{method}")
-               for method, function in (STAND_INS[name] for name in names)}
-    return type(cls.__name__, (cls,), methods) if methods else cls
-
-
-def _named(function: Callable[..., Any], name: str, qualname: str) -> Callable[..., Any]:
-    """A copy of ``function`` named as the method it stands in for (``qualname`` in a
-    report): an error is reported as the course's method of the learner's class, never as a
-    function of ours."""
-    named = types.FunctionType(function.__code__, function.__globals__, name,
-                               function.__defaults__, function.__closure__)
-    named.__qualname__ = qualname
-    return named
-
-
-def stand_in_node(class_name: str) -> type:
-    """A whole node of the course's for the class ``main()`` creates (``TemperatureSensor``).
-
-    :raises KeyError: for a class the course has no stand-in for.
-    """
-    return type(class_name, (Node,), dict(STAND_INS[n] for n in STAND_IN_NODES[class_name]))
+    used = dict.fromkeys(helper for name in names for helper in HELPERS.get(name, ()))
+    parts = [PREAMBLE, *(inspect.getsource(helper) for helper in used),
+             *(inspect.getsource(STAND_INS[name][1]) for name in names)]
+    table = ', '.join(f'{name!r}: ({STAND_INS[name][0]!r}, {STAND_INS[name][1].__name__})'
+                      for name in names)
+    return '\n\n'.join(parts) + f'\n\nSTAND_INS = {{{table}}}\n'

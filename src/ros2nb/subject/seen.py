@@ -1,0 +1,223 @@
+"""What the learner's code reaches for in a subject, seen as it runs (a CPython audit hook).
+
+Part of :mod:`ros2nb.subject`; introduced with grading (``docs/instructors.md``).  Before the
+learner's code is loaded, the subject installs an audit hook (PEP 578, ``sys.addaudithook``:
+no Python code can remove it).  The hook watches the events that reach into the course or
+into the process: stack frames, the garbage collector's objects, a function's code, the
+course's answer files and modules, code compiled or loaded at run time, raw memory
+(``ctypes``), other processes.  Each event the learner's code caused is written at once, as
+one line, on the judge's pipe (the one the runtime acknowledges the judge's clock on), so
+nothing the code does afterwards takes it back; the judge turns each kind into a flag, and the
+kinds that can only serve cheating fail the check (:mod:`ros2nb.judge.reaching`).
+
+Whose code caused an event is read off the stack: a frame is the learner's unless its file is
+the Python installation's, the venv's, ros2nb's own or the course's stand-ins.  An event a
+library raises on the learner's behalf (rclpy's logger reading its caller's frame, a
+``namedtuple`` naming its module) is the library's; the few modules that hand frames or code
+to their caller (``inspect``, ``dis``, ``traceback``'s stack walks, ``logging.currentframe``,
+``ctypes``) pass it on to theirs.
+
+The hook keeps everything it uses in its own closures, bound before the learner's code runs:
+no module's name, no builtin and no global that code could replace later changes what it
+sees.  A hook does not see everything (reading ``__closure__``, ``__globals__`` or
+``object.__subclasses__()``, setting a class's attribute), so what decides a point never
+lives in this process (docs/decisions.md).
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import threading
+from pathlib import Path
+from typing import Any, Callable, Optional
+
+from .out_of_reach import ANSWERS
+
+#: How a line starts on the judge's pipe (the runtime's acknowledgements are JSON objects).
+MARK = 'SEEN'
+#: The file name the stand-ins' code is compiled under (:mod:`.commands`): the course's.
+STAND_IN_FILE = '<ros2nb stand-in>'
+#: Lines written at most (one per kind, event and place): a loop that walks the garbage
+#: collector in every callback must not fill the judge's pipe.
+MAX_LINES = 64
+#: Restricted attributes whose reading raises ``object.__getattr__`` (CPython 3.11).
+CODE_ATTRIBUTES = frozenset({'__code__', 'f_code', 'gi_code', 'cr_code', 'ag_code', 'tb_frame',
+                             'gi_frame', 'cr_frame', 'ag_frame'})
+#: Events whose cause is the innermost frame (passed on by the modules that forward frames).
+FRAME_EVENTS = {'sys._getframe': 'frames', 'sys._current_frames': 'frames',
+                'sys.settrace': 'frames', 'sys.setprofile': 'frames'}
+#: Events whose cause is the frame that called them.
+COMPILE_EVENTS = {'compile': 'compiled', 'exec': 'compiled', 'marshal.loads': 'compiled',
+                  'marshal.load': 'compiled', 'code.__new__': 'compiled',
+                  'function.__new__': 'compiled'}
+#: Events caused by the learner's code whenever any frame of theirs is on the stack.
+ANY_EVENTS = {'gc.get_objects': 'objects', 'gc.get_referrers': 'objects',
+              'gc.get_referents': 'objects', 'subprocess.Popen': 'processes',
+              'os.system': 'processes', 'os.exec': 'processes', 'os.posix_spawn': 'processes',
+              'os.spawn': 'processes', 'os.fork': 'processes', 'os.forkpty': 'processes',
+              'pty.spawn': 'processes', 'sys.addaudithook': 'hooks'}
+#: Events on a path: the course's answer files (opened or listed).
+PATH_EVENTS = frozenset({'open', 'os.listdir', 'os.scandir', 'glob.glob'})
+#: Every event the hook looks at (and ``ctypes.*``).
+WATCHED = frozenset({*FRAME_EVENTS, *COMPILE_EVENTS, *ANY_EVENTS, *PATH_EVENTS, 'import',
+                     'object.__getattr__'})
+
+
+def course_folders() -> tuple[Path, ...]:
+    """ros2nb's own folder and the Python installation's (their code is not the learner's)."""
+    own = Path(__file__).resolve().parent.parent
+    return tuple(sorted({own, *(Path(p).resolve() for p in (sys.prefix, sys.base_prefix,
+                                                            sys.exec_prefix))}))
+
+
+def answer_paths() -> tuple[Path, ...]:
+    """Where the course's answers (:data:`.out_of_reach.ANSWERS`) are on this machine's disk,
+    as path prefixes: each module's file or folder, its compiled forms, and the course's
+    solutions."""
+    top = Path(__file__).resolve().parent.parent.parent
+    found = []
+    for name in ANSWERS:
+        *parents, last = name.split('.')
+        found += [top.joinpath(*parents, last), top.joinpath(*parents, '__pycache__', last + '.')]
+    return (*found, top.parent / 'solutions')
+
+
+def _file_of(module: str) -> str:
+    """The file of a standard module (imported here, before the learner's code)."""
+    return getattr(__import__(module), '__file__', None) or os.devnull
+
+
+def _attribution() -> tuple[Callable[[Any], bool], Callable[..., Any], Callable[[Any], Any]]:
+    """Whose frame: ``learners(frame)``, ``innermost(frame, forwarding)`` (the frame that asked,
+    past the modules that forward), ``anyone(frame)`` (the learner's frame nearest, if any,
+    before the course's own code: what the course's code asks of a library is the course's,
+    and the frames below the subject's command loop, which started it, are nobody's)."""
+    trusted = tuple(str(p) + os.sep for p in course_folders())
+    course = str(Path(__file__).resolve().parent.parent) + os.sep
+    stand_in, frozen = STAND_IN_FILE, '<frozen '
+    logging_file, passing = _file_of('logging'), frozenset({'currentframe', '<lambda>'})
+
+    def learners(frame: Any) -> bool:
+        name = frame.f_code.co_filename
+        return not (name.startswith(trusted) or name.startswith(frozen) or name == stand_in)
+
+    def innermost(frame: Any, forwarding: frozenset) -> Any:
+        while frame is not None and frame.f_code.co_filename in forwarding and not (
+                frame.f_code.co_filename == logging_file and frame.f_code.co_name not in passing):
+            frame = frame.f_back
+        return frame
+
+    def anyone(frame: Any) -> Any:
+        while frame is not None and not learners(frame):
+            if frame.f_code.co_filename.startswith(course):
+                return None
+            frame = frame.f_back
+        return frame
+
+    return learners, innermost, anyone
+
+
+def _teller(write: Callable[[str], Any]) -> Callable[[str, str, Any], None]:
+    """``tell(kind, what, frame)``: one line on the judge's pipe, once per kind, event and
+    place, at most :data:`MAX_LINES`."""
+    written: set = set()
+    mark, limit, length, cut = MARK, MAX_LINES, len, 300
+
+    def tell(kind: str, what: str, frame: Any) -> None:
+        where = f'{frame.f_code.co_filename} line {frame.f_lineno}' if frame is not None else ''
+        key = (kind, what, where)
+        if key in written or length(written) >= limit:
+            return
+        written.add(key)
+        write('\t'.join(part.replace('\t', ' ').replace('\n', ' ')[:cut]
+                        for part in (mark, kind, what, where)) + '\n')
+
+    return tell
+
+
+def _examiner(tell: Callable[[str, str, Any], None]) -> Callable[[str, tuple, Any], None]:
+    """``examine(event, args, caller)``: whether the learner's code caused a watched event,
+    and if so, tell it."""
+    learners, innermost, anyone = _attribution()
+    frames, code = frozenset({_file_of('inspect'), _file_of('traceback'), _file_of('logging')}), \
+        frozenset({_file_of('inspect'), _file_of('dis')})
+    ctypes_folder = str(Path(_file_of('ctypes')).parent) + os.sep
+    frame_events, compile_events, any_events = dict(FRAME_EVENTS), dict(COMPILE_EVENTS), \
+        dict(ANY_EVENTS)
+    code_attributes, path_events, answers = CODE_ATTRIBUTES, PATH_EVENTS, ANSWERS
+    places = tuple(str(p) for p in answer_paths())
+    realpath, fspath, fsdecode, length, instance, anything = os.path.realpath, os.fspath, \
+        os.fsdecode, len, isinstance, any
+    path_types = (str, bytes, os.PathLike)
+
+    def examine(event: str, args: tuple, caller: Any) -> None:
+        if event in frame_events:
+            frame = innermost(caller, frames)
+            if frame is not None and learners(frame):
+                tell(frame_events[event], event, frame)
+        elif event == 'object.__getattr__':
+            frame = innermost(caller, code)
+            if length(args) > 1 and args[1] in code_attributes and frame is not None and \
+                    learners(frame):
+                tell('code', f'.{args[1]}', frame)
+        elif event in compile_events:
+            if caller is not None and learners(caller):
+                tell(compile_events[event], event, caller)
+        elif event in any_events:
+            frame = anyone(caller)
+            if frame is not None:
+                tell(any_events[event], event, frame)
+        elif event.startswith('ctypes.'):
+            frame = caller
+            while frame is not None and frame.f_code.co_filename.startswith(ctypes_folder):
+                frame = frame.f_back
+            if frame is not None and learners(frame):
+                tell('memory', event, frame)
+        elif event == 'import':
+            name = args[0] if args and instance(args[0], str) else ''
+            if anything(name == a or name.startswith(a + '.') for a in answers):
+                tell('answer_module', name, anyone(caller))
+        elif event in path_events and args and instance(args[0], path_types):
+            path = realpath(fsdecode(args[0]) if instance(args[0], bytes) else fspath(args[0]))
+            if path.startswith(places):
+                tell('answer_file', path, anyone(caller))
+
+    return examine
+
+
+def make_hook(write: Callable[[str], Any]) -> Callable[[str, tuple], None]:
+    """The audit hook, writing each event the learner's code caused with ``write``."""
+    examine, getframe, attribute = _examiner(_teller(write)), sys._getframe, getattr
+    watched, busy = WATCHED, threading.local()
+
+    def hook(event: str, args: tuple) -> None:
+        if event not in watched and not event.startswith('ctypes.'):
+            return
+        if attribute(busy, 'on', False):
+            return
+        busy.on = True
+        try:
+            examine(event, args, getframe(1))
+        except Exception:  # noqa: BLE001 - a hook that raises would break the audited call
+            pass
+        finally:
+            busy.on = False
+
+    return hook
+
+
+def install(fd: Optional[int]) -> None:
+    """Install the hook, writing to the judge's pipe ``fd`` (nothing when this process has
+    none: a subject started by hand).  Call it before the learner's code is loaded."""
+    if fd is None:
+        return
+    write, encode = os.write, str.encode
+
+    def send(line: str) -> None:
+        try:
+            write(fd, encode(line, 'utf-8', 'backslashreplace'))
+        except OSError:
+            pass  # the judge went away, or the code closed the pipe (the judge sees that)
+
+    sys.addaudithook(make_hook(send))
