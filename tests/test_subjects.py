@@ -268,17 +268,26 @@ def test_a_subject_ends_by_itself_and_its_exit_handlers_run(tmp_path):
 DDS_LEASE_S = 20.0
 
 MAKES_A_NODE = '''
+import pathlib, time
 from rclpy.node import Node
 
 class Leaver(Node):
     def __init__(self):
         super().__init__('leaver')
+
+def busy(marker):
+    """Code of the learner's still running when the judge ends it."""
+    pathlib.Path(marker).touch()
+    while True:
+        time.sleep(0.01)
 '''
 
 
-def test_a_subject_the_judge_ends_leaves_its_graph_at_once(session):
+@pytest.mark.parametrize('when', ['between commands', 'in a call'])
+def test_a_subject_the_judge_ends_leaves_its_graph_at_once(session, tmp_path, when):
     """A subject the judge ends (``kill_process_group``: a flood, a hang) takes its nodes
-    down on SIGTERM: its participant says it leaves, and the judge's graph drops it at once.
+    down on SIGTERM, also when the learner's code was running and its command caught
+    everything: its participant says it leaves, and the judge's graph drops it at once.
     Ended by SIGTERM's default action, it stayed there until its lease ran out (20 s), its
     /clock subscription matched, and the judge's /clock reached the next subjects late:
     ``test_floods.py``'s topic flood failed so beside four burners, the next subject waiting
@@ -293,6 +302,10 @@ def test_a_subject_the_judge_ends_leaves_its_graph_at_once(session):
     subject.request(NewNode(cls='Leaver'))
     graph = session.observer.node.get_node_names_and_namespaces
     assert wait_until(lambda: ('leaver', '/') in graph()), graph()
+    if when == 'in a call':
+        marker = tmp_path / 'busy'
+        subject.send(Call(name='busy', inputs=[[str(marker)]]))
+        assert wait_until(marker.exists)
     assert kill_process_group(subject.proc) == -15  # ended by the signal, as asked
     # Idle time of the judge's own wait: half the lease, which a vanished participant outlives.
     assert session.observer.wait_until(lambda: ('leaver', '/') not in graph(), DDS_LEASE_S / 2), \

@@ -284,7 +284,14 @@ class Ended(BaseException):
     """SIGTERM came: the judge ends this subject (``processes.kill_process_group``)."""
 
 
+#: Set on SIGTERM: a command whose ``except BaseException`` caught :class:`Ended` (the
+#: learner's code was running) still ends the subject once it returns.
+_ending = False
+
+
 def _on_sigterm(signum: int, _frame: Any) -> None:
+    global _ending
+    _ending = True
     signal.signal(signum, signal.SIG_DFL)  # a second SIGTERM ends the process at once
     raise Ended
 
@@ -322,6 +329,8 @@ def serve(commands: Any, replies: Any, namespace: dict[str, Any], sealer: Any = 
                     raise
                 except BaseException as error:  # a learner's callback may raise anything
                     reply = Reply(ok=False, error=described(error))
+                if _ending:
+                    raise Ended
                 replies.write(json.dumps(wire(reply)) + '\n')
                 replies.flush()
         finally:
