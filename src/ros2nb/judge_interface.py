@@ -142,6 +142,13 @@ class Observer(Protocol):
         :raises Flooded: at once, when a flood was found.
         """
 
+    def settle(self, cpu_s: float) -> None:
+        """Wait, the clock standing still, until the learner's processes sit idle or have
+        worked ``cpu_s`` CPU seconds.
+
+        :raises Flooded: at once, when a flood was found.
+        """
+
     def lines_of(self, logger: str, start: int = 0) -> list[str]:
         """The texts of one logger's lines, from position ``start`` of :attr:`logs` on."""
 

@@ -18,6 +18,13 @@ from ..subject_interface import NewNode, WaitPublishers, WaitReceived
 from ..subject_replies import Counts, LearnerError, NodeMade
 
 
+#: CPU seconds a subject may work once the learner's node is made, the judge's clock standing
+#: still, before the check goes on: a constructor's own work is done by then, and a thread it
+#: started that logs or publishes without waiting has sent thousands of messages, a flood
+#: (:meth:`ros2nb.judge.observer.Observer.settle`).
+SETTLE_CPU_S = 0.25
+
+
 def new_node(judge: Judge, relative: str, cls: str, *, stand_ins: tuple[str, ...] = (),
              seed: Optional[int] = None, args: tuple[Any, ...] = ()
              ) -> tuple[Subject, NodeMade]:
@@ -45,6 +52,7 @@ def new_node(judge: Judge, relative: str, cls: str, *, stand_ins: tuple[str, ...
     if not reply.ok:
         shown = ', '.join(repr(a) for a in args)
         raise raised(f'{cls}({shown})', reply.error)
+    judge.observer.settle(SETTLE_CPU_S)
     lines_logged(judge, reply, mark, reply.started_lines)
     return subject, reply
 

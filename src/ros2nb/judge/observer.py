@@ -27,7 +27,7 @@ from rclpy.signals import SignalHandlerOptions
 from .. import domains
 from ..judge_interface import ARRIVAL_TIMEOUT_S, Heard, Line
 from ..errors import CheckFailed
-from ..patience import Patience, wait_for_work
+from ..patience import LOOK_S, Patience, wait_for_work
 from ..runtime import QUIET_SUBSCRIPTION, node_serving_nothing
 from ..runtime.services import call_until_answered
 from .floods import Floods
@@ -171,6 +171,22 @@ class Observer:
                             self.attending(), seconds, look=self._wait_briefly)
         self.floods.raise_any()
         return met
+
+    def settle(self, cpu_s: float) -> None:
+        """Wait, the clock standing still, until the processes the judge attends to sit idle
+        (one look of :class:`~ros2nb.patience.Patience`), or have worked ``cpu_s`` CPU seconds.
+
+        What a thread of the learner's sends meanwhile without waiting for a timer counts
+        towards a flood in the same window, however fast or busy the machine: a flood is
+        found by the work the flooder did, not by how many clock steps passed meanwhile.
+
+        :raises Flooded: at once, when a flood was found.
+        """
+        patience = Patience(self.attending(), cpu_s)  # idle time counts from now
+        while not self._wait_briefly(lambda: self.floods.line is not None, LOOK_S):
+            if patience.exhausted():
+                break
+        self.floods.raise_any()
 
     def _wait_briefly(self, condition: Callable[[], bool], seconds: float) -> bool:
         """Wait until ``condition()`` holds, at most ``seconds`` on the wall clock."""
