@@ -23,8 +23,9 @@ _POSITIONAL_FIELDS = re.compile(r'^(\w+)\.__init__\(\) takes 1 positional argume
 #: variable ... referenced before assignment").
 _UNSET_LOCAL = re.compile(r"(?:cannot access local variable|local variable) '(\w+)'")
 #: A method called with no arguments where it should have been passed as a callback.
-_MISSING_ARGUMENT = re.compile(r"^(?:\w+\.)?(\w+)\(\) missing 1 required positional argument: "
-                               r"'(\w+)'")
+#: A stand-in of the course's is named "the course's Class.method" (subject.commands._named).
+_MISSING_ARGUMENT = re.compile(r"^(?:the course's )?(?:\w+\.)?(\w+)\(\) missing 1 required "
+                               r"positional argument: '(\w+)'")
 #: What takes a callback: the method is passed, and rclpy calls it later.
 _TAKES_A_CALLBACK = ('add_on_set_parameters_callback', 'create_subscription', 'create_timer')
 
