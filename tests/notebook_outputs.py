@@ -40,7 +40,11 @@ def comparable_outputs(outputs: list) -> list[str]:
                 output['data'][key] = ''.join(value)
         return nbformat.from_dict(output)
 
-    joined = coalesce_streams([one(o) for o in outputs])
+    # the display long work showed and emptied when it ended (ros2nb.working): whether one
+    # was made depends on how long the work took; make solutions drops it, nbval skips it
+    kept = [o for o in outputs if not (o.get('output_type') == 'display_data'
+                                       and not o.get('data'))]
+    joined = coalesce_streams([one(o) for o in kept])
     return [sanitize(f'{o.name}: {o.text}') if o.output_type == 'stream' else
             f'error: {o.ename}: {sanitize(o.evalue)}' if o.output_type == 'error'
             else f'{o.output_type}: {sanitize(str(o.get("data", {}).get("text/plain", "")))}'
