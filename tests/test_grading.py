@@ -258,14 +258,16 @@ def test_feedback_and_notes_say_what_happened(graded, learner):
 @pytest.mark.parametrize('learner', ['complete', 'untouched', 'solved-only-04'])
 def test_every_feedback_page_is_headed_by_the_learners_table_from_the_graders_results(
         graded, learner):
-    """The table of the learner's progress (issue 69), on every page of theirs: each
+    """The table of the learner's progress (issue 69), first on every page of theirs: each
     notebook's points as the grader scored them, and the notebooks not handed in as such."""
     case = EXPECTED[learner]
     for page in NOTEBOOKS:
-        text = shown(graded.out / 'feedback' / learner / f'{page}.html')
-        assert text.startswith('Every notebook, as the grader found it: '
-                               f'{sum(case.scores.values()):g} of {sum(FULL.values()):g} points '
-                               'passed'), (learner, page, text[:200])
+        path = graded.out / 'feedback' / learner / f'{page}.html'
+        assert re.search(r'<body[^>]*><div class="container above"><div id="standing" '
+                         r'class="standing"><table ', path.read_text()), (learner, page)
+        text = shown(path)
+        assert (f'Every notebook, as the grader found it: {sum(case.scores.values()):g} of '
+                f'{sum(FULL.values()):g} points passed') in text, (learner, page)
         for notebook in NOTEBOOKS:
             row = re.search(rf'{notebook} (\S+) of (\S+) (.*?)(?= \d\d-|$)', text)
             assert row is not None, (notebook, text[:2000])
