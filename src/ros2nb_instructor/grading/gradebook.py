@@ -150,8 +150,9 @@ def collect_zip(archive: Path, course: Path, times: Optional[dict] = None,
 
 
 def _not_submitted_page(learner: Learner, notebook: str, points: float, standing: str) -> str:
-    return feedback.page(notebook, standing + feedback.render(
-        'not_submitted.html.j2', learner=learner.shown, notebook=notebook, points=f'{points:g}'))
+    return feedback.page(notebook, feedback.render('above.html.j2', boxes=[standing]) +
+                         feedback.render('not_submitted.html.j2', learner=learner.shown,
+                                         notebook=notebook, points=f'{points:g}'))
 
 
 def standing_table(learner: Learner) -> str:
