@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """CPU seconds of each of the course's notebooks while it is graded, against the limits per
-notebook run (``NOTEBOOK_CPU_S``) and per judge (``JUDGE_CPU_S``).
+notebook run (``NOTEBOOK_CPU_S``) and per notebook's judge (``JUDGE_CPU_S``).
 
 ``python benchmarks/notebook_cpu.py [--learners N] [--corpus] [--burners B] [--share K]``
 grades, with ``ros2nb-grade`` in its sandboxes, a class of ``N`` learners (default 2) who each
@@ -143,10 +143,13 @@ def main() -> int:
     for notebook in sorted({nb for nb, _part in largest}):
         print(f'| {notebook} | {largest.get((notebook, "run"), 0):.1f} '
               f'| {largest.get((notebook, "judge"), 0):.1f} |')
-    for part, limit in (('run', NOTEBOOK_CPU_S), ('judge', JUDGE_CPU_S)):
-        heaviest = max(s for (_nb, kind), s in largest.items() if kind == part)
-        print(f'heaviest {part}: {heaviest:.1f} CPU-s; the limit, {limit} CPU-s, '
-              f'is {limit / heaviest:.1f} times it')
+    heaviest = max(s for (_nb, kind), s in largest.items() if kind == 'run')
+    print(f'heaviest run: {heaviest:.1f} CPU-s; the limit, {NOTEBOOK_CPU_S} CPU-s, '
+          f'is {NOTEBOOK_CPU_S / heaviest:.1f} times it')
+    margins = {nb: JUDGE_CPU_S[nb] / s for (nb, kind), s in largest.items() if kind == 'judge'}
+    tightest = min(margins, key=margins.__getitem__)
+    print(f'tightest judge: {tightest}, {largest[(tightest, "judge")]:.1f} CPU-s; its limit, '
+          f'{JUDGE_CPU_S[tightest]} CPU-s, is {margins[tightest]:.1f} times it')
     return 0
 
 

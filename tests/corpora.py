@@ -199,7 +199,8 @@ def grade_learner(learner: Learner, root: Path, *, knows_nothing: bool = False
     from ros2nb_instructor.grading import sandbox
     from ros2nb_instructor.grading.judging import stopped_verdict
     from ros2nb_instructor.grading.settings import JUDGE_CPU_S
-    judge = sandbox.watched(command, sandbox.Limits(wall_s=JUDGE_TIMEOUT_S, cpu_s=JUDGE_CPU_S),
+    cpu_s = JUDGE_CPU_S[learner.notebook]
+    judge = sandbox.watched(command, sandbox.Limits(wall_s=JUDGE_TIMEOUT_S, cpu_s=cpu_s),
                             env=env, cwd=root, text=True, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, start_new_session=True)
     try:
@@ -209,7 +210,7 @@ def grade_learner(learner: Learner, root: Path, *, knows_nothing: bool = False
     out, err = ended.stdout, ended.stderr
     if ended.out_of_cpu or ended.timed_out:  # what it had not checked scores nothing, as
         verdict = stopped_verdict(out, given / 'source.ipynb',  # in the grader
-                                  ended.out_of_cpu and JUDGE_CPU_S)
+                                  ended.out_of_cpu and cpu_s)
         unchecked = {'passed': False, 'type': 'GradingError', 'message': verdict.problem}
         return {gid: verdict.results.get(f'{learner.notebook}-{gid}', unchecked)
                 for gid in points(learner.notebook)}

@@ -108,7 +108,7 @@ def test_a_judge_that_hears_a_slow_flood_is_stopped_at_its_cpu_limit(tmp_path, m
         '03-sensor-constructor': True, '03-sensor-callback': True, '03-sensor-main': True}, \
         results
     assert problem == (
-        f"checking it reached the grader's limit of {JUDGE_CPU_S:g} CPU-seconds for checking "
+        f"checking it reached the grader's limit of {JUDGE_CPU_S['03']:g} CPU-seconds for checking "
         'a notebook (its checks and the processes that ran your code, together) and was '
         'stopped: its points come from the checks that had run; 03-sensor-hour was not '
         'checked and scores nothing'), problem

@@ -88,15 +88,17 @@ class Floods:
 
     def raise_any(self) -> None:
         """Raise :class:`~ros2nb.judge_interface.Flooded` with the flood's line when there
-        was one, once the processes that may flood are ended and reaped (:attr:`on_flood`):
-        what they sent and is still on its way is dropped on arrival (:meth:`stale`), however
-        long it takes; then count afresh."""
+        was one, once the processes that may flood are ended and reaped (:attr:`on_flood`)
+        and what the judge's subscriptions hold of theirs is taken away (the observer's
+        ``take_stale``); what is still on its way is dropped on arrival (:meth:`stale`),
+        however long it takes; then count afresh."""
         line = self.line
         if line is None:
             return
         self.on_flood()
         with self._observer.changed:
             self.stopped_ns = time.time_ns()
+        self._observer.take_stale()
         self.forget()
         raise Flooded(line)
 

@@ -21,6 +21,7 @@ from rcl_interfaces.msg import Log
 from rcl_interfaces.srv import ListParameters
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.serialization import deserialize_message
 from rclpy.signals import SignalHandlerOptions
 
 from .. import domains
@@ -109,8 +110,9 @@ class Observer:
         self.attending: Callable[[], list[int]] = list
         self._thread = threading.Thread(target=self._spin, name='ros2nb-judge', daemon=True)
         self._thread.start()
-        self.node.create_subscription(Log, '/rosout', self._on_log, ROSOUT_QOS,
-                                      event_callbacks=QUIET_SUBSCRIPTION)
+        #: What the judge hears the learner's code send on: /rosout and the watched topics.
+        self._hearing = [self.node.create_subscription(Log, '/rosout', self._on_log, ROSOUT_QOS,
+                                                       event_callbacks=QUIET_SUBSCRIPTION)]
 
     def _spin(self) -> None:
         """Run the node's callbacks until :meth:`close` (which wakes the wait at once)."""
@@ -148,9 +150,26 @@ class Observer:
                     store.append(Heard(self.now_ns, keep(msg)))
                     self.changed.notify_all()
 
-            self.node.create_subscription(msg_type, topic, note, EVERY_MESSAGE,
-                                          event_callbacks=QUIET_SUBSCRIPTION)
+            self._hearing.append(self.node.create_subscription(
+                msg_type, topic, note, EVERY_MESSAGE, event_callbacks=QUIET_SUBSCRIPTION))
         return self.heard[topic]
+
+    def take_stale(self) -> None:
+        """Take what the judge's subscriptions hold that stopped processes sent
+        (:meth:`~ros2nb.judge.floods.Floods.stale`), serialised, until a history holds no
+        more of it: a flood's backlog, gone before the next check, not read in the spin
+        thread beside it.  A message sent since goes to its callback, as the spin thread's do.
+        """
+        for subscription in list(self._hearing):
+            while True:
+                with subscription.handle:
+                    taken = subscription.handle.take_message(subscription.msg_type, True)
+                if taken is None:
+                    break
+                raw, info = taken
+                if not self.floods.stale(info):
+                    subscription.callback(deserialize_message(raw, subscription.msg_type), info)
+                    break
 
     def quiet_node(self) -> Any:
         """A node of the judge's that no thread spins: what its subscriptions receive waits in

@@ -54,8 +54,7 @@ from .gradebook import Scoring, collect_zip, set_up_course, write_results
 from .judging import Judges
 from .learners import grade_learner
 from .report import write_report
-from .settings import (CELL_TIMEOUT_S, JOBS, JUDGE_CPU_S, NOTEBOOK_CPU_S, NOTEBOOK_TIMEOUT_S,
-                       Settings)
+from .settings import CELL_TIMEOUT_S, JOBS, NOTEBOOK_CPU_S, NOTEBOOK_TIMEOUT_S, Settings
 from .submissions import Learner, find_learners
 
 if TYPE_CHECKING:
@@ -70,8 +69,9 @@ def _options(argv: Optional[list[str]]) -> argparse.Namespace:
     parser.add_argument('--notebook-timeout', type=int, default=NOTEBOOK_TIMEOUT_S)
     parser.add_argument('--notebook-cpu', type=int, default=NOTEBOOK_CPU_S,
                         help="CPU seconds one notebook's run may use in its sandbox")
-    parser.add_argument('--judge-cpu', type=int, default=JUDGE_CPU_S,
-                        help="CPU seconds one notebook's judge may use with its subjects")
+    parser.add_argument('--judge-cpu', type=int, default=None,
+                        help="CPU seconds one notebook's judge may use with its subjects "
+                             "(default: the course's limit for each notebook)")
     parser.add_argument('--jobs', type=int, default=JOBS)
     parser.add_argument('--force', action='store_true',
                         help='replace an earlier grading/ (and any manual grades in it)')

@@ -75,7 +75,7 @@ def judge_notebook(scratch: Scratch, notebook: str, submitted: nbformat.Notebook
     argv = judge_argv(source, given / 'submission.ipynb', settings)
     env = sandbox_env(own / 'home', ROS2NB_WORKSPACE=str(workspace),
                       TMPDIR=str(own / 'tmp'), **{SUBJECTS_FOLDER_ENV: str(subjects)})
-    limits = sandbox.Limits(wall_s=JUDGE_TIMEOUT_S, cpu_s=settings.judge_cpu)
+    limits = sandbox.Limits(wall_s=JUDGE_TIMEOUT_S, cpu_s=settings.judge_cpu_for(notebook))
     try:
         if settings.sandboxed:
             env['FASTDDS_BUILTIN_TRANSPORTS'] = 'UDPv4'  # judge and subjects: own /dev/shm each
