@@ -65,17 +65,17 @@ def main(periods: list[str]) -> int:
     marker = marked()
     from judging import judge_session
     from ros2nb import checks, course
-    from ros2nb.checks import lesson03
+    from ros2nb.checks import sensor_runs
     from ros2nb.judge_interface import captured
     seen: list[list[float]] = []
-    real_run = lesson03._run
+    real_run = sensor_runs.run_sensor
 
     def run(judge, sensor, seconds, **options):  # type: ignore[no-untyped-def]
         result = real_run(judge, sensor, seconds, **options)
         seen.append([t for t, _value in result.readings])
         return result
 
-    lesson03._run = run
+    sensor_runs.run_sensor = run
     print('| period s | check | first readings (s on the judge\'s clock) | verdict | wall s '
           '| CPU-s |')
     print('|---|---|---|---|---|---|')

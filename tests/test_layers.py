@@ -29,7 +29,7 @@ LAYERS: list[tuple[str, ...]] = [
     ('ros2nb.course',),
     ('ros2nb.rules',),
     ('ros2nb.explain',),
-    ('ros2nb.runtime', 'ros2nb.qos'),
+    ('ros2nb.runtime', 'ros2nb.qos', 'ros2nb.qos_profiles'),
     ('ros2nb.terminal',),
     ('ros2nb.kernel',),
     ('ros2nb.judge_interface',),

@@ -27,14 +27,18 @@ import rclpy
 from rclpy.context import Context
 from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
 from rclpy.executors import SingleThreadedExecutor
-from rclpy.qos import (HistoryPolicy, QoSCompatibility, QoSPolicyKind, QoSProfile,
-                       qos_check_compatible)
+from rclpy.qos import QoSProfile
 from rclpy.signals import SignalHandlerOptions
 from std_msgs.msg import Int32
 
 from . import domains
 from .errors import Ros2nbError
+from .qos_profiles import describe, endpoint_lines, incompatibility
 from .runtime import node_serving_nothing
+
+#: ``describe`` is the notebook's (09) way to print a profile; the checks name the others.
+__all__ = ['Deliveries', 'burst', 'burst_while_spinning', 'describe', 'discovered',
+           'endpoint_lines', 'incompatibility', 'late_joiner', 'pair']
 
 #: Seconds a trial waits for discovery (matching) and acknowledgements; the wait ends as
 #: soon as the state is reached, so only a very busy machine or a mismatch costs this long.
@@ -42,45 +46,6 @@ MATCH_TIMEOUT_S = 30.0
 #: Seconds one spin waits for a message; a drain ends after one such empty wait.
 IDLE_S = 0.05
 _topics = itertools.count()
-
-
-def describe(profile: QoSProfile) -> str:
-    """One line: ``RELIABLE, KEEP_LAST (10), VOLATILE``."""
-    if profile.history not in (HistoryPolicy.KEEP_LAST, HistoryPolicy.KEEP_ALL):
-        return f'{profile.reliability.name}, {profile.durability.name}'  # as discovered
-    depth = f' ({profile.depth})' if profile.history == HistoryPolicy.KEEP_LAST else ''
-    return f'{profile.reliability.name}, {profile.history.name}{depth}, {profile.durability.name}'
-
-
-#: What to change for each kind of incompatibility rclpy names (a word of its reason).
-_ADVICE = (('reliab', 'a best-effort publisher never resends, so it cannot serve a '
-                      'reliable subscription; make the subscription BEST_EFFORT (or '
-                      'the publisher RELIABLE)'),
-           ('durab', 'a volatile publisher keeps nothing for late joiners; make the subscription '
-                     'VOLATILE (or the publisher TRANSIENT_LOCAL)'),
-           ('deadline', 'a subscription may only ask for a deadline the publisher promises; '
-                        'leave the deadline out of the subscription\'s profile'),
-           ('lease', 'a subscription may only ask for a liveliness lease the publisher '
-                     'promises; leave the lease duration out of the subscription\'s profile'),
-           ('liveliness', 'a subscription may only ask for the liveliness the publisher '
-                          'offers; leave liveliness at its default (AUTOMATIC)'))
-
-
-def incompatibility(offered: QoSProfile, requested: QoSProfile) -> Optional[str]:
-    """Explain in one line why a publisher's profile cannot serve a subscription's, or None.
-
-    rclpy's own ``qos_check_compatible`` decides (every DDS rule: reliability, durability,
-    deadline, liveliness and its lease); its reason comes first, then what to change.  A
-    pair it only warns about (a policy left to the system default) is None: whether it
-    matches is then the middleware's to show.
-    """
-    compatibility, reason = qos_check_compatible(offered, requested)
-    if compatibility != QoSCompatibility.ERROR:
-        return None
-    said = reason.strip().rstrip(';').removeprefix('ERROR:').strip()
-    advice = next((text for word, text in _ADVICE if word in said.lower()),
-                  'make the subscription ask for no more than the publisher offers')
-    return f'rclpy says: {said}; {advice}.'
 
 
 def discovered(node: Any, topic: str, kind: str, *, seconds: float = MATCH_TIMEOUT_S,
@@ -359,36 +324,3 @@ def burst_while_spinning(subscription_qos: QoSProfile, *, count: int = 30,
         trial.drain()
 
     return _trial(body)
-
-
-def endpoint_lines(info: Any) -> list[str]:
-    """An endpoint's block of ``ros2 topic info --verbose``: node, type, QoS profile."""
-    qos = info.qos_profile
-    history = _policy(qos.history)
-    return [f'Node name: {info.node_name}', f'Node namespace: {info.node_namespace}',
-            f'Topic type: {info.topic_type}', f'Endpoint type: {_policy(info.endpoint_type)}',
-            'QoS profile:', f'  Reliability: {_policy(qos.reliability)}',
-            f'  History (Depth): {history}' if history == 'UNKNOWN' else
-            f'  History (Depth): {history} ({qos.depth})',
-            f'  Durability: {_policy(qos.durability)}', f'  Lifespan: {_duration(qos.lifespan)}',
-            f'  Deadline: {_duration(qos.deadline)}', f'  Liveliness: {_policy(qos.liveliness)}',
-            f'  Liveliness lease duration: {_duration(qos.liveliness_lease_duration)}']
-
-
-def _policy(value: Any) -> str:
-    return value.name if hasattr(value, 'name') else str(value)
-
-
-def _duration(value: Any) -> str:
-    nanoseconds = value.nanoseconds if hasattr(value, 'nanoseconds') else int(value)
-    # rmw reports "infinite" as the largest representable duration.
-    return 'Infinite' if nanoseconds >= 0x7FFFFFFFFFFFFFFF or nanoseconds == 0 else \
-        f'{nanoseconds} nanoseconds'
-
-
-def policy_name(kind: Any) -> str:
-    """``QoSPolicyKind.RELIABILITY`` (or its number) -> ``'Reliability'``."""
-    try:
-        return QoSPolicyKind(kind).name.capitalize()
-    except ValueError:
-        return str(kind)

@@ -13,7 +13,7 @@ from __future__ import annotations
 import difflib
 
 from ..errors import Ros2nbError
-from ..qos import endpoint_lines
+from ..qos_profiles import endpoint_lines
 from ..runtime import current_runtime
 
 #: Topics every ROS 2 process has; they are never reported as unmatched.
