@@ -105,6 +105,8 @@ class Observer:
         self.floods = Floods(self)
         self._quiet: Any = None
         self._stop = False
+        #: Held while a message is taken: by the spin thread, or by :meth:`take_stale`.
+        self._taking = threading.Lock()
         #: The processes whose work the judge waits for (its subjects and the learner's
         #: programs, given by the session): every wait of the judge's lasts while they work.
         self.attending: Callable[[], list[int]] = list
@@ -120,7 +122,8 @@ class Observer:
             with contextlib.suppress(Exception):  # as spin_once: a callback's error is dropped
                 handler, _entity, _node = self.executor.wait_for_ready_callbacks(
                     timeout_sec=SPIN_WAIT_S, condition=self._stopping)
-                handler()
+                with self._taking:  # rcl takes from a subscription in one thread at a time
+                    handler()
 
     def _stopping(self) -> bool:
         return self._stop
@@ -162,7 +165,7 @@ class Observer:
         """
         for subscription in list(self._hearing):
             while True:
-                with subscription.handle:
+                with self._taking, subscription.handle:
                     taken = subscription.handle.take_message(subscription.msg_type, True)
                 if taken is None:
                     break
