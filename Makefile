@@ -90,11 +90,14 @@ graph-tool:
 image-tool:
 	$(call from_debian,podman runc debootstrap,podman runc debootstrap,the image test skips.)
 
-# The fast lane (docs/developing.md): ruff over the course's Python, then the tests that need
-# only Python (no ROS process, kernel, sandbox, browser, image or hub: tests/conftest.py's
-# lanes), notebook structure and layer rules among them.  Run it while you work.
+# The fast lane (docs/developing.md): ruff over the course's Python, mypy over the seams
+# between the places code runs (pyproject.toml: [tool.mypy]; its cache in .cache/mypy), then
+# the tests that need only Python (no ROS process, kernel, sandbox, browser, image or hub:
+# tests/conftest.py's lanes), notebook structure and layer rules among them.  Run it while
+# you work.
 check: $(STAMP) bytecode
 	@$(VENV)/bin/ruff check --quiet .
+	@$(PY) -m mypy
 	@$(PY) -m pytest --lane check -q
 
 # Everything: the fast lane first (a lint error or a broken rule stops here, in a minute),

@@ -30,7 +30,7 @@ def judge(kind: str, starts: int) -> None:
     sys.path.insert(0, str(HERE.parent / 'tests'))
     from ros2nb import domains
     if kind == 'Fast DDS default':  # what every process of the course had before the profile
-        domains.use_discovery_profile = lambda: None  # type: ignore[assignment]
+        domains.use_discovery_profile = lambda: None  # type: ignore[assignment]  # DDS own
         os.environ.pop(domains.PROFILE_ENV, None)
     from nodes import join_times
 

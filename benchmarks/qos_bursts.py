@@ -42,7 +42,7 @@ def main() -> None:
     verdicts: collections.Counter = collections.Counter()
     burst = lesson09.qos.burst
 
-    def counted(*args, **kwargs):  # type: ignore[no-untyped-def]
+    def counted(*args, **kwargs):  # type: ignore[no-untyped-def]  # burst() passed on
         out = burst(*args, **kwargs)
         bursts['whole' if out.matched and lesson09._whole(out.received) else
                f'matched={out.matched} kept={out.received}'] += 1

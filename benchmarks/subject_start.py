@@ -25,6 +25,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from grading_profile import busy_cpu_s  # noqa: E402
 
 from ros2nb.judge.subjects import SUBJECT_PREFIX_ENV, SubjectProcess  # noqa: E402
+from ros2nb.subject_interface import ExecCells  # noqa: E402
 
 CELL = 'import rclpy\nfrom rclpy.node import Node\nrclpy.init()\nnode = Node("started")\n'
 
@@ -34,8 +35,8 @@ def run(count: int, folder: Path) -> tuple[float, float]:
     busy, began = busy_cpu_s(), time.monotonic()
     for _ in range(count):
         subject = SubjectProcess(folder)
-        reply = subject.request('exec_cells', sources=[CELL])
-        assert reply.get('cell_errors') == [], reply
+        reply = subject.request(ExecCells(sources=[CELL]))
+        assert reply.cell_errors == [], reply
         subject.close()
     return (busy_cpu_s() - busy) / count, (time.monotonic() - began) / count
 

@@ -70,7 +70,7 @@ def main(periods: list[str]) -> int:
     seen: list[list[float]] = []
     real_run = sensor_runs.run_sensor
 
-    def run(judge, sensor, seconds, **options):  # type: ignore[no-untyped-def]
+    def run(judge, sensor, seconds, **options):  # type: ignore[no-untyped-def]  # passed on
         result = real_run(judge, sensor, seconds, **options)
         seen.append([t for t, _value in result.readings])
         return result

@@ -375,15 +375,13 @@ def package_dependencies(package_xml: Path) -> list[str]:
     return names
 '''
 
-#: The timer's work done by the request handler: new_node reports a timer of 1 s, and
-#: each ``advance`` calls publish_temperature once per simulated second itself.
+#: The timer's work done by the request handler: each ``advance`` calls publish_temperature
+#: once per simulated second itself (new_node's reply is passed on: a reply names no timers,
+#: the judge sees the node's readings itself).
 FORGED_TIMER = FIND_SUBJECT + '''
 def _forge(_new_node=_HANDLERS.get('new_node'), _advance=_HANDLERS.get('advance')):
-    def new_node(**request):
-        reply = _new_node(**request)
-        if reply.get('ok'):
-            reply['timers'] = [[1_000_000_000, 'publish_temperature']]
-        return reply
+    def new_node(command):  # a reply names no timers: the judge reads them from the graph
+        return _new_node(command)
 
     def advance(seconds, seed=None):
         if seed is not None:

@@ -34,7 +34,7 @@ def main(argv: list[str]) -> int:
     knows_nothing = '--knows-nothing' in argv
     paths = [arg for arg in argv if arg != '--knows-nothing']
     if knows_nothing:  # the one reader's method: modules hold the reader itself
-        source.TEXT.read = KnowsNothing().read  # type: ignore[method-assign]
+        source.TEXT.read = KnowsNothing().read  # type: ignore[method-assign]  # reads nothing
     from ros2nb.judge.__main__ import main as judge
     return judge(['grade', *paths])
 

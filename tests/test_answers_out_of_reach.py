@@ -58,8 +58,9 @@ ros2nb.rules.monitor_status(27.0)
 from ros2nb.subject.forked import serve_from_here
 serve_from_here()  # as python -m ros2nb.judge does
 from ros2nb.judge.subjects import SubjectProcess
+from ros2nb.subject_interface import ExecCells
 subject = SubjectProcess(Path(sys.argv[1]))
-subject.request('exec_cells', sources=[sys.argv[2]])
+subject.request(ExecCells(sources=[sys.argv[2]]))
 subject.close()
 print(subject.output.text())
 '''

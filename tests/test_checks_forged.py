@@ -127,10 +127,10 @@ def test_a_main_that_never_starts_ros(session):
 #: subject created the node: temperature_callback itself does nothing.
 FORGED_SUBSCRIPTION = FIND_SUBJECT + '''
 def _forge(_new_node=_HANDLERS.get('new_node')):
-    def new_node(**request):
-        reply = _new_node(**request)
+    def new_node(command):
+        reply = _new_node(command)
         node = _SUBJECT.node
-        for subscription in node.subscriptions if reply.get('ok') else ():
+        for subscription in node.subscriptions if reply.ok else ():
             counted = subscription.callback
             subscription.callback = lambda msg, counted=counted: (counted(msg), node.unused(msg))
         return reply

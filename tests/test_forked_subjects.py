@@ -18,6 +18,7 @@ from pathlib import Path
 import pytest
 
 from ros2nb.judge.subjects import SUBJECT_PREFIX_ENV, SubjectProcess, subject_env
+from ros2nb.subject_interface import ExecCells
 from ros2nb.processes import kill_process_group
 from waiting import run_to_end, wait_until
 
@@ -58,11 +59,11 @@ def view(tmp_path, judge_pid: int) -> tuple[dict, SubjectProcess]:
     extra = {'TMPDIR': str(tmp_path / 'tmp'), 'HOME': str(tmp_path / 'home'),
              'PYTHONPATH': str(tmp_path / 'lib')}
     subject = SubjectProcess(tmp_path, env=subject_env(extra))
-    subject.send('exec_cells', sources=[f'JUDGE = {judge_pid}\n' + VIEW])
+    subject.send(ExecCells(sources=[f'JUDGE = {judge_pid}\n' + VIEW]))
     reply = None
     while reply is None:
         reply = subject.poll_reply(1.0)
-    assert reply == {'ok': True, 'cell_errors': []}, reply
+    assert reply == {'ok': True, 'error': None, 'cell_errors': []}, reply
     subject.close()
     line, = (line for line in subject.output.text().splitlines() if line.startswith('VIEW '))
     return json.loads(line[len('VIEW '):]), subject
@@ -97,9 +98,10 @@ from pathlib import Path
 print('the judge script ran')
 if __name__ == '__main__':
     from ros2nb.judge.subjects import SubjectProcess
+    from ros2nb.subject_interface import ExecCells
     for _ in range(2):  # the first started afresh, the second forked from a server
         subject = SubjectProcess(Path(sys.argv[1]))
-        subject.request('exec_cells', sources=['import os\\nprint("parent", os.getppid())'])
+        subject.request(ExecCells(sources=['import os\\nprint("parent", os.getppid())']))
         subject.close()
         print('subject said:', subject.output.text().replace('\\n', ' | '))
 '''

@@ -1,7 +1,8 @@
 """The fast lane holds what it promises: lint that can fail, and no test that quietly starts ROS.
 
-``make check`` runs ruff, then ``pytest --lane check`` (tests/conftest.py).  Each protection
-is shown failing on a planted mistake, beside its honest twin passing.
+``make check`` runs ruff, mypy (shown in tests/test_types.py), then ``pytest --lane check``
+(tests/conftest.py).  Each protection is shown failing on a planted mistake, beside its honest
+twin passing; the lanes are run on planted tests with pytest's own ``pytester``.
 """
 
 from __future__ import annotations
@@ -61,23 +62,20 @@ def test_brings_ros_up_marked():
 
 @pytest.mark.ros
 @pytest.mark.kernel
-def test_the_check_lane_fails_a_test_that_starts_ros_or_a_kernel_unmarked(tmp_path):
-    """A copy of tests/conftest.py runs a planted file: the unmarked tests that bring ROS up
-    or start a kernel fail and name their marker; the marked one is left to the slow lane."""
-    (tmp_path / 'conftest.py').write_text((TESTS / 'conftest.py').read_text())
-    (tmp_path / 'test_planted.py').write_text(PLANTED_TESTS)
-    (tmp_path / 'pytest.ini').write_text('[pytest]\n')
-    env = {k: v for k, v in os.environ.items() if k != 'ROS_DOMAIN_ID'}  # the lane's own
-    env['PYTHONPATH'] = os.pathsep.join([str(TESTS), str(ROOT / 'src')])
-    done = subprocess.run([sys.executable, '-m', 'pytest', '-p', 'no:cacheprovider', '-p',
-                           'no:warnings', '-q',
-                           '-c', str(tmp_path / 'pytest.ini'), '--rootdir', str(tmp_path),
-                           '--lane', 'check', str(tmp_path / 'test_planted.py')],
-                          capture_output=True, text=True, env=env, cwd=tmp_path, timeout=600)
-    out = done.stdout
-    assert done.returncode == 1, out[-3000:]
-    assert 'test_brings_ros_up_unmarked started ros in the check lane: mark it ' \
-           '@pytest.mark.ros' in out, out[-3000:]
-    assert 'test_starts_a_kernel_unmarked started kernel in the check lane: mark it ' \
-           '@pytest.mark.kernel' in out, out[-3000:]
-    assert '3 passed, 1 deselected, 2 errors' in out, out[-3000:]
+def test_the_check_lane_fails_a_test_that_starts_ros_or_a_kernel_unmarked(pytester,
+                                                                           monkeypatch):
+    """tests/conftest.py runs a planted file in a pytest of its own (its own process: it
+    brings ROS up): the unmarked tests that bring ROS up or start a kernel fail and name their
+    marker; the marked one is left to the slow lane."""
+    pytester.makeconftest((TESTS / 'conftest.py').read_text())
+    pytester.makepyfile(test_planted=PLANTED_TESTS)
+    pytester.makeini('[pytest]\n')  # none of the course's options: the lane's alone
+    monkeypatch.delenv('ROS_DOMAIN_ID', raising=False)  # the lane claims its own
+    monkeypatch.setenv('PYTHONPATH', os.pathsep.join([str(TESTS), str(ROOT / 'src')]))
+    result = pytester.runpytest_subprocess('-p', 'no:cacheprovider', '-p', 'no:warnings',
+                                           '--lane', 'check', timeout=600)
+    result.stdout.fnmatch_lines([
+        '*test_brings_ros_up_unmarked started ros in the check lane: mark it @pytest.mark.ros*',
+        '*test_starts_a_kernel_unmarked started kernel in the check lane: mark it '
+        '@pytest.mark.kernel*'], consecutive=False)
+    result.assert_outcomes(passed=3, deselected=1, errors=2)

@@ -21,7 +21,7 @@ ARCHITECTURE = ROOT / 'docs' / 'architecture.md'
 LAYERS: list[tuple[str, ...]] = [
     # ros2nb: the learner's kernel; the judge and its subjects reuse the lower layers.
     ('ros2nb.errors', 'ros2nb.processes', 'ros2nb.endpoints', 'ros2nb.nbmeta',
-     'ros2nb.on_first_use'),
+     'ros2nb.on_first_use', 'ros2nb.typed_json'),
     ('ros2nb.domains',),
     ('ros2nb.terminal.workspace',),
     ('ros2nb.terminal.files', 'ros2nb.terminal.colcon', 'ros2nb.terminal.pkg_templates'),
@@ -32,7 +32,7 @@ LAYERS: list[tuple[str, ...]] = [
     ('ros2nb.runtime', 'ros2nb.qos', 'ros2nb.qos_profiles'),
     ('ros2nb.terminal',),
     ('ros2nb.kernel',),
-    ('ros2nb.judge_interface',),
+    ('ros2nb.judge_interface', 'ros2nb.subject_interface', 'ros2nb.subject_replies'),
     ('ros2nb.checks',),
     ('ros2nb.subject',),
     ('ros2nb.judge',),

@@ -5,6 +5,7 @@ processes, verdicts come from the judge's own ROS node.  The course's reference 
 first, so every failure below is its mistake's.
 """
 
+import dataclasses
 import re
 from pathlib import Path
 
@@ -394,26 +395,29 @@ def test_a_worker_built_in_a_list_passes(session, capsys):
 
 
 def test_a_reply_of_no_known_shape_fails_that_check_alone(session, monkeypatch):
-    """A check that meets a reply it cannot read raises an error of its own (KeyError here);
-    before, that ended the judge and every check of the notebook went with it. Now it fails
-    that check with one line, and the notebook's other checks are graded."""
+    """A check that meets a reply it cannot read (the subject runs learner code, which may
+    write anything on its pipe) raises an error of its own, here the typed reply's
+    (Unreadable); before, that ended the judge and every check of the notebook went with it.
+    Now it fails that check with one line, and the notebook's other checks are graded."""
     from ros2nb.judge_interface import captured
     from ros2nb.judge.subjects import SubjectProcess
+    from ros2nb.subject_interface import NewNode
+    from ros2nb.typed_json import Unreadable
 
-    request = SubjectProcess.request
+    reply_to = SubjectProcess.reply_to
 
-    def nonsense(self, op, **arguments):
-        reply = request(self, op, **arguments)
-        return {'ok': True} if op == 'new_node' else reply
+    def nonsense(command, data):
+        return reply_to(command, {'ok': True, 'name': 7} if isinstance(command, NewNode)
+                        else data)
 
-    monkeypatch.setattr(SubjectProcess, 'request', nonsense)
+    monkeypatch.setattr(SubjectProcess, 'reply_to', staticmethod(nonsense))
     session.drop(('file', PLOT))
-    with pytest.raises(KeyError):  # what ended the judge
+    with pytest.raises(Unreadable, match=r'^NodeMade.name is int, not str$'):
         run_check(session, checks.check_plot_callback)
     outcome = captured(lambda: run_check(session, checks.check_plot_callback))
     assert outcome['passed'] is False and '\n' not in outcome['message']
-    assert outcome['message'].startswith('The grader could not finish this check (KeyError'), \
-        outcome
+    assert outcome['message'].startswith('The grader could not finish this check (Unreadable: '
+                                         'NodeMade.name is int, not str)'), outcome
 
 
 #: The Worker's slow callback logs the heartbeat's line itself, between its own two lines, on a
@@ -492,5 +496,11 @@ def test_a_witness_message_without_the_token_counts_for_nothing(session, capsys,
     monkeypatch.setattr(lesson07, 'told', lambda heard, start, token: [
         fact for fact in witnessed.told(heard, start, 'guessed')])
     # the subject counts only what the course's redraw() told: wait for one message each
-    monkeypatch.setattr(lesson07, '_shown', lambda counts: None)
+    real_feed = lesson07.feed
+
+    def feed_counting_nothing(*args, **kwargs):
+        counts, lines = real_feed(*args, **kwargs)
+        return dataclasses.replace(counts, shown=None), lines
+
+    monkeypatch.setattr(lesson07, 'feed', feed_counting_nothing)
     passes_with(session, capsys, PLOT, RIGHT_PLOT, WITNESS_FORGED, checks.check_plot_callback)

@@ -16,6 +16,8 @@ import pytest
 
 from ros2nb.judge import observer
 from ros2nb.judge.subjects import SubjectHung, SubjectProcess
+from ros2nb.subject_interface import Call, ExecCells
+from ros2nb.subject_replies import Called, Encoded, Output
 from ros2nb.processes import BUSY_SHARE, Patience, tree_cpu_seconds, wait_for_work
 from waiting import PATIENCE_S, run_to_end, wait_until
 
@@ -49,20 +51,20 @@ def waits_for_ever():
 @pytest.fixture
 def subject(tmp_path):
     process = SubjectProcess(tmp_path)
-    assert process.request('exec_cells', sources=[CELLS])['cell_errors'] == []
+    assert process.request(ExecCells(sources=[CELLS])).cell_errors == []
     yield process
     process.close()
 
 
-def call(subject: SubjectProcess, name: str, *arguments) -> tuple[dict, float]:
+def call(subject: SubjectProcess, name: str, *arguments) -> tuple[Called, float]:
     began = time.monotonic()
-    reply = subject.request('call', name=name, inputs=[list(arguments)], timeout=LIMIT_S)
+    reply = subject.request(Call(name=name, inputs=[list(arguments)]), timeout=LIMIT_S)
     return reply, time.monotonic() - began
 
 
 def test_slow_honest_work_on_a_busy_machine_is_not_a_hang(subject):
     reply, waited = call(subject, 'slow_but_honest', 0.75 * LIMIT_S)
-    assert reply['outputs'] == [{'result': {'type': 'str', 'value': 'done'}}]
+    assert reply.outputs == [Output(result=Encoded(type='str', value='done'))]
     assert waited > LIMIT_S  # the failure prevented: a wall-clock limit would have cut it
 
 
@@ -255,7 +257,7 @@ def test_a_subject_ends_by_itself_and_its_exit_handlers_run(tmp_path):
     marker = tmp_path / 'exit-handler-ran'
     process = SubjectProcess(tmp_path)
     cells = f"import atexit, pathlib\natexit.register(pathlib.Path({str(marker)!r}).touch)"
-    assert process.request('exec_cells', sources=[cells])['cell_errors'] == []
+    assert process.request(ExecCells(sources=[cells])).cell_errors == []
     process.close()
     assert process.proc.returncode == 0, process.output.text()
     assert marker.exists()

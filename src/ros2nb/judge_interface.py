@@ -14,15 +14,24 @@ import contextlib
 import io
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, ContextManager, Optional, Protocol
+from typing import TYPE_CHECKING, Any, Callable, ContextManager, Optional, Protocol, TypeVar
 
 from .errors import CheckFailed, LearnerCodeError, Ros2nbError
+from .processes import Process
+from .subject_interface import Command
+from .subject_replies import LearnerError, Reply
+
+if TYPE_CHECKING:  # only the types: no ROS import here
+    from rclpy.node import Node
+    from rclpy.publisher import Publisher
 
 #: Seconds the judge waits for what a subject published to arrive over ROS, and for ROS
 #: discovery to show a subject's node; the wait ends as soon as it is there, so a long
 #: limit costs time only on a busy machine or when the thing never comes.  Generous: the
 #: learner's verdict must not depend on how busy the machine is.
 ARRIVAL_TIMEOUT_S = 60.0
+#: The reply type of the command a check sends (:mod:`ros2nb.subject_interface`).
+R = TypeVar('R', bound=Reply)
 
 
 @dataclass(frozen=True)
@@ -41,31 +50,217 @@ class AnswerRef:
         return self.name
 
 
+@dataclass(frozen=True)
+class Heard:
+    """A message the judge's node received.
+
+    :ivar t_ns: the judge's clock when it arrived (ns of simulated time).
+    :ivar value: what the check keeps of it (e.g. a Float32's ``data``).
+    """
+
+    t_ns: int
+    value: Any
+
+
+@dataclass(frozen=True)
+class Line:
+    """A /rosout line the judge's node received.
+
+    :ivar t_ns: the judge's clock when it arrived (ns of simulated time).
+    :ivar name: the logger's name (a node's name).
+    :ivar level: 10 debug, 20 info, 30 warn, 40 error, 50 fatal.
+    :ivar text: the message.
+    """
+
+    t_ns: int
+    name: str
+    level: int
+    text: str
+
+
+class Subject(Protocol):
+    """A process of the judge's that runs the learner's code (:mod:`ros2nb.subject`)."""
+
+    def request(self, command: Command[R], *, timeout: float = ...) -> R:
+        """Send ``command`` (:mod:`ros2nb.subject_interface`) and return its typed reply.
+
+        :param timeout: seconds the subject gets: of CPU time while it works, of the wall
+            clock while it waits.
+        :raises ros2nb.judge.subjects.SubjectHung: when none came in time (or it died).
+        :raises ros2nb.typed_json.Unreadable: for a reply that does not fit its type.
+        """
+
+
+class ProgramOutput(Protocol):
+    """What a program printed (stdout and stderr), collected as it comes."""
+
+    def text(self) -> str:
+        """Its last lines so far, one string."""
+
+
+class Floods(Protocol):
+    """What the learner's code sends beyond any node of the course (:mod:`ros2nb.judge.floods`)."""
+
+    def forget(self) -> None:
+        """Count afresh: no flood, every window empty (a new check)."""
+
+    def raise_any(self) -> None:
+        """Raise :class:`Flooded` once a flood was found (its processes ended first)."""
+
+
+class Observer(Protocol):
+    """The judge's own ROS node (:class:`ros2nb.judge.observer.Observer`): what it hears is
+    stamped with the judge's clock; every wait attends to the work of the learner's processes.
+    """
+
+    @property
+    def node(self) -> Node:
+        """The judge's rclpy node (spun by the judge), for a client or a publisher of a check's."""
+
+    @property
+    def logs(self) -> list[Line]:
+        """Every /rosout line heard, in order of arrival (a check marks ``len(logs)``)."""
+
+    @property
+    def floods(self) -> Floods:
+        """The flood counts of this judge."""
+
+    def watch(self, topic: str, msg_type: Any, keep: Callable[[Any], Any] = ...) -> list[Heard]:
+        """Hear every ``msg_type`` message on ``topic`` from now on, each kept as
+        ``keep(msg)`` (default: its ``data``); the list they go to, the same for a topic
+        watched again."""
+
+    def wait_until(self, condition: Callable[[], bool], seconds: float) -> bool:
+        """Wait until ``condition()`` holds: False once the learner's processes had
+        ``seconds`` of work or idle waiting.
+
+        :raises Flooded: at once, when a flood was found.
+        """
+
+    def lines_of(self, logger: str, start: int = 0) -> list[str]:
+        """The texts of one logger's lines, from position ``start`` of :attr:`logs` on."""
+
+    def endpoints(self, name: str, namespace: str, expected: list[tuple[str, str, str]],
+                  seconds: float = ...) -> list[tuple[str, str, str]]:
+        """The node ``namespace/name``'s ``(kind, topic, type)`` endpoints as the ROS graph
+        shows them, once it holds ``expected`` (what the subject said it made) or after
+        ``seconds``; sorted, without ROS's own topics.
+
+        :raises CheckFailed: when ``seconds`` pass first (the line says what was seen).
+        """
+
+    def spins(self, name: str, namespace: str = '/', seconds: float = ...) -> bool:
+        """True once the node ``name`` answers a parameter call (it got into its spin)."""
+
+    def has_node(self, name: str) -> bool:
+        """True when a running node called ``name`` (any namespace) owns an endpoint."""
+
+    def quiet_node(self) -> Node:
+        """A node of the judge's that no thread spins (it takes only when told)."""
+
+
+class Clock(Protocol):
+    """The judge's clock (:class:`ros2nb.judge.clock.JudgeClock`): the only simulated time
+    the learner's nodes run on."""
+
+    @property
+    def now_ns(self) -> int:
+        """The judge's simulated time now (ns)."""
+
+    @property
+    def now_s(self) -> float:
+        """The judge's simulated time now (s)."""
+
+    def drive(self, subject: Subject, command: Command[R], *, step_s: float, limit_s: float,
+              probe_s: float = 0.0, timeout: float = ..., what: str = 'your code') -> R:
+        """Send ``command`` and step the clock (``step_s`` s a step, at most ``limit_s`` s of
+        simulated time) while the subject's spin wants it; its typed reply once it comes.
+
+        :param probe_s: also stop ``probe_s`` before each whole step (a timer of another
+            period shows).
+        :param what: whose spin would run too long, for the message.
+        :raises CheckFailed: when the spin wants more than ``limit_s``, or an announced
+            message never arrives.
+        """
+
+
 class Judge(Protocol):
     """What a check's body may ask of the judge that runs it (:class:`ros2nb.judge.Session`)."""
 
     workspace: Path  #: the learner's workspace (read only)
     scratch: Path  #: a folder of the judge's own
-    builds: dict[str, Any]  #: packages built so far, by their source's digest
-    observer: Any  #: the judge's own ROS node: graph, messages, logs, stamped by its clock
-    clock: Any  #: the judge's clock (:class:`ros2nb.judge.clock.JudgeClock`)
-    probe_publisher: Any  #: the judge's Float32 publisher on /temperature
+    builds: dict[str, Path]  #: workspaces of packages built so far, by their source's digest
     seed: int  #: the seed of this run's drawn inputs (:func:`ros2nb.checks.drawn.chooser`)
 
-    def file_subject(self, relative: str) -> Any: ...
-    def answer_subject(self, ref: AnswerRef, workspace: Optional[Path] = None) -> Any: ...
-    def answers_workspace(self, steps: tuple[str, ...]) -> Path: ...
-    def drop(self, key: tuple) -> None: ...
-    def drop_all(self) -> None: ...
-    def start(self, argv: list[str], *, cwd: Path,
-              env: Optional[dict[str, str]] = None) -> tuple[Any, Any]: ...
+    @property
+    def observer(self) -> Observer:
+        """The judge's own ROS node: graph, messages, logs, stamped by its clock."""
+
+    @property
+    def clock(self) -> Clock:
+        """The judge's clock."""
+
+    @property
+    def probe_publisher(self) -> Publisher:
+        """The judge's reliable Float32 publisher on /temperature (it plays the sensor)."""
+
+    def file_subject(self, relative: str) -> Subject:
+        """A subject with the learner's file (``relative`` to the workspace) imported.
+
+        :raises CheckFailed: when it is missing, or its import raised.
+        """
+
+    def answer_subject(self, ref: AnswerRef, workspace: Optional[Path] = None) -> Subject:
+        """A subject with the context cells and the learner's answer cells run (in
+        ``workspace``, by default the learner's)."""
+
+    def answers_workspace(self, steps: tuple[str, ...]) -> Path:
+        """The learner's workspace, or a copy with the course's reference node files where
+        ``steps`` (:data:`ros2nb.course.STEPS`) are missing."""
+
+    def drop(self, key: tuple[Any, ...]) -> None:
+        """End the subject of ``key`` (``('file', relative)``), if one runs."""
+
+    def drop_all(self) -> None:
+        """End every subject (their nodes leave the graph)."""
+
+    def start(self, argv: list[str], *, cwd: Path, env: Optional[dict[str, str]] = None
+              ) -> tuple[Process, ProgramOutput]:
+        """Start a program of the learner's (sandboxed while grading), in a session of its own.
+
+        :param env: its whole environment (default: a subject's).
+        """
+
     def run(self, argv: list[str], *, seconds: float, cwd: Path,
             env: Optional[dict[str, str]] = None, what: Optional[str] = None
-            ) -> tuple[int, str]: ...
-    def start_program(self, path: Path, stand_in: Optional[str] = None) -> tuple[Any, Any]: ...
-    def subject_env(self) -> dict[str, str]: ...
-    def hand_over(self, prefix: str, files: dict[str, bytes]) -> Path: ...
-    def taken_back(self, folder: Path) -> ContextManager[Path]: ...
+            ) -> tuple[int, str]:
+        """Run a program of the learner's to its end; its exit code and output.
+
+        :param seconds: what it gets: of its work while it works, of the wall clock while
+            it waits.
+        :raises ros2nb.judge.subjects.SubjectHung: when it still runs after them.
+        """
+
+    def start_program(self, path: Path, stand_in: Optional[str] = None
+                      ) -> tuple[Process, ProgramOutput]:
+        """Start the learner's ``main()`` in ``path`` as ``ros2 run`` would (its node class
+        replaced by the course's ``stand_in`` when given)."""
+
+    def subject_env(self) -> dict[str, str]:
+        """The environment of a subject of this judge (its domain, plain logs, field checks)."""
+
+    def hand_over(self, prefix: str, files: dict[str, bytes]) -> Path:
+        """A new folder of the judge's, named from ``prefix``, with ``files`` (relative path to
+        bytes) the learner's code may read.
+
+        :raises CheckFailed: when the learner's code took a name over meanwhile.
+        """
+
+    def taken_back(self, folder: Path) -> ContextManager[Path]:
+        """A private copy of the files the learner's code left in ``folder`` (links refused).
+
+        :raises CheckFailed: for a link, a folder, or too many bytes.
+        """
 
 
 class Flooded(CheckFailed):
@@ -74,26 +269,24 @@ class Flooded(CheckFailed):
     and kept no more of it.  A check may grade the other parts with a stand-in."""
 
 
-def learner_error(what: str, error: dict, *, context: str = '') -> CheckFailed:
+def learner_error(what: str, error: LearnerError, *, context: str = '') -> CheckFailed:
     """The CheckFailed for an exception the learner's code raised in a subject.
 
     A gap left unwritten says which one; a known mistake gets its one line; anything else
     shows the learner's own traceback (their frames only).
 
     :param what: whose code raised, e.g. ``TemperatureSensor.publish_temperature``.
-    :param error: the subject's description of the exception
-        (:func:`ros2nb.explain.exceptions.describe_error`).
+    :param error: the subject's description of the exception (:class:`LearnerError`).
     :param context: what it was doing, e.g. `` for 19.99 °C``.
     """
-    if error.get('type') == 'NotImplementedError':  # for any input: the input is no clue
+    if error.type == 'NotImplementedError':  # for any input: the input is no clue
         return CheckFailed(f'{what} still raises NotImplementedError: write your code '
                            'where it says YOUR CODE HERE and run that cell again.')
-    if error.get('explanation'):
-        where = error.get('where')
-        return CheckFailed(f'{what} raised{context}: {error["explanation"]}'
-                           + (f' ({where})' if where else ''))
-    return LearnerCodeError(f'{what} raised{context}: {error["type"]}: {error["message"]}',
-                            error.get('traceback', []))
+    if error.explanation:
+        return CheckFailed(f'{what} raised{context}: {error.explanation}'
+                           + (f' ({error.where})' if error.where else ''))
+    return LearnerCodeError(f'{what} raised{context}: {error.type}: {error.message}',
+                            error.traceback)
 
 
 #: The line of a check that ended on an error of its own: one check's points, never the

@@ -14,7 +14,7 @@ import signal
 import subprocess
 import sys
 import time
-from typing import Any, Callable, NoReturn, Optional, Sequence
+from typing import Any, Callable, NoReturn, Optional, Protocol, Sequence
 
 #: Seconds a process gets to exit after Ctrl+C (SIGINT) before SIGTERM, then SIGKILL.
 STOP_GRACE_S = 5.0
@@ -26,7 +26,21 @@ KILL_GRACE_S = 1.0
 POLL_S = 0.02
 
 
-def signal_group(proc: subprocess.Popen, sig: int) -> bool:
+class Process(Protocol):
+    """A process the course started in a session of its own: a :class:`subprocess.Popen`, or
+    a child of the fork server (:class:`ros2nb.subject.forked.ForkedProcess`)."""
+
+    pid: int  #: also its process group's id
+    returncode: Optional[int]  #: its exit code once reaped (negative: the signal), else None
+
+    def poll(self) -> Optional[int]:
+        """Its exit code once it ended, else None (it never waits)."""
+
+    def wait(self, timeout: Optional[float] = None) -> int:
+        """Its exit code, waited for ``timeout`` s at most (then subprocess.TimeoutExpired)."""
+
+
+def signal_group(proc: Process, sig: int) -> bool:
     """Send ``sig`` to the process group of ``proc``; return False if it is gone."""
     try:
         os.killpg(proc.pid, sig)
@@ -35,7 +49,7 @@ def signal_group(proc: subprocess.Popen, sig: int) -> bool:
     return True
 
 
-def stop_process_group(proc: subprocess.Popen, *,
+def stop_process_group(proc: Process, *,
                        signals: Sequence[tuple[int, float]] = (
                            (signal.SIGINT, STOP_GRACE_S), (signal.SIGTERM, TERM_GRACE_S),
                            (signal.SIGKILL, TERM_GRACE_S))) -> Optional[int]:
@@ -64,7 +78,7 @@ def stop_process_group(proc: subprocess.Popen, *,
         return None
 
 
-def kill_process_group(proc: subprocess.Popen) -> Optional[int]:
+def kill_process_group(proc: Process) -> Optional[int]:
     """End ``proc`` and its process group now: SIGTERM, and SIGKILL :data:`KILL_GRACE_S`
     later; return the exit code.
 
@@ -264,7 +278,7 @@ def wait_for_work(condition: Callable[[], Any], pids: Sequence[int], limit_s: fl
     return True
 
 
-def wait_patiently(proc: subprocess.Popen, limit_s: float) -> Optional[int]:
+def wait_patiently(proc: Process, limit_s: float) -> Optional[int]:
     """Wait for ``proc`` to exit, with :class:`Patience` (``limit_s`` of its tree's work, or
     of its idle waiting): on a busy machine a slow exit is not a hang.
 
@@ -295,7 +309,7 @@ def _state(pid: int) -> str:
         return ''
 
 
-def until_waiting(proc: subprocess.Popen, limit_s: float) -> bool:
+def until_waiting(proc: Process, limit_s: float) -> bool:
     """Wait until the main thread of every process under ``proc`` (bubblewrap's own aside)
     sits waiting, in two looks in a row: a program idle in its spin, as a person at a
     terminal sees it before pressing Ctrl+C.  Whether a signal lands in the spin's wait or
@@ -315,7 +329,7 @@ def until_waiting(proc: subprocess.Popen, limit_s: float) -> bool:
     return True
 
 
-def interrupt(proc: subprocess.Popen, sig: int = signal.SIGINT) -> None:
+def interrupt(proc: Process, sig: int = signal.SIGINT) -> None:
     """Press Ctrl+C for ``proc``: send ``sig`` to its process group, as a terminal does.
 
     A program started inside a sandbox (bubblewrap) is reached past the sandbox's own

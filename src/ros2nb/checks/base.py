@@ -24,6 +24,7 @@ from typing import Any, Callable
 from ..errors import CheckFailed, Ros2nbError
 from ..explain.exceptions import describe_error
 from ..judge_interface import learner_error
+from ..subject_replies import LearnerError
 from .dispatch import ask_judge
 
 #: A check's body: ``body(judge, *learner_things) -> the passed sentence``.
@@ -40,10 +41,10 @@ def _register(body: Body, call: Callable[..., None]) -> Callable[..., None]:
         raise RuntimeError(f'two checks are named {name}')  # a mistake of the course's
     CHECKS[name] = body
     functools.update_wrapper(call, body)
-    del call.__wrapped__  # type: ignore[attr-defined]
+    del call.__wrapped__  # type: ignore[attr-defined]  # update_wrapper set it; no type has it
     # What the notebook calls: the body's parameters without the judge, and no return value.
     parameters = list(inspect.signature(body).parameters.values())[1:]
-    call.__signature__ = inspect.Signature(  # type: ignore[attr-defined]
+    call.__signature__ = inspect.Signature(  # type: ignore[attr-defined]  # inspect reads it
         parameters, return_annotation=None)
     call.__annotations__ = {**{name: hint for name, hint in body.__annotations__.items()
                                if name not in ('judge', 'return')}, 'return': 'None'}
@@ -89,4 +90,5 @@ def call_learner(function: Callable[..., Any], *args: Any) -> Any:
     except (CheckFailed, Ros2nbError):  # ros2nb's own line, raised in their code's call
         raise
     except Exception as error:  # their frames only, or the one line of a known mistake
-        raise learner_error(f'{function.__name__}()', describe_error(error)) from None
+        raise learner_error(f'{function.__name__}()', LearnerError(**describe_error(error))
+                            ) from None

@@ -13,11 +13,14 @@ from ..errors import CheckFailed
 from ..terminal.files import parts_verdict
 from std_msgs.msg import Float32
 
-from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
+from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, Subject, learner_error
+from ..subject_interface import NewNode, WaitPublishers, WaitReceived
+from ..subject_replies import Counts, LearnerError, NodeMade
 
 
 def new_node(judge: Judge, relative: str, cls: str, *, stand_ins: tuple[str, ...] = (),
-             seed: Optional[int] = None, args: tuple = ()) -> tuple[Any, dict]:
+             seed: Optional[int] = None, args: tuple[Any, ...] = ()
+             ) -> tuple[Subject, NodeMade]:
     """Create the learner's node ``cls(*args)`` from their file in a subject, on the judge's
     clock, with the course's stand-ins (:mod:`ros2nb.subject.stand_ins`) for the parts the
     check does not grade; raise for what went wrong.
@@ -27,64 +30,70 @@ def new_node(judge: Judge, relative: str, cls: str, *, stand_ins: tuple[str, ...
     """
     mark = len(judge.observer.logs)
     subject = judge.file_subject(relative)
-    reply = subject.request('new_node', cls=cls, stand_ins=list(stand_ins),
-                            seed=seed, args=list(args))
+    reply = subject.request(NewNode(cls=cls, stand_ins=list(stand_ins), seed=seed,
+                                    args=list(args)))
     file = Path(relative).name
-    if reply.get('no_class') or not reply.get('ok'):
+    if reply.no_class or not reply.ok:
         parts_verdict(judge.workspace, relative)
-    if reply.get('no_class'):
-        others = reply['classes']
+    if reply.no_class:
+        others = reply.classes
         hint = (f' (it defines {", ".join(others)}: names must match exactly; the tutorial '
                 'misspelt TemperaturSensor in places)' if others else '')
         raise CheckFailed(f'{file} defines no class {cls}{hint}.')
-    if reply.get('refused'):
-        raise CheckFailed(reply['refused'])
-    if not reply['ok']:
+    if reply.refused:
+        raise CheckFailed(reply.refused)
+    if not reply.ok:
         shown = ', '.join(repr(a) for a in args)
-        raise learner_error(f'{cls}({shown})', reply['error'])
-    lines_logged(judge, reply, mark, reply['started_lines'])
+        raise raised(f'{cls}({shown})', reply.error)
+    lines_logged(judge, reply, mark, reply.started_lines)
     return subject, reply
 
 
-def started_log_verdict(judge: Judge, info: dict, mark: int, cls: str) -> None:
-    if info['started_lines'] == 0 or not lines_logged(judge, info, mark, info['started_lines']):
+def raised(what: str, error: Optional[LearnerError]) -> CheckFailed:
+    """The failure for ``what`` a subject could not do: the ``error`` the learner's code
+    raised, or, when its reply named none, one line to run the check again."""
+    if error is not None:
+        return learner_error(what, error)
+    return CheckFailed(f'{what} did not work, for no reason the grader could read (was the '
+                       'machine very busy?): run this check again.')
+
+
+def started_log_verdict(judge: Judge, info: NodeMade, mark: int, cls: str) -> None:
+    """Raise unless the node ``info`` logged a line while it started."""
+    if info.started_lines == 0 or not lines_logged(judge, info, mark, info.started_lines):
         raise CheckFailed(f'{cls} logged nothing when it started: log a line such as '
                           f"'{cls[:11]} {cls[11:]} Node Started' with the node's logger.")
 
 
-def lines_logged(judge: Judge, info: dict, mark: int, lines: int) -> list[str]:
+def lines_logged(judge: Judge, info: NodeMade, mark: int, lines: int) -> list[str]:
     """Wait until the judge has ``lines`` log lines of the node after ``mark``; return them."""
     observer = judge.observer
-    observer.wait_until(lambda: len(observer.lines_of(info['name'], mark)) >= lines,
+    observer.wait_until(lambda: len(observer.lines_of(info.name, mark)) >= lines,
                         ARRIVAL_TIMEOUT_S)
-    return observer.lines_of(info['name'], mark)
+    return observer.lines_of(info.name, mark)
 
 
-def reach(judge: Judge, subject, node: str) -> None:
+def reach(judge: Judge, subject: Subject, node: str) -> None:
     """Wait until the learner's node (in ``subject``) has discovered the judge's publisher.
 
     Counted from the subject's side: a subscription of an earlier subject that just ended
     may still count on the judge's side for a moment.
     """
     _ = judge.probe_publisher  # created before the subject looks for it
-    if not subject.request('wait_publishers', topic='/' + course.TOPIC,
-                           seconds=ARRIVAL_TIMEOUT_S, timeout=ARRIVAL_TIMEOUT_S + 10)['ok']:
+    if not subject.request(WaitPublishers(topic='/' + course.TOPIC, seconds=ARRIVAL_TIMEOUT_S),
+                           timeout=ARRIVAL_TIMEOUT_S + 10).ok:
         raise CheckFailed(f"The grader's publisher on /{course.TOPIC} never reached {node}: "
                           'check its subscription\'s topic name and type.')
 
 
-def announced(counts: dict, topic: str) -> Optional[int]:
+def announced(counts: Counts, topic: str) -> Optional[int]:
     """How many messages a subject's counts say it published on ``topic``, or None when
-    they say nothing usable: how long to wait for them, never what passes."""
-    published = counts.get('published')
-    if not isinstance(published, dict):
-        return None
-    value = published.get(topic, 0)
-    return value if isinstance(value, int) and not isinstance(value, bool) else None
+    they say nothing (none counted): how long to wait for them, never what passes."""
+    return None if counts.published is None else counts.published.get(topic, 0)
 
 
-def feed(judge: Judge, subject: Any, info: dict, value: float, counts: dict,
-         never: str) -> tuple[dict, list[str]]:
+def feed(judge: Judge, subject: Subject, info: NodeMade, value: float, counts: Counts,
+         never: str) -> tuple[Counts, list[str]]:
     """Publish one reading from the judge's node to the learner's node ``info`` in
     ``subject``, and wait until its subscription took it.
 
@@ -98,11 +107,11 @@ def feed(judge: Judge, subject: Any, info: dict, value: float, counts: dict,
     """
     mark = len(judge.observer.logs)
     judge.probe_publisher.publish(Float32(data=value))
-    reply = subject.request('wait_received', count=counts['received'] + 1,
-                            seconds=ARRIVAL_TIMEOUT_S)
-    if reply['failure']:
-        raise learner_error(reply['failure']['callback'], reply['failure'],
-                            context=f' for {value} °C')
-    if not reply['ok']:
+    reply = subject.request(WaitReceived(count=counts.received + 1, seconds=ARRIVAL_TIMEOUT_S))
+    if reply.failure is not None:
+        raise learner_error(reply.failure.callback, reply.failure, context=f' for {value} °C')
+    if reply.error is not None:  # a callback of theirs raised while the subject drained
+        raise learner_error(f'{info.name} callback', reply.error, context=f' for {value} °C')
+    if not reply.ok:
         raise CheckFailed(f'The reading {value} °C never reached {never}')
-    return reply, lines_logged(judge, info, mark, reply['logged'] - counts['logged'])
+    return reply, lines_logged(judge, info, mark, reply.logged - counts.logged)

@@ -14,8 +14,10 @@ from rclpy.node import Node
 
 from ..endpoints import node_endpoints
 from ..errors import CheckFailed
-from ..judge_interface import AnswerRef, Judge, learner_error
+from ..judge_interface import AnswerRef, Judge
+from ..subject_interface import NewNode
 from .base import call_learner, direct
+from .file_nodes import raised
 from .verdicts import endpoint_verdict
 
 
@@ -64,12 +66,12 @@ def _kernel_node_endpoints(node_class: Any) -> tuple[str, list]:
 
 def _answer_node_endpoints(judge: Judge, ref: AnswerRef) -> tuple[str, list]:
     subject = judge.answer_subject(ref)
-    reply = subject.request('new_node', cls=ref.name, stand_ins=[], seed=None)
-    if reply.get('no_class'):
+    reply = subject.request(NewNode(cls=ref.name))
+    if reply.no_class:
         raise CheckFailed(f'{ref.name} is not defined in your answer cell as a Node subclass.')
-    if reply.get('refused'):
-        raise CheckFailed(reply['refused'])
-    if not reply['ok']:
-        raise learner_error(f'{ref.name}()', reply['error'])
-    found = judge.observer.endpoints(reply['name'], reply['namespace'], reply['endpoints'])
-    return reply['name'], found
+    if reply.refused:
+        raise CheckFailed(reply.refused)
+    if not reply.ok:
+        raise raised(f'{ref.name}()', reply.error)
+    found = judge.observer.endpoints(reply.name, reply.namespace, reply.endpoints)
+    return reply.name, found

@@ -79,15 +79,13 @@ def check_dependencies(judge: Optional[Judge], reader: Any,
         raise CheckFailed(f'{files[0]} does not exist: run the pkg_create cell above first.')
     # What each file declares, read before the learner's reader runs: it may write them.
     wanted = [package_dependencies(files[0])]
-    in_judge = isinstance(reader, AnswerRef) and judge is not None
-    if in_judge:
+    if isinstance(reader, AnswerRef) and judge is not None:
         # The grader's own file: what it declares comes from its text, never from the copy
         # the learner's code can reach.
         folder = judge.hand_over('ros2nb-package-', {
             'graded_reader/package.xml': _EXTRA_PACKAGE_XML.encode()})
         files.append(folder / 'graded_reader' / 'package.xml')
         wanted.append(_depends(parse_package_string(_EXTRA_PACKAGE_XML)))
-    if in_judge:
         outputs = answer_results(judge, reader, [[{'path': str(f)}] for f in files])
         results = [decoded(o, f'{reader.name}(package_xml)') for o in outputs]
     else:

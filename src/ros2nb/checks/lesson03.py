@@ -35,14 +35,14 @@ def _constructor_problem(judge: Judge, run: SensorRun, seconds: float) -> Option
     """What the constructor (part 3) got wrong, as the judge saw it: None when nothing."""
     try:
         node_name_verdict(run.info, course.SENSOR_NODE)
-        endpoint_verdict(run.info['name'], run.found, 'publisher', TOPIC, course.MESSAGE_TYPE)
+        endpoint_verdict(run.info.name, run.found, 'publisher', TOPIC, course.MESSAGE_TYPE)
     except CheckFailed as problem:
         return problem
     if run.problem is not None or not run.readings:
         return run.problem or CheckFailed(_no_readings(judge))
-    problem = period_problem(run.readings, seconds)
-    if problem is not None:
-        return problem
+    period = period_problem(run.readings, seconds)
+    if period is not None:
+        return period
     first = run.readings[0][1]
     if abs(first - course.START_TEMPERATURE_C) > course.MAX_STEP_C + FLOAT32_TOLERANCE_C:
         return CheckFailed(f'The first reading is {first:.2f} °C: the walk starts at '
@@ -109,7 +109,7 @@ def _sensor_constructor(judge: Judge) -> str:
     if problem is not None:
         raise problem
     assert run is not None
-    return (f'{run.info["name"]} publishes {course.MESSAGE_TYPE} on {TOPIC} every '
+    return (f'{run.info.name} publishes {course.MESSAGE_TYPE} on {TOPIC} every '
             f'{course.PUBLISH_PERIOD_S} s of the grader\'s clock, starting next to '
             f'{course.START_TEMPERATURE_C} °C.')
 

@@ -9,11 +9,12 @@ the place of another (:mod:`ros2nb.subject.stand_ins`).
 from __future__ import annotations
 
 import re
-from typing import Any
 
 from .. import course, rules
 from ..errors import CheckFailed
-from ..judge_interface import Judge
+from ..judge_interface import Judge, Subject
+from ..subject_interface import GetCounts
+from ..subject_replies import NodeMade
 from .base import judged
 from .drawn import chooser
 from .mains import run_main
@@ -30,7 +31,7 @@ STATUS_BANDS_C = {'Low': (17.0, course.LOW_BELOW_C - 0.02),
 CALLBACK_DRAWN_PER_STATUS, HIDDEN_DRAWN_PER_STATUS = 2, 10
 
 
-def drawn_readings_c(judge: Any, purpose: str, per_status: int) -> list[float]:
+def drawn_readings_c(judge: Judge, purpose: str, per_status: int) -> list[float]:
     """``per_status`` readings of each status (two decimals, °C), drawn for this run
     (:mod:`.drawn`), in a drawn order: no table of the course's readings holds them."""
     source = chooser(judge, purpose)
@@ -55,31 +56,31 @@ def check_monitor_main(judge: Judge) -> str:
 
 
 # ------------------------------------------------------------------ the monitor
-def _monitor_verdict(info: dict, found: list) -> None:
+def _monitor_verdict(info: NodeMade, found: list[tuple[str, str, str]]) -> None:
     node_name_verdict(info, course.MONITOR_NODE)
-    endpoint_verdict(info['name'], found, 'subscription', '/' + course.TOPIC,
+    endpoint_verdict(info.name, found, 'subscription', '/' + course.TOPIC,
                      course.MESSAGE_TYPE)
 
 
-def _monitor(judge: Judge, stand_ins: tuple[str, ...] = ()) -> tuple[Any, dict]:
+def _monitor(judge: Judge, stand_ins: tuple[str, ...] = ()) -> tuple[Subject, NodeMade]:
     """Make the learner's monitor (with ``stand_ins``); raise for what its constructor got
     wrong (name, subscription, start-up line) as the judge sees it."""
     observer = judge.observer
     mark = len(observer.logs)
     subject, info = new_node(judge, course.SUBSCRIBER_FILE, course.MONITOR_CLASS,
                              stand_ins=stand_ins)
-    _monitor_verdict(info, observer.endpoints(info['name'], info['namespace'], info['endpoints']))
+    _monitor_verdict(info, observer.endpoints(info.name, info.namespace, info.endpoints))
     started_log_verdict(judge, info, mark, course.MONITOR_CLASS)
-    reach(judge, subject, info['name'])
+    reach(judge, subject, info.name)
     return subject, info
 
 
-def _feed(judge: Judge, subject: Any, info: dict,
+def _feed(judge: Judge, subject: Subject, info: NodeMade,
           readings: tuple[float, ...] | list[float]) -> list[list[str]]:
     """Publish readings to the learner's monitor from the judge's node; return the lines it
     logged for each (the subject's counts only say how many to wait for)."""
     per_reading = []
-    counts = subject.request('counts')
+    counts = subject.request(GetCounts())
     for value in readings:
         counts, lines = feed(judge, subject, info, value, counts,
                              "the subscription's callback: keep the subscription in an "
@@ -102,10 +103,10 @@ def _monitor_constructor(judge: Judge) -> str:
         except CheckFailed:
             raise problem from None
     if not lines[0]:
-        raise CheckFailed(f'A reading of {reading[0]} °C reached {info["name"]}, which logged '
+        raise CheckFailed(f'A reading of {reading[0]} °C reached {info.name}, which logged '
                           'nothing: the subscription\'s callback must be '
                           'self.temperature_callback (the method itself, without parentheses).')
-    return (f'{info["name"]} subscribes to /{course.TOPIC} [{course.MESSAGE_TYPE}] and hears the '
+    return (f'{info.name} subscribes to /{course.TOPIC} [{course.MESSAGE_TYPE}] and hears the '
             'grader\'s readings.')
 
 

@@ -19,11 +19,13 @@ from std_msgs.msg import Bool
 from .. import course, rules
 from ..errors import CheckFailed
 from ..explain.ros_settings import ros_arguments_mistake
-from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
+from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, Subject
+from ..subject_interface import Call, RoomNodes, WaitMatched
+from ..subject_replies import Counts
 from .base import judged
 from .drawn import chooser
 from .mains import run_main
-from .file_nodes import announced, feed, lines_logged, new_node, reach
+from .file_nodes import announced, feed, lines_logged, new_node, raised, reach
 from .verdicts import endpoint_verdict, node_name_verdict
 
 #: Readings the fan check sends (°C): both sides of the High threshold; then drawn ones.
@@ -58,17 +60,17 @@ def _fan_controller(judge: Judge) -> str:
     commands = judge.observer.watch('/' + course.FAN_TOPIC, Bool, lambda m: bool(m.data))
     subject, info = new_node(judge, course.FAN_FILE, course.FAN_CLASS)
     node_name_verdict(info, course.FAN_NODE)
-    found = judge.observer.endpoints(info['name'], info['namespace'], info['endpoints'])
-    endpoint_verdict(info['name'], found, 'subscription', '/' + course.TOPIC, course.MESSAGE_TYPE)
-    endpoint_verdict(info['name'], found, 'publisher', '/' + course.FAN_TOPIC,
+    found = judge.observer.endpoints(info.name, info.namespace, info.endpoints)
+    endpoint_verdict(info.name, found, 'subscription', '/' + course.TOPIC, course.MESSAGE_TYPE)
+    endpoint_verdict(info.name, found, 'publisher', '/' + course.FAN_TOPIC,
                      course.FAN_MESSAGE_TYPE)
-    if not subject.request('wait_matched', topic='/' + course.FAN_TOPIC,
-                           seconds=ARRIVAL_TIMEOUT_S)['ok']:
+    if not subject.request(WaitMatched(topic='/' + course.FAN_TOPIC,
+                                       seconds=ARRIVAL_TIMEOUT_S)).ok:
         raise CheckFailed(f'The fan controller\'s publisher never reached the grader\'s '
                           f'subscription on /{course.FAN_TOPIC}: is the machine very busy? '
                           'Run this check again.')
-    reach(judge, subject, info['name'])
-    counts = info
+    reach(judge, subject, info.name)
+    counts: Counts = info
     fan_topic = '/' + course.FAN_TOPIC
     answered_s = []  # per reading: from the judge's publishing it to its command arriving
     readings = _fan_readings(judge)
@@ -96,7 +98,7 @@ def _fan_controller(judge: Judge) -> str:
                               f'should be {want}: the fan is on only when the reading is High, '
                               f'strictly above HIGH_ABOVE_C = {course.HIGH_ABOVE_C} °C.')
     _slow_callback_verdict(min(answered_s), len(readings))
-    return (f'{info["name"]} hears /{course.TOPIC} and publishes one command on '
+    return (f'{info.name} hears /{course.TOPIC} and publishes one command on '
             f'/{course.FAN_TOPIC} per reading, True only when High ({len(readings)} '
             'readings).')
 
@@ -148,14 +150,14 @@ def _counting_monitor(judge: Judge) -> str:
     observer = judge.observer
     mark = len(observer.logs)
     subject, info = new_node(judge, course.PROMISES_FILE, course.COUNTING_CLASS, args=(name,))
-    if info['name'] != name:
-        raise CheckFailed(f"{course.COUNTING_CLASS}('{name}') made a node called {info['name']}: "
+    if info.name != name:
+        raise CheckFailed(f"{course.COUNTING_CLASS}('{name}') made a node called {info.name}: "
                           'pass the name it is given on to super().__init__(name).')
-    found = observer.endpoints(info['name'], info['namespace'], info['endpoints'])
+    found = observer.endpoints(info.name, info.namespace, info.endpoints)
     endpoint_verdict(name, found, 'subscription', '/' + course.TOPIC, course.MESSAGE_TYPE)
-    lines_logged(judge, info, mark, info['started_lines'])
+    lines_logged(judge, info, mark, info.started_lines)
     reach(judge, subject, name)
-    counts = info
+    counts: Counts = info
     source = chooser(judge, '06 counted readings')
     for index in range(1, COUNTED_READINGS + 1):
         value = round(source.uniform(*COUNTED_RANGE_C), 2)
@@ -182,8 +184,8 @@ def _named_as_told(judge: Judge, name: str) -> None:
     """A counting monitor given ``name`` (drawn for this run: no table holds it) is called
     ``name``."""
     _subject, info = new_node(judge, course.PROMISES_FILE, course.COUNTING_CLASS, args=(name,))
-    if info['name'] != name:
-        raise CheckFailed(f"{course.COUNTING_CLASS}('{name}') made a node called {info['name']}: "
+    if info.name != name:
+        raise CheckFailed(f"{course.COUNTING_CLASS}('{name}') made a node called {info.name}: "
                           'pass the name it is given on to super().__init__(name).')
 
 
@@ -203,20 +205,19 @@ def check_counting_monitor(judge: Judge) -> str:
 
 
 # ------------------------------------------------------------------ reusability
-def _room_arguments_of(subject, room: str) -> list[str]:
-    reply = subject.request('call', name=course.ROOMS_FUNCTION, inputs=[[room]])
-    if reply.get('undefined'):
+def _room_arguments_of(subject: Subject, room: str) -> list[str]:
+    reply = subject.request(Call(name=course.ROOMS_FUNCTION, inputs=[[room]]))
+    if reply.undefined:
         raise CheckFailed(f'promises.py defines no function {course.ROOMS_FUNCTION}: write part 5 '
                           '(and run its cell).')
-    output = reply['outputs'][0]
-    if 'error' in output:
-        raise learner_error(f"{course.ROOMS_FUNCTION}('{room}')", output['error'])
-    result = output['result']
-    if result['type'] not in ('list', 'tuple') or \
-            any(item['type'] != 'str' for item in result['value']):
-        raise CheckFailed(f"{course.ROOMS_FUNCTION}('{room}') returned {result['value']!r}; "
+    output = reply.outputs[0] if reply.outputs else None
+    if output is None or output.result is None:
+        raise raised(f"{course.ROOMS_FUNCTION}('{room}')", output.error if output else None)
+    result = output.result
+    if not isinstance(result.value, list) or any(item.type != 'str' for item in result.value):
+        raise CheckFailed(f"{course.ROOMS_FUNCTION}('{room}') returned {result.value!r}; "
                           "return a list of strings, e.g. ['--ros-args', '-r', ...].")
-    arguments = [item['value'] for item in result['value']]
+    arguments = [str(item.value) for item in result.value]
     if '--ros-args' not in arguments:
         raise CheckFailed(f"{course.ROOMS_FUNCTION}('{room}') returned {arguments}: a node reads "
                           "only the arguments after '--ros-args'; start the list with it.")
@@ -234,14 +235,16 @@ def _rooms(judge: Judge) -> str:
     seen: dict[str, str] = {}
     for room in (*course.ROOMS, _drawn_room(judge)):
         arguments = _room_arguments_of(subject, room)
-        reply = subject.request('room_nodes', arguments=arguments)
-        if not reply['ok']:
-            error = reply['error']
-            kind, text = str(error.get('type')), str(error.get('message'))
-            why = ros_arguments_mistake(kind, text) or f'{kind}: {text.splitlines()[0][:160]}'
+        reply = subject.request(RoomNodes(arguments=arguments))
+        if not reply.ok:
+            if reply.error is None:
+                raise raised(f"rooms started with {course.ROOMS_FUNCTION}('{room}')", None)
+            kind, text = reply.error.type, reply.error.message
+            why = ros_arguments_mistake(kind, text) or \
+                f'{kind}: {(text.splitlines() or [""])[0][:160]}'
             raise CheckFailed(f"rclpy refused the arguments {course.ROOMS_FUNCTION}('{room}') "
                               f'returned, {arguments}: {why}')
-        for name, namespace, endpoints in reply['nodes']:
+        for name, namespace, endpoints in reply.nodes:
             full = namespace.rstrip('/') + '/' + name
             found = judge.observer.endpoints(name, namespace, endpoints)
             if namespace != f'/{room}':

@@ -13,6 +13,8 @@ from __future__ import annotations
 from .. import course
 from ..errors import CheckFailed
 from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
+from ..subject_interface import Worker, WorkerStop
+from ..subject_replies import WorkerSpun
 from .base import judged
 from .witnessed import WITNESS_TOPIC, events, new_token, told_to
 
@@ -37,14 +39,14 @@ def _overlapped(events: list[str]) -> tuple[bool, int]:
     return False, done
 
 
-def _worker_cause(reply: dict) -> str:
+def _worker_cause(reply: WorkerSpun) -> str:
     """Why no heartbeat came during slow_work, from the executor and groups the subject
     says it was given (only to name the cause of what the judge saw)."""
-    groups = {name: (kind, number) for name, kind, number in reply.get('groups', [])}
-    if reply.get('executor') == 'SingleThreadedExecutor':
+    groups = {name: (kind, number) for name, kind, number in reply.groups}
+    if reply.executor == 'SingleThreadedExecutor':
         return ('a SingleThreadedExecutor runs one callback at a time, so slow_work holds up '
                 'heartbeat; return a MultiThreadedExecutor')
-    if reply.get('threads') == 1:
+    if reply.threads == 1:
         return ('a MultiThreadedExecutor with num_threads=1 runs one callback at a time: give '
                 'it num_threads=2')
     if groups.get('slow_work') == groups.get('heartbeat') and \
@@ -55,22 +57,22 @@ def _worker_cause(reply: dict) -> str:
             'group of its own for each timer')
 
 
-def _worker_refused(reply: dict) -> None:
+def _worker_refused(reply: WorkerSpun) -> None:
     """Raise for a worker the subject could not spin (its reply names what it found)."""
-    if reply.get('undefined'):
+    if reply.undefined:
         raise CheckFailed(f'promises.py defines no function {course.WORKER_FUNCTION}: write '
                           'part 4 (and run its cell).')
-    if 'error' in reply:
-        raise learner_error(f'{course.WORKER_FUNCTION}()', reply['error'])
-    if 'returned' in reply:
-        raise CheckFailed(f'{course.WORKER_FUNCTION}() returned {reply["returned"]["value"]}; '
+    if reply.error is not None:
+        raise learner_error(f'{course.WORKER_FUNCTION}()', reply.error)
+    if reply.returned is not None:
+        raise CheckFailed(f'{course.WORKER_FUNCTION}() returned {reply.returned.value}; '
                           'return two things, the Worker node and the executor to spin it: '
                           'return node, executor.')
-    if 'timers' in reply:
-        raise CheckFailed(f'{course.WORKER_FUNCTION}() returned a node with {reply["timers"]} '
+    if reply.timers is not None:
+        raise CheckFailed(f'{course.WORKER_FUNCTION}() returned a node with {reply.timers} '
                           'timer(s): return a Worker (part 3), whose two timers run slow_work '
                           'and heartbeat.')
-    if reply.get('unmatched'):
+    if reply.unmatched:
         raise CheckFailed("The worker's witness never reached the grader: is the machine very "
                           'busy? Run this check again.')
 
@@ -80,10 +82,10 @@ def _responsive_worker(judge: Judge) -> str:
     observer = judge.observer
     told = told_to(judge)
     mark, token, name = len(told), new_token(), 'responsive_worker'
-    reply = subject.request('worker', name=course.WORKER_FUNCTION, topic=WITNESS_TOPIC,
-                            token=token, work_s=SLOW_WORK_S, seconds=ARRIVAL_TIMEOUT_S,
+    reply = subject.request(Worker(name=course.WORKER_FUNCTION, topic=WITNESS_TOPIC,
+                                   token=token, work_s=SLOW_WORK_S, seconds=ARRIVAL_TIMEOUT_S),
                             timeout=ARRIVAL_TIMEOUT_S + 30)
-    if not reply.get('ok'):
+    if not reply.ok:
         judge.drop(('file', course.PROMISES_FILE))
         _worker_refused(reply)
 
@@ -94,19 +96,19 @@ def _responsive_worker(judge: Judge) -> str:
     try:
         observer.wait_until(seen, ARRIVAL_TIMEOUT_S)
         # the name as the graph shows it, while the node runs (the reply only words a failure)
-        named = reply.get('name') == name and \
+        named = reply.name == name and \
             observer.wait_until(lambda: observer.has_node(name), ARRIVAL_TIMEOUT_S)
     finally:
-        stopped = subject.request('worker_stop', timeout=60)
+        stopped = subject.request(WorkerStop(), timeout=60)
         judge.drop(('file', course.PROMISES_FILE))
     overlap, done = _overlapped(events(told, mark, token))
-    if stopped.get('failure'):
-        raise learner_error(stopped['failure']['callback'], stopped['failure'])
+    if stopped.failure is not None:
+        raise learner_error(stopped.failure.callback, stopped.failure)
     if not named:
         raise CheckFailed(f"{course.WORKER_FUNCTION}() returned a Worker called "
-                          f"{reply.get('name')}; name it '{name}'.")
+                          f"{reply.name}; name it '{name}'.")
     if overlap:
-        return (f'a heartbeat came while slow_work was busy, on a {reply["executor"]}: the two '
+        return (f'a heartbeat came while slow_work was busy, on a {reply.executor}: the two '
                 'timers run side by side.')
     if done == 0:
         raise CheckFailed(f'slow_work never finished in {ARRIVAL_TIMEOUT_S:g} s: keep both timers '

@@ -11,12 +11,15 @@ failure the judge has seen.
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from typing import Optional
+from typing import Any, Optional
 
 from .. import course
 from ..errors import CheckFailed
-from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge
+from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, Subject
+from ..subject_interface import PlotShown, Run
+from ..subject_replies import Counts, NodeMade
 from .base import judged
 from .drawn import chooser
 from .file_nodes import feed, new_node, reach
@@ -42,21 +45,14 @@ def _gaps_s(judge: Judge) -> list[int]:
             for k in range(len(PLOT_READINGS_C))]
 
 
-def _shown(counts: dict) -> Optional[int]:
-    """How many messages a subject's counts say the course's redraw() told, or None when
-    they say nothing usable: how long to wait for them, never what passes."""
-    told = counts.get('shown')
-    return told if isinstance(told, int) and not isinstance(told, bool) else None
-
-
-def _drawn(judge: Judge, subject, info: dict, value: float, counts: dict, token: str
-           ) -> tuple[dict, list[dict]]:
+def _drawn(judge: Judge, subject: Subject, info: NodeMade, value: float, counts: Counts,
+           token: str) -> tuple[Counts, list[dict[str, Any]]]:
     """Feed one reading and return the subject's counts after it and what the course's
     redraw() drew meanwhile (each redraw: its ``times_s`` and ``temps_c``)."""
     heard = told_to(judge)
-    mark, before = len(heard), _shown(counts)
+    mark, before = len(heard), counts.shown
     counts, _lines = feed(judge, subject, info, value, counts, 'temperature_callback.')
-    after = _shown(counts)
+    after = counts.shown
     # as many redraws as the subject says it told (none: no wait; it says nothing: one)
     expected = 1 if before is None or after is None else after - before
     judge.observer.wait_until(lambda: len(told(heard, mark, token)) >= expected,
@@ -70,18 +66,18 @@ def _plot_callback(judge: Judge) -> str:
     told_to(judge)  # the judge's subscription exists before the subject looks for it
     subject, info = new_node(judge, course.LIVE_PLOT_FILE, course.PLOT_CLASS)
     node_name_verdict(info, course.PLOT_NODE)
-    found = observer.endpoints(info['name'], info['namespace'], info['endpoints'])
-    endpoint_verdict(info['name'], found, 'subscription', '/' + course.TOPIC, course.MESSAGE_TYPE)
-    shown = subject.request('plot_shown', topic=WITNESS_TOPIC, token=token,
-                            seconds=ARRIVAL_TIMEOUT_S, timeout=ARRIVAL_TIMEOUT_S + 30)
-    if not shown['ok']:
+    found = observer.endpoints(info.name, info.namespace, info.endpoints)
+    endpoint_verdict(info.name, found, 'subscription', '/' + course.TOPIC, course.MESSAGE_TYPE)
+    shown = subject.request(PlotShown(topic=WITNESS_TOPIC, token=token,
+                                      seconds=ARRIVAL_TIMEOUT_S), timeout=ARRIVAL_TIMEOUT_S + 30)
+    if not shown.ok:
         raise CheckFailed("The plot's witness never reached the grader: is the machine very "
                           'busy? Run this check again.')
-    reach(judge, subject, info['name'])
-    counts = {**info, 'shown': shown.get('shown')}
+    reach(judge, subject, info.name)
+    counts: Counts = dataclasses.replace(info, shown=shown.shown)
     sent: list[tuple[float, float]] = []
     for value, gap_s in zip(PLOT_READINGS_C, _gaps_s(judge)):
-        judge.clock.drive(subject, 'run', seconds=gap_s, step_s=READING_GAP_S,
+        judge.clock.drive(subject, Run(seconds=gap_s), step_s=READING_GAP_S,
                           limit_s=gap_s, what=course.PLOT_CLASS)
         sent.append((judge.clock.now_s, value))
         counts, drawn = _drawn(judge, subject, info, value, counts, token)
@@ -90,7 +86,8 @@ def _plot_callback(judge: Judge) -> str:
             'on the node\'s clock (the grader\'s simulated time), with its value.')
 
 
-def _point_verdict(judge: Judge, sent: list[tuple[float, float]], drawn: list[dict]) -> None:
+def _point_verdict(judge: Judge, sent: list[tuple[float, float]],
+                   drawn: list[dict[str, Any]]) -> None:
     """One redraw per reading, drawing every reading sent so far: its value, at the time
     it arrived (``sent``: the judge's ``(time, reading)`` of each)."""
     sent_s, value = sent[-1]

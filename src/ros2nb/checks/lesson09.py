@@ -27,6 +27,8 @@ from ..explain.ros_settings import zero_depth_refused
 from ..errors import CheckFailed
 from .answers import defined_verdict, type_name_of
 from ..judge_interface import ARRIVAL_TIMEOUT_S, AnswerRef, Judge, learner_error
+from ..subject_interface import QosAcked, QosEndpoint
+from ..subject_replies import QosMade
 from .base import call_learner, direct
 
 #: The burst of part 1 and what a display of the newest reading must be left with.
@@ -76,14 +78,14 @@ class _Endpoint:
         self.judge, self.observer = judge, judge.observer
         self.topic = f'/ros2nb_qos_trial_{secrets.token_hex(4)}'
         self.subject = judge.answer_subject(ref)
-        reply = self.subject.request('qos_endpoint', name=ref.name, topic=self.topic, kind=kind,
-                                     numbers=list(numbers))
+        reply = self.subject.request(QosEndpoint(name=ref.name, topic=self.topic, kind=kind,
+                                                 numbers=list(numbers)))
         defined_verdict(reply, ref.name)
-        if 'error' in reply:
-            raise learner_error(f'{ref.name}()', reply['error'])
-        if 'returned' in reply:
-            returned = reply['returned']
-            raise CheckFailed(f'{ref.name}() returned {returned["type"]} {returned["value"]}; '
+        if reply.error is not None:
+            raise learner_error(f'{ref.name}()', reply.error)
+        if reply.returned is not None:
+            returned = reply.returned
+            raise CheckFailed(f'{ref.name}() returned {returned.type} {returned.value}; '
                               'return a QoSProfile(...).')
         found = qos.discovered(self.observer.node, self.topic, kind,
                                seconds=ARRIVAL_TIMEOUT_S)
@@ -102,13 +104,15 @@ class _Endpoint:
         self.judge.drop_all()
 
 
-def _history_of(reply: dict) -> QoSProfile:
+def _history_of(reply: QosMade) -> QoSProfile:
     """The reliable, volatile profile with the history and depth of a subject's reply; a
     depth past the burst keeps what the burst's own length would (all of it)."""
     try:
-        history = HistoryPolicy(int(reply['history']))
-        depth = min(max(int(reply['depth']), 0), BURST + 1)
-    except (KeyError, TypeError, ValueError):
+        if reply.history is None or reply.depth is None:
+            raise ValueError('no history or depth')
+        history = HistoryPolicy(reply.history)
+        depth = min(max(reply.depth, 0), BURST + 1)
+    except ValueError:
         raise CheckFailed('The grader could not read the history and depth of your profile '
                           'from the trial (its process was disturbed): run this check again.'
                           ) from None
@@ -192,7 +196,7 @@ def _judged_late_joiner(judge: Judge, ref: AnswerRef) -> tuple[qos.Deliveries, Q
         out.matched = endpoint.observer.wait_until(
             lambda: subscription.get_publisher_count() >= 1, ARRIVAL_TIMEOUT_S)
         if out.matched:
-            endpoint.subject.request('qos_acked', seconds=ARRIVAL_TIMEOUT_S,
+            endpoint.subject.request(QosAcked(seconds=ARRIVAL_TIMEOUT_S),
                                      timeout=ARRIVAL_TIMEOUT_S + 10)
             taken = _take_all(subscription)
             if any(number not in sent for number in taken) or \

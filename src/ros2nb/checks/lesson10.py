@@ -23,10 +23,12 @@ from .. import course, rules
 from ..errors import CheckFailed
 from ..runtime import current_runtime
 from ..terminal import bag
-from .answers import decoded, defined_verdict
+from .answers import decoded, defined_verdict, result_of
 from .bags import (CHECK_LOGGER, ROSOUT, TEMPERATURE, check_bag, check_readings_c, fresh_path,
                    bag_messages, read_back)
-from ..judge_interface import ARRIVAL_TIMEOUT_S, AnswerRef, Judge, learner_error
+from ..judge_interface import ARRIVAL_TIMEOUT_S, AnswerRef, Judge
+from ..subject_interface import Call
+from ..subject_replies import Encoded, Output
 from .base import call_learner, direct
 from .drawn import chooser
 from .witness import STATUS_LINE, Witness, witnessing
@@ -65,28 +67,27 @@ def _call(judge: Optional[Judge], function: Any, label: str, *args: Any,
         subject = judge.answer_subject(function,
                                        workspace=judge.answers_workspace(course.STEPS[10]))
         encoded = [{'path': str(a)} if isinstance(a, Path) else a for a in args]
-        reply = judge.clock.drive(subject, 'call', name=function.name, inputs=[encoded],
+        reply = judge.clock.drive(subject, Call(name=function.name, inputs=[encoded]),
                                   step_s=STEP_S, limit_s=spin_s + SPARE_S, what=label)
         defined_verdict(reply, function.name)
-        output = reply['outputs'][0]
-        if 'error' in output:
-            raise learner_error(label, output['error'])
+        returned = result_of(reply.outputs[0] if reply.outputs else Output(error=reply.error),
+                             label)
         observer = judge.observer
         left = stops is not None and not observer.wait_until(
             lambda: not observer.has_node(stops), ARRIVAL_TIMEOUT_S)
         judge.drop_all()  # its nodes leave the graph: what they said is heard by now
         if left:
             raise CheckFailed(_LEFT_RUNNING.format(label=label, node=stops))
-        return _plain(output['result'])
+        return _plain(returned)
     if spin_s:  # the function runs nodes: none of an earlier cell's may run beside them
         _no_nodes_left(label)
     with contextlib.redirect_stdout(io.StringIO()):  # the verdict is the check's line alone
         result = call_learner(function, *args)
     rt = current_runtime()
     if stops is not None and rt is not None and rt.nodes:
-        left = ', '.join(sorted(rt.nodes))
+        running = ', '.join(sorted(rt.nodes))
         rt.stop()  # the next check's call must start with no node of this one
-        raise CheckFailed(_LEFT_RUNNING.format(label=label, node=left))
+        raise CheckFailed(_LEFT_RUNNING.format(label=label, node=running))
     return result
 
 
@@ -107,11 +108,11 @@ def _no_nodes_left(label: str) -> None:
                           '(and end your function with ros2nb.stop(), so it leaves none).')
 
 
-def _plain(result: dict) -> Any:
+def _plain(result: Encoded) -> Any:
     """A subject's encoded value as plain Python (lists of lists and numbers kept)."""
-    if result['type'] in ('list', 'tuple'):
-        return [_plain(item) for item in result['value']]
-    return decoded({'result': result}, '')
+    if isinstance(result.value, list):
+        return [_plain(item) for item in result.value]
+    return decoded(Output(result=result), '')
 
 
 # ------------------------------------------------------------------ part 1: the recording
@@ -200,9 +201,9 @@ def _recording_verdict(path: Path, label: str, seen: Witness) -> str:
                               f'went out at {t_ns / 1e9:g} s of simulated time: record while the '
                               'nodes spin, with ros2nb.bag_record (it stamps each message with '
                               'the clock).')
-    in_bag = [STATUS_LINE.fullmatch(m.msg) for _s, m in bag_messages(path, ROSOUT)
-              if m.name == course.MONITOR_NODE]
-    in_bag = [(float(m.group(1)), m.group(2)) for m in in_bag if m]
+    lines = [STATUS_LINE.fullmatch(m.msg) for _s, m in bag_messages(path, ROSOUT)
+             if m.name == course.MONITOR_NODE]
+    in_bag = [(float(m.group(1)), m.group(2)) for m in lines if m]
     said = seen.statuses()
     _statuses_follow_readings(said, heard, label)
     if in_bag != [(r, s) for _t, r, s in said]:

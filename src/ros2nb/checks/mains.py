@@ -16,11 +16,11 @@ import re
 import signal
 import subprocess
 from pathlib import Path
-from typing import Any, Optional
+from typing import Optional
 
 from ..errors import CheckFailed
-from ..processes import interrupt, kill_process_group, until_waiting, wait_patiently
-from ..judge_interface import Judge
+from ..processes import Process, interrupt, kill_process_group, until_waiting, wait_patiently
+from ..judge_interface import Judge, Observer, ProgramOutput
 from .source import TEXT
 
 #: Seconds a node process gets to exit after Ctrl+C (which comes once its node spins).
@@ -88,7 +88,7 @@ def run_main(judge: Judge, relative: str, node_name: str, part: int = 5,
             'shutdown from outside (exit code 0, no traceback).')
 
 
-def _stop_run(judge: Judge, path: Path, node_name: str, part: int, sig: int,
+def _stop_run(judge: Judge, path: Path, node_name: str, part: int, sig: signal.Signals,
               stand_in: Optional[str] = None) -> None:
     """Runs of ``main()`` stopped with ``sig`` (its node class replaced by the stand-in when
     given): :data:`CLEAN_STOPS` of them must end cleanly; a run that rclpy's own shutdown race
@@ -112,16 +112,17 @@ class _ShutdownRace(CheckFailed):
     (:data:`RACE_MARKS`), not on what the learner wrote."""
 
 
-def _watch_stop(observer: Any, path: Path, node_name: str, part: int, proc: Any,
-                output: Any, sig: int) -> None:
+def _watch_stop(observer: Observer, path: Path, node_name: str, part: int, proc: Process,
+                output: ProgramOutput, sig: signal.Signals) -> None:
     """Raise for what the running ``main()`` did wrong, as the judge sees it from outside."""
     # Ctrl+C once the node spins (it answers a parameter call), as a learner presses it
     # once the node runs: earlier, a busy machine would decide what the learner is told.
     # The graph is read once for the verdict: the read that ended the wait, not a second one.
     started = _wait_for_node(observer, proc, node_name) and proc.poll() is None
     spinning = started and observer.spins(node_name)
-    if proc.poll() is not None:
-        raise _ended_early(path, part, output.text(), proc.returncode)
+    ended = proc.poll()
+    if ended is not None:
+        raise _ended_early(path, part, output.text(), ended)
     if not started:  # the judge's own graph: no node of that name appeared while it ran
         raise CheckFailed(f'{path.name} never started its node {node_name} (none appeared in the '
                           f'grader\'s ROS graph while the program had {START_PATIENCE_S:g} s to '
@@ -159,7 +160,8 @@ def _watch_stop(observer: Any, path: Path, node_name: str, part: int, proc: Any,
                           f'{_ctrl_c_advice(path, already)}.')
 
 
-def _wait_for_exit(observer: Any, proc: Any, node_name: str, sig: int) -> Optional[int]:
+def _wait_for_exit(observer: Observer, proc: Process, node_name: str, sig: signal.Signals
+                   ) -> Optional[int]:
     """The program's exit code once it ended after ``sig``, or None when it had
     :data:`EXIT_AFTER_CTRL_C_S` (of its work) and still runs; after a shutdown from outside,
     its node is called once if it still runs after :data:`WAKE_AFTER_S`."""
@@ -171,7 +173,7 @@ def _wait_for_exit(observer: Any, proc: Any, node_name: str, sig: int) -> Option
     return wait_patiently(proc, EXIT_AFTER_CTRL_C_S)
 
 
-def _wait_for_node(observer: Any, proc: Any, node_name: str) -> bool:
+def _wait_for_node(observer: Observer, proc: Process, node_name: str) -> bool:
     """Wait until the node is in the judge's graph or the program ended: True then, False
     once the program had :data:`START_PATIENCE_S` (the judge's waits attend to its work)."""
     return observer.wait_until(lambda: proc.poll() is not None or observer.has_node(node_name),
@@ -230,7 +232,7 @@ def _error_line(text: str) -> str:
     return re.sub(r', at /\S+:\d+$', '', line)
 
 
-def _last_frame(text: str, path) -> Optional[tuple[int, str, str]]:
+def _last_frame(text: str, path: Path) -> Optional[tuple[int, str, str]]:
     """(line, function, source) of the learner's file's last frame in a traceback, or None."""
     frames = re.findall(rf'File "{re.escape(str(path))}", line (\d+), in (\w+)', text)
     if not frames:
@@ -240,7 +242,7 @@ def _last_frame(text: str, path) -> Optional[tuple[int, str, str]]:
     return number, function, lines[number - 1].strip() if 0 < number <= len(lines) else ''
 
 
-def _crash_place(text: str, path) -> str:
+def _crash_place(text: str, path: Path) -> str:
     """`` at line N (source)`` for the learner's file's last frame in a traceback, or ''."""
     frame = _last_frame(text, path)
     return '' if frame is None else f' at line {frame[0]} ({frame[2]})'

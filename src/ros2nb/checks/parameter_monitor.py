@@ -18,6 +18,8 @@ from .. import course
 from ..errors import CheckFailed
 from ..runtime.services import call_until_answered
 from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
+from ..subject_interface import GetCounts, Serve
+from ..subject_replies import Counts, LearnerError
 from .file_nodes import feed, lines_logged, new_node, reach
 
 #: The on-set callback the learner writes (part 4); the constructor registers it.
@@ -52,14 +54,14 @@ class ParameterMonitor:
                               'self.declare_parameter() before reading it (names must match '
                               'exactly).') from None
         self.judge, self.observer, self.stand_ins = judge, judge.observer, stand_ins
-        self.name = self.info['name']
-        self.full = self.info['namespace'].rstrip('/') + '/' + self.name
-        lines_logged(judge, self.info, mark, self.info['started_lines'])
+        self.name = self.info.name
+        self.full = self.info.namespace.rstrip('/') + '/' + self.name
+        lines_logged(judge, self.info, mark, self.info.started_lines)
         reach(judge, self.subject, self.name)
-        self.counts = self.info
-        self.subject.request('serve')
+        self.counts: Counts = self.info
+        self.subject.request(Serve())
         self.client = AsyncParameterClient(self.observer.node, self.full)
-        if self.info.get('parameter_services') is False:  # the subject says: no use waiting
+        if not self.info.parameter_services:  # the subject says: no use waiting
             raise CheckFailed(f'{course.MONITOR_CLASS} has no parameter services (was it made '
                               'with start_parameter_services=False?): ros2 param cannot reach '
                               'it; leave that argument out of super().__init__().')
@@ -73,8 +75,9 @@ class ParameterMonitor:
         be lost right after the node appeared); a callback of the learner's that raised is
         named."""
         def failed() -> None:
-            failure = self.subject.request('counts')['failure']
-            if failure:
+            counts = self.subject.request(GetCounts())
+            failure = counts.failure or counts.error
+            if failure is not None:
                 _callback_failure(failure, what)
 
         done = call_until_answered(send, lambda f, s: self.observer.wait_until(f.done, s),
@@ -110,16 +113,16 @@ class ParameterMonitor:
         return found[-1] if found else None
 
 
-def _callback_failure(failure: dict, what: str) -> None:
+def _callback_failure(failure: LearnerError, what: str) -> None:
     """Raise for the learner's on-set callback raising inside the node's parameter service."""
-    if failure.get('type') == 'AttributeError' and "'successful'" in failure.get('message', ''):
-        returned = failure['message'].split("'")[1]
+    if failure.type == 'AttributeError' and "'successful'" in failure.message:
+        returned = failure.message.split("'")[1]
         raise CheckFailed(f'{CALLBACK} returned a {returned}, not a SetParametersResult: return '
                           'SetParametersResult(successful=..., reason=...).')
-    missing = re.fullmatch(r"'(\w+)'", failure.get('message', ''))
-    if failure.get('type') == 'KeyError' and missing and missing.group(1) in \
+    missing = re.fullmatch(r"'(\w+)'", failure.message)
+    if failure.type == 'KeyError' and missing and missing.group(1) in \
             course.THRESHOLD_DEFAULTS_C:
-        where = f' ({failure["where"]})' if failure.get('where') else ''
+        where = f' ({failure.where})' if failure.where else ''
         raise CheckFailed(f'{CALLBACK} raised KeyError: {missing.group(0)} for {what}: it gets '
                           f'only the parameters being set, so read the other with new.get(name, '
                           f'self.get_parameter(name).value){where}.')

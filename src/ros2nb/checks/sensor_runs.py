@@ -10,13 +10,15 @@ reading on ``/temperature`` with the judge's time of its arrival, and the node's
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Optional
+from typing import Optional
 
 from std_msgs.msg import Float32
 
 from .. import course
 from ..errors import CheckFailed
-from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, learner_error
+from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, Subject, learner_error
+from ..subject_interface import Run, SetAttribute, WaitMatched
+from ..subject_replies import NodeMade
 from .file_nodes import lines_logged, new_node
 
 #: Steps of the judge's clock (s), and the probe before each while a constructor runs: a timer
@@ -38,9 +40,9 @@ class SensorRun:
     :ivar problem: what stopped the run early (a callback that raised), or None.
     """
 
-    subject: Any
-    info: dict
-    found: list
+    subject: Subject
+    info: NodeMade
+    found: list[tuple[str, str, str]]
     started_lines: list[str]
     readings: list[tuple[float, float]] = field(default_factory=list)
     lines: list[str] = field(default_factory=list)
@@ -48,6 +50,7 @@ class SensorRun:
 
     @property
     def values(self) -> list[float]:
+        """The readings' values (°C), in order."""
         return [value for _t, value in self.readings]
 
 
@@ -58,8 +61,8 @@ def make_sensor(judge: Judge, stand_ins: tuple[str, ...], seed: int) -> SensorRu
     mark = len(observer.logs)
     subject, info = new_node(judge, course.PUBLISHER_FILE, course.SENSOR_CLASS,
                              stand_ins=stand_ins, seed=seed)
-    found = observer.endpoints(info['name'], info['namespace'], info['endpoints'])
-    return SensorRun(subject, info, found, lines_logged(judge, info, mark, info['started_lines']))
+    found = observer.endpoints(info.name, info.namespace, info.endpoints)
+    return SensorRun(subject, info, found, lines_logged(judge, info, mark, info.started_lines))
 
 
 def run_sensor(judge: Judge, sensor: SensorRun, seconds: float, *, probe_s: float, seed: int,
@@ -72,20 +75,20 @@ def run_sensor(judge: Judge, sensor: SensorRun, seconds: float, *, probe_s: floa
     if ('publisher', TOPIC, course.MESSAGE_TYPE) not in run.found:
         return run  # nothing the judge could hear: the constructor's verdict says why
     if start_c is not None:
-        subject.request('set_attribute', name='temperature', value=start_c)
-    if not subject.request('wait_matched', topic=TOPIC, seconds=ARRIVAL_TIMEOUT_S)['ok']:
+        subject.request(SetAttribute(name='temperature', value=start_c))
+    if not subject.request(WaitMatched(topic=TOPIC, seconds=ARRIVAL_TIMEOUT_S)).ok:
         raise CheckFailed(f'The publisher on {TOPIC} never reached the grader\'s subscription '
                           '(is the machine very busy?): run this check again.')
     first, log_mark, began = len(readings), len(observer.logs), judge.clock.now_ns
     try:
-        reply = judge.clock.drive(subject, 'run', seconds=seconds, seed=seed, step_s=STEP_S,
+        reply = judge.clock.drive(subject, Run(seconds=seconds, seed=seed), step_s=STEP_S,
                                   probe_s=probe_s, limit_s=seconds + 1, what=course.SENSOR_CLASS)
-        if reply.get('failure'):
-            raise learner_error(reply['failure']['callback'], reply['failure'])
+        if reply.failure is not None:
+            raise learner_error(reply.failure.callback, reply.failure)
     except CheckFailed as problem:
         run.problem = problem
     run.readings = [((heard.t_ns - began) / 1e9, heard.value) for heard in readings[first:]]
-    run.lines = [line.text for line in observer.logs[log_mark:] if line.name == run.info['name']]
+    run.lines = [line.text for line in observer.logs[log_mark:] if line.name == run.info.name]
     return run
 
 

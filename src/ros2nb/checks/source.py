@@ -134,8 +134,9 @@ class ClassSource:
             reads what the learner wrote there, never a file a subject may rewrite).
         """
         module = read_module(workspace, relative)
-        found = [s for s in module.body if isinstance(s, ast.ClassDef) and s.name == name] \
-            if module is not None else []
+        if module is None:
+            return None
+        found = [s for s in module.body if isinstance(s, ast.ClassDef) and s.name == name]
         return cls(module, found[-1]) if found else None
 
     def method(self, name: str) -> Optional[ast.FunctionDef]:

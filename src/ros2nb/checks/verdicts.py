@@ -9,6 +9,7 @@ from __future__ import annotations
 import difflib
 
 from ..errors import CheckFailed
+from ..subject_replies import NodeMade
 
 
 def endpoint_verdict(node: str, found: list[tuple[str, str, str]], kind: str, topic: str,
@@ -30,7 +31,8 @@ def endpoint_verdict(node: str, found: list[tuple[str, str, str]], kind: str, to
                       '__init__ and keep it in an attribute of the node.')
 
 
-def node_name_verdict(info: dict, want: str) -> None:
-    if info['name'] != want:
-        raise CheckFailed(f"The node is called {info['name']}; name it {want} in its "
+def node_name_verdict(info: NodeMade, want: str) -> None:
+    """Raise CheckFailed unless the node made (``info``) is called ``want``."""
+    if info.name != want:
+        raise CheckFailed(f"The node is called {info.name}; name it {want} in its "
                           'super().__init__(...) call.')

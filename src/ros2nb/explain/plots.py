@@ -111,7 +111,7 @@ class _GuardOnImport(importlib.abc.MetaPathFinder):
             execute(module)
             _guard(module)
 
-        spec.loader.exec_module = exec_module  # type: ignore[method-assign]
+        spec.loader.exec_module = exec_module  # type: ignore[method-assign]  # then the guard
         return spec
 
 

@@ -14,7 +14,7 @@ it only makes the judge wait longer or stamp its messages later.
 from __future__ import annotations
 
 import time
-from typing import Any, Optional
+from typing import Any, Optional, TypeVar
 
 from rosgraph_msgs.msg import Clock
 
@@ -23,8 +23,13 @@ from ..errors import CheckFailed
 from ..processes import Patience, kill_process_group
 from ..subject.judge_time import JUDGE_CLOCK_QOS
 from ..runtime.core import QUIET_PUBLISHER
+from ..subject_interface import Command
+from ..subject_replies import LearnerError, Reply
+from ..judge_interface import Subject
 from .observer import Observer
 from .subjects import REPLY_TIMEOUT_S, SubjectProcess
+
+R = TypeVar('R', bound=Reply)
 
 #: Seconds between two looks at a subject that is neither answering nor acknowledging.
 POLL_S = 0.05
@@ -77,10 +82,10 @@ class JudgeClock:
             self._observer.now_ns = t_ns
         self._publish()
 
-    def drive(self, subject: SubjectProcess, op: str, *, step_s: float, limit_s: float,
-              probe_s: float = 0.0, timeout: float = REPLY_TIMEOUT_S, what: str = 'your code',
-              **arguments: Any) -> dict:
-        """Send ``op`` to ``subject`` and move the clock on, a step of ``step_s`` at a time,
+    def drive(self, subject: Subject, command: Command[R], *, step_s: float, limit_s: float,
+              probe_s: float = 0.0, timeout: float = REPLY_TIMEOUT_S, what: str = 'your code'
+              ) -> R:
+        """Send ``command`` to ``subject`` and move the clock on, a step of ``step_s`` at a time,
         for as long as the subject's spin wants it (at most ``limit_s`` simulated seconds);
         return the subject's reply once it comes.
 
@@ -96,20 +101,23 @@ class JudgeClock:
         :raises CheckFailed: when the spin wants more than ``limit_s``, or a message the
             subject announced never arrives.
         :raises SubjectHung: when the subject neither answers nor finishes a step in time.
+        :raises TypeError: for a subject this judge did not start.
         """
+        if not isinstance(subject, SubjectProcess):
+            raise TypeError(f'the judge drives only its own subjects, not {subject!r}')
         try:
-            return self._drive(subject, op, (step_s, probe_s), limit_s, timeout, what,
-                               arguments)
+            return subject.reply_to(command, self._drive(subject, command, (step_s, probe_s),
+                                                         limit_s, timeout, what))
         except BaseException:
             # The subject is left in the middle of its command: it serves no other.
             kill_process_group(subject.proc)
             raise
 
-    def _drive(self, subject: SubjectProcess, op: str, steps: tuple[float, float],
-               limit_s: float, timeout: float, what: str, arguments: dict) -> dict:
+    def _drive(self, subject: SubjectProcess, command: Command[Any], steps: tuple[float, float],
+               limit_s: float, timeout: float, what: str) -> Any:
         step_ns, probe_ns = round(steps[0] * 1e9), round(steps[1] * 1e9)
         limit_ns, whole_ns = self.now_ns + round(limit_s * 1e9), self.now_ns + step_ns
-        subject.send(op, **arguments)
+        subject.send(command)
         # Patience reads /proc: it starts only once the subject has been quiet for
         # PATIENCE_LOOK_S (an hour of steps would otherwise read it 7200 times), and looks
         # again every PATIENCE_LOOK_S.
@@ -163,10 +171,10 @@ class JudgeClock:
         if failure:
             explained = bool(failure.get('explained'))
             message = failure['error'].split(': ', 1)[-1] if not explained else failure['error']
-            raise learner_error(failure['callback'], {
-                'type': failure['kind'], 'message': message, 'where': failure['where'],
-                'explanation': failure['error'] if explained else None,
-                'traceback': failure['traceback']})
+            raise learner_error(failure['callback'], LearnerError(
+                type=failure['kind'], message=message, where=failure['where'],
+                explanation=failure['error'] if explained else None,
+                traceback=failure['traceback']))
 
         for logger, total in ack.get('logged', {}).items():
             observer.floods.announced(pid, '/rosout', logger, total)

@@ -84,7 +84,7 @@ class Floods:
         """True for a message (its rmw message info) its sender stamped before the flooding
         processes were reaped: theirs, arriving late, which no check counts or keeps."""
         sent = info.get('source_timestamp') if isinstance(info, dict) else None
-        return bool(sent) and sent < self.stopped_ns
+        return isinstance(sent, int) and 0 < sent < self.stopped_ns
 
     def raise_any(self) -> None:
         """Raise :class:`~ros2nb.judge_interface.Flooded` with the flood's line when there

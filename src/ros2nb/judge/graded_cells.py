@@ -46,7 +46,7 @@ def graded_calls(source: str) -> list[tuple[str, list[ast.expr], list[ast.keywor
         if name is None:
             raise ValueError(f'a graded cell may only call ros2nb.checks functions: '
                              f'{ast.unparse(statement)[:80]}')
-        call = statement.value  # type: ignore[attr-defined]
+        call = statement.value  # type: ignore[attr-defined]  # a call, _is_check_call said
         calls.append((name, call.args, call.keywords))
     return calls
 
@@ -95,7 +95,7 @@ def grade(source: dict, submission: dict, judge: Judge,
         results[meta['grade_id']] = result = {'passed': True, 'lines': []}
         for name, args, keywords in graded_calls(nbmeta.text(cell)):
             values = [_value(a, names) for a in args]
-            options = {k.arg: _value(k.value, names) for k in keywords}
+            options = {k.arg: _value(k.value, names) for k in keywords if k.arg is not None}
             outcome = captured(lambda: checks.run_check(name, judge, *values, **options))
             result['lines'] += outcome.pop('lines')
             if not outcome['passed']:

@@ -13,19 +13,19 @@ import contextlib
 import math
 import threading
 import time
-from dataclasses import dataclass
 from typing import Any, Callable, Optional
 
 import rclpy
 from rcl_interfaces.msg import Log
 from rcl_interfaces.srv import ListParameters
 from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.serialization import deserialize_message
 from rclpy.signals import SignalHandlerOptions
 
 from .. import domains
-from ..judge_interface import ARRIVAL_TIMEOUT_S
+from ..judge_interface import ARRIVAL_TIMEOUT_S, Heard, Line
 from ..errors import CheckFailed
 from ..processes import Patience, wait_for_work
 from ..runtime import QUIET_SUBSCRIPTION, node_serving_nothing
@@ -53,34 +53,6 @@ class _GivenUp(Exception):
     """The processes a wait attended to had their patience (:meth:`Observer.spins`)."""
 
 
-@dataclass(frozen=True)
-class Heard:
-    """A message the judge's node received.
-
-    :ivar t_ns: the judge's clock when it arrived (ns of simulated time).
-    :ivar value: what the check keeps of it (e.g. a Float32's ``data``).
-    """
-
-    t_ns: int
-    value: Any
-
-
-@dataclass(frozen=True)
-class Line:
-    """A /rosout line the judge's node received.
-
-    :ivar t_ns: the judge's clock when it arrived (ns of simulated time).
-    :ivar name: the logger's name (a node's name).
-    :ivar level: 10 debug, 20 info, 30 warn, 40 error, 50 fatal.
-    :ivar text: the message.
-    """
-
-    t_ns: int
-    name: str
-    level: int
-    text: str
-
-
 class Observer:
     """The judge's own ROS node on the judge's domain: graph, messages, logs, probes."""
 
@@ -103,7 +75,7 @@ class Observer:
         self.heard: dict[str, list[Heard]] = {}
         #: What the learner's code sends beyond any node of the course, and its one line.
         self.floods = Floods(self)
-        self._quiet: Any = None
+        self._quiet: Optional[Node] = None
         self._stop = False
         #: Held while a message is taken: by the spin thread, or by :meth:`take_stale`.
         self._taking = threading.Lock()
@@ -113,15 +85,16 @@ class Observer:
         self._thread = threading.Thread(target=self._spin, name='ros2nb-judge', daemon=True)
         self._thread.start()
         #: What the judge hears the learner's code send on: /rosout and the watched topics.
-        self._hearing = [self.node.create_subscription(Log, '/rosout', self._on_log, ROSOUT_QOS,
+        on_log: Any = self._on_log  # with the message's info: rclpy passes it to two arguments
+        self._hearing = [self.node.create_subscription(Log, '/rosout', on_log, ROSOUT_QOS,
                                                        event_callbacks=QUIET_SUBSCRIPTION)]
 
     def _spin(self) -> None:
         """Run the node's callbacks until :meth:`close` (which wakes the wait at once)."""
         while not self._stop:
             with contextlib.suppress(Exception):  # as spin_once: a callback's error is dropped
-                handler, _entity, _node = self.executor.wait_for_ready_callbacks(
-                    timeout_sec=SPIN_WAIT_S, condition=self._stopping)
+                handler = self.executor.wait_for_ready_callbacks(
+                    timeout_sec=SPIN_WAIT_S, condition=self._stopping)[0]
                 with self._taking:  # rcl takes from a subscription in one thread at a time
                     handler()
 
@@ -146,13 +119,14 @@ class Observer:
         if topic not in self.heard:
             self.heard[topic] = store = []
 
-            def note(msg: Any, info: Any) -> None:
+            def noted(msg: Any, info: Any) -> None:
                 with self.changed:
                     if self.floods.stale(info) or self.floods.count(topic, topic):
                         return
                     store.append(Heard(self.now_ns, keep(msg)))
                     self.changed.notify_all()
 
+            note: Any = noted  # with the message's info, as on_log
             self._hearing.append(self.node.create_subscription(
                 msg_type, topic, note, EVERY_MESSAGE, event_callbacks=QUIET_SUBSCRIPTION))
         return self.heard[topic]
@@ -174,7 +148,7 @@ class Observer:
                     subscription.callback(deserialize_message(raw, subscription.msg_type), info)
                     break
 
-    def quiet_node(self) -> Any:
+    def quiet_node(self) -> Node:
         """A node of the judge's that no thread spins: what its subscriptions receive waits in
         their history until the judge takes it (nothing taken before it asks)."""
         if self._quiet is None:
@@ -214,7 +188,7 @@ class Observer:
         with self.changed:
             return [line.text for line in self.logs[start:] if line.name == logger]
 
-    def endpoints(self, name: str, namespace: str, expected: list[list[str]],
+    def endpoints(self, name: str, namespace: str, expected: list[tuple[str, str, str]],
                   seconds: float = ARRIVAL_TIMEOUT_S) -> list[tuple[str, str, str]]:
         """The node's publishers and subscriptions as the ROS graph shows them.
 
@@ -253,7 +227,7 @@ class Observer:
         empty only when five reads in a row failed so.
         """
         for _attempt in range(5):
-            found = []
+            found: list[tuple[str, str, Any]] = []
             try:
                 for topic, _types in self.node.get_topic_names_and_types():
                     for kind, infos in (

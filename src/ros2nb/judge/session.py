@@ -19,19 +19,21 @@ from importlib import resources
 from pathlib import Path
 from typing import Any, Callable, Iterator, Optional
 
+from rclpy.publisher import Publisher
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Bool, Float32
 
 from .. import course
 from ..checks.drawn import new_seed
 from ..errors import CheckFailed
-from ..processes import kill_process_group, wait_patiently
+from ..processes import Process, kill_process_group, wait_patiently
 from ..subject.judge_time import JUDGE_TOPICS_ENV
 from ..subject.forked import fork_program
 from ..terminal.files import parts_verdict
 from ..terminal.workspace import WORKSPACE_ENV
 from .clock import JudgeClock
 from ..judge_interface import AnswerRef, learner_error
+from ..subject_interface import ExecCells, LoadFile
 from .observer import Observer
 from .subjects import (Output, SubjectHung, SubjectProcess, home_and_tmp, subject_env,
                        subject_prefix, subjects_folder)
@@ -66,13 +68,14 @@ class Session:
         self._scratch_fd = os.open(self.scratch, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW)
         self._observer: Optional[Observer] = None
         self._clock: Optional[JudgeClock] = None
-        self._subjects: dict[tuple, SubjectProcess] = {}
-        self._programs: list[Any] = []  # the learner's programs started (start, start_program)
-        self._probe: Any = None
-        self.builds: dict[str, Any] = {}
+        self._subjects: dict[tuple[Any, ...], SubjectProcess] = {}
+        self._programs: list[Process] = []  # the learner's programs (start, start_program)
+        self._probe: Optional[Publisher] = None
+        self.builds: dict[str, Path] = {}
 
     @property
     def observer(self) -> Observer:
+        """The judge's own ROS node (made on first use, hearing the course's topics)."""
         if self._observer is None:
             self._observer = Observer()
             self._observer.attending = self.working_pids
@@ -92,7 +95,7 @@ class Session:
         return self._clock
 
     @property
-    def probe_publisher(self) -> Any:
+    def probe_publisher(self) -> Publisher:
         """The judge's own Float32 publisher on /temperature (it plays the sensor)."""
         if self._probe is None:
             self._probe = self.observer.node.create_publisher(
@@ -100,7 +103,7 @@ class Session:
                 QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE))
         return self._probe
 
-    def subject(self, key: tuple, load: Callable[[SubjectProcess], None],
+    def subject(self, key: tuple[Any, ...], load: Callable[[SubjectProcess], None],
                 workspace: Optional[Path] = None) -> SubjectProcess:
         """A subject for ``key``, started and loaded once per session (in ``workspace``, by
         default the learner's)."""
@@ -134,7 +137,8 @@ class Session:
         for proc in (*(s.proc for s in self._subjects.values()), *self._programs):
             kill_process_group(proc)
 
-    def drop(self, key: tuple) -> None:
+    def drop(self, key: tuple[Any, ...]) -> None:
+        """End the subject of ``key``, if one runs."""
         subject = self._subjects.pop(key, None)
         if subject is not None:
             subject.close()
@@ -153,13 +157,15 @@ class Session:
         path = self.workspace / relative
 
         def load(subject: SubjectProcess) -> None:
-            reply = subject.request('load_file', path=str(path), module=path.stem)
-            if reply.get('missing'):
+            reply = subject.request(LoadFile(path=str(path), module=path.stem))
+            if reply.missing:
                 raise CheckFailed(f'{path.name} does not exist yet: run the %%part cells that '
                                   'write it, from part 1 on.')
-            if not reply['ok']:
+            if not reply.ok:
                 parts_verdict(self.workspace, relative)  # a part never run explains it best
-                raise learner_error(path.name, reply['error'], context=' on import')
+                if reply.error is not None:
+                    raise learner_error(path.name, reply.error, context=' on import')
+                raise CheckFailed(f'{path.name} could not be imported: run this check again.')
 
         return self.subject(('file', relative), load)
 
@@ -167,7 +173,7 @@ class Session:
         """A subject with the course's context cells and the learner's answer cells run (in
         ``workspace``, by default the learner's)."""
         def load(subject: SubjectProcess) -> None:
-            subject.request('exec_cells', sources=list(ref.sources))
+            subject.request(ExecCells(sources=list(ref.sources)))
 
         return self.subject(('cells', ref.sources, str(workspace)), load, workspace)
 
@@ -193,7 +199,7 @@ class Session:
         return self.hand_over('caught-up-', given)
 
     def start(self, argv: list[str], *, cwd: Path,
-              env: Optional[dict[str, str]] = None) -> tuple[subprocess.Popen, Output]:
+              env: Optional[dict[str, str]] = None) -> tuple[subprocess.Popen[str], Output]:
         """Start a program of the learner's (sandboxed while grading) in a session of its own.
 
         :param env: the program's whole environment (default :func:`subject_env`).  While
@@ -213,7 +219,7 @@ class Session:
         return proc, Output(proc.stdout)
 
     def start_program(self, path: Path, stand_in: Optional[str] = None
-                      ) -> tuple[Any, Output]:
+                      ) -> tuple[Process, Output]:
         """Start the learner's ``main()`` in ``path`` as ``ros2 run`` would, in the learner's
         workspace, as :mod:`ros2nb.subject.program` does it (its node class replaced by the
         course's stand-in ``stand_in`` when given): sandboxed while grading, else forked from

@@ -18,13 +18,16 @@ import sys
 import threading
 import time
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any, Optional, TypeVar
 
 from .. import domains
 from ..errors import CheckFailed
 from ..processes import Patience, kill_process_group, stop_process_group
 from ..subject.judge_time import JUDGE_CLOCK_ENV
 from ..subject.forked import fork_subject, has_server
+from ..subject_interface import Command, reply_type, wire
+from ..subject_replies import Reply
+from ..typed_json import decoded
 
 #: JSON list put in front of every subject's command (the grader's sandbox).
 SUBJECT_PREFIX_ENV = 'ROS2NB_SUBJECT_PREFIX'
@@ -41,6 +44,7 @@ REPLY_TIMEOUT_S = 30.0
 POLL_S = 0.25
 #: Lines of a subject's own output kept for hints.
 KEPT_OUTPUT_LINES = 200
+R = TypeVar('R', bound=Reply)
 #: Subjects this process has started.  Unless sandboxed, they are forked from a server
 #: that has imported ROS (:mod:`ros2nb.subject.forked`): all of them in a judge process,
 #: which forks its server from itself as it starts; elsewhere all but the first, which
@@ -169,15 +173,26 @@ class SubjectProcess:
         #: /rosout lines per logger (set by the session that starts it).
         self.heard_base: tuple[dict[str, int], dict[str, int]] = ({}, {})
 
-    def send(self, op: str, **arguments: Any) -> None:
-        """Send one command (its reply comes later: :meth:`receive`, :meth:`poll_reply`)."""
+    def send(self, command: Command[Any]) -> None:
+        """Send one command (its reply comes later: :meth:`poll_reply`, read with
+        :meth:`reply_to`)."""
         try:
-            os.write(self._commands, (json.dumps({'op': op, **arguments}) + '\n').encode())
+            os.write(self._commands, (json.dumps(wire(command)) + '\n').encode())
         except BrokenPipeError:
             raise self._died() from None
 
-    def poll_reply(self, seconds: float) -> Optional[dict]:
-        """The reply, if it has come within ``seconds``; else None.
+    @staticmethod
+    def reply_to(command: Command[R], data: Any) -> R:
+        """A reply as :meth:`poll_reply` read it, as ``command``'s reply type.
+
+        :raises ros2nb.typed_json.Unreadable: when it does not fit that type (the subject
+            runs learner code, which may write anything there): that check fails alone.
+        """
+        reply: R = decoded(reply_type(type(command)), data)
+        return reply
+
+    def poll_reply(self, seconds: float) -> Any:
+        """The reply as JSON, if it has come within ``seconds``; else None.
 
         :raises CheckFailed: when the process ended (its last output line says why).
         """
@@ -215,22 +230,23 @@ class SubjectProcess:
             self.last_ack = newest
         return newest
 
-    def request(self, op: str, *, timeout: float = REPLY_TIMEOUT_S, **arguments: Any) -> dict:
-        """Send one command and return its reply.
+    def request(self, command: Command[R], *, timeout: float = REPLY_TIMEOUT_S) -> R:
+        """Send one command and return its reply (``command``'s reply type).
 
         :param timeout: seconds the subject gets: of CPU time while it works, of the wall
             clock while it waits (:class:`~ros2nb.processes.Patience`), so that a busy
             machine never turns slow honest work into a hang.
         :raises SubjectHung: when no reply comes within ``timeout`` seconds, or the
             process died (its last output line is in the message).
+        :raises ros2nb.typed_json.Unreadable: for a reply that does not fit its type.
         """
-        self.send(op, **arguments)
+        self.send(command)
         sent, patience = time.monotonic(), None
         while True:
             reply = self.poll_reply(POLL_S)
             self.take_ack()
             if reply is not None:
-                return reply
+                return self.reply_to(command, reply)
             # No reply within POLL_S: from now on the subject's CPU time counts.  (Most
             # replies come sooner, and reading /proc for each cost the judge more than the
             # reply.)

@@ -14,8 +14,10 @@ import sys
 
 from ..explain.plots import guard_pyplot
 from ..processes import end_this_process
+from ..subject_interface import LOADERS, command_of, wire
+from ..typed_json import Unreadable
 from . import judge_time, out_of_reach
-from .commands import LOADERS, PROTOCOL_ERROR, load, serve
+from .commands import PROTOCOL_ERROR, load, serve
 
 
 def main(argv: list[str]) -> int:
@@ -30,12 +32,13 @@ def main(argv: list[str]) -> int:
         first = commands.readline()
         if not first:
             return 0
-        request = json.loads(first)
-        if request.get('op') not in LOADERS:
+        try:
+            command = command_of(json.loads(first), LOADERS)
+        except (ValueError, Unreadable):
             return PROTOCOL_ERROR
         refusing = out_of_reach.shut()  # the stand-ins are handed in only once the code is loaded
-        namespace, reply = load(request)
-        replies.write(json.dumps(reply) + '\n')
+        namespace, reply = load(command)
+        replies.write(json.dumps(wire(reply)) + '\n')
         replies.flush()
         serve(commands, replies, namespace, refusing)
     return 0

@@ -28,17 +28,20 @@ from rclpy.node import Node
 from .. import domains
 from ..endpoints import node_endpoints
 from ..errors import Ros2nbError
-from ..explain.exceptions import describe_error
 from ..runtime import Runtime, enable_field_checks
+from ..subject_interface import (COMMANDS, Call, Command, ExecCells, GetCounts, LoadFile,
+                                 NewNode, Run, Serve, Serves, SetAttribute, WaitMatched,
+                                 WaitPublishers, WaitReceived, command_of, wire)
+from ..explain.exceptions import describe_error
+from ..subject_replies import (CallbackFailure, Called, CellsRun, Counts, Loaded, NodeMade,
+                               Output, Reply)
 from .judge_time import JudgeTime
 from .out_of_reach import STAND_INS, Answers
-from .replies import decode_argument, encode
+from .replies import decode_argument, described, encode
 from .trials import Trials
 
 #: Exit code when a command could not even be read.
 PROTOCOL_ERROR = 3
-#: Commands that load the learner's code: the first command, and only the first.
-LOADERS = ('load_file', 'exec_cells', 'nothing')
 
 
 def _without_magics(source: str) -> str:
@@ -50,38 +53,37 @@ def _without_magics(source: str) -> str:
 
 
 # ------------------------------------------------------------------ loading (first command)
-def load(request: dict) -> tuple[dict, dict]:
-    """Run the first command, which loads the learner's code; return (namespace, reply).
+def load(command: Command[Any]) -> tuple[dict[str, Any], Reply]:
+    """Run the first command (:data:`~ros2nb.subject_interface.LOADERS`), which loads the
+    learner's code; return (namespace, reply).
 
     Called before the command loop exists: code of the learner's that looks up the stack
     while it is imported finds this function's frame, the process's ``main()`` and what
     started the process (``runpy``, or the fork server's, :mod:`.fork_server`), never the loop.
     """
-    op = request.get('op')
     namespace: dict[str, Any] = {'__name__': '__main__'}
-    if op == 'load_file':
-        file = Path(request['path'])
+    if isinstance(command, LoadFile):
+        file = Path(command.path)
         if not file.is_file():
-            return namespace, {'ok': False, 'missing': True}
-        spec = importlib.util.spec_from_file_location(request['module'], file)
+            return namespace, Loaded(ok=False, missing=True)
+        spec = importlib.util.spec_from_file_location(command.module, file)
         assert spec is not None and spec.loader is not None
         loaded: ModuleType = importlib.util.module_from_spec(spec)
-        sys.modules[request['module']] = loaded
+        sys.modules[command.module] = loaded
         try:
             spec.loader.exec_module(loaded)
         except BaseException as error:  # the learner's import may raise anything
-            return namespace, {'ok': False, 'error': describe_error(error)}
+            return namespace, Loaded(ok=False, error=described(error))
         namespace.update(vars(loaded))
-        return namespace, {'ok': True}
-    if op == 'exec_cells':
-        errors = []
-        for index, source in enumerate(request['sources']):
-            try:
-                exec(compile(_without_magics(source), f'<cell {index + 1}>', 'exec'), namespace)
-            except BaseException as error:  # the learner's cell may raise anything
-                errors.append(describe_error(error))
-        return namespace, {'ok': True, 'cell_errors': errors}
-    return namespace, {'ok': True}
+        return namespace, Loaded(ok=True)
+    assert isinstance(command, ExecCells)  # the only other loader
+    errors = []
+    for index, source in enumerate(command.sources):
+        try:
+            exec(compile(_without_magics(source), f'<cell {index + 1}>', 'exec'), namespace)
+        except BaseException as error:  # the learner's cell may raise anything
+            errors.append(described(error))
+    return namespace, CellsRun(ok=True, cell_errors=errors)
 
 
 class Subject(Trials):
@@ -93,23 +95,24 @@ class Subject(Trials):
         self.rt: Optional[Runtime] = None
         self.node: Optional[Node] = None
         self.received = 0
-        self.failure: Optional[dict] = None
+        self.failure: Optional[CallbackFailure] = None
         self.rooms: list[Node] = []  # stand-in nodes of the reusability check (notebook 06)
         self._spun = None
         self._qos = None
 
     # ---------------------------------------------------------------- calls
-    def call(self, name: str, inputs: list[list[Any]]) -> dict:
-        function = self.namespace.get(name)
+    def call(self, command: Call) -> Called:
+        """Call the learner's function once per list of arguments."""
+        function = self.namespace.get(command.name)
         if function is None:
-            return {'ok': False, 'undefined': True}
+            return Called(ok=False, undefined=True)
         outputs = []
-        for arguments in inputs:
+        for arguments in command.inputs:
             try:
-                outputs.append({'result': encode(function(*map(decode_argument, arguments)))})
+                outputs.append(Output(result=encode(function(*map(decode_argument, arguments)))))
             except BaseException as error:
-                outputs.append({'error': describe_error(error)})
-        return {'ok': True, 'outputs': outputs}
+                outputs.append(Output(error=described(error)))
+        return Called(ok=True, outputs=outputs)
 
     # ---------------------------------------------------------------- nodes
     def _runtime(self) -> Runtime:
@@ -121,7 +124,8 @@ class Subject(Trials):
 
     def _on_failure(self, node: str, callback: str, error: BaseException) -> None:
         if self.failure is None:
-            self.failure = {'node': node, 'callback': callback, **describe_error(error)}
+            self.failure = CallbackFailure(node=node, callback=callback,
+                                           **describe_error(error))
 
     def _count_receipts(self, subscription: Any) -> None:
         original = subscription.callback
@@ -133,10 +137,10 @@ class Subject(Trials):
         counted.__qualname__ = getattr(original, '__qualname__', 'callback')
         subscription.callback = counted
 
-    def new_node(self, cls: str, stand_ins: list[str], seed: Optional[int],
-                 args: Optional[list] = None) -> dict:
+    def new_node(self, command: NewNode) -> NodeMade:
         """Create ``cls(*args)`` with the named stand-ins (:mod:`.stand_ins`) and run it on the
         judge's clock; stop the node made before."""
+        cls, stand_ins, seed, args = command.cls, command.stand_ins, command.seed, command.args
         rt = self._runtime()
         if self.node is not None:
             if self.node.get_fully_qualified_name() in rt.nodes:
@@ -146,7 +150,7 @@ class Subject(Trials):
         if not isinstance(node_class, type) or not issubclass(node_class, Node):
             found = sorted(n for n, v in self.namespace.items()
                            if isinstance(v, type) and issubclass(v, Node) and v is not Node)
-            return {'ok': False, 'no_class': True, 'classes': found}
+            return NodeMade(ok=False, no_class=True, classes=found)
         if stand_ins:
             node_class = self._answers.hand_in(STAND_INS).with_stand_ins(node_class, stand_ins)
         rt.take_judge_time()
@@ -157,90 +161,92 @@ class Subject(Trials):
         try:
             node = node_class(*(args or []))
         except BaseException as error:
-            return {'ok': False, 'error': describe_error(error)}
+            return NodeMade(ok=False, error=described(error))
         try:
             rt.add(node)
         except Ros2nbError as error:
-            return {'ok': False, 'refused': str(error)}
+            return NodeMade(ok=False, refused=str(error))
         self.node = node
         for subscription in node.subscriptions:
             self._count_receipts(subscription)
         logger = node.get_logger().name
-        return {'ok': True, 'name': node.get_name(), 'namespace': node.get_namespace(),
-                'started_lines': rt.log_counts[logger] - logged_before.get(logger, 0),
-                'endpoints': node_endpoints(node), **self._counts(),
-                # names a failure, never earns a point (``ros2 param`` reaches it or not)
-                'parameter_services': any(service.srv_name.endswith('/set_parameters')
-                                          for service in node.services)}
+        return NodeMade(ok=True, name=node.get_name(), namespace=node.get_namespace(),
+                        started_lines=rt.log_counts[logger] - logged_before.get(logger, 0),
+                        endpoints=node_endpoints(node), **self._counts(),
+                        # names a failure, never earns a point (``ros2 param`` reaches it or not)
+                        parameter_services=any(service.srv_name.endswith('/set_parameters')
+                                               for service in node.services))
 
-    def _counts(self) -> dict:
+    def _counts(self) -> dict[str, Any]:
+        """The fields of :class:`~ros2nb.subject_replies.Counts` now (but ``ok``)."""
         rt = self._runtime()
         logged = rt.log_counts.get(self.node.get_logger().name, 0) if self.node else 0
         shown = self._plot_shown.told if self._plot_shown is not None else None
         return {'received': self.received, 'logged': logged, 'failure': self.failure,
                 'published': JudgeTime.published(), 'shown': shown}
 
-    def counts(self) -> dict:
-        return {'ok': True, **self._counts()}
+    def counts(self, command: GetCounts) -> Counts:
+        """What this process counted so far."""
+        return Counts(ok=True, **self._counts())
 
-    def run(self, seconds: float, seed: Optional[int] = None) -> dict:
+    def run(self, command: Run) -> Counts:
         """Let the nodes run ``seconds`` of the judge's clock (the judge moves it on)."""
-        if seed is not None:
-            random.seed(seed)
-        self._runtime().advance_sim_time(seconds)
-        return {'ok': True, **self._counts()}
+        if command.seed is not None:
+            random.seed(command.seed)
+        self._runtime().advance_sim_time(command.seconds)
+        return Counts(ok=True, **self._counts())
 
-    def set_attribute(self, name: str, value: Any) -> dict:
+    def set_attribute(self, command: SetAttribute) -> Reply:
+        """Set an attribute of the node made last."""
         if self.node is None:
-            return {'ok': False}
-        setattr(self.node, name, value)
-        return {'ok': True}
+            return Reply(ok=False)
+        setattr(self.node, command.name, command.value)
+        return Reply(ok=True)
 
-    def wait_matched(self, topic: str, seconds: float) -> dict:
+    def wait_matched(self, command: WaitMatched) -> Reply:
         """Wait until the node's publishers on ``topic`` reach a subscription (the judge's)."""
-        deadline = time.monotonic() + seconds
+        topic, deadline = command.topic, time.monotonic() + command.seconds
         node = self.node
         publishers = [p for p in node.publishers
                       if node.resolve_topic_name(p.topic_name) == topic] if node else []
         while time.monotonic() < deadline:
             if publishers and all(p.get_subscription_count() >= 1 for p in publishers):
-                return {'ok': True}
+                return Reply(ok=True)
             time.sleep(0.01)
-        return {'ok': False}
+        return Reply(ok=False)
 
-    def wait_publishers(self, topic: str, seconds: float) -> dict:
+    def wait_publishers(self, command: WaitPublishers) -> Reply:
         """Wait until the node's subscriptions on ``topic`` have matched a publisher (the
         judge's).  Their own match, not the graph's list: in a subject that made a node
         before, the graph already lists the judge's publisher while the new subscription
         has not matched it yet, and a reading sent then was lost."""
-        deadline = time.monotonic() + seconds
+        topic, deadline = command.topic, time.monotonic() + command.seconds
         node = self.node
         subscriptions = [s for s in node.subscriptions
                          if node.resolve_topic_name(s.topic_name) == topic] if node else []
         while subscriptions and time.monotonic() < deadline:  # none: nothing can match
             if all(s.get_publisher_count() >= 1 for s in subscriptions):
-                return {'ok': True}
+                return Reply(ok=True)
             time.sleep(0.01)
-        return {'ok': False}
+        return Reply(ok=False)
 
-    def wait_received(self, count: int, seconds: float) -> dict:
+    def wait_received(self, command: WaitReceived) -> Counts:
         """Run callbacks until the node's subscriptions took ``count`` messages (or time is up)."""
-        rt = self._runtime()
-        deadline = time.monotonic() + seconds
+        rt, count = self._runtime(), command.count
+        deadline = time.monotonic() + command.seconds
         while self.received < count and time.monotonic() < deadline:
             with rt.exclusive():
                 rt.drain()
             time.sleep(0.002)
         with rt.exclusive():
             rt.drain()
-        return {'ok': self.received >= count, **self._counts()}
+        return Counts(ok=self.received >= count, **self._counts())
 
-    def serve(self) -> dict:
+    def serve(self, command: Serve) -> Counts:
         """Spin the node in the background from now on: it answers service calls (its
         parameters) whenever the judge makes them."""
         self._runtime().spin_in_background()
-        return {'ok': True, **self._counts()}
-
+        return Counts(ok=True, **self._counts())
 
 
 def serve(commands: Any, replies: Any, namespace: dict[str, Any], answers: Answers) -> None:
@@ -250,25 +256,18 @@ def serve(commands: Any, replies: Any, namespace: dict[str, Any], answers: Answe
         (:func:`.out_of_reach.shut`), which hands in the stand-ins.
     """
     subject = Subject(namespace, answers)
-    handlers: dict[str, Callable[..., dict]] = {
-        'call': subject.call, 'new_node': subject.new_node, 'run': subject.run,
-        'set_attribute': subject.set_attribute, 'wait_matched': subject.wait_matched,
-        'wait_received': subject.wait_received, 'counts': subject.counts,
-        'serve': subject.serve, 'worker': subject.worker, 'worker_stop': subject.worker_stop,
-        'plot_shown': subject.plot_shown,
-        'room_nodes': subject.room_nodes, 'wait_publishers': subject.wait_publishers,
-        'qos_endpoint': subject.qos_endpoint, 'qos_acked': subject.qos_acked,
-    }
+    served: Serves = subject  # the type checker holds every command's method to its types
+    handlers: dict[str, Callable[[Any], Reply]] = {op: getattr(served, op) for op in COMMANDS}
     for line in commands:
         request = json.loads(line)
-        op = request.pop('op')
-        if op == 'quit':
+        if request.get('op') == 'quit':
             break
         try:
-            reply = handlers[op](**request)
+            command = command_of(request, COMMANDS)
+            reply = handlers[command.op](command)
         except BaseException as error:  # a learner's callback may raise anything, also here
-            reply = {'ok': False, 'error': describe_error(error)}
-        replies.write(json.dumps(reply) + '\n')
+            reply = Reply(ok=False, error=described(error))
+        replies.write(json.dumps(wire(reply)) + '\n')
         replies.flush()
     if subject.rt is not None:
         subject.rt.shutdown()

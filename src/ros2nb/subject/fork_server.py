@@ -22,7 +22,7 @@ import socket
 import sys
 import threading
 import traceback
-from typing import Callable, NoReturn
+from typing import Any, Callable, NoReturn, Union
 
 #: What the server imports before it forks the first child: the subject's own modules and
 #: what rclpy imports when the first node starts (the parameter services' types, numpy for
@@ -54,7 +54,8 @@ def serve(sock: socket.socket) -> None:
     signal.signal(signal.SIGCHLD, lambda *_: None)
     status: dict[int, int] = {}  # a child's pid -> the write end of its exit-code pipe
     while True:
-        ready, _, _ = select.select([sock, wake_read], [], [])
+        watched: list[Any] = [sock, wake_read]
+        ready, _, _ = select.select(watched, [], [])
         if wake_read in ready:
             with contextlib.suppress(BlockingIOError):
                 os.read(wake_read, 4096)
@@ -129,7 +130,7 @@ def _become(request: dict, kept: list[int], out: int) -> NoReturn:
     wanted = os.environ.get(CHECK_FIELDS_ENV, '')
     for module in list(sys.modules.values()):
         if 'ros_python_check_fields' in getattr(module, '__dict__', {}):
-            module.ros_python_check_fields = wanted
+            setattr(module, 'ros_python_check_fields', wanted)  # rosidl's module global
     sys.path[:] = [cwd, *filter(None, env.get('PYTHONPATH', '').split(os.pathsep)),
                    *request['site_path']]
     from ..processes import end_this_process
@@ -148,6 +149,7 @@ def _end_as_python_does(call: Callable[[], int]) -> NoReturn:
     gives its code, the threads that are not daemons are waited for, the exit handlers run,
     and a ``KeyboardInterrupt`` that escaped ends the process with SIGINT itself."""
     interrupted = False
+    code: Union[int, str, None]
     try:
         code = call()
     except SystemExit as stop:
@@ -185,7 +187,7 @@ def _standard_streams(unbuffered: bool) -> None:
         buffered = raw if unbuffered and fd else (
             io.BufferedReader(raw) if fd == 0 else io.BufferedWriter(raw))
         streams.append(io.TextIOWrapper(
-            buffered, encoding=encoding, errors=errors,  # type: ignore[arg-type]
+            buffered, encoding=encoding, errors=errors,
             write_through=unbuffered and fd > 0, line_buffering=fd == 2 and not unbuffered))
     sys.stdin, sys.stdout, sys.stderr = streams
 

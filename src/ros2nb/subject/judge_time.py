@@ -116,7 +116,7 @@ class JudgeTime:
             cls._logged[name] += 1
             return made
 
-        Publisher.publish = counted  # type: ignore[method-assign]
+        Publisher.publish = counted  # type: ignore[method-assign]  # every publisher, counted
         rclpy_implementation.rclpy_logging_rcutils_log = logged
 
     def on_clock(self, msg: Clock) -> None:
@@ -172,7 +172,7 @@ class JudgeTime:
         subscription = getattr(source, '_clock_sub', None)
         if subscription is not None:
             node.destroy_subscription(subscription)
-            source._clock_sub = None  # type: ignore[union-attr]
+            source._clock_sub = None  # type: ignore[union-attr]  # found on it just above
 
     def advance(self, runtime: Any, end_ns: int, until: Optional[Callable[[], bool]],
                 on_step: Optional[Callable[[], None]]) -> None:

@@ -37,8 +37,13 @@ def _publisher_on(node: Node, topic: str) -> Any:
     return found[-1]
 
 
+#: The learner's node class a stand-in method is put on: a Node subclass with attributes of
+#: its own (``publisher_``, ``temperature``, ...), which no type declares.
+LearnersNode = Any
+
+
 # ------------------------------------------------------------------ notebook 03: the sensor
-def sensor_init(self: Node) -> None:
+def sensor_init(self: LearnersNode) -> None:
     """Part 3 of temperature_publisher.py: name, publisher, timer, start value, a log line."""
     Node.__init__(self, course.SENSOR_NODE)
     self.publisher_ = self.create_publisher(Float32, course.TOPIC, course.QUEUE_DEPTH)
@@ -47,7 +52,7 @@ def sensor_init(self: Node) -> None:
     self.get_logger().info('Temperature Sensor Node Started')
 
 
-def sensor_callback(self: Node) -> None:
+def sensor_callback(self: LearnersNode) -> None:
     """Part 4 of temperature_publisher.py: one step of the walk, clamped, published, logged.
 
     Does nothing on a node without ``temperature`` (a constructor that calls it before it
@@ -64,7 +69,7 @@ def sensor_callback(self: Node) -> None:
 
 
 # ------------------------------------------------------------------ notebook 04: the monitor
-def monitor_init(self: Node) -> None:
+def monitor_init(self: LearnersNode) -> None:
     """Part 3 of temperature_subscriber.py: name, subscription, a log line."""
     Node.__init__(self, course.MONITOR_NODE)
     self.subscription = self.create_subscription(Float32, course.TOPIC,
@@ -72,14 +77,14 @@ def monitor_init(self: Node) -> None:
     self.get_logger().info('Temperature Monitor Node Started')
 
 
-def monitor_callback(self: Node, msg: Float32) -> None:
+def monitor_callback(self: LearnersNode, msg: Float32) -> None:
     """Part 4 of temperature_subscriber.py: one line with the reading and its status."""
     self.get_logger().info(f'Temperature: {msg.data:.2f}C - Status: '
                            f'{monitor_status(msg.data)}')
 
 
 # ------------------------------------------------------------------ notebook 06: the fan
-def fan_init(self: Node) -> None:
+def fan_init(self: LearnersNode) -> None:
     """Part 2 of fan_controller.py, its constructor."""
     Node.__init__(self, course.FAN_NODE)
     self.subscription = self.create_subscription(Float32, course.TOPIC,
@@ -88,13 +93,13 @@ def fan_init(self: Node) -> None:
     self.get_logger().info('Fan Controller Node Started')
 
 
-def fan_callback(self: Node, msg: Float32) -> None:
+def fan_callback(self: LearnersNode, msg: Float32) -> None:
     """Part 2 of fan_controller.py, its callback: one command per reading."""
     _publisher_on(self, course.FAN_TOPIC).publish(Bool(data=msg.data > course.HIGH_ABOVE_C))
 
 
 # ------------------------------------------------------------------ notebook 08: parameters
-def thresholds_init(self: Node) -> None:
+def thresholds_init(self: LearnersNode) -> None:
     """Part 3 of notebook 08's monitor: both thresholds declared, the on-set callback
     registered, the subscription (its callback, given in the notebook, reads them)."""
     Node.__init__(self, course.MONITOR_NODE)
@@ -109,7 +114,7 @@ def thresholds_init(self: Node) -> None:
     self.get_logger().info('Temperature Monitor Node Started')
 
 
-def thresholds_on_set(self: Node, parameters: list) -> SetParametersResult:
+def thresholds_on_set(self: LearnersNode, parameters: list) -> SetParametersResult:
     """Part 4 of notebook 08's monitor: a change that leaves ``low_below_c`` at or above
     ``high_above_c`` is refused, with a reason."""
     new = {parameter.name: parameter.value for parameter in parameters}
@@ -120,7 +125,7 @@ def thresholds_on_set(self: Node, parameters: list) -> SetParametersResult:
     return SetParametersResult(successful=True)
 
 
-def thresholds_callback(self: Node, msg: Float32) -> None:
+def thresholds_callback(self: LearnersNode, msg: Float32) -> None:
     """Notebook 08's monitor callback (given in part 4): the status by both thresholds as
     they are now."""
     high = self.get_parameter(course.HIGH_PARAMETER).value

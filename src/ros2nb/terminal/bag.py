@@ -30,7 +30,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
-from typing import Any, Optional, Sequence
+from typing import Any, Final, Optional, Sequence
 
 import yaml
 from rclpy.duration import Duration
@@ -50,7 +50,7 @@ from .topic import graph_topics, resolve
 #: The storage every bag of the course uses (rosbag2's default since Iron).
 STORAGE_ID = 'mcap'
 #: rosbag2's metadata version written (Jazzy's rosbag2 writes and reads 9).
-METADATA_VERSION = 9
+METADATA_VERSION: Final = 9
 #: What replay and recording keep: every message (a burst never overflows a queue).
 #: Wall-clock seconds a player waits for its subscriptions to match, or for their acks.
 MATCH_WAIT_S = 2.0

@@ -220,7 +220,7 @@ def _score(scoring: Scoring, learners: list[Learner], batch: set[str]) -> None:
 
 
 def _report(out: Path, learners: list[Learner], rows: list[list[str]],
-            refused: list[str], seed: int) -> None:
+            refused: list[str], seed: Optional[int]) -> None:
     """notes.json (with the seed that grades again with the same inputs: ``--seed``), and
     one line per learner: their total and what happened."""
     (out / 'notes.json').write_text(json.dumps(

@@ -18,7 +18,7 @@ import os
 import time
 import uuid
 from pathlib import Path
-from typing import Iterator, Optional
+from typing import Any, Iterator, Optional
 
 from ..paths import ASSIGNMENT
 from .cluster_task import Graded, Job, accept, course_version, grade_job, resource_name
@@ -124,7 +124,7 @@ class Cluster:
             for future in futures:
                 future.cancel()
 
-    def _submit(self, job: Job):
+    def _submit(self, job: Job) -> Any:
         """``job`` as a task only a checked worker runs (it needs their resource)."""
         # The key names the learner (an nbgrader id) for the dashboard, and is new each time.
         return self.client.submit(
@@ -181,7 +181,7 @@ class Cluster:
         self.client.close()
 
 
-def _unrunnable_keys(dask_scheduler) -> list:
+def _unrunnable_keys(dask_scheduler: Any) -> list:
     """Run on the scheduler: the keys of the tasks no worker can run now."""
     return [task.key for task in dask_scheduler.unrunnable]
 

@@ -15,7 +15,7 @@ import sys
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Optional
+from typing import Any, Optional
 
 from ..paths import ASSIGNMENT, ROOT
 from . import sandbox
@@ -53,7 +53,7 @@ def resource_name(version: str) -> str:
     return f'ros2nb-course-{version}'
 
 
-async def accept(version: str, sandboxed: bool, dask_worker=None) -> Optional[str]:
+async def accept(version: str, sandboxed: bool, dask_worker: Any = None) -> Optional[str]:
     """Run on each worker (``Client.run``): None when it may grade for an instructor whose
     course is ``version`` (it then holds :func:`resource_name`, which every learner's task
     needs, one per thread, and the scheduler knows it), else why not, in words that end the

@@ -46,7 +46,7 @@ def clean_body(body: str) -> str:
                      strip_comments=True)
 
 
-def page(title: str, body: str, styles: list[str] = (), body_class: str = '') -> str:
+def page(title: str, body: str, styles: Sequence[str] = (), body_class: str = '') -> str:
     """A whole page: CSP, the title as text, the given style sheets, the body sanitised."""
     css = ''.join(f'<style>{s}</style>' for s in styles if '</' not in s)
     return (f'<!DOCTYPE html>\n<html><head><meta charset="utf-8">'

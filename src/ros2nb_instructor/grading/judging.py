@@ -15,7 +15,7 @@ import shutil
 import subprocess
 import sys
 from pathlib import Path
-from typing import NamedTuple, Optional
+from typing import Any, NamedTuple, Optional
 
 import nbformat
 
@@ -156,7 +156,7 @@ class Judges:
         self._pool = concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs),
                                                            thread_name_prefix='judge')
 
-    def submit(self, *arguments: object) -> concurrent.futures.Future:
+    def submit(self, *arguments: Any) -> concurrent.futures.Future:
         return self._pool.submit(judge_notebook, *arguments)
 
     def close(self) -> None:

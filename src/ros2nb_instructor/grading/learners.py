@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import concurrent.futures
 import errno
+from typing import Any
 from pathlib import Path
 
 import nbformat
@@ -61,12 +62,14 @@ def grade_learner(course: Path, scratch_root: Path, learner: Learner, notebooks:
 
 
 def _run_and_judge(scratch: Scratch, learner: Learner, notebook: str,
-                   release: nbformat.NotebookNode, settings: Settings, judges: Judges):
+                   release: nbformat.NotebookNode, settings: Settings, judges: Judges
+                   ) -> Any:
     """Run one notebook and submit it to its judge: ``(executed, future)``, or why not (str)."""
     submitted, problem = readable(learner.files[notebook])
     if problem:
         learner.note(notebook, f'{problem}; 0 points')
         return f'{problem}; 0 points.'
+    assert submitted is not None  # readable() gives the notebook or the problem
     if notebooks_of.not_attempted(release, submitted):  # nothing to run: 0, said in a note
         learner.note(notebook, notebooks_of.NOT_ATTEMPTED)
         return f'{notebooks_of.NOT_ATTEMPTED}.'

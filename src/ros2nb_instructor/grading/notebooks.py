@@ -37,7 +37,7 @@ def _grade_id(cell: Any) -> Optional[str]:
 
 
 def _by_grade_id(nb: nbformat.NotebookNode) -> dict[str, Any]:
-    return {_grade_id(c): c for c in nb.cells if _grade_id(c)}
+    return {grade_id: c for c in nb.cells if (grade_id := _grade_id(c))}
 
 
 def _clean(cell: Any) -> None:
@@ -99,6 +99,7 @@ def for_the_run(release: nbformat.NotebookNode,
     course = _by_grade_id(release)
     for cell in _course_cells(nb, course):
         grade_id = _grade_id(cell)
+        assert grade_id is not None  # _course_cells gives the course's graded cells only
         original = course[grade_id]
         if nbgrader(original).get('locked'):
             cell.source, cell.cell_type = original.source, original.cell_type

@@ -148,7 +148,8 @@ def _learners_table(notebooks: list[str], scores: dict[str, dict[str, float]],
 
 def _similarity_table(notebooks: list[str], learners: list[Learner], course: Path) -> str:
     """Answers alike (:mod:`.similarity`): for a person to judge, never a grade."""
-    pairs, common = [], []
+    pairs: list[similarity.Pair] = []
+    common: list[similarity.Common] = []
     for notebook in notebooks:
         own = course / f'{notebook}.ipynb'
         given = NOTEBOOKS / f'{notebook}.ipynb'

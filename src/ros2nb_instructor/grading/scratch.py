@@ -16,6 +16,7 @@ import sys
 import tempfile
 import threading
 from pathlib import Path
+from typing import Callable
 
 from ros2nb.terminal.workspace import WORKSPACE_NAME
 
@@ -118,7 +119,7 @@ class Scratch:
         return given, scratch
 
 
-def _not_for_the_judge(workspace: Path):
+def _not_for_the_judge(workspace: Path) -> Callable[[str, list[str]], list[str]]:
     """``copytree``'s ignore function for :meth:`Scratch.snapshot`."""
     def ignored(folder: str, names: list[str]) -> list[str]:
         skip = {'build', 'install', 'log'} if Path(folder) == workspace else set()

@@ -24,7 +24,7 @@ import re
 import shlex
 import textwrap
 from pathlib import Path
-from typing import NamedTuple, Optional
+from typing import Any, NamedTuple, Optional
 
 from ros2nb import nbmeta
 
@@ -143,9 +143,9 @@ def graded(cells: list[dict], course: Course) -> dict[str, str]:
             if old is not None:
                 found.pop(old, None)
             answer = course.parts.get(part)
-            name = (str(meta['grade_id']) if meta.get('solution') and answer is None else
-                    answer if meta.get('solution') and meta.get('grade_id') == answer else
-                    f'{answer} (an added cell)' if answer else f'{part[0]} part {part[1]}')
+            name = (str(meta.get('grade_id', '?')) if meta.get('solution') and answer is None
+                    else answer if answer and meta.get('solution') and meta.get('grade_id') == answer
+                    else f'{answer} (an added cell)' if answer else f'{part[0]} part {part[1]}')
             written[part] = name
         elif meta.get('solution'):
             name = str(meta.get('grade_id', '?'))
@@ -155,13 +155,14 @@ def graded(cells: list[dict], course: Course) -> dict[str, str]:
     return found
 
 
-def _fingerprint(text: str, boilerplate: object = None):
-    from copydetect import CodeFingerprint
+def _fingerprint(text: str, boilerplate: object = None) -> Any:
+    """copydetect's fingerprint of ``text`` read as Python (its filtered code, its hashes)."""
+    from copydetect import CodeFingerprint  # type: ignore[import-untyped]
     return CodeFingerprint('answer.py', K, 1, boilerplate=boilerplate, language='python',
                            fp=io.StringIO(text))
 
 
-def _ratio(a, b) -> float:
+def _ratio(a: Any, b: Any) -> float:
     """How alike two fingerprinted parts are (0-1): the larger share of either found in the
     other (a copy padded with dead code keeps the share of the original found in it); 0 when
     the smaller share is under :data:`FLOOR` (one holds far more than the other: an answer
@@ -175,7 +176,7 @@ def _ratio(a, b) -> float:
     return float(max(shares)) if min(shares) >= FLOOR else 0.0
 
 
-def fingerprints(cells: list[dict], course: Course, small: set[str]):
+def fingerprints(cells: list[dict], course: Course, small: set[str]) -> dict[str, Any]:
     """name -> fingerprint of each part of :func:`graded`, the ``small`` ones (and those too
     small themselves) in one group, :data:`SMALL`."""
     parts = graded(cells, course)

@@ -106,7 +106,7 @@ def find_learners(folder: Path, notebooks: list[str]) -> tuple[list[Learner], li
 
     :return: the learners (sorted by name) and one line per entry refused.
     """
-    learners, refused, taken = [], [], set()
+    learners, refused, taken = [], [], set[str]()
     for number, entry in enumerate(sorted(folder.iterdir(), key=lambda p: p.name), start=1):
         if entry.is_symlink():
             refused.append(f'"{shown(entry.name)}": a link, not a learner folder (links are '
@@ -216,7 +216,7 @@ def readable(path: Path) -> tuple[Optional[nbformat.NotebookNode], Optional[str]
     try:
         fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
     except OSError as error:
-        return None, f'the file could not be read ({os.strerror(error.errno)})'
+        return None, f'the file could not be read ({error.strerror})'
     with os.fdopen(fd, 'rb') as stream:
         size = os.fstat(stream.fileno()).st_size
         if not stat.S_ISREG(os.fstat(stream.fileno()).st_mode):
