@@ -157,7 +157,7 @@ def graded(cells: list[dict], course: Course) -> dict[str, str]:
 
 def _fingerprint(text: str, boilerplate: object = None) -> Any:
     """copydetect's fingerprint of ``text`` read as Python (its filtered code, its hashes)."""
-    from copydetect import CodeFingerprint  # type: ignore[import-untyped]
+    from copydetect import CodeFingerprint  # type: ignore[import-untyped]  # no stubs, no py.typed
     return CodeFingerprint('answer.py', K, 1, boilerplate=boilerplate, language='python',
                            fp=io.StringIO(text))
 
