@@ -2,11 +2,13 @@
 """What a flooder costs a class: two complete learners graded alone, then beside a learner
 whose sensor floods /rosout.
 
-``python benchmarks/flood_class.py [--reps N] [--topic]`` grades, with ``ros2nb-grade`` in
-its sandboxes, a class of two learners who handed in every notebook complete, and the same
-class with a third who handed in only notebook 03, written as the solution but with a
-constructor that starts a thread logging as fast as it can (``--topic``: publishing on
-/temperature as fast as it can; ``tests/test_floods.py`` has both).  The two classes are
+``python benchmarks/flood_class.py [--reps N] [--kind rosout|topic|callback]`` grades, with
+``ros2nb-grade`` in its sandboxes, a class of two learners who handed in every notebook
+complete, and the same class with a third who handed in only notebook 03, written as the
+solution but with a constructor that starts a thread logging as fast as it can (``--kind
+topic``: publishing on /temperature as fast as it can; ``--kind callback``: no thread, a
+callback that logs 450 lines a reading, a slow flood under the judge's flood limit;
+``tests/test_floods.py`` has all three).  The two classes are
 graded in turn, ``--reps`` times (default 1).  It prints, per grading, the wall seconds and
 the CPU seconds of ``ros2nb-grade`` and every process it started (read from ``/proc`` every
 50 ms, by parent: other work on the machine is left out), the flooder's score of 03 and the
@@ -55,16 +57,19 @@ def flooder_result(out: Path) -> str:
     for page in (out / 'feedback' / 'flooder').rglob('03*.html'):
         text = html.unescape(re.sub(r'<[^>]+>', ' ', page.read_text()))
         found += sorted({m.strip() for m in re.findall(
-            r'(?:CheckFailed|LearnerCodeError|Your node|Your code)[^\n]{0,300}', text)})
+            r'(?:CheckFailed|LearnerCodeError|Your node|Your code|checking it reached)'
+            r'[^\n]{0,300}',
+            text)})
     return '\n'.join(found)
 
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--reps', type=int, default=1)
-    parser.add_argument('--topic', action='store_true', help='flood /temperature instead')
+    parser.add_argument('--kind', choices=('rosout', 'topic', 'callback'), default='rosout',
+                        help='what the flooder floods (default: /rosout from a thread)')
     options = parser.parse_args()
-    kind = 'topic' if options.topic else 'rosout'
+    kind = options.kind
     solutions = sorted((ROOT / 'solutions').glob('*.ipynb'))
     measured: dict[str, list[tuple[float, float]]] = {'two alone': [], 'with flooder': []}
     with tempfile.TemporaryDirectory(prefix='ros2nb-flood-') as tmp:

@@ -34,7 +34,8 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / 'tests'))  # judging.py, the corpora
 SOLUTIONS = ROOT / 'solutions'
 NOTEBOOKS = {p.stem[:2]: p for p in SOLUTIONS.glob('*.ipynb')}
-#: Seconds one learner's judge may take (below the corpora's test limit of 300 s).
+#: Seconds one learner's judge may take (below the corpora's test limit of 300 s); then, as
+#: at its CPU limit, the cells it had not checked fail with the line that says so.
 JUDGE_TIMEOUT_S = 270
 #: A cell's new text, or (old, new) replacements in it.
 Change = Union[str, list[tuple[str, str]]]
@@ -117,7 +118,7 @@ def expected_score(learner: Learner) -> float:
     return sum(p for gid, p in points(learner.notebook).items() if gid not in learner.loses)
 
 
-def _write_parts(nb: dict) -> None:
+def write_parts(nb: dict) -> None:
     """What the notebook's ``%%part`` cells write, in notebook order (as its kernel did)."""
     from ros2nb import course
     from ros2nb.terminal.files import write_part
@@ -165,7 +166,7 @@ def learner_workspace(learner: Learner, root: Path) -> Iterator[tuple[Path, dict
             course.catch_up(number)
         else:
             create_workspace()
-        _write_parts(nb)
+        write_parts(nb)
         yield ws, nb
 
 
@@ -194,12 +195,25 @@ def grade_learner(learner: Learner, root: Path, *, knows_nothing: bool = False
     command = [sys.executable, str(ROOT / 'tests' / 'judge_apart.py'),
                *(['--knows-nothing'] if knows_nothing else []),
                str(given / 'source.ipynb'), str(given / 'submission.ipynb')]
-    judge = subprocess.Popen(command, env=env, cwd=root, text=True, stdout=subprocess.PIPE,
-                             stderr=subprocess.PIPE, start_new_session=True)
+    # Bounded as the grader bounds a judge: its CPU time and its subjects' together.
+    from ros2nb_instructor.grading import sandbox
+    from ros2nb_instructor.grading.judging import stopped_verdict
+    from ros2nb_instructor.grading.settings import JUDGE_CPU_S
+    cpu_s = JUDGE_CPU_S[learner.notebook]
+    judge = sandbox.watched(command, sandbox.Limits(wall_s=JUDGE_TIMEOUT_S, cpu_s=cpu_s),
+                            env=env, cwd=root, text=True, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, start_new_session=True)
     try:
-        out, err = judge.communicate(timeout=JUDGE_TIMEOUT_S)
+        ended = sandbox.run_to_end(judge)
     finally:
-        kill_process_group(judge)  # what it left (nothing, once it answered)
+        kill_process_group(judge.process)  # what it left (nothing, once it answered)
+    out, err = ended.stdout, ended.stderr
+    if ended.out_of_cpu or ended.timed_out:  # what it had not checked scores nothing, as
+        verdict = stopped_verdict(out, given / 'source.ipynb',  # in the grader
+                                  ended.out_of_cpu and cpu_s)
+        unchecked = {'passed': False, 'type': 'GradingError', 'message': verdict.problem}
+        return {gid: verdict.results.get(f'{learner.notebook}-{gid}', unchecked)
+                for gid in points(learner.notebook)}
     lines = out.strip().splitlines()
     assert lines and lines[-1].startswith('{'), f'the judge printed no result: {out}{err}'
     results = json.loads(lines[-1])['results']

@@ -7,6 +7,7 @@ subject reports about the learner's objects.
 """
 
 from corpora import Learner
+from corpus_floods import FLOODERS
 from corpus_tables import TABLES
 
 #: 03: no timer; every step of the course's runtime (found among the garbage collector's
@@ -371,5 +372,6 @@ def record_hour(bag_path):
 '''}, twin='10 twin: record_hour records nothing'),
 ]
 
-#: Lookup tables of the judge's old fixed inputs, beside their honest-wrong twins.
-ATTACKS += TABLES
+#: Lookup tables of the judge's old fixed inputs, beside their honest-wrong twins; a slow
+#: flood the judge's CPU limit ends.
+ATTACKS += TABLES + FLOODERS

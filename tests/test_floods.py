@@ -13,7 +13,8 @@ their points.  What a class pays for a flooder is measured by CPU seconds in
 
 import pytest
 
-from ros2nb import checks
+from ros2nb import checks, course
+from ros2nb_instructor.grading import sandbox
 
 from judging import run_check
 from test_checks import PUB, fails, mutated, restore
@@ -45,10 +46,15 @@ LINES = {'rosout': rf'^Your node temperature_sensor logged over 500 lines to /ro
 
 
 def flooder_notebook(kind: str) -> dict:
-    """Notebook 03 as the solution, its constructor flooding ``kind`` (a key of WORK), as
-    a learner hands it in (for the grader: ``benchmarks/flood_class.py``,
+    """Notebook 03 as the solution, its constructor flooding ``kind`` (a key of WORK), or
+    with ``'callback'`` its callback logging 450 lines a reading (``corpus_floods.py``), as a
+    learner hands it in (for the grader: ``benchmarks/flood_class.py``,
     ``tests/test_notebook_cpu.py``)."""
     from corpora import Learner, submission
+    from corpus_floods import READING_LINE, SLOW_FLOOD
+    if kind == 'callback':
+        return submission(Learner('flooder', '03', {'sensor-callback': [
+            (READING_LINE, SLOW_FLOOD)]}))
     return submission(Learner('flooder', '03', {'sensor-constructor': [
         (STARTED_LINE, FLOODS[kind])]}))
 
@@ -64,3 +70,45 @@ def test_a_constructor_that_floods(session, kind):
         restore(session, PUB)
     # what the ended flooder still had on its way reaches no later check
     run_check(session, checks.check_sensor_constructor)
+
+
+@pytest.mark.sandbox
+@pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))
+@pytest.mark.timeout(900)
+def test_a_judge_that_hears_a_slow_flood_is_stopped_at_its_cpu_limit(tmp_path, monkeypatch):
+    """A callback that logs 450 lines a reading never floods a window of the judge's clock,
+    but its hour sends 1.6 million lines: its judge once worked on for 269 CPU-seconds, until
+    the 600-s limit.  Graded as the grader does (the judge in its sandbox, its subjects
+    sandboxed inside), it is stopped at the judge's CPU limit: the constructor, the callback
+    and main() keep their points, the hour is not checked, and the line says so without
+    blame."""
+    import nbformat
+    from corpora import Learner as CorpusLearner, submission, write_parts
+    from corpus_floods import READING_LINE, SLOW_FLOOD
+    from ros2nb_instructor.grading.judging import judge_notebook
+    from ros2nb_instructor.grading.scratch import Scratch
+    from ros2nb_instructor.grading.settings import JUDGE_CPU_S, Settings
+    from ros2nb_instructor.grading.submissions import Learner
+    from ros2nb.terminal import workspace as ws_module
+    nb = submission(CorpusLearner('flooder', '03', {'sensor-callback': [
+        (READING_LINE, SLOW_FLOOD)]}))
+    scratch = Scratch(tmp_path, Learner('flooder', 'flooder'))
+    monkeypatch.setenv('ROS2NB_WORKSPACE', str(scratch.workspace))
+    monkeypatch.setattr(ws_module, '_current', None)
+    try:
+        course.catch_up(3)  # the workspace as notebook 02 leaves it
+        write_parts(nb)
+        notebook = '03-write-the-publisher'
+        results, problem, _flags = judge_notebook(
+            scratch, notebook, nbformat.from_dict(nb), Settings(120, 600, True),
+            scratch.snapshot(notebook))
+    finally:
+        scratch.remove()
+    assert {gid: r['passed'] for gid, r in results.items()} == {
+        '03-sensor-constructor': True, '03-sensor-callback': True, '03-sensor-main': True}, \
+        results
+    assert problem == (
+        f"checking it reached the grader's limit of {JUDGE_CPU_S['03']:g} CPU-seconds for checking "
+        'a notebook (its checks and the processes that ran your code, together) and was '
+        'stopped: its points come from the checks that had run; 03-sensor-hour was not '
+        'checked and scores nothing'), problem

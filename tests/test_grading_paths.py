@@ -322,7 +322,7 @@ def test_a_copy_of_the_stand_ins_scores_its_twins_score_in_the_sandbox(who, scra
     """The grader's judge, sandboxed with its subjects: notebook 03 built from the course's
     stand-ins through importlib loses what its twin (parts from a module that is not there)
     loses, and only it is flagged.  Before, its subjects imported the stand-ins: full marks."""
-    from corpora import Learner as CorpusLearner, _write_parts, submission
+    from corpora import Learner as CorpusLearner, submission, write_parts
     from corpus_attacks import SENSOR_PARTS, SENSOR_PARTS_TWIN
     monkeypatch.setenv('ROS2NB_WORKSPACE', str(scratch.workspace))
     monkeypatch.setattr(ws_module, '_current', None)
@@ -330,7 +330,7 @@ def test_a_copy_of_the_stand_ins_scores_its_twins_score_in_the_sandbox(who, scra
     cells = SENSOR_PARTS if who == 'attack' else SENSOR_PARTS_TWIN
     nb = submission(CorpusLearner(who, '03', cells))
     course.catch_up(3)
-    _write_parts(nb)
+    write_parts(nb)
     notebook = '03-write-the-publisher'
     results, problem, flags = judge_notebook(scratch, notebook, nbformat.from_dict(nb),
                                              Settings(120, 600, True), scratch.snapshot(notebook))

@@ -2,8 +2,10 @@
 
 The judge's command line (see :mod:`ros2nb.judge`): it opens a :class:`Session`, runs the
 body of each check asked for with it (:func:`ros2nb.checks.run_check`) and prints one JSON
-line with the outcome.  A check draws its inputs from a seed the judge draws itself; only
-the grader gives one (``--seed``, :mod:`ros2nb.checks.drawn`), the learner's kernel never.
+line with the outcome; while grading, also one line per graded cell as soon as it is decided
+(``{"cell": ID, "result": ...}``), which is what a judge stopped at its limits leaves.  A
+check draws its inputs from a seed the judge draws itself; only the grader gives one
+(``--seed``, :mod:`ros2nb.checks.drawn`), the learner's kernel never.
 """
 
 from __future__ import annotations
@@ -61,7 +63,10 @@ def main(argv: list[str]) -> int:
             # every check of a learner's kernel would pay).
             from .flags import notebook_flags
             source, submission = (json.loads(Path(p).read_text()) for p in argv[1:])
-            result = {'results': grade(source, submission, session),
+            def checked(grade_id: str, outcome: dict) -> None:
+                print(json.dumps({'cell': grade_id, 'result': outcome}), flush=True)
+
+            result = {'results': grade(source, submission, session, checked),
                       'flags': notebook_flags(submission, session.workspace)}
     finally:
         session.close()

@@ -8,7 +8,11 @@ what it hears per logger on ``/rosout`` and per topic it watches, and the subjec
 what it sent (:meth:`Floods.announced`), in windows of one second of the judge's clock (or
 while it stands still); past :data:`FLOOD_LIMIT` the judge keeps no more of it, ends the
 processes that run the learner's code and fails the check with one line
-(:class:`~ros2nb.judge_interface.Flooded`).  Introduced in ``03-write-the-publisher.ipynb``.
+(:class:`~ros2nb.judge_interface.Flooded`).  What those processes had sent and the judge had
+not read yet arrives later, and belongs to them, not to the next check: once they are reaped,
+a message stamped by its sender (on the machine's one clock) before that moment is dropped
+(:meth:`Floods.stale`), however long the judge takes to read it.  Introduced in
+``03-write-the-publisher.ipynb``.
 """
 
 from __future__ import annotations
@@ -24,26 +28,22 @@ from ..judge_interface import Flooded
 #: readings while the clock stands still.
 FLOOD_LIMIT = 500
 FLOOD_WINDOW_NS = 1_000_000_000
-#: Wall-clock seconds without a message of a flood that end its draining, and the longest
-#: drain.  Its processes are ended by then, so what still arrives is their backlog, finite:
-#: the drain ends when it stops, however long the judge takes to read it (what a cut-off
-#: drain left would count as a flood of the next check); the cap only guards against a
-#: publisher the judge did not end.
-FLOOD_QUIET_S, FLOOD_DRAIN_S = 0.2, 300.0
-
-
 class Floods:
     """The flood counts of one judge's observer (``observer.now_ns``, ``observer.changed``).
 
     :ivar line: the first flood's one line since :meth:`forget`, or None.
-    :ivar on_flood: ends the processes that may be flooding (the session's subjects and
-        programs); called by :meth:`raise_any`, never in the observer's spin thread.
+    :ivar on_flood: ends and reaps the processes that may be flooding (the session's
+        subjects and programs); called by :meth:`raise_any`, never in the observer's spin
+        thread.
+    :ivar stopped_ns: the machine's time (``time.time_ns()``) when those processes were last
+        reaped: what was sent before it came from them (:meth:`stale`).
     """
 
     def __init__(self, observer: Any) -> None:
         self._observer = observer
         self.line: Optional[str] = None
         self.on_flood: Callable[[], None] = lambda: None
+        self.stopped_ns = 0
         self._windows: dict[tuple[str, str, str], list[int]] = {}
         self._said: dict[tuple[int, str, str], int] = {}
 
@@ -80,20 +80,25 @@ class Floods:
             self.line = None
             self._windows.clear()
 
+    def stale(self, info: Any) -> bool:
+        """True for a message (its rmw message info) its sender stamped before the flooding
+        processes were reaped: theirs, arriving late, which no check counts or keeps."""
+        sent = info.get('source_timestamp') if isinstance(info, dict) else None
+        return isinstance(sent, int) and 0 < sent < self.stopped_ns
+
     def raise_any(self) -> None:
         """Raise :class:`~ros2nb.judge_interface.Flooded` with the flood's line when there
-        was one, once the processes that may flood are ended (:attr:`on_flood`) and what they
-        sent stopped arriving (a flooded window counts on, unkept); then count afresh."""
+        was one, once the processes that may flood are ended and reaped (:attr:`on_flood`)
+        and what the judge's subscriptions hold of theirs is taken away (the observer's
+        ``take_stale``); what is still on its way is dropped on arrival (:meth:`stale`),
+        however long it takes; then count afresh."""
         line = self.line
         if line is None:
             return
         self.on_flood()
-        deadline = time.monotonic() + FLOOD_DRAIN_S
-        while time.monotonic() < deadline:
-            before = sum(window[1] for window in self._windows.values())
-            time.sleep(FLOOD_QUIET_S)
-            if sum(window[1] for window in self._windows.values()) == before:
-                break
+        with self._observer.changed:
+            self.stopped_ns = time.time_ns()
+        self._observer.take_stale()
         self.forget()
         raise Flooded(line)
 

@@ -8,7 +8,7 @@ cells are read, as text: the names they define become :class:`AnswerRef` for the
 from __future__ import annotations
 
 import ast
-from typing import Any, Optional
+from typing import Any, Callable, Optional
 
 from .. import checks, nbmeta
 from ..judge_interface import AnswerRef, Judge, captured
@@ -65,7 +65,9 @@ def _defined_names(source: str) -> set[str]:
     return names
 
 
-def grade(source: dict, submission: dict, judge: Judge) -> dict[str, dict]:
+def grade(source: dict, submission: dict, judge: Judge,
+          checked: Callable[[str, dict], None] = lambda grade_id, result: None
+          ) -> dict[str, dict]:
     """Run every graded cell of ``source`` (the course's notebook, hidden tests included).
 
     Names in a graded call (``LoudListener``) are the learner's: the judge passes an
@@ -76,6 +78,7 @@ def grade(source: dict, submission: dict, judge: Judge) -> dict[str, dict]:
     :param submission: the learner's notebook (nbformat JSON); only its answer cells
         (nbgrader ``solution: true``) are used.
     :param judge: the session every check's body runs with (:func:`ros2nb.checks.run_check`).
+    :param checked: called with each graded cell's id and result as soon as it is decided.
     :return: ``{grade_id: result}`` with ``passed``, ``lines``, ``type``, ``message``.
     """
     context = [nbmeta.text(c) for c in nbmeta.cells(source) if nbmeta.CONTEXT_TAG in
@@ -98,4 +101,5 @@ def grade(source: dict, submission: dict, judge: Judge) -> dict[str, dict]:
             if not outcome['passed']:
                 result.update(outcome)
                 break
+        checked(meta['grade_id'], result)
     return results

@@ -21,6 +21,7 @@ from rcl_interfaces.srv import ListParameters
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.serialization import deserialize_message
 from rclpy.signals import SignalHandlerOptions
 
 from .. import domains
@@ -76,13 +77,17 @@ class Observer:
         self.floods = Floods(self)
         self._quiet: Optional[Node] = None
         self._stop = False
+        #: Held while a message is taken: by the spin thread, or by :meth:`take_stale`.
+        self._taking = threading.Lock()
         #: The processes whose work the judge waits for (its subjects and the learner's
         #: programs, given by the session): every wait of the judge's lasts while they work.
         self.attending: Callable[[], list[int]] = list
         self._thread = threading.Thread(target=self._spin, name='ros2nb-judge', daemon=True)
         self._thread.start()
-        self.node.create_subscription(Log, '/rosout', self._on_log, ROSOUT_QOS,
-                                      event_callbacks=QUIET_SUBSCRIPTION)
+        #: What the judge hears the learner's code send on: /rosout and the watched topics.
+        on_log: Any = self._on_log  # with the message's info: rclpy passes it to two arguments
+        self._hearing = [self.node.create_subscription(Log, '/rosout', on_log, ROSOUT_QOS,
+                                                       event_callbacks=QUIET_SUBSCRIPTION)]
 
     def _spin(self) -> None:
         """Run the node's callbacks until :meth:`close` (which wakes the wait at once)."""
@@ -90,14 +95,15 @@ class Observer:
             with contextlib.suppress(Exception):  # as spin_once: a callback's error is dropped
                 handler = self.executor.wait_for_ready_callbacks(
                     timeout_sec=SPIN_WAIT_S, condition=self._stopping)[0]
-                handler()
+                with self._taking:  # rcl takes from a subscription in one thread at a time
+                    handler()
 
     def _stopping(self) -> bool:
         return self._stop
 
-    def _on_log(self, msg: Log) -> None:
+    def _on_log(self, msg: Log, info: Any) -> None:
         with self.changed:
-            if self.floods.count('/rosout', msg.name):
+            if self.floods.stale(info) or self.floods.count('/rosout', msg.name):
                 return
             self.logs.append(Line(self.now_ns, msg.name, msg.level, msg.msg))
             self.log_counts[msg.name] += 1
@@ -113,16 +119,34 @@ class Observer:
         if topic not in self.heard:
             self.heard[topic] = store = []
 
-            def note(msg: Any) -> None:
+            def noted(msg: Any, info: Any) -> None:
                 with self.changed:
-                    if self.floods.count(topic, topic):
+                    if self.floods.stale(info) or self.floods.count(topic, topic):
                         return
                     store.append(Heard(self.now_ns, keep(msg)))
                     self.changed.notify_all()
 
-            self.node.create_subscription(msg_type, topic, note, EVERY_MESSAGE,
-                                          event_callbacks=QUIET_SUBSCRIPTION)
+            note: Any = noted  # with the message's info, as on_log
+            self._hearing.append(self.node.create_subscription(
+                msg_type, topic, note, EVERY_MESSAGE, event_callbacks=QUIET_SUBSCRIPTION))
         return self.heard[topic]
+
+    def take_stale(self) -> None:
+        """Take what the judge's subscriptions hold that stopped processes sent
+        (:meth:`~ros2nb.judge.floods.Floods.stale`), serialised, until a history holds no
+        more of it: a flood's backlog, gone before the next check, not read in the spin
+        thread beside it.  A message sent since goes to its callback, as the spin thread's do.
+        """
+        for subscription in list(self._hearing):
+            while True:
+                with self._taking, subscription.handle:
+                    taken = subscription.handle.take_message(subscription.msg_type, True)
+                if taken is None:
+                    break
+                raw, info = taken
+                if not self.floods.stale(info):
+                    subscription.callback(deserialize_message(raw, subscription.msg_type), info)
+                    break
 
     def quiet_node(self) -> Node:
         """A node of the judge's that no thread spins: what its subscriptions receive waits in

@@ -131,9 +131,9 @@ class Session:
                                       *self._programs) if proc.poll() is None]
 
     def _end_flood(self) -> None:
-        """End every process that runs the learner's code now (one of them floods), before
-        the flood is raised (:meth:`ros2nb.judge.floods.Floods.raise_any`); what runs next
-        starts its subjects afresh."""
+        """End and reap every process that runs the learner's code now (one of them floods),
+        before the flood is raised (:meth:`ros2nb.judge.floods.Floods.raise_any`); what runs
+        next starts its subjects afresh."""
         for proc in (*(s.proc for s in self._subjects.values()), *self._programs):
             kill_process_group(proc)
 

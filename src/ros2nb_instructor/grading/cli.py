@@ -69,6 +69,9 @@ def _options(argv: Optional[list[str]]) -> argparse.Namespace:
     parser.add_argument('--notebook-timeout', type=int, default=NOTEBOOK_TIMEOUT_S)
     parser.add_argument('--notebook-cpu', type=int, default=NOTEBOOK_CPU_S,
                         help="CPU seconds one notebook's run may use in its sandbox")
+    parser.add_argument('--judge-cpu', type=int, default=None,
+                        help="CPU seconds one notebook's judge may use with its subjects "
+                             "(default: the course's limit for each notebook)")
     parser.add_argument('--jobs', type=int, default=JOBS)
     parser.add_argument('--force', action='store_true',
                         help='replace an earlier grading/ (and any manual grades in it)')
@@ -268,7 +271,7 @@ def _grade(args: argparse.Namespace, submissions: Path, out: Path, started: floa
     grading worked."""
     seed = new_seed() if args.seed is None else args.seed  # one for the class: notes.json
     settings = Settings(args.cell_timeout, args.notebook_timeout, not args.no_sandbox, seed,
-                        args.notebook_cpu)
+                        args.notebook_cpu, args.judge_cpu)
     if not args.scheduler:
         return _grade_with(None, args, submissions, out, started, settings)
     from .cluster import Cluster, ClusterProblem  # Dask is imported for a cluster only

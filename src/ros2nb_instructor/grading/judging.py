@@ -8,6 +8,7 @@ sandbox; a notebook's judge works beside the learner's next notebook.
 from __future__ import annotations
 
 import concurrent.futures
+import contextlib
 import json
 import os
 import shutil
@@ -18,6 +19,7 @@ from typing import Any, NamedTuple, Optional
 
 import nbformat
 
+from ros2nb import nbmeta
 from ros2nb.checks.drawn import SEED_OPTION
 from ros2nb.judge.subjects import SUBJECTS_FOLDER_ENV, home_and_tmp
 
@@ -73,34 +75,52 @@ def judge_notebook(scratch: Scratch, notebook: str, submitted: nbformat.Notebook
     argv = judge_argv(source, given / 'submission.ipynb', settings)
     env = sandbox_env(own / 'home', ROS2NB_WORKSPACE=str(workspace),
                       TMPDIR=str(own / 'tmp'), **{SUBJECTS_FOLDER_ENV: str(subjects)})
-    limits = sandbox.Limits(wall_s=JUDGE_TIMEOUT_S)
-    if settings.sandboxed:
-        env['FASTDDS_BUILTIN_TRANSPORTS'] = 'UDPv4'  # judge and subjects: own /dev/shm each
-        env['ROS2NB_SUBJECT_PREFIX'] = json.dumps(sandbox.inner_prefix(  # the course may be
-            readable=[workspace, ROOT / 'src'], writable=[subjects],  # under /tmp too
-            hidden=[*ANSWER_FOLDERS, own, given]))
-        # The judge may read the course's reference nodes (a notebook handed in alone runs
-        # on them where it relies on an earlier one's, as catch_up promises); its subjects
-        # see only the copies it hands them.
-        box = sandbox.Sandbox(writable=[folder], env=env, cwd=given, nested=True,
-                              readable=[ROOT / 'src', workspace, given])
-        try:
+    limits = sandbox.Limits(wall_s=JUDGE_TIMEOUT_S, cpu_s=settings.judge_cpu_for(notebook))
+    try:
+        if settings.sandboxed:
+            env['FASTDDS_BUILTIN_TRANSPORTS'] = 'UDPv4'  # judge and subjects: own /dev/shm each
+            env['ROS2NB_SUBJECT_PREFIX'] = json.dumps(sandbox.inner_prefix(  # the course may
+                readable=[workspace, ROOT / 'src'], writable=[subjects],  # be under /tmp too
+                hidden=[*ANSWER_FOLDERS, own, given]))
+            # The judge may read the course's reference nodes (a notebook handed in alone runs
+            # on them where it relies on an earlier one's, as catch_up promises); its subjects
+            # see only the copies it hands them.
+            box = sandbox.Sandbox(writable=[folder], env=env, cwd=given, nested=True,
+                                  readable=[ROOT / 'src', workspace, given])
             result = box.run(argv, limits, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                              text=True)
-        except OSError as error:  # e.g. the notebook made its workspace unreadable
-            return Verdict({}, f'the grader could not check it: {error}')
-        out, err, code, timed_out = result.stdout, result.stderr, result.returncode, \
-            result.timed_out
-    else:
-        try:
-            done = subprocess.run(argv, env={**os.environ, **env}, cwd=given, text=True,
-                                  capture_output=True, timeout=JUDGE_TIMEOUT_S)
-            out, err, code, timed_out = done.stdout, done.stderr, done.returncode, False
-        except subprocess.TimeoutExpired:
-            out, err, code, timed_out = '', '', -9, True
-    if timed_out:
-        return Verdict({}, f'checking it took longer than {JUDGE_TIMEOUT_S} s')
-    return _read_verdict(out, err, code)
+        else:  # no sandbox: its limits all the same
+            result = sandbox.run_to_end(sandbox.watched(
+                argv, limits, env={**os.environ, **env}, cwd=given, stdout=subprocess.PIPE,
+                stderr=subprocess.PIPE, text=True))
+    except OSError as error:  # e.g. the notebook made its workspace unreadable
+        return Verdict({}, f'the grader could not check it: {error}')
+    if result.timed_out or result.out_of_cpu:
+        return stopped_verdict(result.stdout or '', source, result.out_of_cpu and limits.cpu_s)
+    return _read_verdict(result.stdout, result.stderr, result.returncode)
+
+
+def stopped_verdict(out: str, source: Path, cpu_s: Optional[float] = None) -> Verdict:
+    """The verdict of a judge stopped at a limit (``cpu_s``: its CPU time's, else its wall
+    time's): the results of the graded cells it had checked (one JSON line each, as it went),
+    and a line that says so and names the cells not checked, which score nothing."""
+    results = {}
+    for line in out.splitlines():
+        with contextlib.suppress(ValueError, TypeError, KeyError):
+            printed = json.loads(line)
+            if isinstance(printed, dict) and isinstance(printed.get('result'), dict):
+                results[str(printed['cell'])] = printed['result']
+    graded = [str(nbmeta.nbgrader_metadata(cell)['grade_id']) for cell in nbmeta.cells(
+        json.loads(source.read_text())) if nbmeta.nbgrader_metadata(cell).get('grade')]
+    unchecked = [grade_id for grade_id in graded if grade_id not in results]
+    limit = (f'the grader\'s limit of {cpu_s:g} CPU-seconds for checking a notebook (its checks '
+             'and the processes that ran your code, together)' if cpu_s else
+             f'the grader\'s limit of {JUDGE_TIMEOUT_S} s for checking a notebook')
+    one = len(unchecked) == 1
+    said = (f'{", ".join(unchecked)} {"was" if one else "were"} not checked and '
+            f'score{"s" if one else ""} nothing' if unchecked else 'every graded cell was checked')
+    return Verdict(results, f'checking it reached {limit} and was stopped: its points come '
+                            f'from the checks that had run; {said}')
 
 
 def judge_argv(source: Path, submission: Path, settings: Settings) -> list[str]:

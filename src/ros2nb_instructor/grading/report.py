@@ -17,7 +17,7 @@ import io
 import statistics
 from pathlib import Path
 
-from ..paths import SOLUTIONS
+from ..paths import NOTEBOOKS, SOLUTIONS
 from . import feedback, similarity
 from .submissions import Learner
 
@@ -152,15 +152,18 @@ def _similarity_table(notebooks: list[str], learners: list[Learner], course: Pat
     common: list[similarity.Common] = []
     for notebook in notebooks:
         own = course / f'{notebook}.ipynb'
+        given = NOTEBOOKS / f'{notebook}.ipynb'
         found, usual = similarity.alike(notebook, own if own.is_file() else None,
                                         {lr.shown: lr.files[notebook] for lr in learners
-                                         if notebook in lr.files})
+                                         if notebook in lr.files},
+                                        given if given.is_file() else None)
         pairs, common = pairs + found, common + usual
-    lines = ['<table id="similarity"><caption>Answers alike: each answer cell, names and '
-             f'layout set aside, beside the course\'s and every classmate\'s (at least '
-             f'{similarity.THRESHOLD:.0%} of {similarity.MIN_TOKENS} tokens or more alike); '
-             'for you to judge, no point changed</caption><tr><th>notebook</th><th>cell</th>'
-             '<th>answer</th><th>beside</th><th>alike</th></tr>']
+    lines = ['<table id="similarity"><caption>Answers alike: what the judge graded (each '
+             'answer, and the parts cells the learner added wrote), names and layout set '
+             'aside, beside the course\'s and every classmate\'s (at least '
+             f'{similarity.THRESHOLD:.0%} of one found in the other; small parts compared '
+             'together per notebook); for you to judge, no point changed</caption><tr>'
+             '<th>notebook</th><th>cell</th><th>answer</th><th>beside</th><th>alike</th></tr>']
     for pair in pairs:
         lines.append(f'<tr><td>{_e(pair.notebook[:2])}</td><td>{_e(pair.cell)}</td>'
                      f'<td>{_e(pair.first)}</td><td>{_e(pair.second)}</td>'

@@ -48,17 +48,13 @@ def run_notebook(scratch: Scratch, notebook: str, prepared: nbformat.NotebookNod
             f'--folder={scratch.home / "notebooks"}']
     env = sandbox_env(scratch.home, ROS2NB_WORKSPACE=str(scratch.workspace))
     limits = sandbox.Limits(wall_s=settings.notebook_timeout, cpu_s=settings.notebook_cpu)
-    stopped = None
+    stopped, out_of_cpu = None, False
     if settings.sandboxed:
         box = sandbox.Sandbox(writable=[scratch.home, out], env=env, cwd=scratch.home,
                               readable=[ROOT / 'src', given],
                               hidden=[ROOT / 'src' / 'ros2nb' / 'reference'])
         result = box.run(argv, limits, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        timed_out = result.timed_out
-        if result.out_of_cpu:
-            stopped = (f'its processes used more than {settings.notebook_cpu:g} CPU-seconds, '
-                       'the limit for a notebook, and were stopped: look for a loop that never '
-                       'waits, such as a thread that logs or publishes as fast as it can')
+        timed_out, out_of_cpu = result.timed_out, result.out_of_cpu
     else:
         try:
             subprocess.run(argv, env=env, cwd=scratch.home, timeout=settings.notebook_timeout,
@@ -66,10 +62,26 @@ def run_notebook(scratch: Scratch, notebook: str, prepared: nbformat.NotebookNod
             timed_out = False
         except subprocess.TimeoutExpired:
             timed_out = True
-    if timed_out:
-        stopped = (f'it ran longer than the {settings.notebook_timeout} s limit for a '
-                   'notebook and was stopped')
-    return (*_read_back(out, notebook, prepared), stopped)
+    executed, status = _read_back(out, notebook, prepared)
+    if timed_out or out_of_cpu:
+        stopped = stopped_note(status, f'the limit of {settings.notebook_cpu:g} CPU-seconds for '
+                               'running a notebook (its kernel and every process it started, '
+                               'together)' if out_of_cpu else
+                               f'the limit of {settings.notebook_timeout} s for running a '
+                               'notebook')
+    return executed, status, stopped
+
+
+def stopped_note(status: dict, limit: str) -> str:
+    """The note of a run stopped at ``limit``: which cells did not run, and that the points
+    come from the grader's checks (a heavy honest run, or a loop, alike: no blame)."""
+    ran, cells = status.get('ran', 0), status.get('cells', 0)
+    which = (f'it was stopped while cell {ran + 1} of {cells} ran, so cells {ran + 1}-{cells} '
+             'did not run' if 0 < ran + 1 < cells else
+             f'it was stopped while cell {ran + 1} of {cells} ran' if cells else
+             'it was stopped')
+    return (f'its run reached {limit}: {which}; its points come from the grader\'s checks, '
+            'which read its answer cells and the files its cells wrote before it was stopped')
 
 
 def _read_back(out: Path, notebook: str, prepared: nbformat.NotebookNode

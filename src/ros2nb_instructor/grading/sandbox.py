@@ -223,25 +223,8 @@ class Sandbox:
             return f'{stage}/{len(sources) - 1}'
 
         bwrap = self.command(argv, staged if stage else str)
-        cgroups, enforced = cgroups_of.make_cgroups(limits.pids, limits.memory_bytes)
-        memory_rlimit = None if 'memory(cgroup)' in enforced else limits.memory_bytes
-        counted = cgroups_of.cpu_seconds(cgroups) is not None
-        cpu_rlimit = None if counted or limits.cpu_s is None else max(1, round(limits.cpu_s))
-        spec = {'procs': [str(c / 'cgroup.procs') for c in cgroups], 'stage': stage and str(stage),
-                'sources': sources, 'uid': HOST_UID if drop else None,
-                'fsize': limits.file_size_bytes, 'as': memory_rlimit, 'cpu': cpu_rlimit}
-        launcher = [sys.executable, '-I', '-S', str(LAUNCHER), '--launch',
-                    json.dumps(spec), '--', *bwrap]
-        enforced = ['wall', 'file-size', *enforced]
-        enforced += ['cpu(cgroup)'] if counted and limits.cpu_s is not None else []
-        enforced += ['cpu(rlimit-cpu, per process)'] if cpu_rlimit else []
-        enforced += ['memory(rlimit-as, per process)'] if memory_rlimit else []
-        try:
-            process = subprocess.Popen(launcher, env={'PATH': '/usr/bin:/bin'}, **popen)
-        except OSError:
-            remove(cgroups, stage)
-            raise
-        return Running(process, tuple(enforced), cgroups, stage, limits)
+        return _launched(bwrap, limits, {'env': {'PATH': '/usr/bin:/bin'}, **popen},
+                         stage=stage, sources=sources, uid=HOST_UID if drop else None)
 
     def run(self, argv: Sequence[str], limits: Limits = Limits(), input: Any = None,
             **popen: Any) -> Result:
@@ -254,11 +237,52 @@ class Sandbox:
         :param popen: passed to :class:`subprocess.Popen` (stdout, stderr, pass_fds, text).
         :return: exit code, whether it timed out, which limits were enforced, outputs.
         """
-        with self.start(argv, limits, **popen) as running:
-            out, err = running.process.communicate(input)
-            code = running.stop()
-        return Result(code, running.timed_out, running.limits_enforced, out, err,
-                      running.out_of_cpu, running.cpu_s)
+        return run_to_end(self.start(argv, limits, **popen), input)
+
+
+def watched(argv: Sequence[str], limits: Limits = Limits(), **popen: Any) -> Running:
+    """Start ``argv`` outside any sandbox, in cgroups of its own watched as a sandbox's are
+    (:class:`Running`: its wall time and the CPU time of all its processes together), where
+    the caller cannot sandbox it: a judge graded unsandboxed, the corpora's judges.
+
+    :param popen: passed to :class:`subprocess.Popen` (env, cwd, stdout, stderr, text).
+    :raises OSError: when the program cannot be started.
+    """
+    return _launched(list(argv), limits, popen)
+
+
+def run_to_end(running: Running, input: Any = None) -> Result:
+    """Talk to a started program (``input`` on stdin) until it ends or a limit stops it."""
+    with running:
+        out, err = running.process.communicate(input)
+        code = running.stop()
+    return Result(code, running.timed_out, running.limits_enforced, out, err,
+                  running.out_of_cpu, running.cpu_s)
+
+
+def _launched(argv: list[str], limits: Limits, popen: dict, *, stage: Path | None = None,
+              sources: Sequence[str] = (), uid: int | None = None) -> Running:
+    """``argv`` started through the launcher in fresh cgroups (its limits, or rlimits where no
+    cgroup could be made), watched by a :class:`Running`."""
+    cgroups, enforced = cgroups_of.make_cgroups(limits.pids, limits.memory_bytes)
+    memory_rlimit = None if 'memory(cgroup)' in enforced else limits.memory_bytes
+    counted = cgroups_of.cpu_seconds(cgroups) is not None
+    cpu_rlimit = None if counted or limits.cpu_s is None else max(1, round(limits.cpu_s))
+    spec = {'procs': [str(c / 'cgroup.procs') for c in cgroups], 'stage': stage and str(stage),
+            'sources': list(sources), 'uid': uid, 'fsize': limits.file_size_bytes,
+            'as': memory_rlimit, 'cpu': cpu_rlimit}
+    launcher = [sys.executable, '-I', '-S', str(LAUNCHER), '--launch', json.dumps(spec), '--',
+                *argv]
+    enforced = ['wall', 'file-size', *enforced]
+    enforced += ['cpu(cgroup)'] if counted and limits.cpu_s is not None else []
+    enforced += ['cpu(rlimit-cpu, per process)'] if cpu_rlimit else []
+    enforced += ['memory(rlimit-as, per process)'] if memory_rlimit else []
+    try:
+        process = subprocess.Popen(launcher, **popen)
+    except OSError:
+        remove(cgroups, stage)
+        raise
+    return Running(process, tuple(enforced), cgroups, stage, limits)
 
 
 def _check_world_readable(paths: Sequence[Path]) -> None:

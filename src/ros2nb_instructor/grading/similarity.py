@@ -1,48 +1,52 @@
-"""Answers that look alike: each answer cell beside the course's own and every classmate's.
+"""Answers that look alike: what the judge graded of each learner, beside the course's own
+answer and every classmate's, by copydetect's winnowed fingerprints (as MOSS does).
 
-Runs on the instructor's host, for ``grading/report.html`` (:mod:`.report`).  An answer cell
-(an nbgrader solution cell) is read as Python tokens (:mod:`tokenize`): comments, blank lines
-and indentation are dropped, and every name that is not a keyword or a builtin becomes a
-placeholder numbered by its first use, so renaming and reformatting change nothing.  Only the
-learner's part counts (between ``### BEGIN SOLUTION`` and ``### END SOLUTION`` when the cell
-keeps them): the lines the course gave are everyone's.  Two answers are compared with
-:class:`difflib.SequenceMatcher`; pairs at or above :data:`THRESHOLD` are listed for a
-person to judge.  Nothing here decides a grade.
+Runs on the instructor's host, for ``grading/report.html`` (:mod:`.report`).  What is
+compared is what the judge grades of a notebook (:func:`graded`): every answer cell, and
+every ``%%part`` cell the learner added, as the file part it writes (a later cell that
+writes the same part stands for it, as in the learner's file).  copydetect reads each as
+Python with its names, strings, comments and layout set aside, and keeps fingerprints of
+:data:`K` characters of what is left; the course's handed-out text (given lines, the
+placeholder) is its boilerplate, no one's work.  A set of fingerprints keeps a copy whose
+branches were reordered (most of them stay), and a copy padded with code of its own is
+measured by the share of the other answer found in it.  Parts too small to be told apart
+(:data:`MIN_CHARS`) are compared together, one group per notebook, so that none is left
+out.  Pairs at or above :data:`THRESHOLD` are listed for a person to judge.  Nothing here
+decides a grade.
 """
 
 from __future__ import annotations
 
-import builtins
-import difflib
 import io
-import json
 import itertools
-import keyword
+import json
 import re
+import shlex
 import textwrap
-import tokenize
 from pathlib import Path
-from typing import NamedTuple, Optional
+from typing import Any, NamedTuple, Optional
 
 from ros2nb import nbmeta
 
-#: Share of matching tokens at or above which two answers are listed (docs/decisions.md).
-THRESHOLD = 0.9
-#: Fewest tokens an answer needs to be compared: shorter ones (a call, an assignment) are
-#: written alike by any honest learner (docs/decisions.md).
-MIN_TOKENS = 30
+#: Share of one answer found in the other at or above which two answers are listed, and the
+#: share of the other found in the one they need as well (docs/decisions.md, "Answers alike").
+THRESHOLD, FLOOR = 0.85, 0.6
+#: Characters of a fingerprint (copydetect's noise threshold: no shorter match counts) and
+#: of the filtered code a part needs to be compared on its own; smaller ones are compared in
+#: their notebook's group (docs/decisions.md).
+K, MIN_CHARS = 12, 40
 #: A cell that at least this share of the learners who handed it in (and at least
 #: :data:`COMMON_LEARNERS` of them) wrote like the course's answer leaves little to choose
 #: (a ``main()`` its comments dictate): it is summed up in one line, not listed pair by pair.
 COMMON_SHARE, COMMON_LEARNERS = 0.5, 3
-#: Most tokens of one answer compared (the course's longest answer has about 100): a cell
-#: bloated to megabytes costs the report no more than this (difflib's time grows with the
-#: product of the two lengths).
-MAX_TOKENS = 2000
+#: Most characters of one part compared: a cell bloated to megabytes costs the report no
+#: more than this.
+MAX_CHARS = 20_000
 #: Who wrote the course's own answer, as the report names it.
 COURSE = 'the course\'s answer'
+#: The name of a notebook's group of parts too small to compare alone.
+SMALL = 'small parts together'
 _PART = re.compile(r'### BEGIN SOLUTION\n(.*?)### END SOLUTION', re.S)
-_KEPT_NAMES = set(keyword.kwlist) | set(dir(builtins)) | {'self'}
 
 
 class Common(NamedTuple):
@@ -75,69 +79,140 @@ def learners_part(text: str) -> str:
     return textwrap.dedent('\n'.join(lines)) + '\n'
 
 
-def tokens(text: str) -> list[str]:
-    """The answer as normalised tokens: no comments, layout or names of its own (each such
-    name is ``_N``, numbered by its first use); words split on white space when the text
-    is not Python."""
-    names: dict[str, str] = {}
-    found = []
+def _part_of(text: str) -> Optional[tuple[str, str]]:
+    """The file and part a ``%%part`` cell writes, or None."""
+    first = text.split('\n', 1)[0]
+    if not first.startswith('%%part'):
+        return None
     try:
-        for token in tokenize.generate_tokens(io.StringIO(text).readline):
-            if token.type in (tokenize.COMMENT, tokenize.NL, tokenize.NEWLINE, tokenize.INDENT,
-                              tokenize.DEDENT, tokenize.ENDMARKER):
-                continue
-            word = token.string
-            if token.type == tokenize.NAME and word not in _KEPT_NAMES:
-                word = names.setdefault(word, f'_{len(names)}')
-            found.append(word)
-    except (tokenize.TokenError, IndentationError, SyntaxError):
-        return text.split()
-    return found
+        words = [w for w in shlex.split(first)[1:] if not w.startswith('--')]
+    except ValueError:
+        return None
+    return (words[0], words[1]) if len(words) >= 2 else None
 
 
-def answers(notebook: Path) -> dict[str, list[str]]:
-    """grade id -> normalised tokens of each code answer cell of a notebook (none for a file
-    that is not a notebook)."""
+def _read(path: Optional[Path]) -> list[dict]:
     try:
-        nb = json.loads(notebook.read_text())
-        cells = nbmeta.cells(nb)
-    except (OSError, ValueError, AttributeError, TypeError):  # not a notebook: no answers
-        return {}
-    found = {}
+        return [c for c in nbmeta.cells(json.loads(path.read_text()))
+                if c.get('cell_type') == 'code'] if path else []
+    except (OSError, ValueError, AttributeError, TypeError):  # not a notebook: nothing
+        return []
+
+
+class Course(NamedTuple):
+    """What the course gives of a notebook: its code cells' texts (no one's work), the
+    answer each ``%%part`` belongs to, and the boilerplate's fingerprints."""
+
+    texts: frozenset[str]
+    parts: dict[tuple[str, str], str]
+    boilerplate: object
+
+
+def course_of(solution: Optional[Path], handed_out: Optional[Path]) -> Course:
+    """The course's side of a notebook: ``solution`` (its answers) and ``handed_out`` (the
+    learner's version: given lines and placeholders, the boilerplate)."""
+    import numpy as np
+    given = _read(handed_out)
+    texts = frozenset(nbmeta.text(c) for c in [*_read(solution), *given]
+                      if c in given or not nbmeta.nbgrader_metadata(c).get('solution'))
+    parts = {}
+    for cell in _read(solution):
+        meta, part = nbmeta.nbgrader_metadata(cell), _part_of(nbmeta.text(cell))
+        if meta.get('solution') and part:
+            parts[part] = str(meta.get('grade_id', '?'))
+    hashes = set()
+    for cell in given:
+        hashes |= _fingerprint(learners_part(nbmeta.text(cell))).hashes
+    return Course(texts, parts, np.array(sorted(hashes), dtype=np.int64))
+
+
+def graded(cells: list[dict], course: Course) -> dict[str, str]:
+    """Name -> the learner's text of each part the judge grades in a notebook's code cells:
+    answer cells by grade id, ``%%part`` cells the learner added by the answer whose part
+    they write (``... (an added cell)``) or by file and part; cells as the course gave them
+    (unsolved answers, given cells) are left out."""
+    found: dict[str, str] = {}
+    written: dict[tuple[str, str], str] = {}
     for cell in cells:
-        meta = nbmeta.nbgrader_metadata(cell)
-        if meta.get('solution') and cell.get('cell_type') == 'code':
-            found[str(meta.get('grade_id', '?'))] = \
-                tokens(learners_part(nbmeta.text(cell)))[:MAX_TOKENS]
+        text = nbmeta.text(cell)
+        if text in course.texts:
+            continue
+        meta, part = nbmeta.nbgrader_metadata(cell), _part_of(text)
+        if part is not None:
+            old = written.pop(part, None)
+            if old is not None:
+                found.pop(old, None)
+            answer = course.parts.get(part)
+            name = (str(meta.get('grade_id', '?')) if meta.get('solution') and answer is None
+                    else answer if answer and meta.get('solution') and meta.get('grade_id') == answer
+                    else f'{answer} (an added cell)' if answer else f'{part[0]} part {part[1]}')
+            written[part] = name
+        elif meta.get('solution'):
+            name = str(meta.get('grade_id', '?'))
+        else:
+            continue
+        found[name] = learners_part(text)[:MAX_CHARS]
     return found
 
 
-def _ratio(a: list[str], b: list[str]) -> float:
-    """How alike two answers are (0-1); 0 when difflib's quick upper bounds already fall
-    under :data:`THRESHOLD` (the full ratio is never above them)."""
-    matcher = difflib.SequenceMatcher(None, a, b, autojunk=False)
-    if matcher.real_quick_ratio() < THRESHOLD or matcher.quick_ratio() < THRESHOLD:
+def _fingerprint(text: str, boilerplate: object = None) -> Any:
+    """copydetect's fingerprint of ``text`` read as Python (its filtered code, its hashes)."""
+    from copydetect import CodeFingerprint  # type: ignore[import-untyped]  # no stubs, no py.typed
+    return CodeFingerprint('answer.py', K, 1, boilerplate=boilerplate, language='python',
+                           fp=io.StringIO(text))
+
+
+def _ratio(a: Any, b: Any) -> float:
+    """How alike two fingerprinted parts are (0-1): the larger share of either found in the
+    other (a copy padded with dead code keeps the share of the original found in it); 0 when
+    the smaller share is under :data:`FLOOR` (one holds far more than the other: an answer
+    that builds on a few lines everyone writes, such as a ``main()`` with an executor)."""
+    from copydetect import compare_files
+    if not a.hashes or not b.hashes:
         return 0.0
-    return matcher.ratio()
+    if len(a.hashes & b.hashes) < FLOOR * min(len(a.hashes), len(b.hashes)):
+        return 0.0  # too few fingerprints in common for the shares below to reach FLOOR
+    _overlap, shares, _slices = compare_files(a, b)
+    return float(max(shares)) if min(shares) >= FLOOR else 0.0
 
 
-def alike(notebook: str, course: Optional[Path], handed: dict[str, Path]
-          ) -> tuple[list[Pair], list[Common]]:
+def fingerprints(cells: list[dict], course: Course, small: set[str]) -> dict[str, Any]:
+    """name -> fingerprint of each part of :func:`graded`, the ``small`` ones (and those too
+    small themselves) in one group, :data:`SMALL`."""
+    parts = graded(cells, course)
+    alone = {name: _fingerprint(text, course.boilerplate) for name, text in parts.items()
+             if name not in small}
+    grouped = sorted(name for name in parts if name in small or
+                     len(alone[name].filtered_code) < MIN_CHARS)
+    found = {name: alone[name] for name in alone if name not in grouped}
+    if grouped:
+        found[SMALL] = _fingerprint('\n'.join(parts[name] for name in grouped),
+                                    course.boilerplate)
+    return found
+
+
+def alike(notebook: str, solution: Optional[Path], handed: dict[str, Path],
+          handed_out: Optional[Path] = None) -> tuple[list[Pair], list[Common]]:
     """Pairs of answers of one notebook at or above :data:`THRESHOLD`, most alike first, and
     the cells most of the class wrote like the course's answer (:data:`COMMON_SHARE`), whose
     pairs among those learners are left out.
 
-    :param course: the course's own notebook (its solutions), compared with each learner's.
+    :param solution: the course's own notebook (its answers), compared with each learner's.
     :param handed: learner's name as shown -> their notebook file.
+    :param handed_out: the learner's version of the notebook (its given lines, boilerplate).
     """
-    read = {who: answers(path) for who, path in sorted(handed.items())}
-    if course is not None:
-        read = {COURSE: answers(course), **read}
+    course = course_of(solution, handed_out)
+    own = fingerprints(_read(solution), course, set())
+    small = {name for name, found in own.items() if len(found.filtered_code) < MIN_CHARS}
+    read = {COURSE: fingerprints(_read(solution), course, small)} if solution else {}
+    read.update({who: fingerprints(_read(path), course, small)
+                 for who, path in sorted(handed.items())})
+    found = _pairs(notebook, read)
     pairs, common = [], []
-    for cell in sorted({cell for found in read.values() for cell in found}):
-        mine = _pairs(notebook, cell, read)
+    for cell in sorted({pair.cell for pair in found}):
+        mine = [pair for pair in found if pair.cell == cell]
         near = {pair.second for pair in mine if pair.first == COURSE}
-        writers = sum(1 for who, found in read.items() if who != COURSE and cell in found)
+        writers = sum(1 for who, parts in read.items() if who != COURSE and cell in parts)
         if len(near) >= max(COMMON_LEARNERS, COMMON_SHARE * writers):
             common.append(Common(notebook, cell, tuple(sorted(near)), writers))
             near.add(COURSE)
@@ -146,11 +221,25 @@ def alike(notebook: str, course: Optional[Path], handed: dict[str, Path]
     return sorted(pairs, key=lambda p: (-p.ratio, p.notebook, p.cell, p.first, p.second)), common
 
 
-def _pairs(notebook: str, cell: str, read: dict[str, dict[str, list[str]]]) -> list[Pair]:
-    """The pairs of one cell at or above :data:`THRESHOLD` (the course's answer first)."""
+def _added(name: str) -> bool:
+    """A part only a learner's added cell wrote (no answer's own cell)."""
+    return name.endswith(' (an added cell)') or ' part ' in name
+
+
+def _pairs(notebook: str, read: dict) -> list[Pair]:
+    """Every pair at or above :data:`THRESHOLD` (the course's answer first): parts of the
+    same name, and each part in an added cell beside every part of the other."""
     found = []
-    written = [(who, cells[cell]) for who, cells in read.items() if cell in cells]
-    for (first, a), (second, b) in itertools.combinations(written, 2):
-        if min(len(a), len(b)) >= MIN_TOKENS and (ratio := _ratio(a, b)) >= THRESHOLD:
-            found.append(Pair(notebook, cell, first, second, ratio))
+    for (first, a), (second, b) in itertools.combinations(read.items(), 2):
+        for cell in sorted(set(a) | set(b)):
+            if cell in a and cell in b:
+                others = [(a[cell], b[cell])]
+            elif _added(cell):
+                mine, theirs = (a[cell], b) if cell in a else (b[cell], a)
+                others = [(mine, part) for part in theirs.values()]
+            else:
+                continue
+            ratio = max(_ratio(x, y) for x, y in others) if others else 0.0
+            if ratio >= THRESHOLD:
+                found.append(Pair(notebook, cell, first, second, ratio))
     return found
