@@ -33,12 +33,12 @@ from std_msgs.msg import Int32
 
 from . import domains
 from .errors import Ros2nbError
-from .qos_profiles import describe, endpoint_lines, incompatibility
+from .qos_profiles import describe, endpoint_lines, incompatibility, policy_name
 from .runtime import node_serving_nothing
 
 #: ``describe`` is the notebook's (09) way to print a profile; the checks name the others.
 __all__ = ['Deliveries', 'burst', 'burst_while_spinning', 'describe', 'discovered',
-           'endpoint_lines', 'incompatibility', 'late_joiner', 'pair']
+           'endpoint_lines', 'incompatibility', 'late_joiner', 'pair', 'policy_name']
 
 #: Seconds a trial waits for discovery (matching) and acknowledgements; the wait ends as
 #: soon as the state is reached, so only a very busy machine or a mismatch costs this long.
