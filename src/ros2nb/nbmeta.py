@@ -36,3 +36,11 @@ def nbgrader_metadata(cell: dict) -> dict:
     meta = cell.get('metadata', {})
     value = meta.get('nbgrader', {}) if isinstance(meta, dict) else {}
     return value if isinstance(value, dict) else {}
+
+
+def graded_cells(notebook: dict) -> list[tuple[str, dict]]:
+    """The code cells nbgrader grades (the judge runs their checks), in notebook order, as
+    ``(grade_id, cell)``."""
+    return [(str(meta.get('grade_id')), cell) for cell in cells(notebook)
+            for meta in [nbgrader_metadata(cell)]
+            if meta.get('grade') and cell.get('cell_type') == 'code']

@@ -28,6 +28,8 @@ from ..judge_interface import Flooded
 #: readings while the clock stands still.
 FLOOD_LIMIT = 500
 FLOOD_WINDOW_NS = 1_000_000_000
+
+
 class Floods:
     """The flood counts of one judge's observer (``observer.now_ns``, ``observer.changed``).
 

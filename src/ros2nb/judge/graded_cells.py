@@ -88,11 +88,8 @@ def grade(source: dict, submission: dict, judge: Judge,
     sources = tuple(context + answers)
     names = {name: AnswerRef(name, sources) for text in answers for name in _defined_names(text)}
     results = {}
-    for cell in nbmeta.cells(source):
-        meta = nbmeta.nbgrader_metadata(cell)
-        if not meta.get('grade') or cell.get('cell_type') != 'code':
-            continue
-        results[meta['grade_id']] = result = {'passed': True, 'lines': []}
+    for grade_id, cell in nbmeta.graded_cells(source):
+        results[grade_id] = result = {'passed': True, 'lines': []}
         for name, args, keywords in graded_calls(nbmeta.text(cell)):
             values = [_value(a, names) for a in args]
             options = {k.arg: _value(k.value, names) for k in keywords if k.arg is not None}
@@ -101,5 +98,5 @@ def grade(source: dict, submission: dict, judge: Judge,
             if not outcome['passed']:
                 result.update(outcome)
                 break
-        checked(meta['grade_id'], result)
+        checked(grade_id, result)
     return results

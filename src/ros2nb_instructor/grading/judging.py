@@ -113,9 +113,8 @@ def stopped_verdict(out: str, source: Path, cpu_s: Optional[float] = None) -> Ve
             printed = json.loads(line)
             if isinstance(printed, dict) and isinstance(printed.get('result'), dict):
                 results[str(printed['cell'])] = printed['result']
-    graded = [str(nbmeta.nbgrader_metadata(cell)['grade_id']) for cell in nbmeta.cells(
-        json.loads(source.read_text())) if nbmeta.nbgrader_metadata(cell).get('grade')]
-    unchecked = [grade_id for grade_id in graded if grade_id not in results]
+    unchecked = [grade_id for grade_id, _cell in nbmeta.graded_cells(
+        json.loads(source.read_text())) if grade_id not in results]
     limit = (f'the grader\'s limit of {cpu_s:g} CPU-seconds for checking a notebook (its checks '
              'and the processes that ran your code, together)' if cpu_s else
              f'the grader\'s limit of {JUDGE_TIMEOUT_S} s for checking a notebook')
