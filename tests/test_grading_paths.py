@@ -245,11 +245,16 @@ def test_a_learners_build_scripts_never_run_in_the_judge(scratch, monkeypatch):
     (package / 'colcon.pkg').write_text(json.dumps(
         {'hooks': [f'share/{course.PACKAGE}/hook/planted.sh']}))
     (package / 'planted.sh').write_text(PLANTED_HOOK)
-    setup = package / 'setup.py'
-    setup.write_text(setup.read_text().replace(
-        '    data_files=[\n', f"    data_files=[\n        ('share/{course.PACKAGE}/hook', "
-                             "['planted.sh']),\n", 1))
+    # The hook goes in the notebook's own setup.py cell: the judge grades setup.py as the
+    # notebook's %%part cells write it (ros2nb.judge.written), so a file changed beside them
+    # would not carry it into the build.
     submitted = nbformat.read(SOLUTION[NB05], as_version=4)
+    planted = [c for c in submitted.cells if c.source.startswith('%%part {SETUP_PY}')]
+    assert len(planted) == 1, 'notebook 05 writes setup.py in one %%part cell'
+    planted[0].source = planted[0].source.replace(
+        '    data_files=[\n', f"    data_files=[\n        ('share/{course.PACKAGE}/hook', "
+                             "['planted.sh']),\n", 1)
+    assert 'planted.sh' in planted[0].source
     results, problem, _flags = judge_notebook(scratch, NB05, submitted,
                                              Settings(120, 600, True, seed=8675309),
                                              scratch.snapshot(NB05))
