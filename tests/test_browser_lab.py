@@ -190,6 +190,13 @@ def test_a_finished_notebook_runs_to_the_end_with_its_check_passing(lab):
     page.screenshot(path=str(shots / 'learner-lab-01-run-all.png'), full_page=True)
 
 
+def shown_lines(cell) -> list[str]:
+    """The lines of a cell's outputs as shown, each output on its own (the text of the whole
+    output area has blank lines between outputs that show nowhere on the page)."""
+    return [line for text in cell.locator('.jp-OutputArea-child').all_inner_texts()
+            for line in text.strip().splitlines()]
+
+
 def test_interrupt_stops_a_spin_with_one_line(lab):
     """Stop ends a spin that would run for 10**7 s, with one line. How fast (the target is
     under a second) is ``make bench BENCH_ARGS='--only interrupt'``'s to measure: a browser
@@ -211,7 +218,9 @@ def test_interrupt_stops_a_spin_with_one_line(lab):
              seen=lambda: cell.inner_text())
     took = time.monotonic() - began
     print(f'\nInterrupt stopped the spin in {took:.2f} s')
-    lines = cell.locator('.jp-OutputArea').inner_text().strip().splitlines()
+    # Each output on its own: the text of the whole area has a blank line where a spin's
+    # progress line came and went, which shows nowhere on the page.
+    lines = shown_lines(cell)
     page.screenshot(path=str(shots / 'learner-lab-01-interrupted.png'))
     assert (lines[0] == 'spinning' and len(lines) == 2
             and lines[1].startswith('Interrupted after ')), lines
@@ -271,9 +280,12 @@ def test_the_first_check_of_03_by_keyboard_alone(lab):
              seen=lambda: page.evaluate(WHERE))
     page.keyboard.press('Escape')  # command mode: keys act on cells
     _press_until(page, 'Shift+Enter', check + 1)  # everything up to the check, run
-    failed = wait_for(lambda: _output(page, check).strip(), 'the check of the unwritten part',
+    # The check's one line first, then (once the cell ended) where the part stands.
+    failed = wait_for(lambda: 'Progress: ' in _output(page, check)
+                      and shown_lines(_cell(page, check)), 'the check of the unwritten part',
                       seen=lambda: _cell(page, check).inner_text())
-    assert not failed.startswith('Check passed') and '\n' not in failed, failed
+    assert len(failed) == 2 and failed[0].startswith('CheckFailed: ') \
+        and failed[1].startswith('Progress: ') and 'not passed yet' in failed[1], failed
 
     solution = nbformat.read(ROOT / 'solutions' / KEYBOARD_NOTEBOOK, 4).cells[answer].source
     _press_until(page, 'ArrowUp', answer)

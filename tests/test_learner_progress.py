@@ -149,6 +149,8 @@ def test_progress_in_a_kernel_after_checks_pass_and_fail_and_after_a_restart(tmp
                             "ends_with='Documents/ROS2_and_RL_Tutorials')")
         assert failed.error[0] == 'CheckFailed'
         assert 'not passed yet' in failed.stdout.splitlines()[-1], failed
+        kinds = [kind for kind, _content in failed.messages]  # the check's line first
+        assert kinds.index('error') < kinds.index('stream'), failed.messages
         shown = kernel.run('ros2nb.progress()')
         assert (tmp_path / graded_parts.RECORD).is_file()  # kept in the work folder
         kernel.restart()

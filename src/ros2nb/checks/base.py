@@ -73,8 +73,25 @@ def _kept(check: str, ok: bool, line: str) -> None:
         said = graded_parts.outcome_line(check, ok, graded_parts.parts())
     except OSError:  # the course's notebooks are not beside ros2nb: no table to point at
         said = None
-    if said:
+    if said and (ok or not _after_this_cell(said)):
         print(said)
+
+
+def _after_this_cell(line: str) -> bool:
+    """Print ``line`` once the running cell has ended (IPython's ``post_run_cell`` event), so
+    that a failed check's own line, shown when its error leaves the cell, is the first the
+    learner reads and the progress line follows it; False outside IPython (print it now)."""
+    loaded = sys.modules.get('IPython')
+    shell = loaded.get_ipython() if loaded is not None else None
+    if shell is None:
+        return False
+
+    def once(_result: object = None) -> None:
+        shell.events.unregister('post_run_cell', once)
+        print(line)
+
+    shell.events.register('post_run_cell', once)
+    return True
 
 
 class _Tee(io.TextIOBase):
