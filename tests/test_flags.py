@@ -172,3 +172,17 @@ def test_a_cell_the_learner_added_is_read_and_a_course_cell_is_not(tmp_path):
         assert notebook_flags(nb, ws) == [], 'without the source, only answer cells are read'
     assert len(flags) == 1 and "(not the course's) line 2: uses gc.get_objects" in flags[0], \
         flags
+
+
+def test_a_cell_with_malformed_grading_metadata_is_read_as_the_learners(tmp_path):
+    """A grade id that is a list (a learner's notebook is any JSON) makes the cell one of the
+    learner's own, read like any other; before, the judge stopped on it (``unhashable type``)
+    and the notebook scored nothing."""
+    from ros2nb.judge.flags import notebook_flags
+    source = json.loads(NOTEBOOKS['01'].read_text())
+    submitted = json.loads(NOTEBOOKS['01'].read_text())
+    submitted['cells'].append({'cell_type': 'code', 'source': 'import gc\ngc.get_objects()\n',
+                               'metadata': {'nbgrader': {'grade': True, 'grade_id': ['a', 'list'],
+                                                         'points': 'ten'}}, 'outputs': []})
+    flags = notebook_flags(submitted, tmp_path, source)
+    assert len(flags) == 1 and 'uses gc.get_objects' in flags[0], flags

@@ -286,7 +286,7 @@ def notebook_flags(submission: dict, workspace: Path, source: Optional[dict] = N
             flags += reaching_in(_python_of_cell(text, parts=False) or '',
                                  f'answer cell {meta.get("grade_id", "?")}')
         elif source is not None and text not in given and not (  # a graded cell, tests hidden
-                set(text.splitlines()) <= lines_of.get(meta.get('grade_id'), set())):
+                set(text.splitlines()) <= lines_of.get(str(meta.get('grade_id')), set())):
             found = reaching_in(_python_of_cell(text, parts=True) or '',
                                 f"cell {index + 1} (not the course's)")
             flags += [flag for flag in found if flag.partition(': ')[2] not in course_does]
