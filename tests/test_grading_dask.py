@@ -76,7 +76,9 @@ CLASS = {
     'Lovelace, Ada': EXPECTED['Lovelace, Ada'],
     'browser-copy': EXPECTED['browser-copy'],
     'kills-its-kernel': EXPECTED['kills-its-kernel'],
-    'reaches-in': Case({NB01: 1}, {NB01: FLAGS_HEADING},
+    # Frames read while the grader ran the code: the part earns nothing (ros2nb.judge.reaching)
+    # and the flags box says why, carried back from the cluster like any feedback.
+    'reaches-in': Case({NB01: 0}, {NB01: FLAGS_HEADING},
                        {NB01: f'{FLAGGED} answer cell {NB01}-challenge-1 line'}),
 }
 
