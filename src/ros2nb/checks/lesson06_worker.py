@@ -10,7 +10,7 @@ answers itself: the slow work lasts until the judge lets it end, and a heartbeat
 its answer left the subject before the slow work's did (the answers' own DDS timestamps).
 An answer reaches the judge only through the executor that took the request, so nothing
 else in the learner's process answers for it; the graph must show one server of each
-service, the Worker.  The executor and groups the subject reports only name the cause of
+service.  The executor and groups the subject reports only name the cause of
 what the judge saw.
 """
 
@@ -76,14 +76,18 @@ def _beat_first(slow: tuple[int, Any], beat: tuple[int, Any]) -> bool:
     return beat[0] < slow[0] and bool(beat[1].values)
 
 
-def _servers(judge: Judge, calls: list[_Calls], name: str, namespace: str) -> Optional[bool]:
-    """What the judge's graph shows of the services: None while the Worker ``name`` does not
-    serve each yet, True when it serves each and nothing else does, False when something
-    else serves one too."""
+def _servers(judge: Judge, calls: list[_Calls]) -> Optional[bool]:
+    """What the judge's graph shows of the services: None while the judge's clients have not
+    matched a server of each yet, True when one server serves each, False when more do.
+
+    Read from the endpoints DDS discovery reports (``service_is_ready``, ``count_services``),
+    never from the graph's list of nodes: there a subject that left can stay for good under
+    its node's name (rmw_fastrtps's graph takes a node list the subject sent before it left
+    after it saw the subject leave, and adds it again), and the services of a node looked up
+    by name are the first such node's, in a judge that ran an earlier Worker those of the
+    one that left (docs/decisions.md)."""
     node = judge.observer.quiet_node()
-    served = {service for service, _types in
-              node.get_service_names_and_types_by_node(name, namespace)}
-    if not all(c.client.service_is_ready() and c.name in served for c in calls):
+    if not all(c.client.service_is_ready() for c in calls):
         return None
     return all(node.count_services(c.name) == 1 for c in calls)
 
@@ -132,7 +136,7 @@ def _overlapped(judge: Judge, subject: Subject, reply: WorkerSpun) -> tuple[bool
     observer, told = judge.observer, told_to(judge)
     slow, beat = calls = [_Calls(judge, name) for name in SERVICES]
     try:
-        where = (judge, calls, reply.name or '', reply.namespace or '/')
+        where = (judge, calls)
         if not observer.wait_until(lambda: _servers(*where) is not None, ARRIVAL_TIMEOUT_S):
             return False, 'never'
         if not _servers(*where):
