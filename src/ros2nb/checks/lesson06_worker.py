@@ -136,10 +136,9 @@ def _overlapped(judge: Judge, subject: Subject, reply: WorkerSpun) -> tuple[bool
     observer, told = judge.observer, told_to(judge)
     slow, beat = calls = [_Calls(judge, name) for name in SERVICES]
     try:
-        where = (judge, calls)
-        if not observer.wait_until(lambda: _servers(*where) is not None, ARRIVAL_TIMEOUT_S):
+        if not observer.wait_until(lambda: _servers(judge, calls) is not None, ARRIVAL_TIMEOUT_S):
             return False, 'never'
-        if not _servers(*where):
+        if not _servers(judge, calls):
             return False, 'servers'
         warm = (slow.send(WARM_UP), beat.send(WARM_UP))
         if not observer.wait_until(lambda: slow.answered(warm[0]) and beat.answered(warm[1]),
@@ -151,7 +150,7 @@ def _overlapped(judge: Judge, subject: Subject, reply: WorkerSpun) -> tuple[bool
             return False, 'never'
         beating = beat.send(WARM_UP)
         observer.wait_until(lambda: beat.answered(beating), BEAT_PATIENCE_S)
-        one_server = _servers(*where)
+        one_server = _servers(judge, calls)
         subject.request(WorkerRelease())
         observer.wait_until(lambda: slow.answered(working) and beat.answered(beating),
                             ARRIVAL_TIMEOUT_S)
