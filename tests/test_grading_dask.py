@@ -17,6 +17,7 @@ import re
 import shutil
 import subprocess
 import sys
+import tempfile
 import threading
 from dataclasses import dataclass
 from pathlib import Path
@@ -142,7 +143,7 @@ def on_dask(tmp_path_factory):
 
 #: A learner's scratch folder, as a cell's output may show it: new for every grading (here
 #: under the grader's temporary folder, on a worker under the worker's).
-SCRATCH = re.compile(r'/tmp/ros2nb-(?:grading|worker)-\w+/(?:scratch/)?learner-\w+/')
+SCRATCH = re.compile(r'/tmp/ros2nb-(?:grading|worker)-[\w-]+/(?:scratch/)?learner-\w+/')
 
 
 #: The box of "Code your instructor will look at" on a feedback page.
@@ -219,6 +220,9 @@ def test_a_worker_killed_mid_class_costs_nobody(on_dask):
     for key in killed['keys']:
         learner = next(name for name in learners if str(key).endswith(f'-{name}'))
         assert 'could not grade' not in json.dumps(notes[learner]), notes[learner]
+    # The killed worker could not unmount its learner's tmpfs; a later task swept them.
+    left = list(Path(tempfile.gettempdir()).glob(f"ros2nb-worker-{killed['pid']}-*"))
+    assert left == [], left
 
 
 def other_course(folder: Path) -> Path:

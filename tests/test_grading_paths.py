@@ -6,6 +6,8 @@ plants the learner's move and shows what the grader makes of it (root, as when g
 
 import json
 import os
+import subprocess
+import sys
 
 import nbformat
 import pytest
@@ -19,7 +21,7 @@ from ros2nb_instructor.grading import notebooks, sandbox
 from ros2nb_instructor.grading.judging import judge_notebook
 from ros2nb_instructor.grading.paths_of_learners import NotARegularFile, read_regular
 from ros2nb_instructor.grading.runs import checked_status
-from ros2nb_instructor.grading.scratch import HOME_BYTES, Scratch
+from ros2nb_instructor.grading.scratch import HOME_BYTES, Scratch, sweep_left_behind
 from ros2nb_instructor.grading.settings import Settings
 from ros2nb_instructor.grading.submissions import Learner
 
@@ -88,6 +90,32 @@ def test_a_learners_home_holds_a_bounded_total(scratch):
         for number in range(HOME_BYTES // len(chunk) + 2):
             (scratch.home / f'filler-{number}').write_bytes(chunk)
     assert scratch.home_full()
+
+
+def mounts_below(folder):
+    """The mount points below ``folder``, as /proc lists them."""
+    with open('/proc/self/mounts') as mounts:
+        return [line.split()[1] for line in mounts if line.split()[1].startswith(f'{folder}/')]
+
+
+@pytest.mark.sandbox
+@pytest.mark.skipif(os.geteuid() != 0, reason='a size-capped scratch needs root (the grader is)')
+def test_what_a_killed_grader_left_is_swept_by_the_next(tmp_path):
+    """A grader killed mid-class (a Dask worker's SIGKILL) cannot unmount its learners'
+    tmpfs: the next grader on the machine removes its folder and mounts, never a running
+    grader's."""
+    ended = subprocess.run([sys.executable, '-c', 'import os; print(os.getpid())'],
+                           capture_output=True, text=True, check=True)
+    left = tmp_path / f'ros2nb-grading-{ended.stdout.strip()}-abc'
+    running = tmp_path / f'ros2nb-grading-{os.getpid()}-def'
+    unnamed = tmp_path / 'ros2nb-grading-xyz'
+    for folder in (left, running, unnamed):
+        folder.mkdir()
+    Scratch(left, Learner('ada', 'ada')).snapshot('03-write-the-publisher')  # never removed
+    assert len(mounts_below(left)) == 2  # the home and the snapshot: what a kill leaves
+    assert sweep_left_behind('ros2nb-grading-', tmp_path) == [left]
+    assert mounts_below(left) == [] and not left.exists()
+    assert running.is_dir() and unnamed.is_dir()
 
 
 def test_a_rewritten_status_is_not_trusted():

@@ -54,6 +54,7 @@ from .gradebook import Scoring, collect_zip, set_up_course, write_results
 from .judging import Judges
 from .learners import file_graded, grade_learner
 from .report import write_report
+from .scratch import grading_folder
 from .settings import CELL_TIMEOUT_S, JOBS, NOTEBOOK_CPU_S, NOTEBOOK_TIMEOUT_S, Settings
 from .submissions import Learner, find_learners
 from .term import add_options, export, forget, load_state, read_term, save_state, with_roster
@@ -124,8 +125,7 @@ def _grade_all(course: Path, learners: list[Learner], notebooks: list[str],
     still run: a class's longest learner (every notebook, one after another) is then
     followed by nbgrader scoring that learner alone, not half the class.
     """
-    with tempfile.TemporaryDirectory(prefix='ros2nb-grading-') as scratch_root:
-        Path(scratch_root).chmod(0o711)
+    with grading_folder('ros2nb-grading-') as scratch_root:
         judges = Judges(jobs)
         # Most notebooks first, so the longest learner does not start last.
         ordered = sorted(learners, key=lambda learner: -len(learner.files))
@@ -133,7 +133,7 @@ def _grade_all(course: Path, learners: list[Learner], notebooks: list[str],
 
         def grade(learner: Learner) -> None:
             try:
-                file_graded(course, learner, grade_learner(course, Path(scratch_root), learner,
+                file_graded(course, learner, grade_learner(course, scratch_root, learner,
                                                            notebooks, settings, judges))
             finally:
                 print(progress.learner_done(learner), flush=True)

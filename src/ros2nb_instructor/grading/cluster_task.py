@@ -13,7 +13,6 @@ from __future__ import annotations
 import hashlib
 import os
 import sys
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Optional
@@ -22,6 +21,7 @@ from ..paths import ASSIGNMENT, ROOT
 from . import sandbox
 from .judging import Judges
 from .learners import Graded, grade_learner
+from .scratch import grading_folder
 from .settings import Settings
 from .submissions import Learner
 
@@ -112,9 +112,7 @@ def grade_job(job: Job) -> FromWorker:
     mine = course_version()
     if mine != job.version:
         raise WrongCourse(f'the worker\'s course is version {mine}, not {job.version}')
-    with tempfile.TemporaryDirectory(prefix='ros2nb-worker-') as folder:
-        top = Path(folder)
-        top.chmod(0o711)  # as a local grading's scratch: the sandboxes' user passes
+    with grading_folder('ros2nb-worker-') as top:
         release = top / 'course' / 'release' / ASSIGNMENT
         release.mkdir(parents=True)
         for notebook, text in job.release.items():

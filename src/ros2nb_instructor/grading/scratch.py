@@ -4,11 +4,14 @@ Runs on the instructor's host.  Each notebook's judge gets a snapshot of the wor
 that notebook left it, copied without following a link.  The folders a sandbox may write
 (the learner's home, a run's output folder, a judge's folder) are each a size-capped tmpfs
 when the grader is root, so one learner filling the disk fills only their own space.  The
-grader writes only in folders of its own, which no sandbox can write.
+grader writes only in folders of its own, which no sandbox can write.  A grader killed
+before it could unmount them leaves its folder behind, mounts and all, until the next grader
+on the machine starts (:func:`grading_folder`).
 """
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
 import stat
@@ -16,7 +19,9 @@ import sys
 import tempfile
 import threading
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Iterator, Optional
+
+import psutil
 
 from ros2nb.terminal.workspace import WORKSPACE_NAME
 
@@ -33,6 +38,65 @@ JUDGE_BYTES = 256 * MiB
 #: What a note says when a learner filled their space.
 OUT_OF_SPACE = ('it ran out of scratch space ({} MB for a learner\'s files); what it wrote '
                 'after that was lost')
+
+
+@contextlib.contextmanager
+def grading_folder(prefix: str) -> Iterator[Path]:
+    """A folder of this grader's in the temporary directory, for its learners' scratch.
+
+    Its name carries this process's id: a grader killed before it could clean up (SIGKILL,
+    the OOM killer, a Dask worker lost mid-class) leaves its folder and its tmpfs mounts
+    behind, and the next grader on this machine that uses ``prefix`` removes them first
+    (:func:`sweep_left_behind`).
+
+    :param prefix: what the folder's name starts with, e.g. ``'ros2nb-grading-'``.
+    """
+    sweep_left_behind(prefix)
+    with tempfile.TemporaryDirectory(prefix=f'{prefix}{os.getpid()}-') as folder:
+        Path(folder).chmod(0o711)  # the sandboxes' own user may pass, nobody may list
+        yield Path(folder)
+
+
+def sweep_left_behind(prefix: str, where: Optional[Path] = None) -> list[Path]:
+    """Remove the folders :func:`grading_folder` made for graders that no longer run, each
+    with the tmpfs mounts below it (deepest first).
+
+    A folder is left alone when it is a link or not this user's, when its name carries no
+    process id, or when that process runs and started before the folder last changed.
+
+    :param where: the folder to look in (default: the temporary directory).
+    :returns: the folders removed.
+    """
+    top = Path(os.path.realpath(where or tempfile.gettempdir()))
+    swept = []
+    for folder in sorted(top.glob(f'{prefix}*')):
+        owner = folder.name[len(prefix):].split('-', 1)[0]
+        try:
+            found = os.lstat(folder)
+        except OSError:
+            continue
+        if not owner.isdigit() or not stat.S_ISDIR(found.st_mode) \
+                or found.st_uid != os.geteuid() or _running_since(int(owner), found.st_ctime):
+            continue
+        below = [Path(p.mountpoint) for p in psutil.disk_partitions(all=True)
+                 if Path(p.mountpoint).is_relative_to(folder)]
+        for mount in sorted(below, key=lambda path: len(path.parts), reverse=True):
+            unmount(mount)
+        shutil.rmtree(folder, ignore_errors=True)
+        swept.append(folder)
+    return swept
+
+
+def _running_since(pid: int, since: float) -> bool:
+    """True when process ``pid`` runs and started by ``since`` (seconds since the epoch),
+    give or take a second: not a later process given a dead one's id, nor a killed one
+    its parent has not reaped yet."""
+    try:
+        process = psutil.Process(pid)
+        return process.create_time() <= since + 1.0 and \
+            process.status() != psutil.STATUS_ZOMBIE
+    except psutil.Error:
+        return False
 
 
 class Scratch:
