@@ -34,7 +34,7 @@ HIDDEN_OUTPUT_NOTE = ('*This cell shows your finished work once you have written
                       'above: run it in the notebook.*')
 #: The outputs that are pictures.
 IMAGES = ('image/png', 'image/jpeg', 'image/gif', 'image/svg+xml')
-#: How the line that says what a figure shows begins (``ros2nb.figures.CAPTION_START``).
+#: How the line that says what a figure shows begins (``ros2nb.nbmeta.CAPTION_START``).
 CAPTION_START = 'Figure: '
 
 

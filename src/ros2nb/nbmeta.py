@@ -8,6 +8,9 @@ from __future__ import annotations
 
 #: Tag of the course's cells a graded answer may rely on (imports, constants).
 CONTEXT_TAG = 'grading-context'
+#: How a figure's caption line begins in a cell's output (``ros2nb.figures`` writes it, the
+#: course's website reads the picture's alternative text by it).
+CAPTION_START = 'Figure: '
 
 
 def cells(notebook: dict) -> list[dict]:

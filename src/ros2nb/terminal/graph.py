@@ -13,7 +13,7 @@ import html
 from typing import Iterable, Optional
 
 from ..errors import Ros2nbError
-from ..figures import CAPTION_START
+from ..nbmeta import CAPTION_START
 from ..patience import wait_for_work
 from ..runtime import current_runtime
 from .background import failures, running_pids
