@@ -72,6 +72,20 @@ def test_a_constructor_that_floods(session, kind):
     run_check(session, checks.check_sensor_constructor)
 
 
+def test_a_flood_while_the_judge_waits_for_the_node_ends_the_wait(session):
+    """The constructor starts its flood, then blocks: the judge, still waiting for the node,
+    ends it as a flood, and part 4 runs in the course's constructor.  Before, the flood's
+    CPU-seconds ran out the subject's patience first, and part 4 failed with "did not finish
+    within 30 s": on a busy machine, so did a constructor that floods and returns at once."""
+    blocks = FLOODS['topic'] + '        import time\n        time.sleep(600)\n'
+    mutated(session, PUB, STARTED_LINE, blocks)
+    try:
+        fails(session, checks.check_sensor_constructor, LINES['topic'])
+        run_check(session, checks.check_sensor_callback)
+    finally:
+        restore(session, PUB)
+
+
 @pytest.mark.sandbox
 @pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))
 @pytest.mark.timeout(900)

@@ -119,6 +119,7 @@ class Session:
             subject = SubjectProcess(where, env=subject_env({
                 WORKSPACE_ENV: str(where), JUDGE_TOPICS_ENV: json.dumps(sorted(heard[0]))}))
             subject.heard_base = heard
+            subject.while_waiting = self.observer.floods.raise_any
             self._subjects[key] = subject
             self.reaching.use(subject)
             try:

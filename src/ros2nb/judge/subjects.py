@@ -20,7 +20,7 @@ import sys
 import threading
 import time
 from pathlib import Path
-from typing import Any, Optional, TypeVar
+from typing import Any, Callable, Optional, TypeVar
 
 from .. import domains
 from ..errors import CheckFailed
@@ -181,6 +181,9 @@ class SubjectProcess:
         #: What the judge had heard when this process started: messages per watched topic,
         #: /rosout lines per logger (set by the session that starts it).
         self.heard_base: tuple[dict[str, int], dict[str, int]] = ({}, {})
+        #: Called while :meth:`request` waits for a reply, before each look: raises to stop
+        #: waiting (the session's: a flood found ends the subjects and fails the check).
+        self.while_waiting: Callable[[], None] = lambda: None
 
     def send(self, command: Command[Any]) -> None:
         """Send one command (its reply comes later: :meth:`poll_reply`, read with
@@ -271,11 +274,17 @@ class SubjectProcess:
             machine never turns slow honest work into a hang.
         :raises SubjectHung: when no reply comes within ``timeout`` seconds, or the
             process died (its last output line is in the message).
+        :raises Exception: what :attr:`while_waiting` raises (the session's:
+            :class:`~ros2nb.judge_interface.Flooded`).
         :raises ros2nb.typed_json.Unreadable: for a reply that does not fit its type.
         """
         self.send(command)
         sent, patience = time.monotonic(), None
         while True:
+            # A flood heard meanwhile ends the wait at once: its CPU-seconds would otherwise
+            # count as this subject's work, and on a busy machine run out its patience
+            # before the reply, so that the learner's line would depend on the machine.
+            self.while_waiting()
             reply = self.poll_reply(POLL_S)
             self.take_ack()
             if reply is not None:
