@@ -315,3 +315,59 @@ def test_a_subject_the_judge_ends_leaves_its_graph_at_once(session, tmp_path, wh
     # Idle time of the judge's own wait: half the lease, which a vanished participant outlives.
     assert session.observer.wait_until(lambda: servers(service) == 0, DDS_LEASE_S / 2), \
         'the ended subject is still in the judge\'s graph'
+
+
+#: Another process on the judge's domain whose node has the name the learner's node will
+#: have, logging without pause: a subject made by an earlier attempt of the same check.
+SAME_NAME_ELSEWHERE = '''
+import rclpy
+from rclpy.node import Node
+rclpy.init()
+node = Node('echoer')
+while True:
+    node.get_logger().info('a line of the other process')
+    rclpy.spin_once(node, timeout_sec=0.002)
+'''
+
+MAKES_A_NODE_THAT_LOGS_ONCE = '''
+from rcl_interfaces.msg import Log
+from rclpy.node import Node
+from rclpy.wait_for_message import wait_for_message
+
+class Echoer(Node):
+    def __init__(self):
+        super().__init__('echoer')
+        self.get_logger().info('up')
+        # The race made certain: a new line of the other process's reaches this process
+        # (its runtime's /rosout subscription as well) while the node is made.
+        while wait_for_message(Log, self, '/rosout')[1].name != 'echoer':
+            pass
+'''
+
+
+def test_a_node_counts_only_the_lines_its_own_process_logged(session):
+    """What a subject says its node logged counts the lines its own process sent, never
+    those of another process's node of the same name, which its /rosout subscription hears
+    too.  Counted as heard, an earlier subject's start-up line that reached the next one
+    while it made its node became a line the judge waited for, and never had, for a whole
+    minute of idle patience (docs/decisions.md)."""
+    from ros2nb.domains import DOMAIN_ENV
+    from ros2nb.processes import kill_process_group
+    from ros2nb.subject_interface import GetCounts, NewNode
+    other = subprocess.Popen([sys.executable, '-c', SAME_NAME_ELSEWHERE],
+                             env={**os.environ, DOMAIN_ENV: str(session.observer.domain_id)},
+                             start_new_session=True)
+    try:
+        assert session.observer.wait_until(lambda: session.observer.lines_of('echoer'),
+                                           PATIENCE_S), 'the other process logged nothing'
+
+        def load(subject: SubjectProcess) -> None:
+            assert subject.request(ExecCells(sources=[MAKES_A_NODE_THAT_LOGS_ONCE])
+                                   ).cell_errors == []
+
+        subject = session.subject(('echoer',), load)
+        made = subject.request(NewNode(cls='Echoer'))
+        assert made.ok and made.started_lines == 1, made
+        assert subject.request(GetCounts()).logged == 1
+    finally:
+        kill_process_group(other)

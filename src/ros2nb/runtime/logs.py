@@ -57,7 +57,7 @@ class LogLines:
 
     def __init__(self) -> None:
         self._our_loggers: set[str] = set()
-        #: /rosout lines received so far, per logger name (the checks count with it).
+        #: /rosout lines received so far, per logger name, from every process on the domain.
         self.log_counts: collections.Counter[str] = collections.Counter()
         # (cell epoch, logger name | None for our own lines | CallbackFailure, level, text)
         self._log_lines: collections.deque[tuple] = collections.deque()

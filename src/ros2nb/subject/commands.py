@@ -188,7 +188,7 @@ class Subject(Trials):
         if seed is not None:
             random.seed(seed)
         self.received, self.failure = 0, None
-        logged_before = dict(rt.log_counts)
+        logged_before = JudgeTime.logged()
         try:
             node = node_class(*(args or []))
         except BaseException as error:
@@ -202,7 +202,8 @@ class Subject(Trials):
             self._count_receipts(subscription)
         logger = node.get_logger().name
         return NodeMade(ok=True, name=node.get_name(), namespace=node.get_namespace(),
-                        started_lines=rt.log_counts[logger] - logged_before.get(logger, 0),
+                        started_lines=(JudgeTime.logged().get(logger, 0)
+                                       - logged_before.get(logger, 0)),
                         endpoints=node_endpoints(node), **self._counts(),
                         # names a failure, never earns a point (``ros2 param`` reaches it or not)
                         parameter_services=any(service.srv_name.endswith('/set_parameters')
@@ -210,8 +211,7 @@ class Subject(Trials):
 
     def _counts(self) -> dict[str, Any]:
         """The fields of :class:`~ros2nb.subject_replies.Counts` now (but ``ok``)."""
-        rt = self._runtime()
-        logged = rt.log_counts.get(self.node.get_logger().name, 0) if self.node else 0
+        logged = JudgeTime.logged().get(self.node.get_logger().name, 0) if self.node else 0
         shown = self._plot_shown.told if self._plot_shown is not None else None
         return {'received': self.received, 'logged': logged, 'failure': self.failure,
                 'published': JudgeTime.published(), 'shown': shown}

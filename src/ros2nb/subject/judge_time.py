@@ -95,6 +95,13 @@ class JudgeTime:
         return dict(cls._counts) if cls._counting else None
 
     @classmethod
+    def logged(cls) -> dict[str, int]:
+        """Lines this process has logged so far, per logger (none when nothing is counted
+        here): the lines its own nodes sent, never those that another process's node of the
+        same name sent, which this process's /rosout subscription hears as well."""
+        return dict(cls._logged) if cls._counting else {}
+
+    @classmethod
     def for_this_process(cls) -> Optional['JudgeTime']:
         """The judge's time when this process is a judge's subject, else None."""
         cls.claim()
