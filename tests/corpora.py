@@ -35,9 +35,21 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / 'tests'))  # judging.py, the corpora
 SOLUTIONS = ROOT / 'solutions'
 NOTEBOOKS = {p.stem[:2]: p for p in SOLUTIONS.glob('*.ipynb')}
-#: Seconds one learner's judge may take (below the corpora's test limit of 300 s); then, as
-#: at its CPU limit, the cells it had not checked fail with the line that says so.
+#: Seconds one learner's judge may take; then, as at its CPU limit, the cells it had not
+#: checked fail with the line that says so.
 JUDGE_TIMEOUT_S = 270
+#: Seconds a test of the corpora takes beside its judges (writing each learner's workspace,
+#: comparing the results).
+BESIDE_JUDGES_S = 30
+
+
+def time_limit_s(gradings: int) -> int:
+    """pytest-timeout's limit for a test that grades ``gradings`` learners one after
+    another: each judge is already bounded (:data:`JUDGE_TIMEOUT_S`), so the test's own
+    limit only catches a hang outside them and must never cut a judge short."""
+    return gradings * (JUDGE_TIMEOUT_S + BESIDE_JUDGES_S)
+
+
 #: A cell's new text, or (old, new) replacements in it.
 Change = Union[str, list[tuple[str, str]]]
 

@@ -21,31 +21,36 @@ from pathlib import Path
 
 import pytest
 
-from corpora import grade_learner, judged, score
+from corpora import grade_learner, judged, score, time_limit_s
 from corpus_attacks import ATTACKS
 from corpus_checks import failed, scores_what_its_twin_scores
 from corpus_reaching import REACHING
 from ros2nb.checks.drawn import new_seed
 
-pytestmark = [pytest.mark.judge, pytest.mark.timeout(300)]
+#: Each test but the text reader's grades an attack and its twin.
+pytestmark = [pytest.mark.judge, pytest.mark.timeout(time_limit_s(2))]
 TWINS = {learner.name: learner for learner in ATTACKS}
 #: The two seeds of this run's gradings of the reaching attacks and their twins (each
 #: pytest-xdist worker draws its own: a new pair every run).
 SEEDS = (new_seed(), new_seed())
 
 
-def test_the_text_reader_only_words_failures(tmp_path):
-    """A learner graded with a reader of their text that knows nothing loses the same part as
-    with the reader: the text chose the words of its line, never whether the part passed.
+@pytest.mark.timeout(time_limit_s(1))
+@pytest.mark.parametrize('knows_nothing', [False, True],
+                         ids=['with the reader', 'with a reader that knows nothing'])
+def test_the_text_reader_only_words_failures(knows_nothing, tmp_path):
+    """Graded with the judge's reader of their text or with one that knows nothing, a learner
+    loses the same part: the text chose the words of its line, never whether the part passed.
     The sensor without a timer: the reader names what is missing, and without it the line
-    says only what the judge saw (which also shows the reader was replaced in the judge)."""
+    says only what the judge saw (which also shows the reader was replaced in the judge).
+    One grading a test, so that each has the whole of its judge's time limit."""
     learner = TWINS['03 twin: no timer']
-    lost = {knows_nothing: failed(grade_learner(learner, tmp_path / str(knows_nothing),
-                                                knows_nothing=knows_nothing))
-            for knows_nothing in (False, True)}
-    assert set(lost[False]) == set(lost[True]) == set(learner.loses), lost
-    assert 'TemperatureSensor has no timer' in lost[False]['sensor-constructor'], lost
-    assert 'has no timer' not in lost[True]['sensor-constructor'], lost
+    lost = failed(grade_learner(learner, tmp_path, knows_nothing=knows_nothing))
+    assert set(lost) == set(learner.loses), lost
+    if knows_nothing:
+        assert 'has no timer' not in lost['sensor-constructor'], lost
+    else:
+        assert 'TemperatureSensor has no timer' in lost['sensor-constructor'], lost
 
 
 #: Attacks the wire can tell from honest code (the rest are flagged: tests/test_flags.py).

@@ -3,10 +3,11 @@
 
 import pytest
 
+from corpora import time_limit_s
 from corpus_checks import full_marks_without_the_text_reader
 from corpus_honest import HONEST
 
-pytestmark = [pytest.mark.judge, pytest.mark.timeout(300)]
+pytestmark = [pytest.mark.judge, pytest.mark.timeout(time_limit_s(1))]
 
 
 @pytest.mark.parametrize('learner', HONEST, ids=[learner.name for learner in HONEST])

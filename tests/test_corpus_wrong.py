@@ -2,10 +2,11 @@
 
 import pytest
 
+from corpora import time_limit_s
 from corpus_checks import loses_exactly_its_part
 from corpus_wrong import WRONG
 
-pytestmark = [pytest.mark.judge, pytest.mark.timeout(300)]
+pytestmark = [pytest.mark.judge, pytest.mark.timeout(time_limit_s(1))]
 
 
 @pytest.mark.parametrize('learner', WRONG, ids=[learner.name for learner in WRONG])
