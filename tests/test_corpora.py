@@ -64,8 +64,10 @@ def test_an_attack_scores_what_its_twin_scores(attack, tmp_path):
 
 @functools.lru_cache(maxsize=None)
 def _twin(name: str, seed: int) -> dict:
-    """The twin's results with ``seed`` (graded once per worker and seed)."""
-    return grade_learner(TWINS[name], Path(tempfile.mkdtemp(prefix='ros2nb-twin-')), seed=seed)
+    """The twin's results with ``seed`` (graded once per worker and seed, in a folder of
+    its own removed afterwards: the results are all that is kept)."""
+    with tempfile.TemporaryDirectory(prefix='ros2nb-twin-') as root:
+        return grade_learner(TWINS[name], Path(root), seed=seed)
 
 
 @pytest.mark.parametrize('run', [0, 1], ids=['seed 1', 'seed 2'])

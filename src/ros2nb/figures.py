@@ -21,6 +21,7 @@ from typing import Any, Sequence
 
 from .course import HIGH_ABOVE_C, LOW_BELOW_C, MAX_TEMPERATURE_C, MIN_TEMPERATURE_C, STATUSES
 from .nbmeta import CAPTION_START
+
 #: The bands' opacity over the white axes: the line drawn over them stays dark on every band.
 BAND_ALPHA = 0.3
 
