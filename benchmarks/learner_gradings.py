@@ -29,12 +29,9 @@ def main() -> int:
     parser.add_argument('--learner', default='03 twin: no timer')
     parser.add_argument('--runs', type=int, default=10)
     options = parser.parse_args()
-    from corpora import grade_learner
-    from corpus_attacks import ATTACKS
+    from corpora import every_learner, grade_learner
     from corpus_checks import failed
-    from corpus_honest import HONEST
-    from corpus_wrong import WRONG
-    learners = {learner.name: learner for learner in (*HONEST, *WRONG, *ATTACKS)}
+    learners = every_learner()
     if options.learner not in learners:
         print(f'no learner {options.learner!r} in the corpora: pick one of tests/corpus_*.py')
         return 2

@@ -288,8 +288,8 @@ def test_a_subject_the_judge_ends_leaves_its_graph_at_once(session, tmp_path, wh
     """A subject the judge ends (``kill_process_group``: a flood, a hang) takes its nodes
     down on SIGTERM, also when the learner's code was running and its command caught
     everything: its participant says it leaves, and the judge's graph drops its endpoints at
-    once.  Ended by SIGTERM's default action, it stayed there until its lease ran out (20 s), its
-    /clock subscription matched, and the judge's /clock reached the next subjects late:
+    once.  Ended by SIGTERM's default action, it stayed there until its lease ran out (20 s),
+    its /clock subscription matched, and the judge's /clock reached the next subjects late:
     ``test_floods.py``'s topic flood failed so beside four burners, the next subject waiting
     over 30 s for the judge's time."""
     from ros2nb.processes import kill_process_group
