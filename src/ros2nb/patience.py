@@ -10,6 +10,7 @@ No mention of ROS here.
 from __future__ import annotations
 
 import os
+import threading
 import time
 from typing import TYPE_CHECKING, Any, Callable, Optional, Sequence
 
@@ -88,7 +89,13 @@ def tree_cpu_seconds(pid: int) -> float:
     return sum(_cpu_seconds(process) for process in process_tree([pid]))
 
 
-def queued_seconds(pids: Sequence[int]) -> tuple[float, bool]:
+def _this_thread() -> tuple[int, int]:
+    """``(pid, thread id)`` of the calling thread, as /proc names them."""
+    return os.getpid(), threading.get_native_id()
+
+
+def queued_seconds(pids: Sequence[int], *, skip: Optional[tuple[int, int]] = None
+                   ) -> tuple[float, bool]:
     """How much the threads of ``pids`` stood ready to run, waiting on the run queue for a
     CPU: the seconds the kernel counted (the second field of ``/proc/PID/task/TID/schedstat``,
     brought up to date only when a thread gets a CPU), and whether one of them stands ready
@@ -98,25 +105,88 @@ def queued_seconds(pids: Sequence[int]) -> tuple[float, bool]:
     Read from /proc here, not through psutil: psutil gives a thread's CPU times but neither
     its time on the run queue nor its state, and these two are what tell a program the
     scheduler starves from one that waits (:class:`Patience`).
+
+    :param skip: ``(pid, thread id)`` of a thread left out: the one that looks, which runs
+        while it reads (a process that waits for itself, :func:`wait_for_work`).
     """
     total, ready = 0.0, False
     for pid in pids:
-        try:
-            tasks = os.listdir(f'/proc/{pid}/task')
-        except OSError:
-            continue
-        for task in tasks:
-            try:
-                with open(f'/proc/{pid}/task/{task}/stat') as stat:
-                    ready = ready or stat.read().rsplit(')', 1)[1].split()[0] == 'R'
-                with open(f'/proc/{pid}/task/{task}/schedstat') as schedstat:
-                    total += int(schedstat.read().split()[1]) / 1e9
-            except (OSError, IndexError, ValueError):
+        for task, state, delay in _threads(pid):
+            if (pid, task) == skip:
                 continue
+            ready = ready or state == 'R'
+            total += delay
     return total, ready
 
 
-def tree_work(pids: int | Sequence[int]) -> tuple[float, float, bool]:
+def _threads(pid: int) -> list[tuple[int, str, float]]:
+    """``(thread id, state, seconds on the run queue so far)`` of each thread of ``pid``
+    (none once it is gone)."""
+    try:
+        tasks = os.listdir(f'/proc/{pid}/task')
+    except OSError:
+        return []
+    found = []
+    for task in tasks:
+        try:
+            with open(f'/proc/{pid}/task/{task}/stat') as stat:
+                state = stat.read().rsplit(')', 1)[1].split()[0]
+            with open(f'/proc/{pid}/task/{task}/schedstat') as schedstat:
+                found.append((int(task), state, int(schedstat.read().split()[1]) / 1e9))
+        except (OSError, IndexError, ValueError):
+            continue
+    return found
+
+
+def run_queue_seconds(thread_ids: Sequence[int]) -> dict[int, float]:
+    """Each thread's seconds on the run queue so far (``/proc/TID/schedstat``), by thread id;
+    a thread that is gone is left out."""
+    found = {}
+    for tid in thread_ids:
+        try:
+            with open(f'/proc/{tid}/schedstat') as schedstat:
+                found[tid] = int(schedstat.read().split()[1]) / 1e9
+        except (OSError, IndexError, ValueError):
+            continue
+    return found
+
+
+class HeldBack:
+    """How long the machine kept some threads from running, look by look.
+
+    Of each interval between two looks, what counts is the most seconds one of the threads
+    stood ready on the run queue (threads wait side by side: their sum is no time of
+    anyone's).  The kernel brings a thread's count up to date only when the thread runs, so
+    what one look misses a later one finds: it is owed, and taken from later intervals,
+    never more than an interval at a time.
+
+    :param threads: each thread's seconds on the run queue so far, by thread id (e.g.
+        :func:`run_queue_seconds`), read at every look.
+    """
+
+    def __init__(self, threads: Callable[[], dict[int, float]]) -> None:
+        self._threads = threads
+        self._last = threads()
+        self._owed = 0.0
+
+    def look(self) -> None:
+        """Read the threads again; what they stood on the run queue since is owed."""
+        now = self._threads()
+        grown = max((delay - self._last.get(tid, 0.0) for tid, delay in now.items()),
+                    default=0.0)
+        self._last = now
+        self._owed += max(0.0, grown)
+
+    def take(self, interval_s: float) -> float:
+        """The seconds of an interval of ``interval_s`` that the threads were kept from
+        running (taken from what is owed)."""
+        held = min(self._owed, interval_s)
+        self._owed -= held
+        return held
+
+
+def tree_work(pids: int | Sequence[int], *, skip: Optional[tuple[int, int]] = None
+              ) -> tuple[float, float, bool]:
     """What process trees have done, as the kernel counts it: the CPU seconds of ``pids``
     and every process under them; the seconds their threads stood ready on the run queue
     for a CPU (:func:`queued_seconds`); and whether one of them stands ready now.
@@ -126,9 +196,11 @@ def tree_work(pids: int | Sequence[int]) -> tuple[float, float, bool]:
     program it waits on look busy.
 
     Introduced in ``03-write-the-publisher.ipynb`` (how long the judge waits for a subject).
+
+    :param skip: a thread left out (:func:`queued_seconds`).
     """
     trees = process_tree([pids] if isinstance(pids, int) else pids)
-    queued, ready = queued_seconds([process.pid for process in trees])
+    queued, ready = queued_seconds([process.pid for process in trees], skip=skip)
     return sum(_cpu_seconds(process) for process in trees), queued, ready
 
 
@@ -146,10 +218,18 @@ class Patience:
     waiting, however long that takes: what bounds a machine that never runs it is outside
     (a test's time limit, a sandbox's wall time, the learner's stop button).
 
+    What the trees wait for may be the watcher's own process (a subject waits for its
+    judge's clock, its answers, its discovery messages): time the machine kept the watcher
+    from running is not the trees' idle time either.  So an idle interval counts only the
+    part of it that the watcher's most delayed thread did not stand on the run queue (its
+    CPU time never counts: a judge busy with other subjects would make every program it
+    waits on look busy).
+
     Introduced in ``03-write-the-publisher.ipynb`` (how long the judge waits for a subject).
 
     :param pids: the process (or processes) at the top of the trees (a sandbox's own
-        process is fine).
+        process is fine; the watcher's own process too, a wait for itself: the thread
+        that looks is left out).
     :param limit_s: seconds of CPU time, or of idle waiting, the trees are given.
     :param started: when the trees were asked (``time.monotonic()``; default now); the time
         since then counts as waiting.  CPU time counts from now: a caller whose answers
@@ -162,11 +242,22 @@ class Patience:
         self.limit_s = limit_s
         now = time.monotonic()
         self.started = now if started is None else started
-        self.cpu_at_start, queued, _ready = tree_work(self.pids)
+        self.cpu_at_start, queued, _ready = tree_work(self.pids, skip=_this_thread())
         #: Seconds on the wall clock the trees sat idle so far.
         self.idle_s = now - self.started
         self._look = (now, self.cpu_at_start + queued)
         self._verdict = False
+        #: What kept the watcher's own process from running (:meth:`_watcher_threads`).
+        self._held = HeldBack(self._watcher_threads)
+
+    def _watcher_threads(self) -> dict[int, float]:
+        """Each thread of the watcher's process (but the one that looks): its seconds on the
+        run queue so far.  Nothing when the watcher is one of the trees (then its time on
+        the run queue is the trees' work already)."""
+        me = _this_thread()
+        if me[0] in self.pids:
+            return {}
+        return {task: delay for task, _state, delay in _threads(me[0]) if task != me[1]}
 
     def exhausted(self) -> bool:
         """True once the trees have had their limit (call it every fraction of a second: it
@@ -175,12 +266,19 @@ class Patience:
         then, busy_then = self._look
         if self._verdict or now - then < LOOK_S:
             return self._verdict
-        cpu, queued, ready = tree_work(self.pids)
+        cpu, queued, ready = tree_work(self.pids, skip=_this_thread())
+        self._held.look()
         if not ready and cpu + queued - busy_then < BUSY_SHARE * (now - then):
-            self.idle_s += now - then
+            self.idle_s += now - then - self._held.take(now - then)
         self._look = (now, cpu + queued)
         self._verdict = cpu - self.cpu_at_start >= self.limit_s or self.idle_s >= self.limit_s
         return self._verdict
+
+    @property
+    def ran_out_idle(self) -> bool:
+        """Whether the trees had their limit by sitting idle (waiting for something), not by
+        working: of what they waited for, the caller knows whose it was."""
+        return self._verdict and self.idle_s >= self.limit_s
 
 
 def poll(condition: Callable[[], Any], seconds: float) -> bool:
