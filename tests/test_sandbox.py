@@ -286,6 +286,23 @@ def test_wall_time_kills_the_sandbox():
     assert (control.timed_out, control.returncode) == (False, 0)
 
 
+#: A program that works 0.3 CPU-seconds, then ends.
+WORKS = 'import time\nbegin = time.process_time()\nwhile time.process_time() - begin < 0.3: pass'
+
+
+def test_wall_time_counts_no_time_the_machine_keeps_the_sandbox_from_running():
+    """A sandbox held to a twentieth of a CPU (a CPU quota, ``Limits.cpu_share``) works 0.3
+    CPU-seconds in 6 s or more: its wall-time limit of 1 s counts only what it worked and
+    waited, not the time it stood ready for a CPU, so it ends on its own.  A wall clock
+    alone cut it after 1 s: on a busy grading host, an honest notebook as a hang."""
+    started = time.monotonic()
+    result = boxed(Sandbox(env=ENV), python_code(WORKS), Limits(wall_s=1.0, cpu_share=0.05))
+    if 'cpu(cgroup)' not in result.limits_enforced:
+        pytest.skip('no CPU quota can be set here: nothing keeps the sandbox from running')
+    assert (result.returncode, result.timed_out) == (0, False), result
+    assert time.monotonic() - started > 1.0  # the failure prevented: past its wall time
+
+
 class _BwrapWithoutDeathSignal(Sandbox):
     """bwrap as bubblewrap#633 leaves it when it is killed while setting up: its child has
     no parent-death signal yet, so it lives on after bwrap, running the program."""
@@ -328,7 +345,7 @@ def test_cpu_time_of_all_processes_together_kills_the_sandbox():
 
 
 def test_cpu_time_falls_back_to_a_limit_per_process(monkeypatch):
-    monkeypatch.setattr(sandbox.cgroups_of, 'make_cgroups', lambda pids, memory: ([], []))
+    monkeypatch.setattr(sandbox.cgroups_of, 'make_cgroups', lambda *limits: ([], []))
     started = time.monotonic()
     result = boxed(Sandbox(env=ENV), python_code('while True: pass'),
                    Limits(wall_s=PATIENCE_S, cpu_s=1))

@@ -10,10 +10,12 @@ knob, not thirty.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import subprocess
 import time
-from typing import Any, Callable, Optional, Sequence
+from pathlib import Path
+from typing import Any, Callable, Iterator, Optional, Sequence
 
 from ros2nb.patience import child_pids, wait_for_work
 
@@ -91,3 +93,36 @@ def _poll(condition: Callable[[], Any], seconds: float, interval: float) -> bool
             return False
         time.sleep(interval)
     return True
+
+
+@contextlib.contextmanager
+def starved(share: float) -> Iterator[Callable[[int], None]]:
+    """A CPU quota of ``share`` CPUs while the block runs (the grader's own cgroups,
+    :func:`ros2nb_instructor.grading.cgroups.make_cgroups`): ``admit(tid)`` puts a process
+    (by its pid, with the children it starts later) or one thread of this process (by its
+    thread id: cgroup v1 moves a thread alone) under it.  A program there gets at most that
+    share however idle the machine is: slow for certain, not by luck.  Skips the test where
+    no quota can be set (not root, no cpu controller)."""
+    import pytest
+    from ros2nb_instructor.grading import cgroups
+    made, enforced = cgroups.make_cgroups(64, 1 << 30, share)
+    quota = [c for c in made if (c / 'cpu.cfs_quota_us').exists() or (c / 'cpu.max').exists()]
+    if 'cpu(cgroup)' not in enforced or not quota:
+        cgroups.remove(made)
+        pytest.skip('no CPU quota can be set here (needs root and a cpu cgroup controller)')
+
+    def admit(tid: int) -> None:
+        for cgroup in quota:
+            Path(cgroup / ('tasks' if (cgroup / 'tasks').exists() else 'cgroup.threads')
+                 ).write_text(str(tid))
+
+    try:
+        yield admit
+    finally:
+        for cgroup in quota:  # whatever is left goes back where it came from: the root
+            root = cgroup.parent / ('tasks' if (cgroup / 'tasks').exists() else 'cgroup.procs')
+            for tid in (cgroup / ('tasks' if (cgroup / 'tasks').exists() else
+                                  'cgroup.threads')).read_text().split():
+                with contextlib.suppress(OSError):
+                    root.write_text(tid)
+        cgroups.remove(made)

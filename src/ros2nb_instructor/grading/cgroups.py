@@ -14,6 +14,7 @@ import os
 import signal
 import time
 from pathlib import Path
+from typing import Mapping
 
 _CGROUP_PREFIX = 'ros2nb-sandbox-'
 _counter = itertools.count()
@@ -35,13 +36,28 @@ def _own_cgroup(controller: str) -> Path | None:
     return None
 
 
-def make_cgroups(pids: int, memory_bytes: int) -> tuple[list[Path], list[str]]:
+#: Microseconds of the scheduler's period a CPU share is a quota of (the kernel's default).
+CPU_PERIOD_US = 100_000
+
+
+def make_cgroups(pids: int, memory_bytes: int, cpu_share: float | None = None
+                 ) -> tuple[list[Path], list[str]]:
     """Fresh cgroups limiting tasks and memory, v1 pids+memory (with cpuacct), else v2;
-    [] when impossible.  :func:`cpu_seconds` reads their CPU time."""
+    [] when impossible.  :func:`cpu_seconds` reads their CPU time, :func:`threads` lists
+    their threads.
+
+    :param cpu_share: CPUs the processes may use together at most (``1/6``: a sixth of one
+        core, as a small pod of a hub gets), a quota of the scheduler's period (v1 ``cpu``,
+        v2 ``cpu.max``); None: no quota.  A quota that cannot be set is left out of the
+        enforced names.
+    """
     name = f'{_CGROUP_PREFIX}{os.getpid()}-{next(_counter)}'
+    quota = None if cpu_share is None else max(1000, round(cpu_share * CPU_PERIOD_US))
     v1 = {'pids': {'pids.max': pids},
           'memory': {'memory.limit_in_bytes': memory_bytes,
                      'memory.memsw.limit_in_bytes': memory_bytes}}
+    if quota is not None:
+        v1['cpu'] = {'cpu.cfs_period_us': CPU_PERIOD_US, 'cpu.cfs_quota_us': quota}
     made, enforced = [], []
     for controller, files in v1.items():
         parent = _own_cgroup(controller)
@@ -49,15 +65,29 @@ def make_cgroups(pids: int, memory_bytes: int) -> tuple[list[Path], list[str]]:
             made.append(parent / name)
             enforced.append(f'{controller}(cgroup)')
     parent = _own_cgroup('cpuacct')
-    if made and parent and _try_cgroup(parent / name, {}):  # counts, limits nothing
-        made.append(parent / name)
+    if made and parent and parent / name not in made and _try_cgroup(parent / name, {}):
+        made.append(parent / name)  # counts, limits nothing (made above where cpu shares it)
     parent = _own_cgroup('')
     if not made and parent and {'pids', 'memory'} <= set(
             _read(parent / 'cgroup.subtree_control').split()):
-        files = {'pids.max': pids, 'memory.max': memory_bytes, 'memory.swap.max': 0}
-        if _try_cgroup(parent / name, files):
-            made, enforced = [parent / name], ['pids(cgroup)', 'memory(cgroup)']
+        v2: dict[str, int | str] = {'pids.max': pids, 'memory.max': memory_bytes,
+                                    'memory.swap.max': 0}
+        cpu = quota is not None and 'cpu' in _read(parent / 'cgroup.subtree_control').split()
+        if cpu:
+            v2['cpu.max'] = f'{quota} {CPU_PERIOD_US}'
+        if _try_cgroup(parent / name, v2):
+            made = [parent / name]
+            enforced = ['pids(cgroup)', 'memory(cgroup)', *(['cpu(cgroup)'] if cpu else [])]
     return made, enforced
+
+
+def threads(cgroups: list[Path]) -> list[int]:
+    """The ids of every thread in the cgroups now (v1 ``tasks``, v2 ``cgroup.threads``)."""
+    found: set[int] = set()
+    for cgroup in cgroups:
+        for listing in ('tasks', 'cgroup.threads'):
+            found.update(int(tid) for tid in _read(cgroup / listing).split() if tid.isdigit())
+    return sorted(found)
 
 
 def cpu_seconds(cgroups: list[Path]) -> float | None:
@@ -81,7 +111,7 @@ def _read(path: Path) -> str:
         return ''
 
 
-def _try_cgroup(path: Path, files: dict[str, int]) -> bool:
+def _try_cgroup(path: Path, files: Mapping[str, int | str]) -> bool:
     try:
         path.mkdir()
     except OSError:

@@ -72,8 +72,12 @@ def _options(argv: Optional[list[str]]) -> argparse.Namespace:
     parser.add_argument('--notebook-cpu', type=int, default=NOTEBOOK_CPU_S,
                         help="CPU seconds one notebook's run may use in its sandbox")
     parser.add_argument('--judge-cpu', type=int, default=None,
-                        help="CPU seconds one notebook's judge may use with its subjects "
-                             "(default: the course's limit for each notebook)")
+                        help="CPU seconds one check of a notebook's judge may use with its "
+                             "subjects (default: the course's limit for each notebook)")
+    parser.add_argument('--cpu-share', type=_share, default=None, metavar='CPUS',
+                        help='CPUs each sandbox may use at most (e.g. 0.167: a sixth of one '
+                             'core, as a small pod of a hub gets); default: what the machine '
+                             'gives')
     parser.add_argument('--jobs', type=int, default=JOBS)
     parser.add_argument('--force', action='store_true',
                         help='replace an earlier grading/ (and any manual grades in it)')
@@ -86,6 +90,19 @@ def _options(argv: Optional[list[str]]) -> argparse.Namespace:
                         help='grade on the workers of this Dask scheduler (tcp://host:8786)')
     add_options(parser)
     return parser.parse_args(argv)
+
+
+def _share(text: str) -> float:
+    """``--cpu-share``'s value: CPUs, more than 0 and at most this machine's."""
+    try:
+        share = float(text)
+    except ValueError:
+        share = -1.0
+    if not 0 < share <= (os.cpu_count() or 1):
+        raise argparse.ArgumentTypeError(
+            f'{text!r} is no share of this machine\'s {os.cpu_count() or 1} CPUs: give a '
+            'number above 0, e.g. 0.167 for a sixth of one core')
+    return share
 
 
 def _seed(text: str) -> int:
@@ -279,7 +296,7 @@ def _grade(args: argparse.Namespace, submissions: Path, out: Path, started: floa
     grading worked."""
     seed = new_seed() if args.seed is None else args.seed  # one for the class: notes.json
     settings = Settings(args.cell_timeout, args.notebook_timeout, not args.no_sandbox, seed,
-                        args.notebook_cpu, args.judge_cpu)
+                        args.notebook_cpu, args.judge_cpu, args.cpu_share)
     if not args.scheduler:
         return _grade_with(None, args, submissions, out, started, settings)
     from .cluster import Cluster, ClusterProblem  # Dask is imported for a cluster only

@@ -47,7 +47,8 @@ def run_notebook(scratch: Scratch, notebook: str, prepared: nbformat.NotebookNod
             str(out / f'{notebook}.run.ipynb'), f'--cell-timeout={settings.cell_timeout}',
             f'--folder={scratch.home / "notebooks"}']
     env = sandbox_env(scratch.home, ROS2NB_WORKSPACE=str(scratch.workspace))
-    limits = sandbox.Limits(wall_s=settings.notebook_timeout, cpu_s=settings.notebook_cpu)
+    limits = sandbox.Limits(wall_s=settings.notebook_timeout, cpu_s=settings.notebook_cpu,
+                            cpu_share=settings.cpu_share)
     stopped, out_of_cpu = None, False
     if settings.sandboxed:
         box = sandbox.Sandbox(writable=[scratch.home, out], env=env, cwd=scratch.home,

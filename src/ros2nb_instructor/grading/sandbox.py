@@ -54,6 +54,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Mapping, Sequence
@@ -227,17 +228,18 @@ class Sandbox:
                          stage=stage, sources=sources, uid=HOST_UID if drop else None)
 
     def run(self, argv: Sequence[str], limits: Limits = Limits(), input: Any = None,
-            **popen: Any) -> Result:
+            steps: Callable[[str], str | None] | None = None, **popen: Any) -> Result:
         """Run ``argv`` in the sandbox to its end or until ``limits.wall_s`` or ``limits.cpu_s``
         runs out.
 
         :param argv: the program and its arguments, as seen inside.
         :param limits: resource limits.
         :param input: data for stdin (needs ``stdin=subprocess.PIPE``).
+        :param steps: the steps its output lines begin (:func:`run_to_end`).
         :param popen: passed to :class:`subprocess.Popen` (stdout, stderr, pass_fds, text).
         :return: exit code, whether it timed out, which limits were enforced, outputs.
         """
-        return run_to_end(self.start(argv, limits, **popen), input)
+        return run_to_end(self.start(argv, limits, **popen), input, steps)
 
 
 def watched(argv: Sequence[str], limits: Limits = Limits(), **popen: Any) -> Running:
@@ -251,20 +253,47 @@ def watched(argv: Sequence[str], limits: Limits = Limits(), **popen: Any) -> Run
     return _launched(list(argv), limits, popen)
 
 
-def run_to_end(running: Running, input: Any = None) -> Result:
-    """Talk to a started program (``input`` on stdin) until it ends or a limit stops it."""
+def run_to_end(running: Running, input: Any = None,
+               steps: Callable[[str], str | None] | None = None) -> Result:
+    """Talk to a started program (``input`` on stdin) until it ends or a limit stops it.
+
+    :param steps: reads each line the program prints on stdout as it comes (it needs
+        ``stdout=subprocess.PIPE, text=True`` and no ``input``): the name of the step that
+        line begins (:meth:`Running.step`), or None.
+    """
     with running:
-        out, err = running.process.communicate(input)
+        if steps is None:
+            out, err = running.process.communicate(input)
+        else:
+            out, err = _read_steps(running, steps)
         code = running.stop()
     return Result(code, running.timed_out, running.limits_enforced, out, err,
-                  running.out_of_cpu, running.cpu_s)
+                  running.out_of_cpu, running.cpu_s, running.stopped_step)
+
+
+def _read_steps(running: Running, steps: Callable[[str], str | None]) -> tuple[str, str]:
+    """Read the program's stdout line by line, marking its steps, and its stderr beside."""
+    process, errors = running.process, []
+    reader = threading.Thread(target=lambda: errors.append(process.stderr.read())
+                              if process.stderr else None, daemon=True)
+    reader.start()
+    lines = []
+    for line in process.stdout or ():
+        lines.append(line)
+        step = steps(line)
+        if step is not None:
+            running.step(step)
+    process.wait()
+    reader.join()
+    return ''.join(lines), ''.join(e for e in errors if e)
 
 
 def _launched(argv: list[str], limits: Limits, popen: dict, *, stage: Path | None = None,
               sources: Sequence[str] = (), uid: int | None = None) -> Running:
     """``argv`` started through the launcher in fresh cgroups (its limits, or rlimits where no
     cgroup could be made), watched by a :class:`Running`."""
-    cgroups, enforced = cgroups_of.make_cgroups(limits.pids, limits.memory_bytes)
+    cgroups, enforced = cgroups_of.make_cgroups(limits.pids, limits.memory_bytes,
+                                                limits.cpu_share)
     memory_rlimit = None if 'memory(cgroup)' in enforced else limits.memory_bytes
     counted = cgroups_of.cpu_seconds(cgroups) is not None
     cpu_rlimit = None if counted or limits.cpu_s is None else max(1, round(limits.cpu_s))

@@ -21,14 +21,17 @@ NOTEBOOK_TIMEOUT_S = 600
 NOTEBOOK_CPU_S = 140
 #: Seconds the judge may take for one notebook.
 JUDGE_TIMEOUT_S = 600
-#: CPU seconds the judge of each notebook (by its number) may use with the processes that run
-#: the learner's code for it; then it is stopped, and the cells it had not checked score
-#: nothing.  At least 2.3 times the heaviest honest judge of that notebook on a slow, busy
-#: machine, and never under 30: a judge's cost is its notebook's (05 builds the package again
-#: and again, 03 drives an hour), and a loop that logs hundreds of lines a reading, under the
-#: flood limit, costs the class no more than its notebook's limit (docs/decisions.md, "Every
-#: judge's CPU bounded"; benchmarks/notebook_cpu.py measures them).
-JUDGE_CPU_S = {'00': 30, '01': 30, '02': 30, '03': 60, '04': 35, '05': 125, '06': 30,
+#: CPU seconds one check of each notebook (by its number) may use, the judge's and the
+#: processes' that run the learner's code for it, counted from the line the judge prints as
+#: the check begins; then the judge is stopped, and the cells it had not checked score
+#: nothing.  Counted per check, not per notebook: which check of a heavy notebook meets a
+#: limit shared by all of them would depend on how much the earlier ones cost on the day
+#: (a slow flood's main() point did).  At least 2.5 times the heaviest honest check of that
+#: notebook, at a sixth of a CPU beside two CPU burners, and never under 30: a loop that
+#: logs hundreds of lines a reading, under the flood limit, costs the class at most this in
+#: each check it floods (docs/decisions.md, "Every judge's CPU bounded";
+#: benchmarks/load_harness.py measures the checks).
+JUDGE_CPU_S = {'00': 30, '01': 30, '02': 30, '03': 30, '04': 30, '05': 60, '06': 30,
                '07': 30, '08': 30, '09': 30, '10': 55}
 #: Notebooks graded at the same time: one more than the CPUs (a notebook often waits).
 JOBS = (os.cpu_count() or 1) + 1
@@ -39,8 +42,9 @@ class Settings:
     """How to grade: the limits, whether to sandbox, and the seed of the judges' drawn inputs
     (:mod:`ros2nb.checks.drawn`; None: each judge draws its own).  ``notebook_cpu`` (CPU
     seconds; None: no limit) applies only in a sandbox; ``judge_cpu`` (the same for each
-    notebook's judge; None: :data:`JUDGE_CPU_S`) wherever the host can make a cgroup, else
-    per process."""
+    check of a notebook's judge; None: :data:`JUDGE_CPU_S`) wherever the host can make a
+    cgroup; ``cpu_share``, the CPUs each sandbox may use at most (a CPU quota,
+    :class:`~ros2nb_instructor.grading.running.Limits`; None: what the machine gives)."""
 
     cell_timeout: int
     notebook_timeout: int
@@ -48,9 +52,10 @@ class Settings:
     seed: Optional[int] = None
     notebook_cpu: Optional[float] = NOTEBOOK_CPU_S
     judge_cpu: Optional[float] = None
+    cpu_share: Optional[float] = None
 
     def judge_cpu_for(self, notebook: str) -> float:
-        """The CPU seconds the judge of ``notebook`` (``NN-title``) may use."""
+        """The CPU seconds one check of ``notebook`` (``NN-title``) may use."""
         if self.judge_cpu is not None:
             return self.judge_cpu
         return JUDGE_CPU_S.get(notebook[:2], max(JUDGE_CPU_S.values()))
