@@ -43,6 +43,18 @@ class CheckFailed(_OneLine, AssertionError):
     """A check of your work did not pass; the message says what to change."""
 
 
+class NotDecided(_OneLine, RuntimeError):
+    """A check could not decide, for a reason that is not your code's: something it waited
+    for from the grader's own side (its processes, its clock, ROS discovery between them)
+    never came on a machine too busy to bring it.  Nothing is wrong with your code yet: the
+    check runs again by itself (:data:`ros2nb.checks.NOT_DECIDED_TRIES` times in all), and
+    says so when it still could not decide.
+
+    Not a :class:`CheckFailed`: no check may take it for the learner's failure and word it
+    as one.
+    """
+
+
 class LearnerCodeError(CheckFailed):
     """Your own code raised while a check ran it; shown with its traceback (your lines only).
 

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, ContextManager, Optional, Protocol, TypeVar
 
-from .errors import CheckFailed, LearnerCodeError, Ros2nbError
+from .errors import CheckFailed, LearnerCodeError, NotDecided, Ros2nbError
 from .processes import Process
 from .subject_interface import Command
 from .subject_replies import LearnerError, Reply
@@ -318,7 +318,8 @@ def captured(call: Callable[[], Any]) -> dict:
     that check with one line (:data:`UNFINISHED`), so a notebook's other checks still count.
 
     :return: ``passed`` and the printed ``lines``; when failed also ``type``
-        (``'CheckFailed'`` or ``'LearnerCodeError'``), ``message`` and, for the latter,
+        (``'CheckFailed'``, ``'LearnerCodeError'`` or ``'NotDecided'``: the check could
+        not decide, :class:`~ros2nb.errors.NotDecided`), ``message`` and, for the second,
         ``traceback`` (the learner's frames, one string each).
     """
     out = io.StringIO()
@@ -328,6 +329,9 @@ def captured(call: Callable[[], Any]) -> dict:
     except LearnerCodeError as error:
         return {'passed': False, 'type': 'LearnerCodeError', 'message': str(error),
                 'traceback': error.traceback_lines, 'lines': out.getvalue().splitlines()}
+    except NotDecided as error:
+        return {'passed': False, 'type': 'NotDecided', 'message': str(error),
+                'lines': out.getvalue().splitlines()}
     except (CheckFailed, Ros2nbError) as error:
         return {'passed': False, 'type': 'CheckFailed', 'message': str(error),
                 'lines': out.getvalue().splitlines()}
@@ -342,10 +346,13 @@ def show_result(result: dict) -> None:
     """Print a passed result's lines (:func:`captured`), or raise the failure it describes.
 
     :raises CheckFailed: (or :class:`LearnerCodeError`) with the judge's verdict.
+    :raises NotDecided: when the judge could not decide.
     """
     if result['passed']:
         print('\n'.join(result['lines']))
         return
     if result['type'] == 'LearnerCodeError':
         raise LearnerCodeError(result['message'], result['traceback'])
+    if result['type'] == 'NotDecided':
+        raise NotDecided(result['message'])
     raise CheckFailed(result['message'])

@@ -60,7 +60,9 @@ __getattr__, __dir__ = loader(globals(), _MODULE_OF)
 
 
 def run_check(name: str, judge: Optional[Judge], *args: Any, **kwargs: Any) -> None:
-    """Run the body of the check ``name`` once, with ``judge``, and print its passed line.
+    """Run the body of the check ``name`` with ``judge`` and print its passed line; once,
+    or again while it could not decide (:func:`.base.decided`; the judge's subjects end
+    between tries).
 
     The judge's one way into the checks (:mod:`ros2nb.judge`): its lesson's module loads on
     first use, and the body registered under ``name`` runs with the judge's session.
@@ -70,16 +72,23 @@ def run_check(name: str, judge: Optional[Judge], *args: Any, **kwargs: Any) -> N
         :class:`~ros2nb.judge_interface.AnswerRef`).
     :raises ValueError: for a name no lesson registers (a mistake of the course's).
     :raises CheckFailed: (or :class:`~ros2nb.errors.LearnerCodeError`) with the verdict.
+    :raises NotDecided: when no try could decide (its line says so, and why).
     """
-    from .base import CHECKS, passed
+    from .base import CHECKS, decided, passed
     if name in _MODULE_OF:
         getattr(sys.modules[__name__], name)  # loads its lesson's module, which registers it
     if name not in CHECKS:
         raise ValueError(f'no check is named {name!r}')
+    again = judge.drop_all if judge is not None else (lambda: None)
+    passed(decided(lambda: _run_once(CHECKS[name], judge, args, kwargs), again))
+
+
+def _run_once(body: Any, judge: Optional[Judge], args: tuple[Any, ...],
+              kwargs: dict[str, Any]) -> str:
+    """One run of a check's body; its passed line."""
     observer = getattr(judge, 'observer', None)
     if observer is None:
-        passed(CHECKS[name](judge, *args, **kwargs))
-        return
+        return body(judge, *args, **kwargs)
     # A flood of the learner's code fails the check it happened in, whatever the check made
     # of what was left (the judge ended the flooding processes): its line says what happened.
     # So does code that reached into the course as it ran (the subjects' audit hooks), first.
@@ -88,7 +97,7 @@ def run_check(name: str, judge: Optional[Judge], *args: Any, **kwargs: Any) -> N
     if reaching is not None:
         reaching.forget()
     try:
-        message = CHECKS[name](judge, *args, **kwargs)
+        message = body(judge, *args, **kwargs)
     except BaseException:
         if reaching is not None:
             reaching.raise_any()
@@ -97,7 +106,8 @@ def run_check(name: str, judge: Optional[Judge], *args: Any, **kwargs: Any) -> N
     if reaching is not None:
         reaching.raise_any()
     observer.floods.raise_any()
-    passed(message)
+    return message
+
 
 #: Checks that ``progress(check=True)`` leaves out although they need no argument: each
 #: builds the package with colcon (tens of seconds on a busy machine).

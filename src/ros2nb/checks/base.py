@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Any, Callable, Iterator
 
 from .. import course, graded_parts, working
-from ..errors import CheckFailed, Ros2nbError
+from ..errors import CheckFailed, NotDecided, Ros2nbError
 from ..explain.exceptions import describe_error
 from ..judge_interface import learner_error
 from ..subject_replies import LearnerError
@@ -146,12 +146,38 @@ def direct(body: Body) -> Callable[..., None]:
         try:
             with _progress_kept(body.__name__):
                 with working.shown(body.__name__):
-                    message = body(None, *args, **kwargs)
+                    message = decided(lambda: body(None, *args, **kwargs), lambda: None)
                 passed(message)
         finally:
             _running.pop()
 
     return _register(body, call)
+
+
+#: Times a check runs before it says it could not decide (:class:`~ros2nb.errors.NotDecided`):
+#: what it waited for from the grader's own side came in none of them.
+NOT_DECIDED_TRIES = 3
+#: The line of a check that could not decide, after its last try.
+NOT_DECIDED = ('Not decided, nothing is wrong with your code yet: {reason} ({tries} tries, on a '
+               'machine too busy to bring it). Run this check again; if it says this again, '
+               'tell your instructor.')
+
+
+def decided(run_once: Callable[[], str], between: Callable[[], None]) -> str:
+    """A check's passed line: ``run_once()``, run again (after ``between()``) while it could
+    not decide, :data:`NOT_DECIDED_TRIES` times in all.
+
+    :raises NotDecided: when no try could decide (:data:`NOT_DECIDED`, with the last reason).
+    """
+    for tries in range(1, NOT_DECIDED_TRIES + 1):
+        try:
+            return run_once()
+        except NotDecided as why:
+            if tries == NOT_DECIDED_TRIES:
+                raise NotDecided(NOT_DECIDED.format(reason=str(why).rstrip('.'),
+                                                    tries=tries)) from None
+            between()
+    raise AssertionError('unreachable')  # pragma: no cover - the loop returns or raises
 
 
 def passed(message: str) -> None:

@@ -144,6 +144,14 @@ def _run_and_judge(scratch: Scratch, learner: Learner, notebook: str,
     return Judging(tuple(said), executed, verdict)
 
 
+#: A graded cell's result type when its check could not decide (:class:`ros2nb.errors.NotDecided`).
+NOT_DECIDED = 'NotDecided'
+#: The note of a notebook with cells its judge could not decide.
+UNDECIDED = ('the grader could not decide {cells} (what it waited for from its own side never '
+             'came: the machine was too busy), which score nothing for now: grade this learner '
+             'again (LEARNER=) when the machine is calm')
+
+
 def _not_gradable(error: Exception) -> str:
     """The note of a notebook the grader could not take through (its feedback says it)."""
     if isinstance(error, OSError) and error.errno == errno.ENOSPC:
@@ -167,6 +175,10 @@ def judged(notebook: str, release: nbformat.NotebookNode, outcome: Outcome) -> G
             verdict: Verdict = outcome.verdict.result()
             if verdict.problem:
                 said.append(verdict.problem)
+            undecided = sorted(gid for gid, r in verdict.results.items()
+                               if not r.get('passed') and r.get('type') == NOT_DECIDED)
+            if undecided:  # not the learner's failure: grade them again once the host is calm
+                said.append(UNDECIDED.format(cells=', '.join(undecided)))
             if verdict.flags:  # the instructor's to look at; the points are the verdict alone
                 said.append(f'{FLAGGED} ' + ' | '.join(verdict.flags))
                 flags = tuple(verdict.flags)
