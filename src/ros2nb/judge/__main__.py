@@ -2,8 +2,10 @@
 
 The judge's command line (see :mod:`ros2nb.judge`): it opens a :class:`Session`, runs the
 body of each check asked for with it (:func:`ros2nb.checks.run_check`) and prints one JSON
-line with the outcome; while grading, also one line per graded cell as soon as it is decided
-(``{"cell": ID, "result": ...}``), which is what a judge stopped at its limits leaves.  A
+line with the outcome; while grading, also one line as each graded cell starts
+(``{"begin": ID}``: the grader counts each check's CPU time from there) and one as soon as
+it is decided (``{"cell": ID, "result": ..., "cpu_s": ...}``, with the CPU seconds it took,
+this process's and its subjects'), which is what a judge stopped at its limits leaves.  A
 check draws its inputs from a seed the judge draws itself; only the grader gives one
 (``--seed``, :mod:`ros2nb.checks.drawn`), the learner's kernel never.
 """
@@ -17,6 +19,7 @@ from pathlib import Path
 from typing import Any, Optional
 
 from .. import working
+from ..patience import tree_cpu_seconds
 from ..processes import end_this_process
 from ..subject.forked import SUBJECT_PREFIX_ENV, serve_from_here
 
@@ -74,10 +77,18 @@ def main(argv: list[str]) -> int:
             if rewritten:  # what another cell wrote into the package is never graded
                 session.grade_as_written(rewritten)
 
-            def checked(grade_id: str, outcome: dict[str, Any]) -> None:
-                print(json.dumps({'cell': grade_id, 'result': outcome}), flush=True)
+            began = [0.0]
 
-            result = {'results': grade(source, submission, session, checked),
+            def starting(grade_id: str) -> None:
+                began[0] = tree_cpu_seconds(os.getpid())
+                print(json.dumps({'begin': grade_id}), flush=True)
+
+            def checked(grade_id: str, outcome: dict[str, Any]) -> None:
+                cpu_s = round(tree_cpu_seconds(os.getpid()) - began[0], 2)
+                print(json.dumps({'cell': grade_id, 'result': outcome, 'cpu_s': cpu_s}),
+                      flush=True)
+
+            result = {'results': grade(source, submission, session, checked, starting),
                       'flags': flags + [REWRITTEN.format(name=Path(r).name) for r in rewritten]
                       + session.reaching.flags()}
     finally:

@@ -8,7 +8,11 @@ what it hears per logger on ``/rosout`` and per topic it watches, and the subjec
 what it sent (:meth:`Floods.announced`), in windows of one second of the judge's clock (or
 while it stands still); past :data:`FLOOD_LIMIT` the judge keeps no more of it, ends the
 processes that run the learner's code and fails the check with one line
-(:class:`~ros2nb.judge_interface.Flooded`).  What those processes had sent and the judge had
+(:class:`~ros2nb.judge_interface.Flooded`).  So does more in one check than any node of the course sends in
+the longest check (:data:`CHECK_FLOOD_LIMIT`): a loop that logs hundreds of lines for each
+reading stays under the window's limit, and its cost grows with every simulated second a check
+runs; counted in messages, not CPU seconds, it is found in the same check however busy the
+machine.  What those processes had sent and the judge had
 not read yet arrives later, and belongs to them, not to the next check: once they are reaped,
 a message stamped by its sender (on the machine's one clock) before that moment is dropped
 (:meth:`Floods.stale`), however long the judge takes to read it.  Introduced in
@@ -28,6 +32,11 @@ from ..judge_interface import Flooded
 #: readings while the clock stands still.
 FLOOD_LIMIT = 500
 FLOOD_WINDOW_NS = 1_000_000_000
+#: Lines one logger may send, and messages a watched topic may carry, within one check: the
+#: longest checks hear an hour of the sensor (3,600 readings, a line each) and notebook 10's
+#: recording its monitor's 3,600 statuses beside; a fifth of what a judge can hear within the
+#: CPU limit of one check (``ros2nb_instructor.grading.settings.JUDGE_CPU_S``).
+CHECK_FLOOD_LIMIT = 20_000
 
 
 class Floods:
@@ -47,22 +56,25 @@ class Floods:
         self.on_flood: Callable[[], None] = lambda: None
         self.stopped_ns = 0
         self._windows: dict[tuple[str, str, str], list[int]] = {}
+        self._totals: dict[tuple[str, str, str], int] = {}
         self._said: dict[tuple[int, str, str], int] = {}
 
     def count(self, where: str, who: str, count: int = 1, source: str = 'heard') -> bool:
         """Count ``count`` messages of ``who`` on ``where`` (``source``: heard by the judge,
-        or ``said`` by a subject) in their window of the judge's clock; True (keep them not)
-        once the window holds more than :data:`FLOOD_LIMIT`.  The caller holds
-        ``observer.changed``."""
-        now = self._observer.now_ns
-        window = self._windows.setdefault((source, where, who), [now, 0])
+        or ``said`` by a subject) in their window of the judge's clock and in this check; True
+        (keep them not) once the window holds more than :data:`FLOOD_LIMIT`, or the check
+        more than :data:`CHECK_FLOOD_LIMIT`.  The caller holds ``observer.changed``."""
+        now, key = self._observer.now_ns, (source, where, who)
+        window = self._windows.setdefault(key, [now, 0])
         if now - window[0] >= FLOOD_WINDOW_NS:
             window[:] = [now, 0]
         window[1] += count
-        if window[1] <= FLOOD_LIMIT:
+        self._totals[key] = total = self._totals.get(key, 0) + count
+        if window[1] <= FLOOD_LIMIT and total <= CHECK_FLOOD_LIMIT:
             return False
         if self.line is None:
-            self.line = flood_line(where, who, now - window[0])
+            self.line = flood_line(where, who, now - window[0]) if window[1] > FLOOD_LIMIT \
+                else check_flood_line(where, who)
             self._observer.changed.notify_all()
         return True
 
@@ -81,6 +93,7 @@ class Floods:
         with self._observer.changed:
             self.line = None
             self._windows.clear()
+            self._totals.clear()
 
     def stale(self, info: Any) -> bool:
         """True for a message (its rmw message info) its sender stamped before the flooding
@@ -117,3 +130,15 @@ def flood_line(where: str, who: str, span_ns: int) -> str:
     return (f'Your code published over {FLOOD_LIMIT:,} messages on {who} {when} (the sensor '
             'publishes one a second): look for a loop that publishes without waiting for a '
             'timer.')
+
+
+def check_flood_line(where: str, who: str) -> str:
+    """The one line of a flood of ``who`` on ``where`` over one check
+    (:data:`CHECK_FLOOD_LIMIT`)."""
+    if where == '/rosout':
+        return (f'Your node {who} logged over {CHECK_FLOOD_LIMIT:,} lines to /rosout in one '
+                'check (a node of the course logs one line per reading or tick, 3,600 in an '
+                'hour): look for a loop that logs many lines for each reading.')
+    return (f'Your code published over {CHECK_FLOOD_LIMIT:,} messages on {who} in one check (the '
+            'sensor publishes one a second, 3,600 in an hour): look for a loop that publishes '
+            'many messages for each reading.')

@@ -66,8 +66,8 @@ def _defined_names(source: str) -> set[str]:
 
 
 def grade(source: dict, submission: dict, judge: Judge,
-          checked: Callable[[str, dict], None] = lambda grade_id, result: None
-          ) -> dict[str, dict]:
+          checked: Callable[[str, dict], None] = lambda grade_id, result: None,
+          starting: Callable[[str], None] = lambda grade_id: None) -> dict[str, dict]:
     """Run every graded cell of ``source`` (the course's notebook, hidden tests included).
 
     Names in a graded call (``LoudListener``) are the learner's: the judge passes an
@@ -79,6 +79,7 @@ def grade(source: dict, submission: dict, judge: Judge,
         (nbgrader ``solution: true``) are used.
     :param judge: the session every check's body runs with (:func:`ros2nb.checks.run_check`).
     :param checked: called with each graded cell's id and result as soon as it is decided.
+    :param starting: called with each graded cell's id before its checks run.
     :return: ``{grade_id: result}`` with ``passed``, ``lines``, ``type``, ``message``.
     """
     context = [nbmeta.text(c) for c in nbmeta.cells(source) if nbmeta.CONTEXT_TAG in
@@ -89,6 +90,7 @@ def grade(source: dict, submission: dict, judge: Judge,
     names = {name: AnswerRef(name, sources) for text in answers for name in _defined_names(text)}
     results = {}
     for grade_id, cell in nbmeta.graded_cells(source):
+        starting(grade_id)
         results[grade_id] = result = {'passed': True, 'lines': []}
         for name, args, keywords in graded_calls(nbmeta.text(cell)):
             values = [_value(a, names) for a in args]

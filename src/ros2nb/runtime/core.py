@@ -99,10 +99,12 @@ class Runtime(LogLines, Spinning, NodeKeeping, SimulatedClock):
         self.node = node_serving_nothing(INTERNAL_NODE_NAME, enable_rosout=False)
         self._clock_publisher = self.node.create_publisher(
             Clock, '/clock', 10, event_callbacks=QUIET_PUBLISHER)
-        rosout_qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE,
-                                durability=DurabilityPolicy.TRANSIENT_LOCAL)
-        self.node.create_subscription(Log, '/rosout', self._on_log, rosout_qos,
-                                      event_callbacks=QUIET_SUBSCRIPTION)
+        if self.judge_time is None:  # a judge's subject shows no lines: the judge hears them
+            # itself, and a flood of the learner's cost the subject as much again to hear
+            rosout_qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE,
+                                    durability=DurabilityPolicy.TRANSIENT_LOCAL)
+            self.node.create_subscription(Log, '/rosout', self._on_log, rosout_qos,
+                                          event_callbacks=QUIET_SUBSCRIPTION)
         self.executor.add_node(self.node)
         self.follow_judge_clock()  # in a judge's subject only: the judge's time from now on
         self.start_spinning()

@@ -78,7 +78,8 @@ def judge_notebook(scratch: Scratch, notebook: str, submitted: nbformat.Notebook
     argv = judge_argv(source, given / 'submission.ipynb', settings)
     env = sandbox_env(own / 'home', ROS2NB_WORKSPACE=str(workspace),
                       TMPDIR=str(own / 'tmp'), **{SUBJECTS_FOLDER_ENV: str(subjects)})
-    limits = sandbox.Limits(wall_s=JUDGE_TIMEOUT_S, cpu_s=settings.judge_cpu_for(notebook))
+    limits = sandbox.Limits(wall_s=JUDGE_TIMEOUT_S, cpu_step_s=settings.judge_cpu_for(notebook),
+                            cpu_share=settings.cpu_share)
     try:
         if settings.sandboxed:
             env['FASTDDS_BUILTIN_TRANSPORTS'] = 'UDPv4'  # judge and subjects: own /dev/shm each
@@ -90,23 +91,38 @@ def judge_notebook(scratch: Scratch, notebook: str, submitted: nbformat.Notebook
             # see only the copies it hands them.
             box = sandbox.Sandbox(writable=[folder], env=env, cwd=given, nested=True,
                                   readable=[ROOT / 'src', workspace, given])
-            result = box.run(argv, limits, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                             text=True)
+            result = box.run(argv, limits, steps=check_begins, stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)
         else:  # no sandbox: its limits all the same
             result = sandbox.run_to_end(sandbox.watched(
                 argv, limits, env={**os.environ, **env}, cwd=given, stdout=subprocess.PIPE,
-                stderr=subprocess.PIPE, text=True))
+                stderr=subprocess.PIPE, text=True), steps=check_begins)
     except OSError as error:  # e.g. the notebook made its workspace unreadable
         return Verdict({}, f'the grader could not check it: {error}')
     if result.timed_out or result.out_of_cpu:
-        return stopped_verdict(result.stdout or '', source, result.out_of_cpu and limits.cpu_s)
+        return stopped_verdict(result.stdout or '', source,
+                               result.out_of_cpu and limits.cpu_step_s, result.step)
     return _read_verdict(result.stdout, result.stderr, result.returncode)
 
 
-def stopped_verdict(out: str, source: Path, cpu_s: Optional[float] = None) -> Verdict:
-    """The verdict of a judge stopped at a limit (``cpu_s``: its CPU time's, else its wall
-    time's): the results of the graded cells it had checked (one JSON line each, as it went),
-    and a line that says so and names the cells not checked, which score nothing."""
+def check_begins(line: str) -> Optional[str]:
+    """The graded cell whose check begins at this line of the judge's (``{"begin": ID}``),
+    or None: each check's CPU time counts from there (``Limits.cpu_step_s``)."""
+    if not line.startswith('{"begin"'):
+        return None
+    with contextlib.suppress(ValueError):
+        begun = json.loads(line)
+        if isinstance(begun, dict) and isinstance(begun.get('begin'), str):
+            return begun['begin']
+    return None
+
+
+def stopped_verdict(out: str, source: Path, cpu_s: Optional[float] = None,
+                    check: Optional[str] = None) -> Verdict:
+    """The verdict of a judge stopped at a limit (``cpu_s``: the CPU time of one ``check``,
+    else its wall time): the results of the graded cells it had checked (one JSON line each,
+    as it went), and a line that says so and names the cells not checked, which score
+    nothing."""
     results = {}
     for line in out.splitlines():
         with contextlib.suppress(ValueError, TypeError, KeyError):
@@ -115,13 +131,14 @@ def stopped_verdict(out: str, source: Path, cpu_s: Optional[float] = None) -> Ve
                 results[str(printed['cell'])] = printed['result']
     unchecked = [grade_id for grade_id, _cell in nbmeta.graded_cells(
         json.loads(source.read_text())) if grade_id not in results]
-    limit = (f'the grader\'s limit of {cpu_s:g} CPU-seconds for checking a notebook (its checks '
-             'and the processes that ran your code, together)' if cpu_s else
+    limit = (f'the grader\'s limit of {cpu_s:g} CPU-seconds for one check (the check and the '
+             'processes that ran your code, together)' if cpu_s else
              f'the grader\'s limit of {JUDGE_TIMEOUT_S} s for checking a notebook')
     one = len(unchecked) == 1
     said = (f'{", ".join(unchecked)} {"was" if one else "were"} not checked and '
             f'score{"s" if one else ""} nothing' if unchecked else 'every graded cell was checked')
-    return Verdict(results, f'checking it reached {limit} and was stopped: its points come '
+    what = f'checking {check}' if check else 'checking it'
+    return Verdict(results, f'{what} reached {limit} and was stopped: its points come '
                             f'from the checks that had run; {said}')
 
 
