@@ -10,8 +10,9 @@ own command (``python -m ros2nb.judge grade``, in a process and session of its o
 on the submission.  Only the learner's kernel and the sandboxes are left out: a notebook's
 answer cells reach the judge as its files and its answer cells, which is all the judge reads.
 
-``python tests/corpora.py [--seed N] [NAME ...]`` prints ``name<TAB>score<TAB>full marks
-less the parts it must lose<TAB>failed grade ids``, one line per learner; with an older
+``python tests/corpora.py [--seed N] [--cpu-share CPUS] [--json] [NAME ...]`` prints
+``name<TAB>score<TAB>full marks less the parts it must lose<TAB>failed grade ids``, one line
+per learner (with ``--json`` every part's result); with an older
 checkout's ``src`` on ``PYTHONPATH`` it scores the same learners with that checkout's judge
 (the closing notes' "before" column).
 """
@@ -41,6 +42,12 @@ JUDGE_TIMEOUT_S = 270
 #: Seconds a test of the corpora takes beside its judges (writing each learner's workspace,
 #: comparing the results).
 BESIDE_JUDGES_S = 30
+#: Simulated seconds of notebook 03's hidden hour for a learner graded for other parts: the
+#: hour is most of a 03 grading's CPU time, and what it checks (every reading's step and
+#: range) holds from the first minutes.  A learner who must lose the hour gets the whole of
+#: it, and so does the sample class's complete learner (tests/test_grading.py), through the
+#: grader.
+SHORT_HOUR_S = 300
 
 
 def time_limit_s(gradings: int) -> int:
@@ -199,20 +206,24 @@ def learner_workspace(learner: Learner, root: Path) -> Iterator[tuple[Path, dict
 
 
 def grade_learner(learner: Learner, root: Path, *, knows_nothing: bool = False,
-                  seed: Optional[int] = None) -> dict[str, dict]:
+                  seed: Optional[int] = None, cpu_share: Optional[float] = None
+                  ) -> dict[str, dict]:
     """Grade one learner's notebook in a fresh workspace under ``root``, with the judge's
     own command in a process and session of its own (``judge_apart.py``), as the grader
     runs it (with the grading's ``seed`` of the drawn inputs, when given).
 
     :param knows_nothing: the judge's reader of the learner's text finds nothing.
+    :param cpu_share: CPUs the judge and its subjects may use together (a CPU quota; None:
+        what the machine gives), as the grader's ``--cpu-share``.
     :return: ``{grade id without NN-: result}`` (``passed``, and ``message`` when failed).
     :raises AssertionError: when the judge printed no result (its output in the message).
     """
-    return judged(learner, root, knows_nothing=knows_nothing, seed=seed)[0]
+    return judged(learner, root, knows_nothing=knows_nothing, seed=seed, cpu_share=cpu_share)[0]
 
 
 def judged(learner: Learner, root: Path, *, knows_nothing: bool = False,
-           seed: Optional[int] = None) -> tuple[dict[str, dict], list[str]]:
+           seed: Optional[int] = None, cpu_share: Optional[float] = None
+           ) -> tuple[dict[str, dict], list[str]]:
     """:func:`grade_learner`'s results, and the judge's flags (its text scan's and what the
     subjects' audit hooks saw, ``at run time``)."""
     from ros2nb import domains
@@ -227,26 +238,29 @@ def judged(learner: Learner, root: Path, *, knows_nothing: bool = False,
     (given / 'submission.ipynb').write_text(json.dumps(nb))
     env = {k: v for k, v in os.environ.items() if k != domains.DOMAIN_ENV}
     env.update({WORKSPACE_ENV: str(ws), GRADING_ENV: '1'})
+    short = learner.notebook == '03' and not _hour_judged(learner)
     command = [sys.executable, str(ROOT / 'tests' / 'judge_apart.py'),
                *(['--knows-nothing'] if knows_nothing else []),
+               *(['--hour-s', str(SHORT_HOUR_S)] if short else []),
                str(given / 'source.ipynb'), str(given / 'submission.ipynb'),
                *(['--seed', str(seed)] if seed is not None else [])]
-    # Bounded as the grader bounds a judge: its CPU time and its subjects' together.
+    # Bounded as the grader bounds a judge: each check's CPU time and its subjects' together.
     from ros2nb_instructor.grading import sandbox
-    from ros2nb_instructor.grading.judging import stopped_verdict
+    from ros2nb_instructor.grading.judging import check_begins, stopped_verdict
     from ros2nb_instructor.grading.settings import JUDGE_CPU_S
     cpu_s = JUDGE_CPU_S[learner.notebook]
-    judge = sandbox.watched(command, sandbox.Limits(wall_s=JUDGE_TIMEOUT_S, cpu_s=cpu_s),
+    judge = sandbox.watched(command, sandbox.Limits(wall_s=JUDGE_TIMEOUT_S, cpu_step_s=cpu_s,
+                                                    cpu_share=cpu_share),
                             env=env, cwd=root, text=True, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, start_new_session=True)
     try:
-        ended = sandbox.run_to_end(judge)
+        ended = sandbox.run_to_end(judge, steps=check_begins)
     finally:
         kill_process_group(judge.process)  # what it left (nothing, once it answered)
     out, err = ended.stdout, ended.stderr
     if ended.out_of_cpu or ended.timed_out:  # what it had not checked scores nothing, as
         verdict = stopped_verdict(out, given / 'source.ipynb',  # in the grader
-                                  ended.out_of_cpu and cpu_s)
+                                  ended.out_of_cpu and cpu_s, ended.step)
         unchecked = {'passed': False, 'type': 'GradingError', 'message': verdict.problem}
         return ({gid: verdict.results.get(f'{learner.notebook}-{gid}', unchecked)
                  for gid in points(learner.notebook)}, [])
@@ -255,6 +269,13 @@ def judged(learner: Learner, root: Path, *, knows_nothing: bool = False,
     verdict = json.loads(lines[-1])
     return ({gid[3:]: result for gid, result in verdict['results'].items()},
             verdict.get('flags', []))
+
+
+def _hour_judged(learner: Learner) -> bool:
+    """Whether the learner (or, for an attack, its twin) must lose notebook 03's hour: then
+    the whole hour decides it."""
+    twin = every_learner().get(learner.twin) if learner.twin else None
+    return 'sensor-hour' in (*learner.loses, *(twin.loses if twin else ()))
 
 
 def flags_of(learner: Learner, root: Path) -> list[str]:
@@ -284,23 +305,40 @@ def every_learner() -> dict[str, Learner]:
     return found
 
 
-def main(names: list[str]) -> int:
-    """Print each named learner's score (all of them without names); ``--seed N`` first:
-    the grading's seed of the drawn inputs (else the judge draws one)."""
-    seed = None
-    if names[:1] == ['--seed']:
-        seed, names = int(names[1]), names[2:]
+def main(argv: list[str]) -> int:
+    """Print each named learner's score (all of them without names).  Options first:
+    ``--seed N``, the grading's seed of the drawn inputs (else the judge draws one);
+    ``--cpu-share CPUS``, the judge's CPU quota (:func:`grade_learner`); ``--json``, one
+    JSON line per learner instead: its name and every part's result
+    (``benchmarks/load_harness.py`` compares them)."""
+    seed, share, as_json, names = None, None, False, list(argv)
+    while names[:1] in (['--seed'], ['--cpu-share'], ['--json']):
+        option = names.pop(0)
+        if option == '--json':
+            as_json = True
+        elif option == '--seed':
+            seed = int(names.pop(0))
+        else:
+            share = float(names.pop(0))
     learners = every_learner()
     for name in names or learners:
         learner = learners[name]
         with tempfile.TemporaryDirectory(prefix='ros2nb-corpus-') as root:
             try:
-                results = grade_learner(learner, Path(root), seed=seed)
+                results = grade_learner(learner, Path(root), seed=seed, cpu_share=share)
                 failed = sorted(gid for gid, r in results.items() if not r['passed'])
                 shown = f'{score(learner, results):g}'
             except Exception as error:  # an older judge may not grade it at all
+                results = {}
                 failed, shown = [f'{type(error).__name__}: {error}'[:120]], 'error'
-        print(f'{name}\t{shown}\t{expected_score(learner):g}\t{",".join(failed)}', flush=True)
+        if as_json:
+            print(json.dumps({'name': name, 'results': {
+                gid: {k: r.get(k) for k in ('passed', 'type', 'message')}
+                for gid, r in results.items()}, 'error': None if results else failed[0]}),
+                flush=True)
+        else:
+            print(f'{name}\t{shown}\t{expected_score(learner):g}\t{",".join(failed)}',
+                  flush=True)
     return 0
 
 

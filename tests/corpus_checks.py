@@ -7,7 +7,10 @@
   in their text nor as their code runs (the subjects' audit hooks).
 - A wrong learner (``corpus_wrong.py``) loses exactly the part it gets wrong, each with a
   one-line message.
-- An attack (``corpus_attacks.py``) scores what its honest twin scores.
+- An attack (``corpus_attacks.py``) scores no more than its honest twin: it loses every
+  part its twin loses.  The twin itself is a wrong learner, graded once a run with the wrong
+  corpus (``test_corpus_wrong.py``), which shows that it loses exactly those parts: the
+  attack is held to them, not graded beside it again.
 """
 
 from __future__ import annotations
@@ -37,12 +40,10 @@ def loses_exactly_its_part(learner: Learner, root: Path) -> None:
 
 
 def scores_what_its_twin_scores(attack: Learner, twin: Learner, root: Path) -> None:
-    attacked = grade_learner(attack, root / 'attack')
-    honest = grade_learner(twin, root / 'twin')
-    assert set(failed(honest)) == set(twin.loses)
+    attacked = grade_learner(attack, root)
     # The protection is that an attack gains nothing: it loses every part its twin loses.
     # It may lose more: a flood logged outside the runtime (not spun on the judge's clock,
     # so never acknowledged) can still be arriving when a later part of the same notebook
     # listens, and then that part hears it too.
-    assert set(failed(attacked)) >= set(failed(honest)), failed(attacked)
-    assert score(attack, attacked) <= score(twin, honest)
+    assert set(failed(attacked)) >= set(twin.loses), failed(attacked)
+    assert score(attack, attacked) <= expected_score(twin)

@@ -1,13 +1,13 @@
-"""Attacks beside their twins, and the text reader that only words failures.
+"""Attacks held to their twins, and the text reader that only words failures.
 
 The honest and wrong corpora are graded in ``test_corpus_honest.py`` and
-``test_corpus_wrong.py`` (see ``corpus_checks.py``).  Each attack (``corpus_attacks.py``)
-scores what its honest twin scores, except those the wire cannot tell from honest code, which
-the judge flags for the instructor instead (``tests/test_flags.py``).  The attacks that reach
-into the process they run in (``corpus_reaching.py``) are graded twice beside their twins,
-with two seeds of the drawn inputs: each scores at most its twin's in both, its lost parts
-say why in one line, and those the subject's audit hook sees (``seen``) are flagged at run
-time.
+``test_corpus_wrong.py`` (see ``corpus_checks.py``), the attacks' honest twins with the wrong
+corpus: each twin loses exactly its parts.  Each attack (``corpus_attacks.py``) loses every
+part its twin loses, except those the wire cannot tell from honest code, which the judge
+flags for the instructor instead (``tests/test_flags.py``).  The attacks that reach into the
+process they run in (``corpus_reaching.py``) are graded twice, with two seeds of the drawn
+inputs: each loses its twin's parts in both, its lost parts say why in one line, and those
+the subject's audit hook sees (``seen``) are flagged at run time.
 
 ``python tests/corpora.py`` prints every learner's score; run with an older checkout's judge it
 gives the "before" column of the closing notes.
@@ -15,27 +15,22 @@ gives the "before" column of the closing notes.
 
 from __future__ import annotations
 
-import functools
-import tempfile
-from pathlib import Path
-
 import pytest
 
-from corpora import grade_learner, judged, score, time_limit_s
+from corpora import expected_score, grade_learner, judged, score, time_limit_s
 from corpus_attacks import ATTACKS
 from corpus_checks import failed, scores_what_its_twin_scores
 from corpus_reaching import REACHING
 from ros2nb.checks.drawn import new_seed
 
-#: Each test but the text reader's grades an attack and its twin.
-pytestmark = [pytest.mark.judge, pytest.mark.timeout(time_limit_s(2))]
+#: Each test grades one learner.
+pytestmark = [pytest.mark.judge, pytest.mark.timeout(time_limit_s(1))]
 TWINS = {learner.name: learner for learner in ATTACKS}
-#: The two seeds of this run's gradings of the reaching attacks and their twins (each
-#: pytest-xdist worker draws its own: a new pair every run).
+#: The two seeds of this run's gradings of the reaching attacks (each pytest-xdist worker
+#: draws its own: a new pair every run).
 SEEDS = (new_seed(), new_seed())
 
 
-@pytest.mark.timeout(time_limit_s(1))
 @pytest.mark.parametrize('knows_nothing', [False, True],
                          ids=['with the reader', 'with a reader that knows nothing'])
 def test_the_text_reader_only_words_failures(knows_nothing, tmp_path):
@@ -62,24 +57,14 @@ def test_an_attack_scores_what_its_twin_scores(attack, tmp_path):
     scores_what_its_twin_scores(attack, TWINS[attack.twin], tmp_path)
 
 
-@functools.lru_cache(maxsize=None)
-def _twin(name: str, seed: int) -> dict:
-    """The twin's results with ``seed`` (graded once per worker and seed, in a folder of
-    its own removed afterwards: the results are all that is kept)."""
-    with tempfile.TemporaryDirectory(prefix='ros2nb-twin-') as root:
-        return grade_learner(TWINS[name], Path(root), seed=seed)
-
-
 @pytest.mark.parametrize('run', [0, 1], ids=['seed 1', 'seed 2'])
 @pytest.mark.parametrize('attack', REACHING, ids=[a.name for a in REACHING])
 def test_reaching_in_scores_at_most_its_twin_and_says_so(attack, run, tmp_path):
     seed, twin = SEEDS[run], TWINS[attack.twin]
     attacked, flags = judged(attack, tmp_path, seed=seed)
-    honest = _twin(attack.twin, seed)
     lost = failed(attacked)
     context = (seed, lost, flags)
-    assert set(failed(honest)) == set(twin.loses), (seed, failed(honest))
-    assert set(lost) >= set(failed(honest)), context
-    assert score(attack, attacked) <= score(twin, honest), context
+    assert set(lost) >= set(twin.loses), context
+    assert score(attack, attacked) <= expected_score(twin), context
     assert all(message and '\n' not in message for message in lost.values()), context
     assert any('at run time' in flag for flag in flags) == attack.seen, context
