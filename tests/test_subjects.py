@@ -16,7 +16,8 @@ import pytest
 
 from ros2nb.judge import observer
 from ros2nb.judge.subjects import SubjectHung, SubjectProcess
-from ros2nb.subject_interface import Call, ExecCells
+from ros2nb.errors import NotDecided
+from ros2nb.subject_interface import Call, ExecCells, NewNode
 from ros2nb.subject_replies import Called, Encoded, Output
 from ros2nb.patience import BUSY_SHARE, Patience, tree_cpu_seconds, wait_for_work
 from waiting import PATIENCE_S, run_to_end, starved, wait_until
@@ -90,6 +91,32 @@ print('starved', flush=True)
 while True:
     pass
 """
+
+
+#: A node class, in a cell of its own, for the judge's clock test below.
+NODE_CELL = """
+from rclpy.node import Node
+
+class Quiet(Node):
+    def __init__(self):
+        super().__init__('quiet')
+"""
+
+
+def test_a_subject_that_waits_idle_for_the_judges_clock_is_not_decided(tmp_path):
+    """A subject's new runtime waits for its judge's first /clock (its time), and says so on
+    the judge's pipe.  When that never comes, the learner's code has not run yet: the check
+    could not decide, and says so; it once blamed the learner's code for not finishing.
+    Here no judge publishes a clock at all."""
+    process = SubjectProcess(tmp_path)
+    try:
+        assert process.request(ExecCells(sources=[NODE_CELL])).cell_errors == []
+        with pytest.raises(NotDecided, match="^the grader's clock never reached the process "
+                                             'that runs your code$'):
+            process.request(NewNode(cls='Quiet', stand_ins=[], args=[]), timeout=LIMIT_S)
+    finally:
+        process.close()
+
 
 
 def test_a_program_the_scheduler_starves_is_working_not_waiting():

@@ -30,6 +30,9 @@ if TYPE_CHECKING:  # only the types: no ROS import here
 #: limit costs time only on a busy machine or when the thing never comes.  Generous: the
 #: learner's verdict must not depend on how busy the machine is.
 ARRIVAL_TIMEOUT_S = 60.0
+#: What the names of the judge's own nodes begin with, as the ROS graph shows them: what is
+#: not the learner's on a topic.
+JUDGE_NODES = '_ros2nb_judge'
 #: The reply type of the command a check sends (:mod:`ros2nb.subject_interface`).
 R = TypeVar('R', bound=Reply)
 
@@ -158,7 +161,7 @@ class Observer(Protocol):
         shows them, once it holds ``expected`` (what the subject said it made) or after
         ``seconds``; sorted, without ROS's own topics.
 
-        :raises CheckFailed: when ``seconds`` pass first (the line says what was seen).
+        :raises NotDecided: when ``seconds`` pass first (the line says what was seen).
         """
 
     def spins(self, name: str, namespace: str = '/', seconds: float = ...) -> bool:

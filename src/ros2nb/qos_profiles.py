@@ -84,3 +84,24 @@ def policy_name(kind: Any) -> str:
         return QoSPolicyKind(kind).name.capitalize()
     except ValueError:
         return str(kind)
+
+
+def why_unmatched(node: Any, topic: str, ours: str) -> Optional[str]:
+    """Why an endpoint of the nodes named ``ours...`` (a prefix) on ``topic`` and another's
+    cannot talk, from the profiles the graph shows (``node`` sees it): ``'publisher'`` or
+    ``'subscription'`` (the one of ours it cannot reach), then :func:`incompatibility`'s line;
+    None when every pair could match."""
+    publishers = node.get_publishers_info_by_topic(topic)
+    subscriptions = node.get_subscriptions_info_by_topic(topic)
+    for offers, requests, side in ((publishers, subscriptions, 'subscription'),
+                                   (publishers, subscriptions, 'publisher')):
+        for offered in offers:
+            for requested in requests:
+                mine = offered if side == 'publisher' else requested
+                other = requested if side == 'publisher' else offered
+                if not mine.node_name.startswith(ours) or other.node_name.startswith(ours):
+                    continue
+                why = incompatibility(offered.qos_profile, requested.qos_profile)
+                if why:
+                    return f'{side}: {why}'
+    return None

@@ -9,11 +9,12 @@ from pathlib import Path
 from typing import Any, Optional
 
 from .. import course
-from ..errors import CheckFailed
+from ..errors import CheckFailed, NotDecided
+from ..qos_profiles import why_unmatched
 from ..terminal.files import parts_verdict
 from std_msgs.msg import Float32
 
-from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, Subject, learner_error
+from ..judge_interface import ARRIVAL_TIMEOUT_S, JUDGE_NODES, Judge, Subject, learner_error
 from ..subject_interface import NewNode, WaitPublishers, WaitReceived
 from ..subject_replies import Counts, LearnerError, NodeMade
 
@@ -57,6 +58,18 @@ def new_node(judge: Judge, relative: str, cls: str, *, stand_ins: tuple[str, ...
     return subject, reply
 
 
+def unreached(judge: Judge, topic: str, what: str) -> Exception:
+    """Why ``what`` (the learner's publisher or subscription on ``topic``) and the grader's
+    endpoint there never matched: a profile the other side cannot serve (a CheckFailed that
+    names it, rclpy's own rule, from the profiles the graph shows), or else a machine too
+    busy to bring them together in time (:class:`~ros2nb.errors.NotDecided`)."""
+    why = why_unmatched(judge.observer.node, topic, JUDGE_NODES)
+    if why is not None:
+        side, _, reason = why.partition(': ')
+        return CheckFailed(f"{what} on {topic} cannot reach the grader's {side}: {reason}")
+    return NotDecided(f"{what} on {topic} never reached the grader's endpoint there")
+
+
 def raised(what: str, error: Optional[LearnerError]) -> CheckFailed:
     """The failure for ``what`` a subject could not do: the ``error`` the learner's code
     raised, or, when its reply named none, one line to run the check again."""
@@ -91,8 +104,7 @@ def reach(judge: Judge, subject: Subject, node: str) -> None:
     _ = judge.probe_publisher  # created before the subject looks for it
     if not subject.request(WaitPublishers(topic='/' + course.TOPIC, seconds=ARRIVAL_TIMEOUT_S),
                            timeout=ARRIVAL_TIMEOUT_S + 10).ok:
-        raise CheckFailed(f"The grader's publisher on /{course.TOPIC} never reached {node}: "
-                          'check its subscription\'s topic name and type.')
+        raise unreached(judge, '/' + course.TOPIC, f'The subscription of {node}')
 
 
 def announced(counts: Counts, topic: str) -> Optional[int]:

@@ -26,7 +26,7 @@ from .base import judged
 from .drawn import chooser
 from .mains import run_main
 from .file_nodes import (announced, feed, lines_logged, new_node, raised, reach,
-                         started_log_verdict)
+                         started_log_verdict, unreached)
 from .verdicts import endpoint_verdict, node_name_verdict
 
 #: Readings the fan check sends (°C): both sides of the High threshold; then drawn ones.
@@ -69,9 +69,7 @@ def _fan_controller(judge: Judge) -> str:
     started_log_verdict(judge, info, mark, course.FAN_CLASS)  # the task's third step
     if not subject.request(WaitMatched(topic='/' + course.FAN_TOPIC,
                                        seconds=ARRIVAL_TIMEOUT_S)).ok:
-        raise CheckFailed(f'The fan controller\'s publisher never reached the grader\'s '
-                          f'subscription on /{course.FAN_TOPIC}: is the machine very busy? '
-                          'Run this check again.')
+        raise unreached(judge, '/' + course.FAN_TOPIC, f'The publisher of {info.name}')
     reach(judge, subject, info.name)
     counts: Counts = info
     fan_topic = '/' + course.FAN_TOPIC

@@ -24,7 +24,7 @@ from std_msgs.msg import Int32
 
 from .. import qos
 from ..explain.ros_settings import zero_depth_refused
-from ..errors import CheckFailed
+from ..errors import CheckFailed, NotDecided
 from .answers import defined_verdict, type_name_of
 from ..judge_interface import ARRIVAL_TIMEOUT_S, AnswerRef, Judge, learner_error
 from ..subject_interface import QosAcked, QosEndpoint
@@ -131,15 +131,14 @@ def _kept(history: QoSProfile) -> qos.Deliveries:
     kernel's, or the judge's own, never a subject's).  A burst that did not arrive whole met
     a busy machine, not the profile: it is sent again, to a new subscription.
 
-    :raises CheckFailed: when that happened :data:`BURST_TRIES` times (run it again).
+    :raises NotDecided: when that happened :data:`BURST_TRIES` times.
     """
     for _ in range(BURST_TRIES):
         got = qos.burst(_reliable(history), count=BURST)
         if got.matched and _whole(got.received):
             return got
-    raise CheckFailed(f'The grader\'s burst of {BURST} never reached a subscription with your '
-                      f'profile whole in {BURST_TRIES} tries (is the machine very busy?): run '
-                      'this check again.')
+    raise NotDecided(f'the grader\'s burst of {BURST} never reached a subscription with your '
+                     f'profile whole in {BURST_TRIES} tries')
 
 
 def _judged_match(judge: Judge, ref: AnswerRef,

@@ -19,7 +19,7 @@ from ..errors import CheckFailed
 from ..judge_interface import ARRIVAL_TIMEOUT_S, Judge, Subject, learner_error
 from ..subject_interface import Run, SetAttribute, WaitMatched
 from ..subject_replies import NodeMade
-from .file_nodes import lines_logged, new_node
+from .file_nodes import lines_logged, new_node, unreached
 
 #: Steps of the judge's clock (s), and the probe before each while a constructor runs: a timer
 #: of another period fires on the probe, off the whole periods (JudgeClock.drive's probe_s).
@@ -77,8 +77,7 @@ def run_sensor(judge: Judge, sensor: SensorRun, seconds: float, *, probe_s: floa
     if start_c is not None:
         subject.request(SetAttribute(name='temperature', value=start_c))
     if not subject.request(WaitMatched(topic=TOPIC, seconds=ARRIVAL_TIMEOUT_S)).ok:
-        raise CheckFailed(f'The publisher on {TOPIC} never reached the grader\'s subscription '
-                          '(is the machine very busy?): run this check again.')
+        raise unreached(judge, TOPIC, f'The publisher of {sensor.info.name}')
     first, log_mark, began = len(readings), len(observer.logs), judge.clock.now_ns
     try:
         reply = judge.clock.drive(subject, Run(seconds=seconds, seed=seed), step_s=STEP_S,

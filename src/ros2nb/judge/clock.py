@@ -19,8 +19,9 @@ from typing import Any, Optional, TypeVar
 from rosgraph_msgs.msg import Clock
 
 from .. import working
-from ..judge_interface import ARRIVAL_TIMEOUT_S, learner_error
-from ..errors import CheckFailed
+from ..judge_interface import ARRIVAL_TIMEOUT_S, JUDGE_NODES, learner_error
+from ..errors import CheckFailed, NotDecided
+from ..qos_profiles import why_unmatched
 from ..patience import Patience
 from ..processes import kill_process_group
 from ..subject.judge_time import JUDGE_CLOCK_QOS
@@ -103,6 +104,7 @@ class JudgeClock:
         :raises CheckFailed: when the spin wants more than ``limit_s``, or a message the
             subject announced never arrives.
         :raises SubjectHung: when the subject neither answers nor finishes a step in time.
+        :raises NotDecided: when it sat idle that long waiting for the judge's clock.
         :raises TypeError: for a subject this judge did not start.
         """
         if not isinstance(subject, SubjectProcess):
@@ -160,7 +162,7 @@ class JudgeClock:
                 patience, looked = Patience(subject.proc.pid, timeout,
                                             started=quiet_since), time.monotonic()
             elif patience.exhausted():
-                raise subject.given_up(timeout)
+                raise subject.ran_out(patience, timeout)
             else:
                 looked = time.monotonic()
 
@@ -200,6 +202,11 @@ class JudgeClock:
             return short
 
         if not observer.wait_until(lambda: not missing(), ARRIVAL_TIMEOUT_S):
-            raise CheckFailed(f'Messages on {", ".join(missing())} were published but never '
-                              f'reached the grader within {ARRIVAL_TIMEOUT_S:g} s (is the '
-                              'machine very busy?): run this check again.')
+            for topic in missing():  # a profile the grader's subscription cannot take
+                why = why_unmatched(observer.node, topic, JUDGE_NODES) \
+                    if not topic.startswith('/rosout') else None
+                if why is not None:
+                    raise CheckFailed(f'Messages on {topic} were published but cannot reach '
+                                      f"the grader's {why}")
+            raise NotDecided(f'Messages on {", ".join(missing())} were published but never '
+                             'reached the grader')

@@ -8,11 +8,11 @@ what it hears per logger on ``/rosout`` and per topic it watches, and the subjec
 what it sent (:meth:`Floods.announced`), in windows of one second of the judge's clock (or
 while it stands still); past :data:`FLOOD_LIMIT` the judge keeps no more of it, ends the
 processes that run the learner's code and fails the check with one line
-(:class:`~ros2nb.judge_interface.Flooded`).  So does more in one check than any node of the course sends in
-the longest check (:data:`CHECK_FLOOD_LIMIT`): a loop that logs hundreds of lines for each
-reading stays under the window's limit, and its cost grows with every simulated second a check
-runs; counted in messages, not CPU seconds, it is found in the same check however busy the
-machine.  What those processes had sent and the judge had
+(:class:`~ros2nb.judge_interface.Flooded`).  So does more in one check than any node of the
+course sends in the longest check (:data:`CHECK_FLOOD_LIMIT`): a loop that logs hundreds of
+lines for each reading stays under the window's limit, and its cost grows with every
+simulated second a check runs; counted in messages, not CPU seconds, it is found in the same
+check however busy the machine.  What those processes had sent and the judge had
 not read yet arrives later, and belongs to them, not to the next check: once they are reaped,
 a message stamped by its sender (on the machine's one clock) before that moment is dropped
 (:meth:`Floods.stale`), however long the judge takes to read it.  Introduced in

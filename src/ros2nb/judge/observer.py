@@ -25,8 +25,8 @@ from rclpy.serialization import deserialize_message
 from rclpy.signals import SignalHandlerOptions
 
 from .. import domains
-from ..judge_interface import ARRIVAL_TIMEOUT_S, Heard, Line
-from ..errors import CheckFailed
+from ..judge_interface import ARRIVAL_TIMEOUT_S, JUDGE_NODES, Heard, Line
+from ..errors import NotDecided
 from ..patience import LOOK_S, Patience, wait_for_work
 from ..runtime import QUIET_SUBSCRIPTION, node_serving_nothing
 from ..runtime.services import call_until_answered
@@ -61,7 +61,7 @@ class Observer:
         self.context = rclpy.Context()
         rclpy.init(context=self.context, domain_id=self.domain_id,
                    signal_handler_options=SignalHandlerOptions.NO)
-        self.node = node_serving_nothing('_ros2nb_judge', context=self.context)
+        self.node = node_serving_nothing(JUDGE_NODES, context=self.context)
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
         self.changed = threading.Condition()
@@ -152,7 +152,7 @@ class Observer:
         """A node of the judge's that no thread spins: what its subscriptions receive waits in
         their history until the judge takes it (nothing taken before it asks)."""
         if self._quiet is None:
-            self._quiet = node_serving_nothing('_ros2nb_judge_taker', context=self.context)
+            self._quiet = node_serving_nothing(f'{JUDGE_NODES}_taker', context=self.context)
         return self._quiet
 
     def counts(self) -> tuple[dict[str, int], dict[str, int]]:
@@ -216,7 +216,7 @@ class Observer:
 
         :return: ``(kind, topic, type)`` triples, ``kind`` being ``'publisher'`` or
             ``'subscription'``, sorted, without ROS's own topics.
-        :raises CheckFailed: when ``seconds`` pass first (the line says what was seen).
+        :raises NotDecided: when ``seconds`` pass first (the line says what was seen).
         """
         want = {tuple(e) for e in expected}
         owners: dict[bytes, set] = {}
@@ -233,7 +233,7 @@ class Observer:
 
         if not wait_for_work(covered, self.attending(), seconds):
             # not the learner's mistake: say what happened
-            raise CheckFailed(self._unseen(name, len(owners), want, found, seconds))
+            raise NotDecided(self._unseen(name, len(owners), want, found, seconds))
         return sorted(e for e in found if e[1] not in ('/rosout', '/parameter_events', '/clock'))
 
     def _endpoint_infos(self) -> list[tuple[str, str, Any]]:
@@ -270,13 +270,12 @@ class Observer:
         """Why the graph never showed what a subject said its node made, in one line."""
         if processes > 1:
             return (f'{processes} programs have a node named {name} on the grader\'s ROS domain '
-                    f'{self.domain_id}, so the grader cannot tell yours apart: run this check '
-                    'again (another program on this machine uses that domain).')
+                    f'{self.domain_id}, so the grader cannot tell yours apart (another program '
+                    'on this machine uses that domain)')
         missing = ', '.join(f'{kind} on {topic}' for kind, topic, _ in sorted(want - found))
         shown = ', '.join(f'{kind} on {topic}' for kind, topic, _ in sorted(found)) or 'nothing'
-        return (f'The grader could not see the {missing} of {name} in the ROS graph within '
-                f'{seconds:g} s (it saw {shown}; is the machine very busy?): run this check '
-                'again.')
+        return (f'the grader could not see the {missing} of {name} in the ROS graph (it saw '
+                f'{shown})')
 
     def spins(self, name: str, namespace: str = '/', seconds: float = ARRIVAL_TIMEOUT_S) -> bool:
         """True once the node ``name`` answers a call of its ``list_parameters`` service.

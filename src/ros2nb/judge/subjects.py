@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any, Callable, Optional, TypeVar
 
 from .. import domains
-from ..errors import CheckFailed
+from ..errors import CheckFailed, NotDecided
 from ..patience import Patience
 from ..processes import kill_process_group, stop_process_group
 from ..subject.judge_time import JUDGE_CLOCK_ENV
@@ -137,6 +137,16 @@ def _well_formed_ack(line: bytes) -> Optional[dict]:
     return ack
 
 
+def _waiting(line: bytes) -> Optional[str]:
+    """What a subject says it waits for (``{"waiting": TEXT or null}``), or None."""
+    try:
+        said = json.loads(line)
+    except ValueError:
+        return None
+    waiting = said.get('waiting') if isinstance(said, dict) else None
+    return waiting[:80] if isinstance(waiting, str) else None
+
+
 class SubjectHung(CheckFailed):
     """The learner's code did not answer in time."""
 
@@ -175,6 +185,10 @@ class SubjectProcess:
         #: sent with the first command, before any learner code runs there.
         self.seal = secrets.token_hex(32)
         self._sealed = False
+        #: What the subject last said it waits for on the judge's side (the judge's clock,
+        #: :data:`~ros2nb.subject.judge_time.WAITING_FOR_CLOCK`), or None: idle there, it is
+        #: not the learner's code that hangs.
+        self.waiting_for: Optional[str] = None
         #: What the learner's code reached for, as the subject's audit hook wrote it on the
         #: same pipe (:mod:`ros2nb.judge.reaching`), in order.
         self.seen: list[Reached] = []
@@ -236,6 +250,8 @@ class SubjectProcess:
             ack = _well_formed_ack(line)
             if ack is not None:
                 newest = ack
+            elif line.startswith(b'{"waiting"'):
+                self.waiting_for = _waiting(line)
         if newest is not None:
             self.last_ack = newest
         return newest
@@ -274,6 +290,8 @@ class SubjectProcess:
             machine never turns slow honest work into a hang.
         :raises SubjectHung: when no reply comes within ``timeout`` seconds, or the
             process died (its last output line is in the message).
+        :raises NotDecided: when it sat idle that long waiting for the judge's side (its
+            clock: :attr:`waiting_for`).
         :raises Exception: what :attr:`while_waiting` raises (the session's:
             :class:`~ros2nb.judge_interface.Flooded`).
         :raises ros2nb.typed_json.Unreadable: for a reply that does not fit its type.
@@ -295,7 +313,17 @@ class SubjectProcess:
             if patience is None:
                 patience = Patience(self.proc.pid, timeout, started=sent)
             elif patience.exhausted():
-                raise self.given_up(timeout)
+                raise self.ran_out(patience, timeout)
+
+    def ran_out(self, patience: Patience, timeout: float) -> Exception:
+        """End this subject, which had its ``patience`` (of ``timeout`` seconds); the error to
+        raise for it: :class:`NotDecided` when it sat idle waiting for the judge's side
+        (:attr:`waiting_for`), else :meth:`given_up`'s."""
+        self.take_ack()  # what it said last
+        if patience.ran_out_idle and self.waiting_for is not None:
+            kill_process_group(self.proc)
+            return NotDecided(f'{self.waiting_for} never reached the process that runs your code')
+        return self.given_up(timeout)
 
     def given_up(self, timeout: float) -> SubjectHung:
         """End this subject, which used up ``timeout`` seconds; the error to raise for it."""

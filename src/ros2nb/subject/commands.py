@@ -33,6 +33,7 @@ from rclpy.node import Node
 from .. import domains
 from ..endpoints import node_endpoints
 from ..errors import Ros2nbError
+from ..patience import wait_for_work
 from ..runtime import Runtime, enable_field_checks
 from ..subject_interface import (COMMANDS, Call, Command, ExecCells, GetCounts, LoadFile,
                                  NewNode, Run, Serve, Serves, SetAttribute, StandIns,
@@ -47,6 +48,16 @@ from .trials import Trials
 
 #: Exit code when a command could not even be read.
 PROTOCOL_ERROR = 3
+#: Longest wait for a message in one round of :meth:`Subject.wait_received` (s): a message
+#: ends the wait at once.
+RECEIVE_WAIT_S = 0.05
+
+
+def _waited(condition: Callable[[], bool], seconds: float) -> bool:
+    """Whether ``condition()`` came true before this process had ``seconds`` of work or idle
+    waiting for it (:func:`ros2nb.patience.wait_for_work`, its own threads watched): a
+    subject the machine starves, or that waits for a judge the machine starves, waits on."""
+    return wait_for_work(condition, [os.getpid()], seconds)
 
 
 def _without_magics(source: str) -> str:
@@ -236,39 +247,41 @@ class Subject(Trials):
 
     def wait_matched(self, command: WaitMatched) -> Reply:
         """Wait until the node's publishers on ``topic`` reach a subscription (the judge's)."""
-        topic, deadline = command.topic, time.monotonic() + command.seconds
         node = self.node
         publishers = [p for p in node.publishers
-                      if node.resolve_topic_name(p.topic_name) == topic] if node else []
-        while time.monotonic() < deadline:
-            if publishers and all(p.get_subscription_count() >= 1 for p in publishers):
-                return Reply(ok=True)
-            time.sleep(0.01)
-        return Reply(ok=False)
+                      if node.resolve_topic_name(p.topic_name) == command.topic] if node else []
+        return Reply(ok=bool(publishers) and _waited(
+            lambda: all(p.get_subscription_count() >= 1 for p in publishers), command.seconds))
 
     def wait_publishers(self, command: WaitPublishers) -> Reply:
         """Wait until the node's subscriptions on ``topic`` have matched a publisher (the
         judge's).  Their own match, not the graph's list: in a subject that made a node
         before, the graph already lists the judge's publisher while the new subscription
         has not matched it yet, and a reading sent then was lost."""
-        topic, deadline = command.topic, time.monotonic() + command.seconds
         node = self.node
         subscriptions = [s for s in node.subscriptions
-                         if node.resolve_topic_name(s.topic_name) == topic] if node else []
-        while subscriptions and time.monotonic() < deadline:  # none: nothing can match
-            if all(s.get_publisher_count() >= 1 for s in subscriptions):
-                return Reply(ok=True)
-            time.sleep(0.01)
-        return Reply(ok=False)
+                         if node.resolve_topic_name(s.topic_name) == command.topic] if node else []
+        return Reply(ok=bool(subscriptions) and _waited(  # none: nothing can match
+            lambda: all(s.get_publisher_count() >= 1 for s in subscriptions), command.seconds))
 
     def wait_received(self, command: WaitReceived) -> Counts:
-        """Run callbacks until the node's subscriptions took ``count`` messages (or time is up)."""
+        """Run callbacks until the node's subscriptions took ``count`` messages (or this
+        process sat idle ``seconds`` waiting for them)."""
         rt, count = self._runtime(), command.count
-        deadline = time.monotonic() + command.seconds
-        while self.received < count and time.monotonic() < deadline:
-            with rt.exclusive():
-                rt.drain()
-            time.sleep(0.002)
+
+        def drained(condition: Callable[[], bool], seconds: float) -> bool:
+            deadline = time.monotonic() + seconds
+            while not condition():
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    return False
+                with rt.exclusive():
+                    rt._run_one(min(left, RECEIVE_WAIT_S))  # wakes when a message comes
+                    rt.drain()
+            return True
+
+        wait_for_work(lambda: self.received >= count, [os.getpid()], command.seconds,
+                      look=drained)
         with rt.exclusive():
             rt.drain()
         return Counts(ok=self.received >= count, **self._counts())

@@ -24,6 +24,7 @@ from rclpy.publisher import Publisher
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 
+from ..patience import wait_for_work
 from ..runtime.simulated_clock import follow_judge_time
 
 #: Set by a judge for its subjects: the file descriptor its runtime writes one line to for
@@ -36,10 +37,15 @@ JUDGE_CLOCK_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
 #: The topics the judge hears (a JSON list in the environment of its subjects): a message
 #: published there must reach it, so a subject's spin starts once they are matched.
 JUDGE_TOPICS_ENV = 'ROS2NB_JUDGE_TOPICS'
-#: Wall-clock seconds a subject's spin waits at most for its publishers to reach the judge.
+#: Seconds a subject's spin waits at most for its publishers to reach the judge, and for the
+#: judge to say it heard a finished spin: of this process's work, or of its idle waiting
+#: (:func:`ros2nb.patience.wait_for_work`), never time the machine kept it from running.
 JUDGE_MATCH_WAIT_S = 30.0
 #: Seconds one wait for the judge's next step lasts before it is waited for again.
 JUDGE_STEP_WAIT_S = 0.5
+#: What a subject says on the judge's pipe while its new runtime waits for the judge's first
+#: ``/clock`` (``{"waiting": "the judge's clock"}``; ``{"waiting": null}`` once it came).
+WAITING_FOR_CLOCK = "the grader's clock"
 
 
 class JudgeTime:
@@ -161,11 +167,21 @@ class JudgeTime:
     # ------------------------------------------------------------ what the runtime asks
     def follow(self, runtime: Any) -> None:
         """Subscribe ``runtime``'s own node to the judge's ``/clock`` and take its time now:
-        waits for the judge's latest step (kept for late joiners)."""
+        waits for the judge's latest step (kept for late joiners), and says so on the judge's
+        pipe meanwhile (:data:`WAITING_FOR_CLOCK`): a process that sits idle there waits for
+        the judge, not for the learner's code."""
         runtime.node.create_subscription(Clock, '/clock', self.on_clock, JUDGE_CLOCK_QOS)
-        while self.latest_ns is None:
-            runtime._run_one(JUDGE_STEP_WAIT_S)
+        if self.latest_ns is None:
+            self._say({'waiting': WAITING_FOR_CLOCK})
+            while self.latest_ns is None:
+                runtime._run_one(JUDGE_STEP_WAIT_S)
+            self._say({'waiting': None})
         runtime.sim_now_ns = self.latest_ns
+
+    def _say(self, what: dict[str, Any]) -> None:
+        """One line of JSON on the judge's pipe."""
+        with contextlib.suppress(OSError):  # the judge went away: nothing left to tell
+            os.write(self._fd, (json.dumps(what) + '\n').encode())
 
     def take_latest(self, runtime: Any) -> None:
         """Move ``runtime`` to the judge's latest step, if the judge's clock moved on."""
@@ -212,25 +228,29 @@ class JudgeTime:
                 self.ack(runtime.sim_now_ns, end_ns, runtime.failures, runtime.is_ours)
             released = self.heard
             self.ack(runtime.sim_now_ns, None, runtime.failures, runtime.is_ours)
+
+            def taken(condition: Callable[[], bool], seconds: float) -> bool:
+                deadline = time.monotonic() + seconds
+                while not condition() and time.monotonic() < deadline:
+                    runtime.stop_button.point()
+                    runtime._run_one(min(JUDGE_STEP_WAIT_S, seconds))
+                return condition()
+
             # Go on (the caller may destroy the nodes next, and with them their lines not yet
             # delivered) once the judge says it heard all of it, at most JUDGE_MATCH_WAIT_S.
-            deadline = time.monotonic() + JUDGE_MATCH_WAIT_S
-            while self.heard == released and time.monotonic() < deadline:
-                runtime.stop_button.point()
-                runtime._run_one(JUDGE_STEP_WAIT_S)
+            wait_for_work(lambda: self.heard != released, [os.getpid()], JUDGE_MATCH_WAIT_S,
+                          look=taken)
 
 
 def _reach_judge(runtime: Any, topics: frozenset) -> None:
-    """Wait (at most :data:`JUDGE_MATCH_WAIT_S` of the wall clock) until each publisher of
-    ``runtime``'s on a topic the judge hears has matched a subscription: a message published
-    before the judge's subscription was discovered would never reach it (a volatile topic
-    keeps nothing for late joiners), however idle or busy the machine."""
+    """Wait (at most :data:`JUDGE_MATCH_WAIT_S`) until each publisher of ``runtime``'s on a
+    topic the judge hears has matched a subscription: a message published before the judge's
+    subscription was discovered would never reach it (a volatile topic keeps nothing for late
+    joiners), however idle or busy the machine."""
     publishers = [p for node in (runtime.node, *runtime.nodes.values()) for p in node.publishers
                   if p.topic_name in topics]
-    deadline = time.monotonic() + JUDGE_MATCH_WAIT_S
-    while any(p.get_subscription_count() < 1 for p in publishers) and \
-            time.monotonic() < deadline:
-        time.sleep(0.01)
+    wait_for_work(lambda: all(p.get_subscription_count() >= 1 for p in publishers),
+                  [os.getpid()], JUDGE_MATCH_WAIT_S)
 
 
 def install() -> None:
