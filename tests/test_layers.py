@@ -20,7 +20,8 @@ ARCHITECTURE = ROOT / 'docs' / 'architecture.md'
 #: its own layer (no circles) and of the layers below, never of a layer above.
 LAYERS: list[tuple[str, ...]] = [
     # ros2nb: the learner's kernel; the judge and its subjects reuse the lower layers.
-    ('ros2nb.errors', 'ros2nb.patience', 'ros2nb.processes', 'ros2nb.endpoints', 'ros2nb.nbmeta',
+    ('ros2nb.errors', 'ros2nb.patience', 'ros2nb.processes', 'ros2nb.temporary',
+     'ros2nb.endpoints', 'ros2nb.nbmeta',
      'ros2nb.on_first_use', 'ros2nb.typed_json', 'ros2nb.working', 'ros2nb.unfinished',
      'ros2nb.graded_parts'),
     ('ros2nb.domains',),

@@ -16,6 +16,7 @@ from .kernel import add, install, shutdown, spin, start, stop
 from .on_first_use import loader
 from .runtime import current_runtime
 from .runtime.rates import callback_groups, timer_runs
+from .temporary import temporary_folder
 from .terminal.background import NodeProcess, ros2_start, stop_all
 from .terminal.colcon import colcon_build, source_workspace
 from .terminal.echo import message_type, record, topic_echo, topic_hz
@@ -56,6 +57,6 @@ __all__ = [
     'param_dump', 'param_get', 'param_list', 'param_set', 'pkg_create', 'progress', 'qos',
     'record', 'rules',
     'ros2_run', 'ros2_start', 'run_and_interrupt', 'shutdown', 'source_workspace', 'spin',
-    'start', 'stop', 'stop_all', 'timer_runs', 'topic_echo', 'topic_hz', 'topic_info',
-    'topic_list', 'tree', 'unmatched_topics', 'write_file', 'write_part',
+    'start', 'stop', 'stop_all', 'temporary_folder', 'timer_runs', 'topic_echo', 'topic_hz',
+    'topic_info', 'topic_list', 'tree', 'unmatched_topics', 'write_file', 'write_part',
 ]

@@ -12,11 +12,11 @@ import contextlib
 import math
 import random
 import shutil
-import tempfile
 from pathlib import Path
 from typing import Any, Iterator, Optional
 
 from .. import course
+from ..temporary import owned_folder, temporary_folder
 from ..terminal import bag
 
 from ..judge_interface import Judge
@@ -43,8 +43,7 @@ def fresh_path(judge: Optional[Judge], name: str) -> Iterator[Path]:
     """A bag folder that does not exist yet, in the judge's scratch folder (None: the kernel's
     temporary one); removed with what the learner's function put beside it once the check
     is done."""
-    parent = str(judge.scratch) if judge is not None else None
-    folder = Path(tempfile.mkdtemp(prefix='ros2nb-bag-', dir=parent))
+    folder = owned_folder('ros2nb-bag-', judge.scratch if judge is not None else None)
     try:
         yield folder / name
     finally:
@@ -76,7 +75,7 @@ def check_bag(judge: Optional[Judge], name: str, readings: list[float]) -> Itera
             write_check_bag(path, readings)
             yield path
         return
-    with tempfile.TemporaryDirectory(prefix='ros2nb-bag-') as private:
+    with temporary_folder('bag') as private:
         write_check_bag(Path(private) / name, readings)
         files = {f'{name}/{f.name}': f.read_bytes() for f in (Path(private) / name).iterdir()}
     folder = judge.hand_over('ros2nb-bag-', files)

@@ -14,11 +14,11 @@ import os
 import secrets
 import shutil
 import stat
-import tempfile
 from pathlib import Path
 from typing import Iterator
 
 from ..errors import CheckFailed
+from ..temporary import owned_folder
 
 #: Most bytes :func:`taken_back` copies out of one folder (an hour's bag is < 1 MiB).
 MAX_TAKEN_BACK_BYTES = 64 << 20
@@ -82,7 +82,7 @@ def taken_back(scratch: Path, scratch_fd: int, folder: Path) -> Iterator[Path]:
     """
     relative = folder.relative_to(scratch)
     opened: list[int] = []
-    private = Path(tempfile.mkdtemp(prefix='ros2nb-taken-back-'))
+    private = owned_folder('ros2nb-taken-back-')
     try:
         where = scratch_fd
         for part in relative.parts:

@@ -11,7 +11,6 @@ import os
 import shutil
 import subprocess
 import sys
-import tempfile
 from importlib import resources
 from pathlib import Path
 from typing import Any, Callable, ContextManager, Optional
@@ -26,6 +25,7 @@ from ..errors import CheckFailed
 from ..processes import Process, kill_process_group, wait_patiently
 from ..subject.judge_time import JUDGE_TOPICS_ENV
 from ..subject.forked import fork_program
+from ..temporary import owned_folder
 from ..terminal.files import parts_verdict
 from ..terminal.workspace import WORKSPACE_ENV
 from . import handed
@@ -60,8 +60,7 @@ class Session:
         #: or a fresh one, drawn here, after the subjects' fork server started.
         self.seed = new_seed() if seed is None else seed
         shared = subjects_folder()
-        self.scratch = Path(tempfile.mkdtemp(prefix='ros2nb-judge-',
-                                             dir=home_and_tmp(shared)[1] if shared else None))
+        self.scratch = owned_folder('ros2nb-judge-', home_and_tmp(shared)[1] if shared else None)
         # Opened before any subject runs: what the judge writes there for them goes through
         # this descriptor, never through a path a subject may have changed since.
         self._scratch_fd = os.open(self.scratch, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW)

@@ -53,11 +53,12 @@ import os
 import shutil
 import subprocess
 import sys
-import tempfile
 import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Mapping, Sequence
+
+from ros2nb.temporary import owned_folder
 
 from . import cgroups as cgroups_of
 from .running import Limits, MiB, Result, Running, remove
@@ -216,7 +217,7 @@ class Sandbox:
             _check_world_readable([*(_python_paths() if self.python else ()), *self.readable])
             for path in self.writable:
                 _hand_over(Path(path))
-        stage = Path(tempfile.mkdtemp(prefix='ros2nb-stage-')) if drop else None
+        stage = owned_folder('ros2nb-stage-') if drop else None
         sources: list[str] = []
 
         def staged(path: Path) -> str:  # HOST_UID cannot look up e.g. /root/.pyenv itself

@@ -21,8 +21,8 @@ import threading
 from pathlib import Path
 from typing import Callable, Iterator, Optional
 
-import psutil
 
+from ros2nb import temporary
 from ros2nb.terminal.workspace import WORKSPACE_NAME
 
 from .paths_of_learners import mount_capped, nearly_full, real_folder_below, unmount
@@ -59,44 +59,12 @@ def grading_folder(prefix: str) -> Iterator[Path]:
 
 def sweep_left_behind(prefix: str, where: Optional[Path] = None) -> list[Path]:
     """Remove the folders :func:`grading_folder` made for graders that no longer run, each
-    with the tmpfs mounts below it (deepest first).
-
-    A folder is left alone when it is a link or not this user's, when its name carries no
-    process id, or when that process runs and started before the folder last changed.
+    with the tmpfs mounts below it (deepest first): :func:`ros2nb.temporary.sweep_left_behind`.
 
     :param where: the folder to look in (default: the temporary directory).
     :returns: the folders removed.
     """
-    top = Path(os.path.realpath(where or tempfile.gettempdir()))
-    swept = []
-    for folder in sorted(top.glob(f'{prefix}*')):
-        owner = folder.name[len(prefix):].split('-', 1)[0]
-        try:
-            found = os.lstat(folder)
-        except OSError:
-            continue
-        if not owner.isdigit() or not stat.S_ISDIR(found.st_mode) \
-                or found.st_uid != os.geteuid() or _running_since(int(owner), found.st_ctime):
-            continue
-        below = [Path(p.mountpoint) for p in psutil.disk_partitions(all=True)
-                 if Path(p.mountpoint).is_relative_to(folder)]
-        for mount in sorted(below, key=lambda path: len(path.parts), reverse=True):
-            unmount(mount)
-        shutil.rmtree(folder, ignore_errors=True)
-        swept.append(folder)
-    return swept
-
-
-def _running_since(pid: int, since: float) -> bool:
-    """True when process ``pid`` runs and started by ``since`` (seconds since the epoch),
-    give or take a second: not a later process given a dead one's id, nor a killed one
-    its parent has not reaped yet."""
-    try:
-        process = psutil.Process(pid)
-        return process.create_time() <= since + 1.0 and \
-            process.status() != psutil.STATUS_ZOMBIE
-    except psutil.Error:
-        return False
+    return temporary.sweep_left_behind(prefix, where, unmount)
 
 
 class Scratch:
