@@ -116,9 +116,10 @@ check: $(STAMP) bytecode
 	@$(PY) -m pytest --lane check -q -n 2
 
 # Everything: the fast lane first (a lint error or a broken rule stops here, in a minute),
-# the website (make docs, which its browser test opens), then three steps, always all three (tests/run_steps.sh): the slow lane of tests/ with
-# pytest-xdist, and nbval over solutions/ and notebooks/ alongside it; one failure never
-# hides the others, the results come together at the end, and make fails if any step failed.
+# the website (make docs, which its browser test opens), then four steps, always all four
+# (tests/run_steps.sh): the slow lane of tests/ with pytest-xdist, and beside it nbval over
+# solutions/ and notebooks/ and the course's image built and run; one failure never hides the
+# others, the results come together at the end, and make fails if any step failed.
 # Six workers: much of a slow test's time is a judge and its subject waiting on each other
 # step by step, and fewer left the cores idle between steps (docs/decisions.md).
 TEST_WORKERS ?= 6

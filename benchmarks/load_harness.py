@@ -36,7 +36,6 @@ import re
 import resource
 import subprocess
 import sys
-import tempfile
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -44,6 +43,7 @@ from typing import Iterator, Optional
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / 'tests'))
+from ros2nb.temporary import temporary_folder  # noqa: E402
 PR_SET_CHILD_SUBREAPER = 36  # linux/prctl.h
 CORPORA = ROOT / 'tests' / 'corpora.py'
 GRADE = str(Path(sys.executable).with_name('ros2nb-grade'))
@@ -140,7 +140,7 @@ def graded(which: list[str], seed: int, share: Optional[float], jobs: int
     began, cpu = time.monotonic(), _cpu_seconds()
     verdicts = grade_corpus(corpus_names(which), seed, share, jobs)
     if 'class' in which:
-        with tempfile.TemporaryDirectory(prefix='ros2nb-load-harness-') as folder:
+        with temporary_folder('load-harness') as folder:
             verdicts.update(grade_class(Path(folder), seed, share, jobs))
     _reap_orphans()
     return verdicts, time.monotonic() - began, _cpu_seconds() - cpu

@@ -27,10 +27,11 @@ import re
 import shlex
 import subprocess
 import sys
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Iterator, Optional, Union
+
+from ros2nb.temporary import temporary_folder
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / 'tests'))  # judging.py, the corpora
@@ -323,7 +324,7 @@ def main(argv: list[str]) -> int:
     learners = every_learner()
     for name in names or learners:
         learner = learners[name]
-        with tempfile.TemporaryDirectory(prefix='ros2nb-corpus-') as root:
+        with temporary_folder('corpus') as root:
             try:
                 results = grade_learner(learner, Path(root), seed=seed, cpu_share=share)
                 failed = sorted(gid for gid, r in results.items() if not r['passed'])

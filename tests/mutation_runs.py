@@ -24,7 +24,6 @@ import copy
 import io
 import json
 import os
-import tempfile
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -33,6 +32,7 @@ from typing import Iterator, Optional
 from ros2nb import checks, course
 from ros2nb.judge.graded_cells import grade
 from ros2nb.judge.session import Session
+from ros2nb.temporary import temporary_folder
 from ros2nb.judge_interface import captured
 
 from judging import judging_env
@@ -271,7 +271,7 @@ def run_notebook(number: str, out: Path, chosen: Optional[set[str]] = None,
     when ``baseline``); write each outcome to ``out`` as a JSON line as it comes; return
     them."""
     found = []
-    with tempfile.TemporaryDirectory(prefix=f'ros2nb-mutants-{number}-') as root:
+    with temporary_folder(f'mutants-{number}') as root:
         run = NotebookRun(number, Path(root))
         try:
             with out.open('w') as written:

@@ -16,6 +16,8 @@ import nbformat
 from nbclient import NotebookClient
 from nbval.plugin import coalesce_streams, get_sanitize_patterns
 
+from ros2nb.temporary import owned_folder
+
 ROOT = Path(__file__).resolve().parent.parent
 PATTERNS = get_sanitize_patterns((ROOT / 'tests' / 'sanitize.cfg').read_text())
 IGNORED = 'nbval-ignore-output'
@@ -73,9 +75,8 @@ def kernel_env(parent: Path, domain: Optional[int] = None) -> dict[str, str]:
     """A kernel's environment: a workspace of its own (a new learner's) under ``parent`` (a
     test's ``tmp_path``, which pytest removes), in a folder that tests/sanitize.cfg masks;
     no ROS domain unless one is forced."""
-    import tempfile
     env = {k: v for k, v in os.environ.items() if k != 'ROS_DOMAIN_ID'}
-    scratch = Path(tempfile.mkdtemp(prefix='ros2nb-test-', dir=parent))
+    scratch = owned_folder('ros2nb-test-', parent)
     env['ROS2NB_WORKSPACE'] = str(scratch / 'ROS2_and_RL_Tutorials')
     if domain is not None:
         env['ROS_DOMAIN_ID'] = str(domain)

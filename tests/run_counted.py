@@ -6,7 +6,8 @@ and system) of all the processes it started into CPU_FILE, and exits with COMMAN
 A process's CPU is counted once its parent reaps it, but a step's processes do not all have
 one: a daemon forks twice (podman's conmon), and a kernel that is killed leaves its children
 to whoever adopts them.  This process is their subreaper (``PR_SET_CHILD_SUBREAPER``): every
-orphan of the step is adopted here and reaped when it ends, so its CPU counts too.
+orphan of the step is adopted here and reaped when it ends, so its CPU counts too.  What is
+still running when the step's command ended, the step left behind: it is ended, and named.
 """
 
 from __future__ import annotations
@@ -17,6 +18,9 @@ import resource
 import signal
 import subprocess
 import sys
+from pathlib import Path
+
+import psutil
 
 PR_SET_CHILD_SUBREAPER = 36  # linux/prctl.h
 
@@ -40,6 +44,41 @@ def reaped_cpu_s() -> float:
     return usage.ru_utime + usage.ru_stime
 
 
+def end_left_running(step: str) -> None:
+    """End the processes the step left running (orphans adopted here: the step's command
+    has ended), each with what it started, and say which they were."""
+    left = psutil.Process().children()
+    if not left:
+        return
+    shown = []
+    for process in left:
+        try:
+            shown.append(' '.join(process.cmdline())[:100])
+        except psutil.Error:
+            continue
+    everything = [p for process in left for p in _with_children(process)]
+    for process in everything:
+        try:
+            process.terminate()
+        except psutil.Error:
+            pass
+    _gone, alive = psutil.wait_procs(everything, timeout=5)
+    for process in alive:
+        try:
+            process.kill()
+        except psutil.Error:
+            pass
+    print(f'=== make test: {step} left {len(left)} process(es) running, ended now: '
+          + '; '.join(shown), flush=True)
+
+
+def _with_children(process: psutil.Process) -> list[psutil.Process]:
+    try:
+        return [process, *process.children(recursive=True)]
+    except psutil.Error:
+        return [process]
+
+
 def main(argv: list[str]) -> int:
     cpu_file, command = argv[0], argv[1:]
     adopt_orphans()
@@ -47,6 +86,7 @@ def main(argv: list[str]) -> int:
     # the step would inherit.
     signal.signal(signal.SIGINT, lambda *_: None)
     code = subprocess.run(command).returncode
+    end_left_running(f'the step {Path(cpu_file).stem}')
     with open(cpu_file, 'w') as out:
         out.write(f'{reaped_cpu_s():.0f}\n')
     return code

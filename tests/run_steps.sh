@@ -1,18 +1,22 @@
 #!/usr/bin/env bash
-# `make test`: the three test steps, every time, then their results together.
+# `make test`: the four test steps, every time, then their results together.
 #
 #   1. the slow lane of tests/ with pytest-xdist (in the foreground: its output is what you
-#      watch; `make check` ran the fast lane before);
+#      watch; `make check` ran the fast lane before), but the image;
 #   2. nbval over solutions/ (every deterministic output compared);
-#   3. nbval over notebooks/ (every check of an unwritten part must fail with its message).
+#   3. nbval over notebooks/ (every check of an unwritten part must fail with its message);
+#   4. the course's image, built and run with podman (tests/test_image.py: a newcomer's first
+#      run builds it cold, minutes of mostly downloads and compiling).
 #
-# Steps 2 and 3 run alongside step 1, each in its own pytest process (every process and
+# Steps 2 to 4 run alongside step 1, each in its own pytest process (every process and
 # kernel claims a ROS domain and a workspace of its own); their output is kept in a log
 # and shown once step 1 has ended.  One failure never hides another: the exit code is 1
 # if any step failed.  A step still running after STEP_LIMIT_S seconds (a hang that every
 # per-test limit missed) is stopped and says so: make test always ends with its results.
 # Each result gives the step's wall seconds and the CPU seconds of all its processes
-# (tests/run_counted.py).
+# (tests/run_counted.py).  What ended processes left behind (temporary folders, sandbox
+# cgroups) is swept first and last (tests/left_behind.py); processes a step left running
+# are ended by its run_counted.py.
 #
 # Every step runs at the same priority (NBVAL_NICE=0).  The sample class (step 1's longest
 # chain) is scored as each learner ends, so tests/ is CPU-bound across all its workers, not
@@ -24,7 +28,8 @@ set -u
 python=$1 workers=$2
 STEP_LIMIT_S=${STEP_LIMIT_S:-3000}
 NBVAL_NICE=${NBVAL_NICE:-0}
-logs=$(mktemp -d "${TMPDIR:-/tmp}/ros2nb-make-test-XXXXXX")
+"$python" tests/left_behind.py  # what an earlier run, killed, left
+logs=$(mktemp -d "${TMPDIR:-/tmp}/ros2nb-make-test-$$-XXXXXX")  # named for this shell: swept
 trap 'rm -rf "$logs"' EXIT
 
 run() {  # run NAME NICENESS ARGS...: pytest ARGS; its exit code to $logs/NAME.rc, its wall
@@ -52,18 +57,22 @@ run() {  # run NAME NICENESS ARGS...: pytest ARGS; its exit code to $logs/NAME.r
 run solutions "$NBVAL_NICE" --nbval solutions --nbval-current-env --nbval-sanitize-with tests/sanitize.cfg \
     > "$logs/solutions.log" 2>&1 &
 run notebooks "$NBVAL_NICE" --nbval-lax notebooks --nbval-current-env > "$logs/notebooks.log" 2>&1 &
-echo "=== make test: the slow lane of tests/ (nbval over solutions/ and notebooks/ runs alongside)"
-run tests 0 tests --lane slow -n "$workers" --dist loadfile --no-loadscope-reorder --durations=15
+run image "$NBVAL_NICE" tests/test_image.py --lane slow -q > "$logs/image.log" 2>&1 &
+echo "=== make test: the slow lane of tests/ (nbval over solutions/ and notebooks/, and the" \
+     "image, run alongside)"
+run tests 0 tests --lane slow -m 'not image' -n "$workers" --dist loadfile --no-loadscope-reorder \
+    --durations=15
 wait
-for name in solutions notebooks; do
-    echo "=== make test: nbval $name/ (ran alongside tests/)"
+for name in solutions notebooks image; do
+    echo "=== make test: $([ "$name" = image ] && echo "the image" || echo "nbval $name/") (ran alongside tests/)"
     cat "$logs/$name.log"
 done
+"$python" tests/left_behind.py  # what the steps' ended processes left
 failed=0
 echo "=== make test: results"
-for name in tests solutions notebooks; do
+for name in tests solutions notebooks image; do
     rc=$(cat "$logs/$name.rc" 2>/dev/null || echo 'none')
-    label=$([ "$name" = tests ] && echo 'tests/' || echo "nbval $name/")
+    case $name in tests) label='tests/' ;; image) label='the image' ;; *) label="nbval $name/" ;; esac
     if [ "$rc" = 0 ]; then result=passed; else result="FAILED (exit $rc)"; failed=1; fi
     printf '  %-17s %s in %s s (%s CPU-s)\n' "$label" "$result" \
         "$(cat "$logs/$name.s" 2>/dev/null || echo '?')" "$(cat "$logs/$name.cpu" 2>/dev/null || echo '?')"

@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from ros2nb import domains
+from ros2nb.temporary import owned_folder
 
 CLAIM = textwrap.dedent('''
     import sys, time
@@ -188,8 +189,7 @@ SYSTEM_PYTHON = '/usr/bin/python3'
 def test_another_users_kernel_gets_another_domain():
     """Two learners (two Unix users) on one JupyterHub share the lock folder."""
     import shutil
-    import tempfile
-    tmp_path = Path(tempfile.mkdtemp(prefix='ros2nb-test-users-'))  # reachable by every user
+    tmp_path = owned_folder('ros2nb-test-users-')  # reachable by every user
     locks = tmp_path / 'locks'
     package = tmp_path / 'shared' / 'ros2nb'  # domains.py needs nothing of ROS: copy it out
     package.mkdir(parents=True)

@@ -16,7 +16,6 @@ import re
 import shutil
 import subprocess
 import sys
-import tempfile
 import threading
 import time
 from dataclasses import dataclass
@@ -28,6 +27,7 @@ import pytest
 from grading_samples import (EXPECTED, FULL, GRADE_WITH_FAULTS, MARK, NB01, NOT_UTF8, PWNED, ROOT,
                              SOLUTION, STAGES, build)
 
+from ros2nb.temporary import owned_folder
 from ros2nb_instructor.grading import sandbox
 from ros2nb_instructor.grading.scratch import HOME_BYTES
 
@@ -104,8 +104,7 @@ def grader_tmp():
     memory segments (a few MB) use besides; the growth is measured there, in the grader's folder.
     """
     shm = Path('/dev/shm')
-    folder = Path(tempfile.mkdtemp(prefix='ros2nb-test-grader-tmp-',
-                                   dir=shm if shm.is_dir() else None))
+    folder = owned_folder('ros2nb-test-grader-tmp-', shm if shm.is_dir() else None)
     folder.chmod(0o1777)  # as /tmp: the sandboxes' own user passes through to its folders
     try:
         yield folder

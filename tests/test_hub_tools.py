@@ -5,13 +5,13 @@ from __future__ import annotations
 import os
 import shutil
 import stat
-import tempfile
 from pathlib import Path
 
 import pytest
 
 from ros2nb_instructor.hub import collect as collector
 from ros2nb_instructor.hub import singleuser as launcher
+from ros2nb.temporary import owned_folder
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -93,7 +93,7 @@ def test_collect_needs_the_hub_group():
 
 
 def test_hub_check_finds_the_folder_that_keeps_learners_out():
-    top = Path(tempfile.mkdtemp(prefix='ros2nb-hub-check-'))
+    top = owned_folder('ros2nb-hub-check-')
     try:
         top.chmod(0o755)
         python = top / 'closed' / 'bin' / 'python'

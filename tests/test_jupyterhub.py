@@ -39,7 +39,6 @@ import signal
 import socket
 import subprocess
 import sys
-import tempfile
 import time
 import uuid
 from dataclasses import dataclass
@@ -51,6 +50,7 @@ import requests
 from notebook_outputs import comparable_outputs, compared
 from waiting import PATIENCE_S, wait_for as poll
 from ros2nb.patience import LOOK_S, Patience, child_pids
+from ros2nb.temporary import owned_folder
 from tornado.httpclient import HTTPRequest
 from tornado.websocket import (WebSocketClientConnection, WebSocketClosedError,
                                websocket_connect)
@@ -421,7 +421,7 @@ async def run_class(hub: Hub, tokens: dict[str, str], cells: list[dict]) -> tupl
 
 @pytest.fixture(scope='module')
 def class_run():
-    folder = Path(tempfile.mkdtemp(prefix='ros2nb-hub-'))
+    folder = owned_folder('ros2nb-hub-')
     hub: Optional[Hub] = None
     try:
         began = time.monotonic()

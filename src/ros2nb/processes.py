@@ -9,6 +9,7 @@ sent to the group reaches whatever it started too.  How long a process may take 
 from __future__ import annotations
 
 import atexit
+import ctypes
 import os
 import signal
 import subprocess
@@ -142,6 +143,28 @@ def interrupt(proc: Process, sig: int = signal.SIGINT) -> None:
                 process.send_signal(sig)
             except psutil_module().Error:
                 pass
+
+
+#: ``prctl`` option: the signal this process gets when the thread that started it ends.
+PR_SET_PDEATHSIG = 1
+
+
+def die_with_parent(sig: int = signal.SIGTERM) -> None:
+    """Have the kernel send ``sig`` to this process when its parent ends (Linux's parent-death
+    signal; nothing elsewhere): a judge whose kernel was restarted or killed, a fork server
+    whose judge was, a subject whose server was, does not live on with no one to end it.
+    A process whose parent ended while this was being set (it was adopted meanwhile) gets
+    ``sig`` now.
+
+    Call it first thing; ``sig`` must end the process or lead it to end.
+    """
+    parent = os.getppid()
+    try:
+        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, int(sig), 0, 0, 0)
+    except (OSError, AttributeError):  # not Linux: nothing to set
+        return
+    if os.getppid() != parent:  # (a sandbox's first process has parent 1: not a sign)
+        os.kill(os.getpid(), sig)
 
 
 def end_this_process(code: int) -> NoReturn:

@@ -13,6 +13,7 @@ from __future__ import annotations
 import os
 import shutil
 import stat
+import subprocess
 import tempfile
 from pathlib import Path
 from typing import Callable, Optional
@@ -79,6 +80,31 @@ def sweep_left_behind(prefix: str, where: Optional[Path] = None,
         shutil.rmtree(folder, ignore_errors=True)
         swept.append(folder)
     return swept
+
+
+def sweep_all(where: Optional[Path] = None) -> list[Path]:
+    """Remove every folder of the course's (``ros2nb-...-<pid>-<random>``) in ``where`` (the
+    temporary folder by default) whose process no longer runs, whatever its prefix: what
+    ``make test`` does last, for the processes it ended (a kernel nbval stopped) or that were
+    killed, and whose folder no later one of their kind swept.  Folders of processes that
+    still run, and the machine's domain locks (``ros2nb-domains``), stay.
+
+    :returns: the folders removed.
+    """
+    top = Path(os.path.realpath(where or tempfile.gettempdir()))
+    swept = []
+    for folder in sorted(top.glob('ros2nb-*')):
+        parts = folder.name.split('-')
+        if len(parts) >= 3 and parts[-2].isdigit():
+            swept += sweep_left_behind(folder.name[:-len('-'.join(parts[-2:]))], top,
+                                       _unmounted)
+    return swept
+
+
+def _unmounted(folder: Path) -> None:
+    """Detach a mount below a folder left behind (a grader's tmpfs: it was root)."""
+    subprocess.run(['umount', '-l', str(folder)], stdout=subprocess.DEVNULL,
+                   stderr=subprocess.DEVNULL)
 
 
 def running_since(pid: int, since: float) -> bool:

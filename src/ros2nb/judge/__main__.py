@@ -14,13 +14,14 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import sys
 from pathlib import Path
 from typing import Any, Optional
 
 from .. import working
 from ..patience import tree_cpu_seconds
-from ..processes import end_this_process
+from ..processes import die_with_parent, end_this_process
 from ..subject.forked import SUBJECT_PREFIX_ENV, serve_from_here
 
 # Nothing of the checks, the judge's session or the course's answers is imported yet: the
@@ -46,8 +47,17 @@ def arguments(argv: list[str]) -> tuple[list[str], Optional[int]]:
     return argv, seed
 
 
+def _ended(signum: int, _frame: Any) -> None:
+    """SIGTERM (its kernel ended it, or ended itself): end here, the session closed on the
+    way out (its subjects and programs ended too)."""
+    signal.signal(signum, signal.SIG_DFL)  # a second one ends the process at once
+    raise SystemExit(128 + signum)
+
+
 def main(argv: list[str]) -> int:
     """Run one check, or grade one notebook; print the outcome as one JSON line."""
+    signal.signal(signal.SIGTERM, _ended)
+    die_with_parent(signal.SIGTERM)  # a kernel restarted or killed takes its judge with it
     working.tell_on_stderr()  # what it does, for the kernel that waits (none of its children)
     if not os.environ.get(SUBJECT_PREFIX_ENV):  # subjects not sandboxed: forked from here,
         serve_from_here()  # before ROS starts and before any answer is imported
@@ -62,7 +72,7 @@ def main(argv: list[str]) -> int:
     except Ros2nbError as problem:
         print(problem, file=sys.stderr)
         return 2
-    session = Session(default_workspace(), seed)
+    session, hurried = Session(default_workspace(), seed), False
     try:
         if argv[0] == 'check':
             result: Any = captured(lambda: checks.run_check(argv[1], session))
@@ -91,8 +101,11 @@ def main(argv: list[str]) -> int:
             result = {'results': grade(source, submission, session, checked, starting),
                       'flags': flags + [REWRITTEN.format(name=Path(r).name) for r in rewritten]
                       + session.reaching.flags()}
+    except SystemExit:  # ended from outside (_ended): the learner's processes go at once
+        hurried = True
+        raise
     finally:
-        session.close()
+        session.close(hurried=hurried)
     print(json.dumps(result))
     return 0
 

@@ -302,8 +302,18 @@ class Session:
         """
         return handed.taken_back(self.scratch, self._scratch_fd, folder)
 
-    def close(self) -> None:
+    def close(self, *, hurried: bool = False) -> None:
+        """End the subjects and programs, the observer, and remove the scratch folder.
+
+        :param hurried: the judge is being ended from outside (its kernel ended): the
+            processes that run the learner's code are ended at once, not asked first, and
+            the folder goes before the observer, in case the end comes sooner.
+        """
+        if hurried:
+            self._end_flood()  # every process of the learner's code, ended and reaped now
         self.drop_all()
+        if hurried:
+            shutil.rmtree(self.scratch, ignore_errors=True)
         if self._observer is not None:
             self._observer.close()
         os.close(self._scratch_fd)

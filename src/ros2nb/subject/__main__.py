@@ -10,10 +10,11 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import sys
 
 from ..explain.plots import guard_pyplot
-from ..processes import end_this_process
+from ..processes import die_with_parent, end_this_process
 from ..subject_interface import LOADERS, command_of, wire
 from ..typed_json import Unreadable
 from . import judge_time, out_of_reach, seen
@@ -23,6 +24,7 @@ from .shown import make_sealer
 
 def main(argv: list[str]) -> int:
     """Entry point: ``python -m ros2nb.subject IN_FD OUT_FD``."""
+    die_with_parent(signal.SIGTERM)  # a judge (or its server) that ended takes it along
     judge_time.install()  # the judge's pipe and time: this process's alone, never a child's
     seen.install(judge_time.JudgeTime.pipe())  # before anything of the learner's runs
     guard_pyplot()  # plt.pause / plt.show in a callback: the learner's one line

@@ -24,6 +24,8 @@ import threading
 import traceback
 from typing import Any, Callable, NoReturn, Union
 
+from ..processes import die_with_parent
+
 #: What the server imports before it forks the first child: the subject's own modules and
 #: what rclpy imports when the first node starts (the parameter services' types, numpy for
 #: their arrays, rosidl's type support with its parser).  numpy starts no thread with
@@ -75,6 +77,8 @@ def serve(sock: socket.socket) -> None:
             signal.set_wakeup_fd(-1)
             signal.signal(signal.SIGCHLD, signal.SIG_DFL)
             signal.signal(signal.SIGINT, signal.default_int_handler)
+            signal.signal(signal.SIGTERM, signal.SIG_DFL)
+            die_with_parent(signal.SIGTERM)  # a server that ended takes its children along
             try:
                 _become(json.loads(message), fds[:-2], fds[-2])
             finally:  # it could not become the child (its folder went away?): say why
@@ -209,6 +213,7 @@ def preload() -> None:
 
 def main(argv: list[str]) -> int:
     """``python -m ros2nb.subject.fork_server SOCKET_FD``: a fork server started afresh."""
+    die_with_parent(signal.SIGKILL)  # the process that started it takes it along
     preload()
     serve(socket.socket(fileno=int(argv[0])))
     return 0

@@ -37,6 +37,7 @@ import threading
 import time
 from typing import IO, Optional
 
+from ..processes import die_with_parent
 from . import fork_server
 from .out_of_reach import answers_loaded
 
@@ -156,6 +157,7 @@ def serve_from_here() -> None:
     parent_end, server_end = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
     if os.fork() == 0:
         try:
+            die_with_parent(signal.SIGKILL)  # the judge that ended takes its server along
             parent_end.close()
             # Not the parent's output: whoever reads that waits for its end, not the server's.
             devnull = os.open(os.devnull, os.O_RDWR)

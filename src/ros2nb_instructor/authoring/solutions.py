@@ -16,13 +16,13 @@ import argparse
 import os
 import shutil
 import sys
-import tempfile
 from pathlib import Path
 from typing import Optional
 
 import nbformat
 from nbclient import NotebookClient
 from ros2nb.graded_parts import RECORD_ENV
+from ros2nb.temporary import owned_folder
 from ros2nb.terminal.workspace import WORKSPACE_NAME
 
 from ..paths import ROOT, SOLUTIONS
@@ -81,7 +81,7 @@ def main(argv: Optional[list[str]] = None) -> int:
         if path.parent != SOLUTIONS.resolve() or not path.is_file():
             parser.error(f'{path} is not a notebook of {SOLUTIONS}: name one of '
                          'solutions/*.ipynb')
-    scratch = Path(tempfile.mkdtemp(prefix='ros2nb-test-'))
+    scratch = owned_folder('ros2nb-test-')
     try:
         for path in paths:
             execute(path, scratch / WORKSPACE_NAME)

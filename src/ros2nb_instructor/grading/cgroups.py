@@ -16,6 +16,8 @@ import time
 from pathlib import Path
 from typing import Mapping
 
+from ros2nb.temporary import running_since
+
 _CGROUP_PREFIX = 'ros2nb-sandbox-'
 _counter = itertools.count()
 
@@ -52,6 +54,7 @@ def make_cgroups(pids: int, memory_bytes: int, cpu_share: float | None = None
         enforced names.
     """
     name = f'{_CGROUP_PREFIX}{os.getpid()}-{next(_counter)}'
+    sweep_left_behind()
     quota = None if cpu_share is None else max(1000, round(cpu_share * CPU_PERIOD_US))
     v1 = {'pids': {'pids.max': pids},
           'memory': {'memory.limit_in_bytes': memory_bytes,
@@ -79,6 +82,25 @@ def make_cgroups(pids: int, memory_bytes: int, cpu_share: float | None = None
             made = [parent / name]
             enforced = ['pids(cgroup)', 'memory(cgroup)', *(['cpu(cgroup)'] if cpu else [])]
     return made, enforced
+
+
+def sweep_left_behind() -> list[Path]:
+    """Remove the sandbox cgroups of graders that no longer run (killed before they could:
+    a cgroup outlives its processes), killing what is left in them; return them.  One of a
+    grader that still runs is left alone."""
+    swept = []
+    for controller in ('pids', 'memory', 'cpu', 'cpuacct', ''):
+        parent = _own_cgroup(controller)
+        for cgroup in sorted(parent.glob(f'{_CGROUP_PREFIX}*')) if parent else ():
+            owner = cgroup.name[len(_CGROUP_PREFIX):].split('-', 1)[0]
+            if not owner.isdigit() or running_since(int(owner), cgroup.stat().st_ctime):
+                continue
+            try:
+                remove([cgroup])
+            except OSError:  # a grader of another user's, or busy: left for the next sweep
+                continue
+            swept.append(cgroup)
+    return swept
 
 
 def threads(cgroups: list[Path]) -> list[int]:
