@@ -87,8 +87,15 @@ def corpus_names(which: list[str]) -> list[str]:
     return [learner.name for name in which if name in chosen for learner in chosen[name]]
 
 
+#: CPU seconds of each check (``notebook-part``) of the corpora, the most any learner's took,
+#: in the pass that ran last: what the CPU limit of one check must leave room for.
+CHECK_CPU_S: dict[str, float] = {}
+
+
 def grade_corpus(names: list[str], seed: int, share: Optional[float], jobs: int) -> Verdicts:
     """Each learner's results, ``jobs`` judges at a time (one ``tests/corpora.py`` each)."""
+    CHECK_CPU_S.clear()
+
     def one(name: str) -> tuple[str, object]:
         argv = [sys.executable, str(CORPORA), '--json', '--seed', str(seed),
                 *(['--cpu-share', str(share)] if share else []), name]
@@ -97,6 +104,10 @@ def grade_corpus(names: list[str], seed: int, share: Optional[float], jobs: int)
         if not lines:
             return name, {'error': (done.stderr.strip().splitlines() or ['no output'])[-1]}
         found = json.loads(lines[-1])
+        for part, cpu_s in found.get('cpu_s', {}).items():
+            if isinstance(cpu_s, (int, float)):
+                key = f'{name[:2]}-{part}'
+                CHECK_CPU_S[key] = max(CHECK_CPU_S.get(key, 0.0), cpu_s)
         return name, found['results'] or {'error': found['error']}
 
     with ThreadPoolExecutor(jobs) as pool:
@@ -176,9 +187,11 @@ def main() -> int:
     ctypes.CDLL(None, use_errno=True).prctl(PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0)
     options.out.mkdir(parents=True, exist_ok=True)
     idle, idle_wall, idle_cpu = graded(which, options.seed, None, options.jobs)
+    idle_checks = dict(CHECK_CPU_S)
     print(f'idle: {len(idle)} verdicts in {idle_wall:.0f} s, {idle_cpu:.0f} CPU-s', flush=True)
     with burners(options.burners):
         starved, wall, cpu = graded(which, options.seed, options.share, options.jobs)
+    starved_checks = dict(CHECK_CPU_S)
     print(f'{options.share:.3f} of a CPU each, beside {options.burners} burners: {len(starved)} '
           f'verdicts in {wall:.0f} s, {cpu:.0f} CPU-s (the burners\' not counted)', flush=True)
     differ = differences(idle, starved)
@@ -186,7 +199,11 @@ def main() -> int:
         'seed': options.seed, 'share': options.share, 'burners': options.burners,
         'idle': {'wall_s': idle_wall, 'cpu_s': idle_cpu, 'verdicts': idle},
         'starved': {'wall_s': wall, 'cpu_s': cpu, 'verdicts': starved},
-        'differ': differ}, indent=1))
+        'differ': differ, 'check_cpu_s': {'idle': idle_checks, 'starved': starved_checks}},
+        indent=1))
+    print('the costliest check of each kind, CPU-s idle / starved (judge and subjects):')
+    for check in sorted(set(idle_checks) | set(starved_checks)):
+        print(f'  {check}: {idle_checks.get(check, 0):.1f} / {starved_checks.get(check, 0):.1f}')
     print('\n'.join(differ) if differ else 'no verdict differs')
     print(f'{len(differ)} verdicts differ of {len(set(idle) | set(starved))}')
     return 1 if differ else 0

@@ -111,6 +111,10 @@ def read_log(path: Path) -> tuple[dict[int, list[tuple[float, float, str]]], col
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
     parser.add_argument('--top', type=int, default=25, help='tests to list (default 25)')
+    parser.add_argument('--output', type=Path, default=None,
+                        help="a file for make test's own output (default: none kept)")
+    parser.add_argument('--every-test', type=Path, default=None,
+                        help='a file for the CPU and wall seconds of every test, one a line')
     parser.add_argument('command', nargs='*', default=['make', '--no-print-directory', 'test'],
                         help='what to run instead of make test (after --), e.g. '
                              '-- .venv/bin/python -m pytest tests/test_isolation.py')
@@ -124,8 +128,9 @@ def main() -> int:
                                                             os.environ.get('PYTHONPATH')])))
         with Family() as sampler:
             busy, started = busy_cpu_s(), time.monotonic()
-            done = subprocess.run(options.command, cwd=root, env=env,
-                                  stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT)
+            with open(options.output or os.devnull, 'w') as output:
+                done = subprocess.run(options.command, cwd=root, env=env, stdout=output,
+                                      stderr=subprocess.STDOUT)
             wall, busy = time.monotonic() - started, busy_cpu_s() - busy
         spans, own, walls = read_log(log) if log.exists() else ({}, collections.Counter(), {})
     per_test, unclaimed = charged(sampler, spans)
@@ -140,6 +145,10 @@ def main() -> int:
     print(f'{"CPU-s":>8} {"wall-s":>7}  test file (wall: its tests\' seconds, summed)')
     for name, cpu in files.most_common():
         print(f'{cpu:8.1f} {file_wall[name]:7.1f}  {name}')
+    if options.every_test:
+        options.every_test.write_text(''.join(
+            f'{cpu:.2f}\t{walls.get(test, 0.0):.2f}\t{test}\n'
+            for test, cpu in per_test.most_common()))
     print(f'\n{"CPU-s":>8} {"wall-s":>7}  the {top} costliest tests')
     for test, cpu in per_test.most_common(top):
         print(f'{cpu:8.1f} {walls.get(test, 0.0):7.1f}  {test[:150]}')

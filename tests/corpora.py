@@ -268,8 +268,13 @@ def judged(learner: Learner, root: Path, *, knows_nothing: bool = False,
     lines = out.strip().splitlines()
     assert lines and lines[-1].startswith('{'), f'the judge printed no result: {out}{err}'
     verdict = json.loads(lines[-1])
-    return ({gid[3:]: result for gid, result in verdict['results'].items()},
-            verdict.get('flags', []))
+    cpu_s = {}  # what each check cost, judge and subjects: the judge's line as it was decided
+    for line in lines[:-1]:
+        if line.startswith('{"cell"'):
+            decided = json.loads(line)
+            cpu_s[decided['cell']] = decided.get('cpu_s')
+    return ({gid[3:]: {**result, 'cpu_s': cpu_s.get(gid)}
+             for gid, result in verdict['results'].items()}, verdict.get('flags', []))
 
 
 def _hour_judged(learner: Learner) -> bool:
@@ -335,8 +340,9 @@ def main(argv: list[str]) -> int:
         if as_json:
             print(json.dumps({'name': name, 'results': {
                 gid: {k: r.get(k) for k in ('passed', 'type', 'message')}
-                for gid, r in results.items()}, 'error': None if results else failed[0]}),
-                flush=True)
+                for gid, r in results.items()}, 'cpu_s': {
+                gid: r.get('cpu_s') for gid, r in results.items()},
+                'error': None if results else failed[0]}), flush=True)
         else:
             print(f'{name}\t{shown}\t{expected_score(learner):g}\t{",".join(failed)}',
                   flush=True)
