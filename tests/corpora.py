@@ -43,12 +43,15 @@ JUDGE_TIMEOUT_S = 270
 #: Seconds a test of the corpora takes beside its judges (writing each learner's workspace,
 #: comparing the results).
 BESIDE_JUDGES_S = 30
-#: Simulated seconds of notebook 03's hidden hour for a learner graded for other parts: the
-#: hour is most of a 03 grading's CPU time, and what it checks (every reading's step and
-#: range) holds from the first minutes.  A learner who must lose the hour gets the whole of
-#: it, and so does the sample class's complete learner (tests/test_grading.py), through the
-#: grader.
+#: Simulated seconds of notebook 03's hidden hour, and of the hour notebook 10 records, for a
+#: learner graded for other parts: each hour is most of its grading's CPU time, and what it
+#: checks (every reading's step and range; every reading and status in the bag) holds from
+#: the first minutes.  A learner who must lose that hour gets the whole of it, and so does
+#: the sample class's complete learner (tests/test_grading.py), through the grader.
 SHORT_HOUR_S = 300
+#: Each notebook's hour: the part that judges it, and the grading context's line that sets
+#: the hour the learner's function records (notebook 10's ``HOUR_S``).
+HOURS = {'03': ('sensor-hour', None), '10': ('record-hour', 'HOUR_S = 3600\n')}
 
 
 def time_limit_s(gradings: int) -> int:
@@ -235,11 +238,17 @@ def judged(learner: Learner, root: Path, *, knows_nothing: bool = False,
         pass  # written: the judge reads it from its own process
     given = root / 'given'
     given.mkdir()
-    (given / 'source.ipynb').write_text(NOTEBOOKS[learner.notebook].read_text())
+    short = learner.notebook in HOURS and not _hour_judged(learner)
+    source = NOTEBOOKS[learner.notebook].read_text()
+    hour_line = HOURS.get(learner.notebook, ('', None))[1]
+    if short and hour_line:  # the context cell's hour, as the judge runs it (JSON-escaped)
+        assert json.dumps(hour_line)[1:-1] in source, hour_line
+        source = source.replace(json.dumps(hour_line)[1:-1],
+                                json.dumps(f'HOUR_S = {SHORT_HOUR_S}\n')[1:-1])
+    (given / 'source.ipynb').write_text(source)
     (given / 'submission.ipynb').write_text(json.dumps(nb))
     env = {k: v for k, v in os.environ.items() if k != domains.DOMAIN_ENV}
     env.update({WORKSPACE_ENV: str(ws), GRADING_ENV: '1'})
-    short = learner.notebook == '03' and not _hour_judged(learner)
     command = [sys.executable, str(ROOT / 'tests' / 'judge_apart.py'),
                *(['--knows-nothing'] if knows_nothing else []),
                *(['--hour-s', str(SHORT_HOUR_S)] if short else []),
@@ -278,10 +287,10 @@ def judged(learner: Learner, root: Path, *, knows_nothing: bool = False,
 
 
 def _hour_judged(learner: Learner) -> bool:
-    """Whether the learner (or, for an attack, its twin) must lose notebook 03's hour: then
-    the whole hour decides it."""
+    """Whether the learner (or, for an attack, its twin) must lose its notebook's hour
+    (:data:`HOURS`): then the whole hour decides it."""
     twin = every_learner().get(learner.twin) if learner.twin else None
-    return 'sensor-hour' in (*learner.loses, *(twin.loses if twin else ()))
+    return HOURS[learner.notebook][0] in (*learner.loses, *(twin.loses if twin else ()))
 
 
 def flags_of(learner: Learner, root: Path) -> list[str]:

@@ -6,8 +6,9 @@ session of its own, the course's reference nodes hidden by ``ROS2NB_GRADING``, w
 grading's seed when given), and prints the judge's JSON lines.  With ``--knows-nothing`` the
 judge's reader of the learner's text (:data:`ros2nb.checks.source.TEXT`) finds nothing: no
 point may depend on reading the learner's code.  With ``--hour-s S`` notebook 03's hidden
-hour lasts S simulated seconds: the hour is most of a 03 grading's CPU time, and a corpus's
-learner graded for another part needs no more of it (``corpora.py``: ``SHORT_HOUR_S``).
+hour, and the hour notebook 10 records, last S simulated seconds: each hour is most of its
+grading's CPU time, and a corpus's learner graded for another part needs no more of it
+(``corpora.py``: ``SHORT_HOUR_S``, which also shortens the hour of 10's grading context).
 
 The corpora's tests (``corpora.py``) start it rather than judging in the test process: a judge
 steps its subject's clock one simulated second at a time, each step a turn of each process,
@@ -41,8 +42,10 @@ def main(argv: list[str]) -> int:
     if knows_nothing:  # the one reader's method: modules hold the reader itself
         source.TEXT.read = KnowsNothing().read  # type: ignore[method-assign]  # reads nothing
     if paths[:1] == ['--hour-s']:
+        from ros2nb import course
         from ros2nb.checks import lesson03
         lesson03.HOUR_S = int(paths[1])
+        course.RECORD_S = float(paths[1])
         paths = paths[2:]
     from ros2nb.judge.__main__ import main as judge
     return judge(['grade', *paths])  # SOURCE SUBMISSION [--seed N]

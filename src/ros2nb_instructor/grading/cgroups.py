@@ -93,11 +93,11 @@ def sweep_left_behind() -> list[Path]:
         parent = _own_cgroup(controller)
         for cgroup in sorted(parent.glob(f'{_CGROUP_PREFIX}*')) if parent else ():
             owner = cgroup.name[len(_CGROUP_PREFIX):].split('-', 1)[0]
-            if not owner.isdigit() or running_since(int(owner), cgroup.stat().st_ctime):
-                continue
             try:
+                if not owner.isdigit() or running_since(int(owner), cgroup.stat().st_ctime):
+                    continue
                 remove([cgroup])
-            except OSError:  # a grader of another user's, or busy: left for the next sweep
+            except OSError:  # gone meanwhile (its grader removed it), or busy: left alone
                 continue
             swept.append(cgroup)
     return swept
