@@ -15,7 +15,6 @@ from pathlib import Path
 
 import nbformat
 
-from judging import FIND_SUBJECT
 
 ROOT = Path(__file__).resolve().parent.parent
 SOLUTION = {p.stem: p for p in (ROOT / 'solutions').glob('*.ipynb')}
@@ -75,12 +74,14 @@ EXPECTED = {
     'empty-file': Case({NB01: 0}, {NB01: 'the file is empty'}, {NB01: 'the file is empty'}),
     'corrupt-file': Case({NB01: 0}, {NB01: 'not a valid notebook'}, {NB01: 'not a valid notebook'}),
     # ---- every legal folder name and file name is graded or named
-    'Zoë': Case({NB01: 1}),
-    'two words': Case({NB01: 1}),
+    # (their notebooks as handed out: a name reaches intake, nbgrader's ids, the feedback's
+    # folders and the CSV, never a run, which sees an id of the grader's only)
+    'Zoë': Case({NB01: 0}, {}, {NB01: 'not attempted'}),
+    'two words': Case({NB01: 0}, {}, {NB01: 'not attempted'}),
     # nbgrader reads the ids it leaves out of a batch as one comma-separated string
-    'Lovelace, Ada': Case({NB01: 1}, {}, {'_folder': 'graded under the id learner-'}),
-    'browser-copy': Case({NB01: 1}, {}, {NB01: f'graded {NB01} (1).ipynb as {NB01}.ipynb'}),
-    'glob[*]chars': Case({NB01: 1}, {}, {'_folder': 'graded under the id learner-'}),
+    'Lovelace, Ada': Case({NB01: 0}, {}, {'_folder': 'graded under the id learner-'}),
+    'browser-copy': Case({NB01: 0}, {}, {NB01: f'graded {NB01} (1).ipynb as {NB01}.ipynb'}),
+    'glob[*]chars': Case({NB01: 0}, {}, {'_folder': 'graded under the id learner-'}),
     # ---- the course's graded cells cannot be removed or re-weighted
     'deletes-the-check': Case({NB01: 1}, {NB01: 'Check passed'}),
     'claims-100-points': Case({NB01: 0}),
@@ -100,15 +101,12 @@ EXPECTED = {
                             {NB01: 'an attachment of 200 MB'}),
     # ---- nothing a learner's code touched is trusted (honest twin: complete's 02)
     'rewrites-package-xml': Case({NB02: 0}, {NB02: 'but it declares'}),
-    # a sensor without a timer, and its honest twin; the forger's import walks the stack to
-    # its subject's request loop, which the subjects' audit hooks see: every check that loads
-    # its file fails (main() alone, run as ros2 run does, earns its 1 of 6)
-    'forges-its-timer': Case({NB03: 1}, {NB03: 'reads stack frames'}),
-    'no-timer': Case({NB03: 4}, {NB03: 'TemperatureSensor has no timer'}),
+    # (a sensor that forges its timer through its subject's request loop is an attack of the
+    # corpora, tests/test_checks_forged.py; the flags box it earned, tests/test_grading_dask.py)
     # ---- issue 36: one learner never costs the class (honest twin: complete's 01)
-    NOT_UTF8: Case({NB01: 1}, {}, {'_folder': 'graded under the id learner-'}),
-    'odd-file-name': Case({NB01: 1}, {}, {'_folder': 'notes-\\xe9t\\xe9.ipynb is not one of'}),
-    FORMULA: Case({NB01: 1}, {}, {'_folder': 'graded under the id learner-'}),
+    NOT_UTF8: Case({NB01: 0}, {}, {'_folder': 'graded under the id learner-'}),
+    'odd-file-name': Case({NB01: 0}, {}, {'_folder': 'notes-\\xe9t\\xe9.ipynb is not one of'}),
+    FORMULA: Case({NB01: 0}, {}, {'_folder': 'graded under the id learner-'}),
     'lies-in-its-status': Case({NB01: 1}, {}, {NB01: 'reported (its own words, unchecked): '
                                                      '"the grader crashed'}),
     'quadratic-markdown': Case({NB01: 1}, {NB01: 'Check passed'},
@@ -377,30 +375,6 @@ def package_dependencies(package_xml: Path) -> list[str]:
     return names
 '''
 
-#: The timer's work done by the request handler: each ``advance`` calls publish_temperature
-#: once per simulated second itself (new_node's reply is passed on: a reply names no timers,
-#: the judge sees the node's readings itself).
-FORGED_TIMER = FIND_SUBJECT + '''
-def _forge(_new_node=_HANDLERS.get('new_node'), _advance=_HANDLERS.get('advance')):
-    def new_node(command):  # a reply names no timers: the judge reads them from the graph
-        return _new_node(command)
-
-    def advance(seconds, seed=None):
-        if seed is not None:
-            random.seed(seed)
-        for _ in range(round(seconds)):
-            _SUBJECT.node.publish_temperature()
-        return _advance(seconds=seconds)
-
-    _HANDLERS.update(new_node=new_node, advance=advance)
-
-
-if _SUBJECT is not None:
-    _forge()
-'''
-
-TIMER_LINE = '        self.timer = self.create_timer(PUBLISH_PERIOD_S, self.publish_temperature)\n'
-MAIN_GUARD = "\nif __name__ == '__main__':"
 
 #: A callback that waits for a flag only another callback could set: with one thread
 #: spinning, it waits for ever. (The hangs wait rather than compute: a hung cell keeps its
@@ -488,11 +462,11 @@ def build(folder: Path, *, grading_out: Path, submissions: Path, decoy_gradebook
         SOLUTION[NB01], {-1: 'import rclpy\nrclpy.shutdown()'}))
     put('empty-file', NB01, '')
     put('corrupt-file', NB01, '{"cells": [{"cell_type": "code", "sou')
-    put('Zoë', NB01, SOLUTION[NB01])
-    put('two words', NB01, SOLUTION[NB01])
-    put('Lovelace, Ada', NB01, SOLUTION[NB01])
-    put('browser-copy', NB01, SOLUTION[NB01], name=f'{NB01} (1).ipynb')
-    put('glob[*]chars', NB01, SOLUTION[NB01])
+    put('Zoë', NB01, LEARNER[NB01])
+    put('two words', NB01, LEARNER[NB01])
+    put('Lovelace, Ada', NB01, LEARNER[NB01])
+    put('browser-copy', NB01, LEARNER[NB01], name=f'{NB01} (1).ipynb')
+    put('glob[*]chars', NB01, LEARNER[NB01])
     deleted = nbformat.read(SOLUTION[NB01], as_version=4)
     deleted.cells = [c for c in deleted.cells if 'learner-check' not in c.metadata.get('tags', [])]
     put('deletes-the-check', NB01, deleted)
@@ -533,10 +507,10 @@ for number in range(80):
 def _hostile_class_three(folder: Path, put) -> None:
     """The third hostile class (issue 36): names, markdown, snapshots, formulas, lies, and a
     fault planted in each host-side stage (graded with GRADE_WITH_FAULTS)."""
-    put(NOT_UTF8, NB01, SOLUTION[NB01])
-    put('odd-file-name', NB01, SOLUTION[NB01])
-    put('odd-file-name', NB01, SOLUTION[NB01], name=os.fsdecode(b'notes-\xe9t\xe9.ipynb'))
-    put(FORMULA, NB01, SOLUTION[NB01])
+    put(NOT_UTF8, NB01, LEARNER[NB01])
+    put('odd-file-name', NB01, LEARNER[NB01])
+    put('odd-file-name', NB01, LEARNER[NB01], name=os.fsdecode(b'notes-\xe9t\xe9.ipynb'))
+    put(FORMULA, NB01, LEARNER[NB01])
     put('lies-in-its-status', NB01, _with_cells(SOLUTION[NB01], {99: LIE_IN_THE_STATUS}))
     put('quadratic-markdown', NB01, _with_cells(SOLUTION[NB01], {3: '[x](' * 100_000},
                                                 markdown=True))
@@ -581,10 +555,6 @@ def _hostile_class_two(folder: Path, put) -> None:
     answer = next(c for c in rewriter.cells if 'def package_dependencies' in c.source)
     answer.source = REWRITING_READER
     put('rewrites-package-xml', NB02, rewriter)
-    put('no-timer', NB03, _replaced(nbformat.read(SOLUTION[NB03], as_version=4), TIMER_LINE, ''))
-    put('forges-its-timer', NB03, _replaced(_replaced(  # its import rewrites its subject's replies
-        nbformat.read(SOLUTION[NB03], as_version=4), TIMER_LINE, ''),
-        MAIN_GUARD, FORGED_TIMER + MAIN_GUARD))
 
 
 def _with_attachment(source: Path, data: bytes) -> nbformat.NotebookNode:

@@ -74,8 +74,8 @@ CLASS = {
     'complete': Case({n: EXPECTED['complete'].scores[n] for n in (NB00, NB01, NB02)}),
     'untouched': Case({NB01: 0, NB02: 0}, {}, {NB01: 'not attempted', NB02: 'not attempted'}),
     'empty-file': EXPECTED['empty-file'],
-    'Lovelace, Ada': EXPECTED['Lovelace, Ada'],
-    'browser-copy': EXPECTED['browser-copy'],
+    'Lovelace, Ada': Case({NB01: 1}, {}, {'_folder': 'graded under the id learner-'}),
+    'browser-copy': Case({NB01: 1}, {}, {NB01: f'graded {NB01} (1).ipynb as {NB01}.ipynb'}),
     'kills-its-kernel': EXPECTED['kills-its-kernel'],
     # Frames read while the grader ran the code: the part earns nothing (ros2nb.judge.reaching)
     # and the flags box says why, carried back from the cluster like any feedback.
