@@ -195,6 +195,26 @@ def test_a_half_built_node_freed_later_never_silences_the_next_of_its_name(ros, 
         ros2nb.add(sensor)
 
 
+def test_a_publisher_made_in_the_kernel_has_met_its_subscriptions_when_made(ros):
+    """Notebook 10's kernel checks hear a replay through subscriptions of the kernel's own,
+    and ``bag_play`` waits for its publishers to match (``terminal.bag.MATCH_WAIT_S`` of the
+    wall clock) before the first message: in one process that wait never waits, however
+    busy the machine, so no reading is lost to it."""
+    from ros2nb.terminal.bag import KEEP_ALL
+    listener = rclpy.create_node('bag_listener', context=ros.context)
+    player = rclpy.create_node('bag_player', context=ros.context)
+    try:
+        for qos in (KEEP_ALL, 10):
+            listener.create_subscription(Float32, '/temperature', lambda _m: None, qos)
+        for _ in range(10):
+            publisher = player.create_publisher(Float32, '/temperature', KEEP_ALL)
+            assert publisher.get_subscription_count() == 2
+            player.destroy_publisher(publisher)
+    finally:
+        listener.destroy_node()
+        player.destroy_node()
+
+
 def test_same_name_replaces_old_node(ros, capsys):
     first = ros2nb.add(Sensor())
     second = ros2nb.add(Sensor())
