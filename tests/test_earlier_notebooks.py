@@ -4,9 +4,9 @@ and a learner's file imported afresh after every edit (issue 65, item 3).
 The node files are built from the notebooks' own cells, as a learner's ``%%part`` cells build
 them: 04's monitor, then 08's parts run with part 4 left out (the walk's case).  The last tests
 are the walk itself in real kernels: notebook 10 after an unfinished 08 says what to finish in
-one line, and passes once 08 is finished, with no kernel restart; and its recording check,
-run again as the learner runs it, passes correct code whenever the collector frees the
-monitor the failed try left half-built.
+one line, and passes once 08 is finished, with no kernel restart; and its recording and
+replay checks, run again as the learner runs them, pass correct code whenever the collector
+frees the monitor the failed try left half-built.
 """
 
 from __future__ import annotations
@@ -269,5 +269,33 @@ def test_10_recording_passes_correct_code_after_a_failed_attempt(tmp_path):
         assert kernel.run('ros2nb.stop()').error is None
         passed = kernel.run(n10['fededecd'])
         assert passed.error is None and passed.stdout.startswith('Check passed: the bag'), passed
+    finally:
+        kernel.close()
+
+
+@pytest.mark.kernel
+@pytest.mark.ros
+@pytest.mark.timeout(900)
+def test_10_replay_passes_correct_code_after_a_failed_attempt(tmp_path):
+    """check_replay the same way: its first try fails for 08's part 4 (the monitor made
+    half-built), another cell's error lets the first one's traceback go, the part written,
+    replay's cell and the check again: once the new monitor runs, the collector frees the
+    half-built one, which took the new monitor's statuses along ("temperature_monitor logged
+    no status during the replay" on correct code)."""
+    n10, ws = solution_cells('10-record-and-replay'), tmp_path / 'ws'
+    kernel = Kernel(ws)
+    try:
+        assert kernel.run(n10['b61bfe20']).error is None  # catch_up(10)
+        write_monitor(ws, {**PARTS_08, 4: PARTS_04[4]})  # 08's part 4 never run
+        for cell in (n10['5d79509a'], COLLECT_ONCE_A_MONITOR_RUNS, n10['2cbd3dc0']):
+            assert kernel.run(cell).error is None
+        unfinished = course.unfinished_line(ws, course.SUBSCRIBER_FILE, 10)
+        failed = kernel.run(n10['efb946fb'])  # check_replay(replay)
+        assert failed.error == ('CheckFailed', [f'CheckFailed: {unfinished}']), failed
+        write_monitor(ws, PARTS_08)  # 08 finished
+        assert kernel.run('1 / 0').error is not None  # any cell's error
+        assert kernel.run(n10['2cbd3dc0']).error is None
+        passed = kernel.run(n10['efb946fb'])
+        assert passed.error is None and passed.stdout.startswith('Check passed: 60'), passed
     finally:
         kernel.close()
