@@ -3,7 +3,8 @@
 The tests of what a learner sees in a cell (a check's lines, the line long work updates, the
 progress table, the mutation tests' ``mutation_runs.py``) read the kernel's own messages, as
 JupyterLab gets them.  The wait for a cell counts the kernel's work, not the wall clock
-(tests/waiting.py).
+(tests/waiting.py).  The solutions' cells are here by id, and the monitor's file as the
+``%%part`` cells of notebooks 04 and 08 write it (the walks through earlier notebooks).
 """
 
 from __future__ import annotations
@@ -127,3 +128,21 @@ def solution_cells(notebook: str) -> dict[str, str]:
     import json
     data = json.loads((ROOT / 'solutions' / f'{notebook}.ipynb').read_text())
     return {c['id']: ''.join(c['source']) for c in data['cells']}
+
+
+N04, N08 = solution_cells('04-write-the-subscriber'), solution_cells('08-parameters')
+#: The subscriber's parts as 04 writes them, and as 08 writes them.
+PARTS_04 = {3: N04['c43c4e05'], 4: N04['9bfa2c2b']}
+PARTS_08 = {1: N08['08-18'], 2: N08['08-19'], 3: N08['08-21'], 4: N08['08-24'], 5: N08['08-27']}
+#: nbgrader's lines around a solution, which the learner's file never holds.
+MARKERS = ('### BEGIN SOLUTION', '### END SOLUTION')
+
+
+def body(cell: str) -> str:
+    """A ``%%part`` cell's code, as the file gets it (nbgrader's markers left out)."""
+    return '\n'.join(line for line in cell.split('\n')[1:] if line.strip() not in MARKERS)
+
+
+def monitor(parts: dict[int, str]) -> str:
+    """The monitor's file as the given ``%%part`` cells (part number -> cell) write it."""
+    return '\n\n'.join(body(parts[n]).rstrip('\n') for n in sorted(parts)) + '\n'

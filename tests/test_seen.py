@@ -78,8 +78,8 @@ def test_each_kind_is_seen_with_the_learners_line(tmp_path, code, kind, what):
 
 def test_what_a_library_or_the_course_does_for_the_learner_is_not_seen(tmp_path):
     """rclpy's logger and Python's read their caller's frame, a namedtuple and a dataclass
-    compile code, a traceback is printed, the runtime walks the garbage collector for nodes,
-    a library imports ctypes: none of it is the learner's reaching in."""
+    compile code, a traceback is printed, the runtime lists the nodes it knows, a library
+    imports ctypes: none of it is the learner's reaching in."""
     found = seen(tmp_path, '''
 import collections, dataclasses, logging, traceback, enum
 P = collections.namedtuple('P', 'a b')

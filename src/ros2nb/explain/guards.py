@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from typing import Any, Callable, Optional
 
+from rclpy.exceptions import InvalidHandle
 from rclpy.node import Node
 
 from ..endpoints import type_name
@@ -38,7 +39,11 @@ def check_node(node: Any, rt: Any) -> None:
     if not hasattr(node, '_Node__node'):
         raise Ros2nbError(f"{type(node).__name__}.__init__ never calls "
                           "super().__init__('node_name'): make that its first line.")
-    name = node.get_name()
+    try:
+        name = node.get_name()
+    except InvalidHandle:
+        raise Ros2nbError(f'This {type(node).__name__} was destroyed (by ros2nb.stop() or '
+                          'destroy_node()): create a new one, then hand it over.') from None
     if node.context is not rt.context or not node.context.ok():
         raise Ros2nbError(f'{name} was created before ROS 2 was (re)started in this kernel: run '
                           'the cell that creates it again, then hand it over.')

@@ -106,7 +106,9 @@ def add(node: Node) -> Node:
     """Hand a node to the kernel's executor, replacing a running node of the same name.
 
     Re-running the cell that creates a node therefore never doubles it: the old node
-    (its timers and subscriptions) is taken out of service first.  What the node logs
+    (its timers and subscriptions) is taken out of service first, and so is any other node
+    of that name made in this kernel and never handed over (one whose ``__init__`` failed
+    part-way, say).  What the node logs
     while it starts is printed here.  Common mistakes are refused with one line: a timer
     of period 0, a callback that is not callable (``self.tick()`` instead of
     ``self.tick``), a message passed instead of its type (``Float32()``), a topic used
@@ -127,6 +129,10 @@ def add(node: Node) -> Node:
 
 def stop(node: Optional[NodeOrName] = None) -> list[str]:
     """Stop and destroy one running node, or all of them; ROS itself stays up.
+
+    Every other node of a stopped node's name made in this kernel is destroyed with it
+    (rcl's one /rosout publisher per name ends with the first of them destroyed, so none
+    of them is left to log without it).
 
     Their log lines are no longer shown here afterwards (a process started with
     :func:`ros2nb.ros2_start` may run a node of the same name: its lines are not this

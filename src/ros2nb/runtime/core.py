@@ -27,7 +27,7 @@ from ..errors import SHUT_DOWN_MESSAGE, Ros2nbError
 from .callers import use_cheaper_caller_lookup
 from .simulated_clock import SimulatedClock
 from .logs import LogLines
-from .nodes import NodeKeeping, destroy_stray_nodes, drop_qos_warnings
+from .nodes import NodeKeeping, destroy_stray_nodes, drop_qos_warnings, keep_shared_names
 from .spinning import Spinning
 
 #: Hidden name of the kernel's own node (names starting with ``_`` are hidden
@@ -93,6 +93,7 @@ class Runtime(LogLines, Spinning, NodeKeeping, SimulatedClock):
         rclpy.init(args=['--ros-args', '--disable-stdout-logs', '--disable-external-lib-logs'],
                    domain_id=domain_id, signal_handler_options=SignalHandlerOptions.NO)
         self.context = rclpy.get_default_context()
+        keep_shared_names(self.context)  # no node of a name in use freed under the others
         self.domain_id = self.context.get_domain_id()
         self.executor = SingleThreadedExecutor()
         # The kernel's own node serves nothing and logs nothing.
