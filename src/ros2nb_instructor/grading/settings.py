@@ -31,7 +31,7 @@ JUDGE_TIMEOUT_S = 600
 #: logs hundreds of lines a reading, under the flood limit, costs the class at most this in
 #: each check it floods (docs/decisions.md, "Every judge's CPU bounded";
 #: benchmarks/load_harness.py measures the checks).
-JUDGE_CPU_S = {'00': 30, '01': 30, '02': 30, '03': 30, '04': 30, '05': 60, '06': 30,
+JUDGE_CPU_S = {'00': 30, '01': 30, '02': 30, '03': 40, '04': 30, '05': 60, '06': 30,
                '07': 30, '08': 30, '09': 30, '10': 55}
 #: Notebooks graded at the same time: one more than the CPUs (a notebook often waits).
 JOBS = (os.cpu_count() or 1) + 1
