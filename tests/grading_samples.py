@@ -15,7 +15,6 @@ from pathlib import Path
 
 import nbformat
 
-
 ROOT = Path(__file__).resolve().parent.parent
 SOLUTION = {p.stem: p for p in (ROOT / 'solutions').glob('*.ipynb')}
 LEARNER = {p.stem: p for p in (ROOT / 'notebooks').glob('*.ipynb')}

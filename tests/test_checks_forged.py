@@ -16,13 +16,38 @@ import pytest
 from ros2nb import checks, course
 from ros2nb.judge_interface import AnswerRef
 
-from grading_samples import FORGED_TIMER, MAIN_GUARD, REWRITING_READER, TIMER_LINE
+from grading_samples import REWRITING_READER
 from nodes import name_without_endpoints
 from waiting import wait_for
 from judging import FIND_SUBJECT, run_check
 from test_checks import PUB, SUB, fails, mutated, restore
 
 pytestmark = [pytest.mark.judge, pytest.mark.timeout(300)]
+
+#: The timer's work done by the request handler: each ``advance`` calls publish_temperature
+#: once per simulated second itself (new_node's reply is passed on: a reply names no timers,
+#: the judge sees the node's readings itself).
+FORGED_TIMER = FIND_SUBJECT + '''
+def _forge(_new_node=_HANDLERS.get('new_node'), _advance=_HANDLERS.get('advance')):
+    def new_node(command):  # a reply names no timers: the judge reads them from the graph
+        return _new_node(command)
+
+    def advance(seconds, seed=None):
+        if seed is not None:
+            random.seed(seed)
+        for _ in range(round(seconds)):
+            _SUBJECT.node.publish_temperature()
+        return _advance(seconds=seconds)
+
+    _HANDLERS.update(new_node=new_node, advance=advance)
+
+
+if _SUBJECT is not None:
+    _forge()
+'''
+
+TIMER_LINE = '        self.timer = self.create_timer(PUBLISH_PERIOD_S, self.publish_temperature)\n'
+MAIN_GUARD = "\nif __name__ == '__main__':"
 
 #: The callback's work done by the request handler: each ``advance`` steps the walk,
 #: publishes and logs the reading itself, while publish_temperature does nothing.
