@@ -324,8 +324,8 @@ if os.fork() == 0:
                 os._exit(0)
     os._exit(0)
 os.wait()
-print('ready', flush=True)
-try:
+try:  # Ctrl+C may come as soon as 'ready' is out
+    print('ready', flush=True)
     while True:
         time.sleep(0.05)
 except KeyboardInterrupt:
