@@ -28,8 +28,10 @@ def check_expanded_path(judge: Optional[Judge], make_path: Any, *, ends_with: st
     if isinstance(make_path, AnswerRef) and judge is not None:  # their subject's home
         path = decoded(answer_results(judge, make_path, [[]])[0], f'{make_path.name}()')
         home = Path(judge.subject_env()['HOME'])
+        shown = '~'  # the grader's folder for it: its name would differ from run to run
     else:
         path, home = call_learner(make_path), Path.home()
+        shown = str(home)
     if not isinstance(path, Path):
         raise CheckFailed(f'{make_path.__name__}() returned {type_name_of(path)} {path!r}; return '
                           'a pathlib.Path.')
@@ -37,7 +39,7 @@ def check_expanded_path(judge: Optional[Judge], make_path: Any, *, ends_with: st
         raise CheckFailed(f'{path} still contains "~": Python does not expand it, call '
                           '.expanduser().')
     if home not in path.parents:
-        raise CheckFailed(f'{path} is not inside your home folder {home}: a path that '
+        raise CheckFailed(f'{path} is not inside your home folder {shown}: a path that '
                           'starts with "/" starts at the root of the disk.')
     if not str(path).endswith(ends_with):
         raise CheckFailed(f'{path} should end with {ends_with}.')
