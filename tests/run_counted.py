@@ -47,7 +47,7 @@ def reaped_cpu_s() -> float:
 def end_left_running(step: str) -> None:
     """End the processes the step left running (orphans adopted here: the step's command
     has ended), each with what it started, and say which they were."""
-    left = psutil.Process().children()
+    left = [process for process in psutil.Process().children() if _running(process)]
     if not left:
         return
     shown = []
@@ -70,6 +70,15 @@ def end_left_running(step: str) -> None:
             pass
     print(f'=== make test: {step} left {len(left)} process(es) running, ended now: '
           + '; '.join(shown), flush=True)
+
+
+def _running(process: psutil.Process) -> bool:
+    """False for a process that ended and waits only to be reaped (a zombie: it runs nothing
+    and has no command line to name)."""
+    try:
+        return process.status() != psutil.STATUS_ZOMBIE
+    except psutil.Error:
+        return False
 
 
 def _with_children(process: psutil.Process) -> list[psutil.Process]:
