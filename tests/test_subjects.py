@@ -210,8 +210,8 @@ def test_a_program_that_waits_for_its_starved_watcher_is_not_idle(answered):
 
     def answer() -> None:
         admit(threading.get_native_id())
-        begin = time.process_time()
-        while time.process_time() - begin < 0.05:
+        begin = time.thread_time()  # this thread's own work: the worker's others work too
+        while time.thread_time() - begin < 0.05:
             pass
         program.stdin.write('go\n')
         program.stdin.flush()
