@@ -21,11 +21,11 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / 'tests'))
-from kernels import PARTS_04, PARTS_08, Kernel, monitor, solution_cells  # noqa: E402
+from kernels import (CATCH_UP_10, CHECK_RECORDING_10, CONTEXT_10, PARTS_04,  # noqa: E402
+                     PARTS_08, RECORD_HOUR_10, Kernel, monitor)
 
 from ros2nb.course import SUBSCRIBER_FILE as SUBSCRIBER  # noqa: E402
 
-N10 = solution_cells('10-record-and-replay')
 CPU = 'import os; print(sum(os.times()[:2]))'
 
 
@@ -38,20 +38,20 @@ def walk(import_again: bool, gc_off: bool) -> None:
     ws = Path(tempfile.mkdtemp(prefix='ros2nb-walk-10-')) / 'ws'
     kernel = Kernel(ws)
     try:
-        kernel.run(N10['b61bfe20'])  # catch_up(10)
+        kernel.run(CATCH_UP_10)
         (ws / SUBSCRIBER).write_text(monitor({**PARTS_08, 4: PARTS_04[4]}))
-        kernel.run(N10['5d79509a'])
-        kernel.run(N10['1266d1a4'])
+        kernel.run(CONTEXT_10)
+        kernel.run(RECORD_HOUR_10)
         if gc_off:
             kernel.run('import gc; gc.disable()')
-        said = [line(kernel.run(N10['fededecd']))]
+        said = [line(kernel.run(CHECK_RECORDING_10))]
         (ws / SUBSCRIBER).write_text(monitor(PARTS_08))
         if import_again:
-            kernel.run(N10['5d79509a'])
-        kernel.run(N10['1266d1a4'])
-        said.append(line(kernel.run(N10['fededecd'])))
+            kernel.run(CONTEXT_10)
+        kernel.run(RECORD_HOUR_10)
+        said.append(line(kernel.run(CHECK_RECORDING_10)))
         kernel.run('ros2nb.stop()')
-        said.append(line(kernel.run(N10['fededecd'])))
+        said.append(line(kernel.run(CHECK_RECORDING_10)))
         cpu = float(kernel.run(CPU).stdout)
     finally:
         kernel.close()

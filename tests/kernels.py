@@ -134,6 +134,12 @@ N04, N08 = solution_cells('04-write-the-subscriber'), solution_cells('08-paramet
 #: The subscriber's parts as 04 writes them, and as 08 writes them.
 PARTS_04 = {3: N04['c43c4e05'], 4: N04['9bfa2c2b']}
 PARTS_08 = {1: N08['08-18'], 2: N08['08-19'], 3: N08['08-21'], 4: N08['08-24'], 5: N08['08-27']}
+N10 = solution_cells('10-record-and-replay')
+#: Notebook 10's cells by what they do: ros2nb.course.catch_up(10); the context that imports
+#: the monitor; record_hour(bag_path) and its check; replay(bag_path, rate) and its check.
+CATCH_UP_10, CONTEXT_10 = N10['b61bfe20'], N10['5d79509a']
+RECORD_HOUR_10, CHECK_RECORDING_10 = N10['1266d1a4'], N10['fededecd']
+REPLAY_10, CHECK_REPLAY_10 = N10['2cbd3dc0'], N10['efb946fb']
 #: nbgrader's lines around a solution, which the learner's file never holds.
 MARKERS = ('### BEGIN SOLUTION', '### END SOLUTION')
 

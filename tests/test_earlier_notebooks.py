@@ -18,7 +18,8 @@ import textwrap
 from pathlib import Path
 
 import pytest
-from kernels import N04, PARTS_04, PARTS_08, Kernel, monitor, solution_cells
+from kernels import (CATCH_UP_10, CHECK_RECORDING_10, CHECK_REPLAY_10, CONTEXT_10, N04, PARTS_04,
+                     PARTS_08, RECORD_HOUR_10, REPLAY_10, Kernel, monitor)
 
 import ros2nb
 from ros2nb import course
@@ -196,7 +197,6 @@ def test_import_file_follows_every_edit(workspace):
 @pytest.mark.ros
 @pytest.mark.timeout(900)
 def test_10_after_an_unfinished_08_says_what_to_finish_and_passes_once_it_is(tmp_path):
-    n10 = solution_cells('10-record-and-replay')
     eight, ten = Kernel(tmp_path / 'ws'), Kernel(tmp_path / 'ws')
     try:
         # 04's monitor, whole; then 08's parts, part 4 left out: the walk's workspace.
@@ -205,16 +205,16 @@ def test_10_after_an_unfinished_08_says_what_to_finish_and_passes_once_it_is(tmp
         for cell in (N04['72a68119'], N04['426b2e3a'], PARTS_04[3], PARTS_04[4], N04['20f95939'],
                      PARTS_08[1], PARTS_08[2], PARTS_08[3], PARTS_08[5]):
             assert eight.run(cell).error is None
-        set_up = ten.run(n10['b61bfe20'])  # catch_up(10): before anything uses the monitor
+        set_up = ten.run(CATCH_UP_10)  # before anything uses the monitor
         unfinished = [line for line in set_up.stdout.splitlines() if 'not finished' in line]
         assert len(unfinished) == 1 and 'on_set_thresholds' in unfinished[0] \
             and 'notebook 08, part 4' in unfinished[0], set_up
-        for cell in ('5d79509a', '2cbd3dc0'):  # the context (imports the monitor), replay()
-            assert ten.run(n10[cell]).error is None
-        failed = ten.run(n10['efb946fb'])  # check_replay(replay)
+        for cell in (CONTEXT_10, REPLAY_10):
+            assert ten.run(cell).error is None
+        failed = ten.run(CHECK_REPLAY_10)
         assert failed.error == ('CheckFailed', [f'CheckFailed: {unfinished[0]}']), failed
         assert eight.run(PARTS_08[4]).error is None  # 08 finished, in its own kernel
-        passed = ten.run(n10['efb946fb'])  # no restart, no import cell run again
+        passed = ten.run(CHECK_REPLAY_10)  # no restart, no import cell run again
         assert passed.error is None and passed.stdout.startswith('Check passed: '), passed
     finally:
         eight.close()
@@ -241,6 +241,20 @@ threading.Thread(target=_collect_once_a_monitor_runs, daemon=True).start()
 """
 
 
+def first_try_fails_for_part_4(kernel: Kernel, ws: Path, run: str, check: str) -> None:
+    """A learner's first try at one of notebook 10's checks with 08's part 4 unwritten: the
+    check fails with the line that says so (their monitor made half-built), and then they
+    write the part.  The collector is held off until a monitor runs again."""
+    assert kernel.run(CATCH_UP_10).error is None
+    write_monitor(ws, {**PARTS_08, 4: PARTS_04[4]})  # 08's part 4 never run
+    for cell in (CONTEXT_10, COLLECT_ONCE_A_MONITOR_RUNS, run):
+        assert kernel.run(cell).error is None
+    unfinished = course.unfinished_line(ws, course.SUBSCRIBER_FILE, 10)
+    failed = kernel.run(check)
+    assert failed.error == ('CheckFailed', [f'CheckFailed: {unfinished}']), failed
+    write_monitor(ws, PARTS_08)  # 08 finished
+
+
 @pytest.mark.kernel
 @pytest.mark.ros
 @pytest.mark.timeout(900)
@@ -252,22 +266,15 @@ def test_10_recording_passes_correct_code_after_a_failed_attempt(tmp_path):
     the collector while the new monitor logged, and took rcl's /rosout publisher of their
     name along: "For reading 3078 (25.49 °C) temperature_monitor said nothing" on correct
     code."""
-    n10, ws = solution_cells('10-record-and-replay'), tmp_path / 'ws'
+    ws = tmp_path / 'ws'
     kernel = Kernel(ws)
     try:
-        assert kernel.run(n10['b61bfe20']).error is None  # catch_up(10)
-        write_monitor(ws, {**PARTS_08, 4: PARTS_04[4]})  # 08's part 4 never run
-        for cell in (n10['5d79509a'], COLLECT_ONCE_A_MONITOR_RUNS, n10['1266d1a4']):
-            assert kernel.run(cell).error is None
-        unfinished = course.unfinished_line(ws, course.SUBSCRIBER_FILE, 10)
-        failed = kernel.run(n10['fededecd'])  # check_recording(record_hour)
-        assert failed.error == ('CheckFailed', [f'CheckFailed: {unfinished}']), failed
-        write_monitor(ws, PARTS_08)  # 08 finished
-        assert kernel.run(n10['1266d1a4']).error is None
-        left = kernel.run(n10['fededecd']).error
+        first_try_fails_for_part_4(kernel, ws, RECORD_HOUR_10, CHECK_RECORDING_10)
+        assert kernel.run(RECORD_HOUR_10).error is None
+        left = kernel.run(CHECK_RECORDING_10).error
         assert left is not None and '(/temperature_sensor)' in left[1][0], left
         assert kernel.run('ros2nb.stop()').error is None
-        passed = kernel.run(n10['fededecd'])
+        passed = kernel.run(CHECK_RECORDING_10)
         assert passed.error is None and passed.stdout.startswith('Check passed: the bag'), passed
     finally:
         kernel.close()
@@ -282,20 +289,13 @@ def test_10_replay_passes_correct_code_after_a_failed_attempt(tmp_path):
     replay's cell and the check again: once the new monitor runs, the collector frees the
     half-built one, which took the new monitor's statuses along ("temperature_monitor logged
     no status during the replay" on correct code)."""
-    n10, ws = solution_cells('10-record-and-replay'), tmp_path / 'ws'
+    ws = tmp_path / 'ws'
     kernel = Kernel(ws)
     try:
-        assert kernel.run(n10['b61bfe20']).error is None  # catch_up(10)
-        write_monitor(ws, {**PARTS_08, 4: PARTS_04[4]})  # 08's part 4 never run
-        for cell in (n10['5d79509a'], COLLECT_ONCE_A_MONITOR_RUNS, n10['2cbd3dc0']):
-            assert kernel.run(cell).error is None
-        unfinished = course.unfinished_line(ws, course.SUBSCRIBER_FILE, 10)
-        failed = kernel.run(n10['efb946fb'])  # check_replay(replay)
-        assert failed.error == ('CheckFailed', [f'CheckFailed: {unfinished}']), failed
-        write_monitor(ws, PARTS_08)  # 08 finished
+        first_try_fails_for_part_4(kernel, ws, REPLAY_10, CHECK_REPLAY_10)
         assert kernel.run('1 / 0').error is not None  # any cell's error
-        assert kernel.run(n10['2cbd3dc0']).error is None
-        passed = kernel.run(n10['efb946fb'])
+        assert kernel.run(REPLAY_10).error is None
+        passed = kernel.run(CHECK_REPLAY_10)
         assert passed.error is None and passed.stdout.startswith('Check passed: 60'), passed
     finally:
         kernel.close()
