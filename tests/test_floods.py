@@ -91,6 +91,22 @@ def test_a_flood_while_the_judge_waits_for_the_node_ends_the_wait(session):
         restore(session, PUB)
 
 
+def test_what_one_run_of_main_logs_counts_in_that_run_alone(session):
+    """main() runs four times in its check, on the machine's clock while the judge's stands
+    still: every line of the check fell in one window of the judge's clock.  A main() that
+    logs 200 lines before it spins (under the window's 500) failed as a flood in its third
+    run on any machine, and a slow flood's late lines from one run, arriving as the next
+    began, failed main() on a busy one.  Counted per run, it keeps its point."""
+    chatty = ('    node = TemperatureSensor()\n'
+              "    for line in range(200):\n"
+              "        node.get_logger().info(f'starting, step {line}')\n")
+    mutated(session, PUB, '    node = TemperatureSensor()\n', chatty)
+    try:
+        run_check(session, checks.check_sensor_main)
+    finally:
+        restore(session, PUB)
+
+
 @pytest.mark.sandbox
 @pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))
 @pytest.mark.timeout(900)

@@ -115,6 +115,10 @@ class Floods(Protocol):
     def raise_any(self) -> None:
         """Raise :class:`Flooded` once a flood was found (its processes ended first)."""
 
+    def ended(self) -> None:
+        """The processes that may flood were ended and reaped (one run of a program):
+        what they sent is theirs, dropped wherever it still is; count afresh."""
+
 
 class Observer(Protocol):
     """The judge's own ROS node (:class:`ros2nb.judge.observer.Observer`): what it hears is

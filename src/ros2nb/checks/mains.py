@@ -109,6 +109,7 @@ def _stop_run(judge: Judge, path: Path, node_name: str, part: int, sig: signal.S
                 raise
         finally:
             kill_process_group(proc)
+            judge.observer.floods.ended()  # its late lines never count in the next run
 
 
 class _ShutdownRace(CheckFailed):

@@ -111,11 +111,19 @@ class Floods:
         if line is None:
             return
         self.on_flood()
+        self.ended()
+        raise Flooded(line)
+
+    def ended(self) -> None:
+        """The processes that may flood were ended and reaped (by a flood, or a check that
+        ran a program once): what they sent before now is theirs, taken away and dropped on
+        arrival (:meth:`stale`), never counted in the next run's windows; count afresh.  A
+        program runs on the machine's clock while the judge's stands still, so its lines
+        share one window: counted per run, what one run sends never fails the next."""
         with self._observer.changed:
             self.stopped_ns = time.time_ns()
         self._observer.take_stale()
         self.forget()
-        raise Flooded(line)
 
 
 def flood_line(where: str, who: str, span_ns: int) -> str:

@@ -132,6 +132,11 @@ def main(argv: list[str]) -> int:
         status['finished'] = True
     except DeadKernelError:
         status['kernel_died_at'] = status['ran']
+        # Whether the kernel said the number of the cell it died in before it died is a race
+        # of the machine's: no number is shown for that cell on any machine.
+        for cell in nb.cells[status['ran']:]:
+            if cell.cell_type == 'code':
+                cell.execution_count = None
     except Exception as error:  # nbclient could not go on: say why, keep what ran
         status['runner_error'] = f'{type(error).__name__}: {str(error)[:300]}'
     save(nb, args.out, status)
