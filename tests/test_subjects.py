@@ -19,7 +19,7 @@ from ros2nb.judge.subjects import SubjectHung, SubjectProcess
 from ros2nb.errors import NotDecided
 from ros2nb.subject_interface import Call, ExecCells, NewNode
 from ros2nb.subject_replies import Called, Encoded, Output
-from ros2nb.patience import BUSY_SHARE, Patience, tree_cpu_seconds, wait_for_work
+from ros2nb.patience import BUSY_SHARE, LOOK_S, Patience, tree_cpu_seconds, wait_for_work
 from waiting import PATIENCE_S, run_to_end, starved, wait_until
 
 pytestmark = pytest.mark.judge
@@ -193,15 +193,21 @@ def test_a_wait_lasts_while_its_program_works_and_counts_only_its_idle_time():
 WAITS_FOR_A_LINE = "print('ready', flush=True)\ninput()\nprint('got it', flush=True)\n"
 
 
+#: CPU seconds the starved watcher works before it answers.
+ANSWER_WORK_S = 0.1
+
+
 @pytest.mark.parametrize('answered', [True, False], ids=['answered', 'never answered'])
 def test_a_program_that_waits_for_its_starved_watcher_is_not_idle(answered):
     """What a subject waits for may be its judge's own work (its clock, its answers, its
     discovery messages): time the machine keeps the judge's threads from running is not the
     subject's idle time.  Here the watcher's own thread that must answer gets a fiftieth of
-    a CPU and works 0.05 CPU-seconds first; the program sits idle meanwhile, well past its
-    limit on the wall clock.  Counted as its idle time, the wait gave up before the answer
-    came (a subject made beside a busy judge was told its code did not finish).  A program
-    nobody answers is still given up after its limit of idle time."""
+    a CPU and works 0.1 CPU-seconds first; the program sits idle meanwhile, five times its
+    limit on the wall clock (what the watcher's looks miss: the first look's length, and what
+    the answering thread stood ready after the last look before it ended).  Counted as its
+    idle time, the wait gave up before the answer came (a subject made beside a busy judge
+    was told its code did not finish).  A program nobody answers is still given up after
+    its limit of idle time."""
     limit = 1.0
     program = subprocess.Popen([sys.executable, '-c', WAITS_FOR_A_LINE], text=True,
                                stdin=subprocess.PIPE, stdout=subprocess.PIPE)
@@ -211,7 +217,7 @@ def test_a_program_that_waits_for_its_starved_watcher_is_not_idle(answered):
     def answer() -> None:
         admit(threading.get_native_id())
         begin = time.thread_time()  # this thread's own work: the worker's others work too
-        while time.thread_time() - begin < 0.05:
+        while time.thread_time() - begin < ANSWER_WORK_S:
             pass
         program.stdin.write('go\n')
         program.stdin.flush()
@@ -260,6 +266,25 @@ sleeper.kill()
 #: keeps the watcher's thread from running is not the program's idle time, so a busy
 #: machine lengthens the wait (by how much depends on the machine's load).
 CUT = 30
+
+
+def test_a_watcher_late_to_its_first_look_counts_a_look_of_waiting():
+    """Callers start counting a moment after they asked (``started``), a look's length as
+    they mean it; a watcher the machine kept from its first look for seconds (a thread of
+    its own holding the GIL while its cgroup's quota held it back) counted those seconds as
+    the program's idle time, and gave up on it at its first look."""
+    limit = 3.0
+    sleeper = subprocess.Popen([sys.executable, '-c', 'import time\nprint("asleep", flush=True)'
+                                '\ntime.sleep(3600)'], stdout=subprocess.PIPE, text=True)
+    try:
+        assert sleeper.stdout.readline() == 'asleep\n'
+        patience = Patience(sleeper.pid, limit, started=time.monotonic() - 5 * limit)
+        time.sleep(LOOK_S)
+        assert not patience.exhausted()  # the failure prevented: 5 s counted as waiting
+        assert wait_until(patience.exhausted)  # an idle program is still given up
+    finally:
+        sleeper.kill()
+        sleeper.wait()
 
 
 def test_a_busy_watcher_does_not_make_a_waiting_program_look_busy():

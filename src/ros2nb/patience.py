@@ -231,9 +231,10 @@ class Patience:
         process is fine; the watcher's own process too, a wait for itself: the thread
         that looks is left out).
     :param limit_s: seconds of CPU time, or of idle waiting, the trees are given.
-    :param started: when the trees were asked (``time.monotonic()``; default now); the time
-        since then counts as waiting.  CPU time counts from now: a caller whose answers
-        mostly come at once starts measuring late, and spares /proc meanwhile.
+    :param started: when the trees were asked (``time.monotonic()``; default now), at most
+        a look (:data:`LOOK_S`) ago as the caller meant it; that time counts as waiting.
+        CPU time counts from now: a caller whose answers mostly come at once starts
+        measuring late, and spares /proc meanwhile.
     """
 
     def __init__(self, pids: int | Sequence[int], limit_s: float,
@@ -243,8 +244,10 @@ class Patience:
         now = time.monotonic()
         self.started = now if started is None else started
         self.cpu_at_start, queued, _ready = tree_work(self.pids, skip=_this_thread())
-        #: Seconds on the wall clock the trees sat idle so far.
-        self.idle_s = now - self.started
+        #: Seconds on the wall clock the trees sat idle so far.  Of the time before this
+        #: first look, a look's length counts: what the watcher took beyond it was its own
+        #: lateness (the machine, or its own work, kept it from looking), not their waiting.
+        self.idle_s = min(now - self.started, LOOK_S)
         self._look = (now, self.cpu_at_start + queued)
         self._verdict = False
         #: What kept the watcher's own process from running (:meth:`_watcher_threads`).
