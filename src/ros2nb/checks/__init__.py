@@ -82,20 +82,14 @@ def run_check(name: str, judge: Optional[Judge], *args: Any, **kwargs: Any) -> N
         return
     # A flood of the learner's code fails the check it happened in, whatever the check made
     # of what was left (the judge ended the flooding processes): its line says what happened.
-    # So does code that reached into the course as it ran (the subjects' audit hooks), first.
-    reaching = getattr(judge, 'reaching', None)
+    # (What the subjects' audit hooks saw is only noted for the instructor: no check relies
+    # on it, ros2nb.judge.reaching.)
     observer.floods.forget()
-    if reaching is not None:
-        reaching.forget()
     try:
         message = CHECKS[name](judge, *args, **kwargs)
     except BaseException:
-        if reaching is not None:
-            reaching.raise_any()
         observer.floods.raise_any()
         raise
-    if reaching is not None:
-        reaching.raise_any()
     observer.floods.raise_any()
     passed(message)
 
