@@ -4,10 +4,11 @@ The honest and wrong corpora are graded in ``test_corpus_honest.py`` and
 ``test_corpus_wrong.py`` (see ``corpus_checks.py``).  Each attack (``corpus_attacks.py``)
 scores what its honest twin scores, except those the wire cannot tell from honest code, which
 the judge flags for the instructor instead (``tests/test_flags.py``).  The attacks that reach
-into the process they run in (``corpus_reaching.py``) are graded twice beside their twins,
-with two seeds of the drawn inputs: each scores at most its twin's in both, its lost parts
-say why in one line, and those the subject's audit hook sees (``seen``) are flagged at run
-time.
+into the process they run in (``corpus_reaching.py``, the sixth hostile class's among them)
+are graded twice beside their twins, with two seeds of the drawn inputs, as the grader grades
+them (the judge and each subject sandboxed): each scores at most its twin's in both (the
+sixth class's exactly its twin's), its lost parts say why in one line, and those the
+subject's audit hook sees (``seen``) are noted at run time, never a verdict.
 
 ``python tests/corpora.py`` prints every learner's score; run with an older checkout's judge it
 gives the "before" column of the closing notes.
@@ -21,15 +22,18 @@ from pathlib import Path
 
 import pytest
 
-from corpora import grade_learner, judged, score, time_limit_s
+from corpora import BESIDE_JUDGES_S, grade_learner, judged_in_sandbox, score, time_limit_s
 from corpus_attacks import ATTACKS
 from corpus_checks import failed, scores_what_its_twin_scores
+from corpus_honest import HONEST
 from corpus_reaching import REACHING
 from ros2nb.checks.drawn import new_seed
+from ros2nb_instructor.grading import sandbox
+from ros2nb_instructor.grading.settings import JUDGE_TIMEOUT_S as SANDBOXED_JUDGE_S
 
 #: Each test but the text reader's grades an attack and its twin.
 pytestmark = [pytest.mark.judge, pytest.mark.timeout(time_limit_s(2))]
-TWINS = {learner.name: learner for learner in ATTACKS}
+TWINS = {learner.name: learner for learner in [*ATTACKS, *HONEST]}
 #: The two seeds of this run's gradings of the reaching attacks and their twins (each
 #: pytest-xdist worker draws its own: a new pair every run).
 SEEDS = (new_seed(), new_seed())
@@ -64,22 +68,30 @@ def test_an_attack_scores_what_its_twin_scores(attack, tmp_path):
 
 @functools.lru_cache(maxsize=None)
 def _twin(name: str, seed: int) -> dict:
-    """The twin's results with ``seed`` (graded once per worker and seed, in a folder of
-    its own removed afterwards: the results are all that is kept)."""
+    """The twin's results with ``seed``, graded as the grader grades (once per worker and
+    seed, in a folder of its own removed afterwards: the results are all that is kept)."""
     with tempfile.TemporaryDirectory(prefix='ros2nb-twin-') as root:
-        return grade_learner(TWINS[name], Path(root), seed=seed)
+        return judged_in_sandbox(TWINS[name], Path(root), seed=seed)[0]
 
 
+@pytest.mark.sandbox
+@pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))
+@pytest.mark.timeout(2 * (SANDBOXED_JUDGE_S + BESIDE_JUDGES_S))  # an attack and its twin
 @pytest.mark.parametrize('run', [0, 1], ids=['seed 1', 'seed 2'])
 @pytest.mark.parametrize('attack', REACHING, ids=[a.name for a in REACHING])
 def test_reaching_in_scores_at_most_its_twin_and_says_so(attack, run, tmp_path):
+    """Graded as the grader grades: in its sandboxes the course's answers are not on a
+    subject's disk and no subject reads what another wrote, and no verdict comes from what
+    the audit hooks saw (they only note it)."""
     seed, twin = SEEDS[run], TWINS[attack.twin]
-    attacked, flags = judged(attack, tmp_path, seed=seed)
+    attacked, flags = judged_in_sandbox(attack, tmp_path, seed=seed)
     honest = _twin(attack.twin, seed)
     lost = failed(attacked)
     context = (seed, lost, flags)
     assert set(failed(honest)) == set(twin.loses), (seed, failed(honest))
     assert set(lost) >= set(failed(honest)), context
     assert score(attack, attacked) <= score(twin, honest), context
+    if attack.extra.get('sixth'):
+        assert score(attack, attacked) == score(twin, honest), context
     assert all(message and '\n' not in message for message in lost.values()), context
     assert any('at run time' in flag for flag in flags) == attack.seen, context
