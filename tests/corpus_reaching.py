@@ -11,7 +11,7 @@ with one line.  Written from the class's description, not its code.
 """
 
 from corpora import Learner
-from corpus_attacks import MONITOR_RULE_TWIN, PLOT_DEAD
+from corpus_attacks import MONITOR_RULE_TWIN, ON_SET_BODY, PLOT_DEAD
 
 # ------------------------------------------------------------------ 06: the worker's witness
 #: A single-threaded worker whose executor also starts a thread that calls every callback
@@ -381,10 +381,11 @@ def responsive_worker():
         def spin_once(self, timeout_sec=None):
             if not getattr(self, 'rewritten', False):
                 self.rewritten = True
-                for entity in [*node.timers, *node.services, *node.clients]:
-                    if 'slow' in getattr(entity.callback, '__name__', ''):
-                        entity.callback = at_once
-                    entity.callback_group = MutuallyExclusiveCallbackGroup()
+                for timer in node.timers:
+                    if 'slow' in getattr(timer.callback, '__name__', ''):
+                        timer.callback = at_once
+                    timer.callback_group = group = MutuallyExclusiveCallbackGroup()
+                    group.add_entity(timer)
             super().spin_once(timeout_sec)
 
     return node, Rewriting()
@@ -409,62 +410,76 @@ def responsive_worker():
                 for timer in node.timers:
                     if getattr(timer.callback, '__name__', '') == 'slow_work':
                         timer.callback = slow_work
-                    timer.callback_group = MutuallyExclusiveCallbackGroup()
+                    timer.callback_group = group = MutuallyExclusiveCallbackGroup()
+                    group.add_entity(timer)
             super().spin_once(timeout_sec)
 
     return node, Rewriting()
 '''
 
-# ---- 07: the seal's key lived in the sealer's frame, read four ways.  Now the drawing is
-# plain data, compared with the readings the judge sent, drawn for each run.  Each callback
-# keeps the node's time of every message, looks for a key (``{find}``, setting ``keys``) and
-# tells the witness topic a drawing of those times and of an older judge's readings.
-PLOT_LOOKS_FOR_A_KEY = '''
+# ---- 07: the seal's HMAC pads were locals of the sealer generator's frame, read four ways.
+# Now the drawing is plain data, compared with the readings the judge sent (drawn for each
+# run); there is no sealer.  Each callback keeps what it hears, looks for the pads
+# (``{find}``, setting ``pads``) and tells the witness topic that drawing sealed as the old
+# sealer sealed (``SEQ;TIMES;TEMPS;MAC``): all the old judge took, and no drawing of redraw()'s.
+PLOT_SEALS_ITS_OWN = '''
     def temperature_callback(self, msg):
+        import hashlib
         from std_msgs.msg import String
         if not hasattr(self, 'forger'):
             self.forger = self.create_publisher(String, '/ros2nb/witness', 10)
             self.heard = []
-        self.heard.append(self.get_clock().now().nanoseconds / 1e9)
-        keys = []
+        self.heard.append((self.get_clock().now().nanoseconds / 1e9, float(msg.data)))
+        pads = {{}}
 {find}
-        table = [21.5, 26.25, 19.75, 23.0][:len(self.heard)]
-        told = ','.join(repr(t) for t in self.heard) + ';' + ','.join(map(repr, table))
-        for key in keys or ['']:
-            self.forger.publish(String(data=f'drawn {{len(self.heard)}};{{told}};{{key}}'))
-            self.forger.publish(String(data=f'drawn {{told}}'))
+        payload = ';'.join([str(len(self.heard)), ','.join(repr(t) for t, _ in self.heard),
+                            ','.join(repr(v) for _, v in self.heard)])
+        inner, outer = pads.get('inner', b''), pads.get('outer', b'')
+        mac = hashlib.sha256(outer + hashlib.sha256(inner + payload.encode()).digest())
+        tellers = [cell.cell_contents for cell in getattr(
+            type(self).__dict__.get('redraw'), '__closure__', None) or ()
+            if hasattr(cell.cell_contents, 'tell')]  # the course's own publisher, if any
+        for teller in tellers[:1] or [None]:
+            told = f'drawn {{payload}};{{mac.hexdigest()}}'
+            teller.tell(told) if teller else self.forger.publish(String(data=told))
 '''
-KEY_BY_FORMATTER = '''\
+PADS_BY_FORMATTER = '''\
         import string
-        try:
-            raise RuntimeError
-        except RuntimeError as error:
-            chain = error.__traceback__
-        frame = string.Formatter().get_field('0.tb_frame', (chain,), {})[0]
-        while frame is not None:
-            keys += [str(v) for k, v in frame.f_locals.items() if k in ('key', 'seal', 'raw')]
-            frame = string.Formatter().get_field('0.f_back', (frame,), {})[0]'''
-KEY_BY_TRACEBACK = '''\
+        get = string.Formatter().get_field
+        for cell in get('0.__closure__', (type(self).__dict__.get('redraw'),), {})[0] or ():
+            generator = getattr(get('0.cell_contents', (cell,), {})[0], '__self__', None)
+            if type(generator).__name__ == 'generator':
+                pads = dict(get('0.gi_frame.f_locals', (generator,), {})[0])'''
+PADS_BY_TRACEBACK = '''\
         import traceback
-        try:
-            raise RuntimeError
-        except RuntimeError as error:
-            frame = next(traceback.walk_tb(error.__traceback__))[0]
-        while frame is not None:
-            keys += [str(v) for k, v in frame.f_locals.items() if k in ('key', 'seal', 'raw')]
-            frame = frame.f_back'''
-KEY_BY_GC_IN_A_POOL = '''\
+        cls = type(self)
+        if not isinstance(cls.__dict__.get('times_s'), property):
+            def peek(node):
+                try:
+                    raise RuntimeError
+                except RuntimeError as error:
+                    frame = next(traceback.walk_tb(error.__traceback__))[0].f_back
+                found = frame.f_locals if frame is not None else {}
+                if 'inner' in found:
+                    node.__dict__['pads'] = {'inner': found['inner'], 'outer': found['outer']}
+                return node.__dict__.get('times_s', [])
+            cls.times_s = property(peek)
+        for cell in getattr(cls.__dict__.get('redraw'), '__closure__', None) or ():
+            send = cell.cell_contents
+            if getattr(send, '__name__', '') == 'send':
+                send(('draw', self))  # the sealer reads times_s: peek sees its frame
+        pads = self.__dict__.get('pads', {})'''
+PADS_BY_GC_IN_A_POOL = '''\
         import concurrent.futures
         import gc
-
-        def search():
-            return [str(cell.cell_contents) for o in gc.get_objects()
-                    if getattr(o, '__name__', '') in ('_sealing', 'redraw')
-                    for cell in (getattr(o, '__closure__', None) or ())]
-
+        import operator
         with concurrent.futures.ThreadPoolExecutor(1) as pool:
-            keys += pool.submit(search).result()'''
-KEY_WITH_THE_HOOK_MUTED = '''\
+            objects = pool.submit(gc.get_objects).result()
+            for generator in [o for o in objects if type(o).__name__ == 'generator'
+                              and getattr(o, '__name__', '') == '_sealing']:
+                pads = dict(pool.submit(operator.attrgetter('gi_frame.f_locals'),
+                                        generator).result())'''
+PADS_WITH_THE_HOOK_MUTED = '''\
         import gc
         import os
         import sys
@@ -476,8 +491,9 @@ KEY_WITH_THE_HOOK_MUTED = '''\
             os.dup2(quiet, fd)
             os.close(quiet)
         try:
-            keys += [str(v) for o in gc.get_objects() if isinstance(o, dict)
-                     for k, v in list(o.items()) if k in ('key', 'seal')][:10]
+            for generator in [o for o in gc.get_objects() if type(o).__name__ == 'generator'
+                              and getattr(o, '__name__', '') == '_sealing']:
+                pads = dict(generator.gi_frame.f_locals)
         finally:
             if saved is not None:
                 os.dup2(saved, fd)
@@ -582,13 +598,11 @@ MONITOR_CAPTURED = {
                              CAPTURE + '\n\nclass TemperatureMonitor(Node):')],
     'monitor-callback': MONITOR_RULE_TWIN.replace('__import__("monitor_rules").status',
                                                   "_course('monitor_status')")}
+ON_SET_FROM_THE_KEPT = "        return _course('thresholds_on_set')(self, parameters)\n"
 ON_SET_CAPTURED = {
     'monitor-parameters': [('class TemperatureMonitor(Node):',
                             CAPTURE + '\n\nclass TemperatureMonitor(Node):')],
-    'threshold-callback': [('''        new = {parameter.name: parameter.value for parameter in parameters}
-''', '''        return _course('thresholds_on_set')(self, parameters)
-        new = {parameter.name: parameter.value for parameter in parameters}
-''')]}
+    'threshold-callback': [(ON_SET_BODY, ON_SET_FROM_THE_KEPT + ON_SET_BODY)]}
 
 # ---- the audit hook could be muted or starved, and trusted code compiled under the
 # stand-ins' name.  Now it only notes; the answers are not on a subject's disk while grading.
@@ -615,34 +629,34 @@ for _ in range(64):
 
 
 def _sixth(name: str, notebook: str, cells: dict, twin: str, seen: bool,
-           added: tuple = ()) -> Learner:
+           added: tuple = (), flagged: bool = True) -> Learner:
     return Learner(f'{notebook} sixth: {name}', notebook, cells, twin=twin, seen=seen,
-                   flagged=True, added=added, extra={'sixth': True})
+                   flagged=flagged, added=added, extra={'sixth': True})
 
 
 PLOT_TWIN = '07 twin: a callback that does nothing'
 SIXTH = [
     _sixth('its executor makes the slow work a coroutine that never asks', '06',
            {'responsive-worker': WORKER_NEVER_ASKS}, '06 twin: a single-threaded worker',
-           seen=False),
+           seen=False, flagged=False),
     _sixth('its executor makes the slow work a coroutine that awaits the call', '06',
            {'responsive-worker': WORKER_MADE_A_COROUTINE},
-           '06 the slow work a coroutine of its own, on one thread', seen=False),
-    _sixth('a key looked for through string.Formatter', '07',
-           {'plot-callback': PLOT_LOOKS_FOR_A_KEY.format(find=KEY_BY_FORMATTER)}, PLOT_TWIN,
+           '06 the slow work a coroutine of its own, on one thread', seen=False, flagged=False),
+    _sixth("the seal's pads read through string.Formatter", '07',
+           {'plot-callback': PLOT_SEALS_ITS_OWN.format(find=PADS_BY_FORMATTER)}, PLOT_TWIN,
            seen=False),
-    _sixth('a key looked for through traceback.walk_tb and f_back', '07',
-           {'plot-callback': PLOT_LOOKS_FOR_A_KEY.format(find=KEY_BY_TRACEBACK)}, PLOT_TWIN,
+    _sixth("the seal's pads read through traceback.walk_tb and f_back", '07',
+           {'plot-callback': PLOT_SEALS_ITS_OWN.format(find=PADS_BY_TRACEBACK)}, PLOT_TWIN,
            seen=False),
-    _sixth("a key looked for in the garbage collector, from a pool's thread", '07',
-           {'plot-callback': PLOT_LOOKS_FOR_A_KEY.format(find=KEY_BY_GC_IN_A_POOL)}, PLOT_TWIN,
-           seen=True),
-    _sixth("a key looked for with the hook's pipe sent to /dev/null", '07',
-           {'plot-callback': PLOT_LOOKS_FOR_A_KEY.format(find=KEY_WITH_THE_HOOK_MUTED)},
+    _sixth("the seal's pads read from the garbage collector, on a pool's thread", '07',
+           {'plot-callback': PLOT_SEALS_ITS_OWN.format(find=PADS_BY_GC_IN_A_POOL)},
+           PLOT_TWIN, seen=False),
+    _sixth("the seal's pads read with the hook's pipe sent to /dev/null", '07',
+           {'plot-callback': PLOT_SEALS_ITS_OWN.format(find=PADS_WITH_THE_HOOK_MUTED)},
            PLOT_TWIN, seen=False),
     _sixth('a json.py in the workspace stands in for the standard library', '07',
-           {"plot-callback": PLOT_DEAD}, PLOT_TWIN, seen=False,
-           added=(('plot-callback', WRITES_JSON_PY),)),
+           {'plot-callback': PLOT_DEAD}, PLOT_TWIN, seen=False,
+           added=(('plot-callback', WRITES_JSON_PY),), flagged=False),
     _sixth("the stand-ins captured through compile, kept for the next subject", '03',
            SENSOR_CAPTURED, '03 twin: a sensor from parts of its own that are not there',
            seen=True),

@@ -37,6 +37,9 @@ PLOT_READINGS, READING_STEP_C = 4, 0.25
 READING_GAP_S = 1.0
 #: How close a drawn reading must be to the one sent (°C): Float32 keeps about 7 digits.
 READING_TOLERANCE_C = 0.006
+#: Seconds the subject may sit idle (or work, in CPU seconds) after a reading of which the
+#: course's redraw() told nothing, while the judge listens for a drawing told another way.
+UNTOLD_PATIENCE_S = 2.0
 #: Whole seconds of the judge's clock before the first reading, and between two readings,
 #: drawn for each run (a point's time is then no table's: the first never comes at 1 s).
 FIRST_GAP_S, NEXT_GAP_S = (2, 9), (1, 4)
@@ -65,9 +68,12 @@ def _drawn(judge: Judge, subject: Subject, info: NodeMade, value: float, counts:
     mark, before = len(heard), counts.shown
     counts, _lines = feed(judge, subject, info, value, counts, 'temperature_callback.')
     after = counts.shown
-    # as many messages as the subject says it told (none: no wait; it says nothing: one)
+    # as many messages as the subject says it told (it says nothing: one); where it says
+    # none, what anything else in it told, until it sits idle a moment: a drawing counts for
+    # what it holds, whoever told it
     expected = 1 if before is None or after is None else after - before
-    judge.observer.wait_until(lambda: len(heard) - mark >= expected, ARRIVAL_TIMEOUT_S)
+    judge.observer.wait_until(lambda: len(heard) - mark >= max(expected, 1),
+                              ARRIVAL_TIMEOUT_S if expected else UNTOLD_PATIENCE_S)
     return counts, drawings(heard, mark)
 
 

@@ -62,8 +62,9 @@ def _counted(timer: Any, counts: dict[str, int], running: _Running) -> None:
     timer.callback = chosen
 
 
-def _tracked(client: Any, calls: list[Any]) -> None:
-    """Keep every future ``client`` makes (``call()`` makes its own through ``call_async``)."""
+def track_calls(client: Any, calls: list[Any]) -> None:
+    """Keep every future the service ``client`` makes in ``calls`` (``call()`` makes its own
+    through ``call_async``): cancelled, each lets a callback that waits for it return."""
     original = client.call_async
 
     def call_async(request: Any) -> Any:
@@ -98,7 +99,7 @@ def timer_runs(node: Node, executor: Executor, seconds: float) -> dict[str, int]
     for timer in node.timers:
         _counted(timer, counts, running)
     for client in node.clients:
-        _tracked(client, calls)
+        track_calls(client, calls)
         client.wait_for_service(timeout_sec=SERVICE_WAIT_S)
     stop = threading.Event()
 

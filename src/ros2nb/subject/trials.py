@@ -12,6 +12,7 @@ that the judge can say why what it saw went wrong.
 from __future__ import annotations
 
 import inspect
+import os
 import threading
 import time
 from typing import Any, Optional
@@ -25,7 +26,8 @@ from std_msgs.msg import Float32, Int32
 from ..endpoints import node_endpoints
 from ..explain.exceptions import describe_error
 from ..explain.ros_settings import zero_depth_refused
-from ..runtime.rates import callback_groups
+from ..patience import wait_for_work
+from ..runtime.rates import callback_groups, track_calls
 from ..subject_interface import (PlotShown, QosAcked, QosEndpoint, RoomNodes, Worker,
                                  WorkerStop)
 from ..subject_replies import (CallbackFailure, PlotWitnessed, QosMade, Reply, RoomsMade,
@@ -58,7 +60,7 @@ class Trials:
     rooms: list[Node]
     node: Optional[Node]
     _spun: Optional[tuple[Node, Executor, threading.Thread, threading.Event,
-                          list[CallbackFailure]]]
+                          list[CallbackFailure], list[Any]]]
     _qos: Optional[tuple[Node, Any]]
     _plot_shown: Optional[Shown] = None
 
@@ -97,17 +99,20 @@ class Trials:
                                                 if inspect.iscoroutinefunction(t.callback)]}
         if len(timers) < 2:
             return WorkerSpun(ok=False, timers=len(timers), **facts)
-        deadline = time.monotonic() + command.seconds
-        while not all(client.service_is_ready() for client in node.clients):
-            if time.monotonic() >= deadline:
-                return WorkerSpun(ok=False, unmatched=True, **facts)
-            time.sleep(0.01)
+        # Discovery is this process's work: waited for while it works or waits for a CPU, and
+        # given up after ``seconds`` of sitting idle (ros2nb.patience), never of a busy machine.
+        if not wait_for_work(lambda: all(c.service_is_ready() for c in node.clients),
+                             [os.getpid()], command.seconds):
+            return WorkerSpun(ok=False, unmatched=True, **facts)
         stop = threading.Event()
         failures: list[CallbackFailure] = []
+        calls: list[Any] = []
+        for client in node.clients:  # to end, at the stop, a call no executor can answer
+            track_calls(client, calls)
         thread = threading.Thread(target=_spin, args=(node, executor, stop, failures),
                                   name='ros2nb-subject-worker', daemon=True)
         executor.add_node(node)
-        self._spun = (node, executor, thread, stop, failures)
+        self._spun = (node, executor, thread, stop, failures, calls)
         thread.start()
         return WorkerSpun(ok=True, **facts)
 
@@ -115,9 +120,13 @@ class Trials:
         """Stop spinning the learner's worker; the first failure of its callbacks, if any."""
         if self._spun is None:
             return WorkerStopped(ok=True)
-        node, executor, thread, stop, failures = self._spun
+        node, executor, thread, stop, failures, calls = self._spun
         self._spun = None
         stop.set()
+        # A callback that waits for a call's answer its executor can never take (a
+        # SingleThreadedExecutor, or every thread of one waiting) returns once it is cancelled.
+        for future in list(calls):
+            future.cancel()
         thread.join()
         executor.shutdown(timeout_sec=5)
         node.destroy_node()
