@@ -45,6 +45,10 @@ BEATS, BEAT_SPREAD_S = 2, course.HEARTBEAT_PERIOD_S / 2
 #: takes it a moment of work, never a wait, so the wait ends on a state (idle with the
 #: heartbeat due), never on how busy the machine is.
 BEAT_PATIENCE_S = 5.0
+#: The same for the first call of the slow job, which a Worker's slow timer makes every
+#: ``SLOW_PERIOD_S`` of its running: a Worker that sat idle this long without asking never
+#: will (and meanwhile its heartbeat fills /rosout on a clock that stands still).
+ASK_PATIENCE_S = 5.0
 #: /rosout as the judge taps it here: reliable, and what the Worker logged shortly before
 #: the judge's subscription matched it (rcl keeps each node's last lines).
 ROSOUT_QOS = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE,
@@ -194,7 +198,7 @@ def _held(judge: Judge, job: _SlowJob, heard: _Heartbeats) -> tuple[str, bool]:
     went wrong ('never': no slow job asked for; 'servers': another server of it), and
     whether the heartbeat kept coming meanwhile."""
     observer = judge.observer
-    if not observer.wait_until(job.take, ARRIVAL_TIMEOUT_S):
+    if not observer.wait_until(job.take, ASK_PATIENCE_S):
         return 'never', False
 
     def beating() -> bool:
@@ -240,10 +244,10 @@ def _responsive_worker(judge: Judge) -> str:
                           'itself, once it has heard the heartbeat; return the Worker and its '
                           'executor, and add no node or service of your own.')
     if problem == 'never':
-        raise CheckFailed(f'slow_work never asked for the slow job within '
-                          f'{ARRIVAL_TIMEOUT_S:g} s: keep the Worker of part 3 as given (its '
-                          f'slow_work calls the {course.SLOW_SERVICE} service), add it to no '
-                          'other executor, and keep both its timers.')
+        raise CheckFailed(f'slow_work never asked for the slow job while the Worker ran: keep '
+                          f'the Worker of part 3 as given (its slow_work calls the '
+                          f'{course.SLOW_SERVICE} service), add it to no other executor, and keep '
+                          'both its timers.')
     if beat:
         how = ('slow_work, a coroutine, hands the executor back while it waits'
                if 'slow_work' in reply.coroutines else 'the two timers run side by side')

@@ -11,8 +11,8 @@ ends, every kind's count.  The judge reads those lines
 
 A detector only: no check fails or passes on it, and its silence proves nothing (the hook runs
 in the learner's process, where code can read, replace or mute anything).  What decides a
-point is observed from outside that process (docs/decisions.md).  A subject that ended as
-asked without its last line had its channel closed or redirected: that is a note too.  The
+point is observed from outside that process (docs/decisions.md).  A subject that ended on
+``quit`` without its last line had its channel closed or redirected: that is a note too.  The
 text scan (:mod:`ros2nb.judge.flags`) is a second opinion.
 """
 

@@ -347,9 +347,10 @@ class SubjectProcess:
             pass
         stop_process_group(self.proc)
         self.take_seen()  # what its audit hook wrote last
-        # It ended as asked (on ``quit``, or SIGTERM) yet its hook's last line never came:
-        # something in it closed or redirected the pipe (a note; a SIGKILL says nothing).
-        self.channel_lost = not self.seen_ended and self.proc.returncode in (0, -15)
+        # It ended as asked, on ``quit``, yet its hook's last line never came: something in it
+        # closed or redirected the pipe (a note).  A subject the judge ended says nothing:
+        # sandboxed, the exit code is its sandbox's, whose end kills it at once.
+        self.channel_lost = not self.seen_ended and self.proc.returncode == 0
         for fd in (self._replies, self._acks):
             with contextlib.suppress(OSError):
                 os.close(fd)
