@@ -63,8 +63,8 @@ def subject_prefix(writable: Sequence[Path] = ()) -> list[str]:
     nothing else of the judge's folder is writable, or visible but ``handed/``."""
     value = os.environ.get(SUBJECT_PREFIX_ENV)
     prefix = json.loads(value) if value else []
-    if not prefix:
-        return []
+    if not prefix or prefix[-1] != '--':  # not bubblewrap's (a test's ``env``): as it is
+        return prefix
     binds = [arg for path in writable for arg in ('--bind', str(path), str(path))]
     return [*prefix[:-1], *binds, prefix[-1]]  # before its closing '--'
 
