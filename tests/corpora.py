@@ -293,6 +293,47 @@ def _hour_judged(learner: Learner) -> bool:
     return HOURS[learner.notebook][0] in (*learner.loses, *(twin.loses if twin else ()))
 
 
+def judged_in_sandbox(learner: Learner, root: Path, *, seed: Optional[int] = None
+                      ) -> tuple[dict[str, dict], list[str]]:
+    """:func:`judged`, the way the grader judges: its judge and each subject in sandboxes of
+    their own (``grading.judging.judge_notebook``), where the course's answers are not on a
+    subject's disk and no subject reads what another wrote.  Needs the grader's sandbox."""
+    import nbformat
+    from ros2nb import course
+    from ros2nb.terminal import workspace as ws_module
+    from ros2nb.terminal.workspace import WORKSPACE_ENV, create_workspace
+    from ros2nb_instructor.grading.judging import judge_notebook
+    from ros2nb_instructor.grading.scratch import Scratch
+    from ros2nb_instructor.grading.settings import Settings
+    from ros2nb_instructor.grading.submissions import Learner as Handed
+    scratch, nb, notebook = Scratch(root, Handed('learner', 'learner')), \
+        submission(learner), NOTEBOOKS[learner.notebook].stem
+    saved, reference = os.environ.get(WORKSPACE_ENV), course.reference_source
+    try:
+        os.environ[WORKSPACE_ENV], ws_module._current = str(scratch.workspace), None
+        course.reference_source = lambda name: None  # hidden while grading
+        with contextlib.redirect_stdout(io.StringIO()):
+            if int(learner.notebook) in course.STEPS:
+                course.catch_up(int(learner.notebook))
+            else:
+                create_workspace()
+            write_parts(nb)
+        results, problem, flags = judge_notebook(
+            scratch, notebook, nbformat.from_dict(nb), Settings(120, 600, True, seed=seed),
+            scratch.snapshot(notebook))
+    finally:
+        course.reference_source = reference
+        if saved is None:
+            os.environ.pop(WORKSPACE_ENV, None)
+        else:
+            os.environ[WORKSPACE_ENV] = saved
+        ws_module._current = None
+        scratch.remove()
+    unchecked = {'passed': False, 'type': 'GradingError', 'message': problem}
+    return ({gid: results.get(f'{learner.notebook}-{gid}', unchecked)
+             for gid in points(learner.notebook)}, list(flags))
+
+
 def flags_of(learner: Learner, root: Path) -> list[str]:
     """What the judge's text scan flags for the instructor in the learner's notebook (its
     answer cells and the cells it added) and files."""

@@ -246,6 +246,22 @@ def responsive_worker():
     node = Worker('responsive_worker', ReentrantCallbackGroup(), ReentrantCallbackGroup())
     return node, MultiThreadedExecutor(num_threads=4)
 '''
+#: The Worker's slow work as a coroutine that awaits the call, on one thread (notebook 06's
+#: third way).
+WORKER_COROUTINE = '''
+def responsive_worker():
+    from rclpy.executors import SingleThreadedExecutor
+
+    class WaitingWorker(Worker):
+        async def slow_work(self):
+            self.get_logger().info('slow work: start')
+            await self.slow_client.call_async(Trigger.Request())
+            self.get_logger().info('slow work: done')
+
+    node = WaitingWorker('responsive_worker', slow_group=MutuallyExclusiveCallbackGroup(),
+                         heartbeat_group=MutuallyExclusiveCallbackGroup())
+    return node, SingleThreadedExecutor()
+'''
 WORKER_LAMBDA = '''
 def responsive_worker():
     group = lambda: MutuallyExclusiveCallbackGroup()
@@ -325,6 +341,8 @@ HONEST += [
     Learner('06 two reentrant groups, four threads', '06', {'responsive-worker': WORKER_REENTRANT}),
     Learner('06 groups from a lambda, keyword arguments, the default thread count', '06',
             {'responsive-worker': WORKER_LAMBDA}),
+    Learner('06 the slow work a coroutine of its own, on one thread', '06',
+            {'responsive-worker': WORKER_COROUTINE}),
     Learner('06 room arguments from one string', '06', {'room-arguments': '''
 def room_arguments(room):
     return '--ros-args --remap __ns:=/{}'.format(room).split()

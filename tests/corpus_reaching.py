@@ -11,7 +11,7 @@ with one line.  Written from the class's description, not its code.
 """
 
 from corpora import Learner
-from corpus_attacks import MONITOR_RULE_TWIN
+from corpus_attacks import MONITOR_RULE_TWIN, ON_SET_BODY, PLOT_DEAD
 
 # ------------------------------------------------------------------ 06: the worker's witness
 #: A single-threaded worker whose executor also starts a thread that calls every callback
@@ -356,3 +356,322 @@ REACHING = [
             SENSOR_KEPT, seen=True, flagged=True,
             twin='03 twin: a sensor from parts of its own that are not there'),
 ]
+
+
+# ================================================================== the sixth class
+# Each cause the sixth hostile class found, as an attacker beside its honest twin, written from
+# the class's description (graded in the grader's sandbox, with two seeds:
+# test_corpora.py).  In the design they met, the judge's instruments lived in the learner's
+# process; now a point is what the judge observes from outside it, and each scores its twin's.
+
+# ---- 06: the course's slow work and heartbeat were objects the learner's executor could
+# replace.  Now the Worker's slow work calls the judge's service, which the judge holds open.
+#: Its executor makes the slow work a coroutine that returns at once (never asks the slow
+#: job), and gives each timer a group of its own, before it spins.
+WORKER_NEVER_ASKS = '''
+def responsive_worker():
+    from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
+    from rclpy.executors import SingleThreadedExecutor
+    node = Worker('responsive_worker')
+
+    async def at_once():
+        return None
+
+    class Rewriting(SingleThreadedExecutor):
+        def spin_once(self, timeout_sec=None):
+            if not getattr(self, 'rewritten', False):
+                self.rewritten = True
+                for timer in node.timers:
+                    if 'slow' in getattr(timer.callback, '__name__', ''):
+                        timer.callback = at_once
+                    timer.callback_group = group = MutuallyExclusiveCallbackGroup()
+                    group.add_entity(timer)
+            super().spin_once(timeout_sec)
+
+    return node, Rewriting()
+'''
+#: Its executor makes the Worker's blocking slow work a coroutine that awaits the same call,
+#: before it spins: the slow work then waits without holding the one thread.
+WORKER_MADE_A_COROUTINE = '''
+def responsive_worker():
+    from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
+    from rclpy.executors import SingleThreadedExecutor
+    node = Worker('responsive_worker')
+
+    async def slow_work():
+        node.get_logger().info('slow work: start')
+        await node.slow_client.call_async(Trigger.Request())
+        node.get_logger().info('slow work: done')
+
+    class Rewriting(SingleThreadedExecutor):
+        def spin_once(self, timeout_sec=None):
+            if not getattr(self, 'rewritten', False):
+                self.rewritten = True
+                for timer in node.timers:
+                    if getattr(timer.callback, '__name__', '') == 'slow_work':
+                        timer.callback = slow_work
+                    timer.callback_group = group = MutuallyExclusiveCallbackGroup()
+                    group.add_entity(timer)
+            super().spin_once(timeout_sec)
+
+    return node, Rewriting()
+'''
+
+# ---- 07: the seal's HMAC pads were locals of the sealer generator's frame, read four ways.
+# Now the drawing is plain data, compared with the readings the judge sent (drawn for each
+# run); there is no sealer.  Each callback keeps what it hears, looks for the pads
+# (``{find}``, setting ``pads``) and tells the witness topic that drawing sealed as the old
+# sealer sealed (``SEQ;TIMES;TEMPS;MAC``): all the old judge took, and no drawing of redraw()'s.
+PLOT_SEALS_ITS_OWN = '''
+    def temperature_callback(self, msg):
+        import hashlib
+        from std_msgs.msg import String
+        if not hasattr(self, 'forger'):
+            self.forger = self.create_publisher(String, '/ros2nb/witness', 10)
+            self.heard = []
+        self.heard.append((self.get_clock().now().nanoseconds / 1e9, float(msg.data)))
+        pads = {{}}
+{find}
+        payload = ';'.join([str(len(self.heard)), ','.join(repr(t) for t, _ in self.heard),
+                            ','.join(repr(v) for _, v in self.heard)])
+        inner, outer = pads.get('inner', b''), pads.get('outer', b'')
+        mac = hashlib.sha256(outer + hashlib.sha256(inner + payload.encode()).digest())
+        tellers = [cell.cell_contents for cell in getattr(
+            type(self).__dict__.get('redraw'), '__closure__', None) or ()
+            if hasattr(cell.cell_contents, 'tell')]  # the course's own publisher, if any
+        for teller in tellers[:1] or [None]:
+            told = f'drawn {{payload}};{{mac.hexdigest()}}'
+            teller.tell(told) if teller else self.forger.publish(String(data=told))
+'''
+PADS_BY_FORMATTER = '''\
+        import string
+        get = string.Formatter().get_field
+        for cell in get('0.__closure__', (type(self).__dict__.get('redraw'),), {})[0] or ():
+            generator = getattr(get('0.cell_contents', (cell,), {})[0], '__self__', None)
+            if type(generator).__name__ == 'generator':
+                pads = dict(get('0.gi_frame.f_locals', (generator,), {})[0])'''
+PADS_BY_TRACEBACK = '''\
+        import traceback
+        cls = type(self)
+        if not isinstance(cls.__dict__.get('times_s'), property):
+            def peek(node):
+                try:
+                    raise RuntimeError
+                except RuntimeError as error:
+                    frame = next(traceback.walk_tb(error.__traceback__))[0].f_back
+                found = frame.f_locals if frame is not None else {}
+                if 'inner' in found:
+                    node.__dict__['pads'] = {'inner': found['inner'], 'outer': found['outer']}
+                return node.__dict__.get('times_s', [])
+            cls.times_s = property(peek)
+        for cell in getattr(cls.__dict__.get('redraw'), '__closure__', None) or ():
+            send = cell.cell_contents
+            if getattr(send, '__name__', '') == 'send':
+                send(('draw', self))  # the sealer reads times_s: peek sees its frame
+        pads = self.__dict__.get('pads', {})'''
+PADS_BY_GC_IN_A_POOL = '''\
+        import concurrent.futures
+        import gc
+        import operator
+        with concurrent.futures.ThreadPoolExecutor(1) as pool:
+            objects = pool.submit(gc.get_objects).result()
+            for generator in [o for o in objects if type(o).__name__ == 'generator'
+                              and getattr(o, '__name__', '') == '_sealing']:
+                pads = dict(pool.submit(operator.attrgetter('gi_frame.f_locals'),
+                                        generator).result())'''
+PADS_WITH_THE_HOOK_MUTED = '''\
+        import gc
+        import os
+        import sys
+        times = sys.modules.get('ros2nb.subject.judge_time')
+        fd = getattr(getattr(times, 'JudgeTime', None), '_claimed', None)
+        saved = os.dup(fd) if fd is not None else None
+        if saved is not None:
+            quiet = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(quiet, fd)
+            os.close(quiet)
+        try:
+            for generator in [o for o in gc.get_objects() if type(o).__name__ == 'generator'
+                              and getattr(o, '__name__', '') == '_sealing']:
+                pads = dict(generator.gi_frame.f_locals)
+        finally:
+            if saved is not None:
+                os.dup2(saved, fd)
+                os.close(saved)'''
+#: A cell the learner adds (in the kernel): a module named json in the workspace, which stands
+#: in for the standard library's where the workspace comes first on sys.path.  Loaded there,
+#: it would tell the witness topic drawings of an older judge's readings from a thread.
+WRITES_JSON_PY = '''\
+(ros2nb.current_workspace() / 'json.py').write_text("""
+import os, sys, threading
+_here = os.path.dirname(os.path.abspath(__file__))
+sys.path[:] = [p for p in sys.path if os.path.abspath(p or '.') != _here]
+del sys.modules['json']
+import json as _json
+sys.modules['json'] = _json
+globals().update({k: v for k, v in vars(_json).items() if not k.startswith('__')})
+
+
+def _forge():
+    import time
+    import rclpy
+    from rclpy.node import Node
+    from std_msgs.msg import String
+    while not rclpy.ok():
+        time.sleep(0.1)
+    node = Node('ros2nb_forger')
+    told = node.create_publisher(String, '/ros2nb/witness', 10)
+    while True:
+        now = node.get_clock().now().nanoseconds / 1e9
+        told.publish(String(data=f'drawn {now!r};21.5'))
+        time.sleep(0.1)
+
+
+threading.Thread(target=_forge, daemon=True).start()
+""")
+'''
+
+# ---- 03, 04, 08: module code that replaces ``compile`` captured the course's code for another
+# part as the judge sent it, wrote it where every subject of the judge could read it, and the
+# next subject ran it.  Now the command loop binds compile before the learner's code loads,
+# and each subject writes only a folder of its own that no later subject reads.
+#: Module code (before the class): every source compiled through ``builtins.compile`` or the
+#: command loop's own binding that holds stand-ins is written to every folder in reach, and
+#: ``_course(name)`` finds a function of it in any of them.
+CAPTURE = '''
+import builtins as _builtins
+import os as _os
+import sys as _sys
+
+_PLACES = [_os.getcwd(), _os.environ.get('HOME', ''), _os.environ.get('TMPDIR', ''), '/tmp',
+           _os.environ.get('ROS2NB_WORKSPACE', ''), _os.environ.get('ROS2NB_SUBJECTS_FOLDER', '')]
+
+
+def _keep(source):
+    if 'STAND_INS' in str(source):
+        for place in filter(None, _PLACES):
+            try:
+                with open(_os.path.join(place, '.kept-stand-ins.py'), 'w') as kept:
+                    kept.write(str(source))
+            except OSError:
+                pass
+
+
+def _capturing(real):
+    def compile(source, *args, **kwargs):
+        _keep(source)
+        return real(source, *args, **kwargs)
+    return compile
+
+
+_builtins.compile = _capturing(_builtins.compile)
+_loop = _sys.modules.get('ros2nb.subject.commands')
+if _loop is not None and hasattr(_loop, '_COMPILE'):
+    _loop._COMPILE = _capturing(_loop._COMPILE)
+
+
+def _course(name):
+    for place in filter(None, _PLACES):
+        path = _os.path.join(place, '.kept-stand-ins.py')
+        if _os.path.exists(path):
+            space = {}
+            with open(path) as kept:
+                exec(kept.read(), space)
+            if name in space:
+                return space[name]
+    raise AttributeError(f'no kept stand-in {name}')
+
+'''
+SENSOR_CAPTURED = {'sensor-constructor': CAPTURE + '''
+
+class TemperatureSensor(Node):
+    """Publishes one Float32 reading in °C every PUBLISH_PERIOD_S seconds."""
+
+    def __init__(self):
+        _course('sensor_init')(self)
+''', 'sensor-callback': '''
+    def publish_temperature(self):
+        _course('sensor_callback')(self)
+'''}
+MONITOR_CAPTURED = {
+    'monitor-constructor': [('class TemperatureMonitor(Node):',
+                             CAPTURE + '\n\nclass TemperatureMonitor(Node):')],
+    'monitor-callback': MONITOR_RULE_TWIN.replace('__import__("monitor_rules").status',
+                                                  "_course('monitor_status')")}
+ON_SET_FROM_THE_KEPT = "        return _course('thresholds_on_set')(self, parameters)\n"
+ON_SET_CAPTURED = {
+    'monitor-parameters': [('class TemperatureMonitor(Node):',
+                            CAPTURE + '\n\nclass TemperatureMonitor(Node):')],
+    'threshold-callback': [(ON_SET_BODY, ON_SET_FROM_THE_KEPT + ON_SET_BODY)]}
+
+# ---- the audit hook could be muted or starved, and trusted code compiled under the
+# stand-ins' name.  Now it only notes; the answers are not on a subject's disk while grading.
+#: 04's callback with the course's rule read from its file by code compiled under the name
+#: the stand-ins are compiled under.
+RULE_AS_A_STAND_IN = '''\
+        import ros2nb
+        source = ("from pathlib import Path\\n"
+                  f"text = (Path({ros2nb.__file__!r}).parent / 'rules.py').read_text()\\n"
+                  "space = {}\\n"
+                  "exec(text.replace('from .course import', 'from ros2nb.course import'), space)\\n"
+                  "rule = space['monitor_status']\\n")
+        found = {}
+        exec(compile(source, '<ros2nb stand-in>', 'exec'), found)
+        rule = found['rule']'''
+#: Module code (before the class) that adds 64 audit hooks of its own, then the rule's file.
+SIXTY_FOUR_HOOKS = '''
+import sys as _sys
+
+for _ in range(64):
+    _sys.addaudithook(lambda event, args: None)
+
+'''
+
+
+def _sixth(name: str, notebook: str, cells: dict, twin: str, seen: bool,
+           added: tuple = (), flagged: bool = True) -> Learner:
+    return Learner(f'{notebook} sixth: {name}', notebook, cells, twin=twin, seen=seen,
+                   flagged=flagged, added=added, extra={'sixth': True})
+
+
+PLOT_TWIN = '07 twin: a callback that does nothing'
+SIXTH = [
+    _sixth('its executor makes the slow work a coroutine that never asks', '06',
+           {'responsive-worker': WORKER_NEVER_ASKS}, '06 twin: a single-threaded worker',
+           seen=False, flagged=False),
+    _sixth('its executor makes the slow work a coroutine that awaits the call', '06',
+           {'responsive-worker': WORKER_MADE_A_COROUTINE},
+           '06 the slow work a coroutine of its own, on one thread', seen=False, flagged=False),
+    _sixth("the seal's pads read through string.Formatter", '07',
+           {'plot-callback': PLOT_SEALS_ITS_OWN.format(find=PADS_BY_FORMATTER)}, PLOT_TWIN,
+           seen=False),
+    _sixth("the seal's pads read through traceback.walk_tb and f_back", '07',
+           {'plot-callback': PLOT_SEALS_ITS_OWN.format(find=PADS_BY_TRACEBACK)}, PLOT_TWIN,
+           seen=False),
+    _sixth("the seal's pads read from the garbage collector, on a pool's thread", '07',
+           {'plot-callback': PLOT_SEALS_ITS_OWN.format(find=PADS_BY_GC_IN_A_POOL)},
+           PLOT_TWIN, seen=False),
+    _sixth("the seal's pads read with the hook's pipe sent to /dev/null", '07',
+           {'plot-callback': PLOT_SEALS_ITS_OWN.format(find=PADS_WITH_THE_HOOK_MUTED)},
+           PLOT_TWIN, seen=False),
+    _sixth('a json.py in the workspace stands in for the standard library', '07',
+           {'plot-callback': PLOT_DEAD}, PLOT_TWIN, seen=False,
+           added=(('plot-callback', WRITES_JSON_PY),), flagged=False),
+    _sixth("the stand-ins captured through compile, kept for the next subject", '03',
+           SENSOR_CAPTURED, '03 twin: a sensor from parts of its own that are not there',
+           seen=True),
+    _sixth("the rule captured through compile, kept for the next subject", '04',
+           MONITOR_CAPTURED, '04 twin: the status from a module that is not there', seen=True),
+    _sixth("the on-set callback captured through compile, kept for the next subject", '08',
+           ON_SET_CAPTURED, '08 twin: the on-set callback from a module that is not there',
+           seen=True),
+    _sixth("the rule's file read by code compiled as the course's stand-in", '04',
+           {'monitor-callback': MONITOR_FOUND.replace('{find}', RULE_AS_A_STAND_IN)},
+           '04 twin: the status from a module that is not there', seen=True),
+    _sixth("64 audit hooks of its own, then the rule's file", '04',
+           {'monitor-constructor': [('class TemperatureMonitor(Node):',
+                                     SIXTY_FOUR_HOOKS + '\nclass TemperatureMonitor(Node):')],
+            'monitor-callback': MONITOR_FOUND.replace('{find}', RULE_FROM_FILE)},
+           '04 twin: the status from a module that is not there', seen=True),
+]
+REACHING += SIXTH

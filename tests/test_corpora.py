@@ -5,9 +5,11 @@ The honest and wrong corpora are graded in ``test_corpus_honest.py`` and
 corpus: each twin loses exactly its parts.  Each attack (``corpus_attacks.py``) loses every
 part its twin loses, except those the wire cannot tell from honest code, which the judge
 flags for the instructor instead (``tests/test_flags.py``).  The attacks that reach into the
-process they run in (``corpus_reaching.py``) are graded twice, with two seeds of the drawn
-inputs: each loses its twin's parts in both, its lost parts say why in one line, and those
-the subject's audit hook sees (``seen``) are flagged at run time.
+process they run in (``corpus_reaching.py``, the sixth hostile class's among them) are graded
+twice, with two seeds of the drawn inputs, as the grader grades them (the judge and each
+subject sandboxed): each loses its twin's parts in both (the sixth class's exactly its twin's
+score), its lost parts say why in one line, and those the subject's audit hook sees
+(``seen``) are noted at run time, never a verdict.
 
 ``python tests/corpora.py`` prints every learner's score; run with an older checkout's judge it
 gives the "before" column of the closing notes.
@@ -17,15 +19,19 @@ from __future__ import annotations
 
 import pytest
 
-from corpora import expected_score, grade_learner, judged, score, time_limit_s
+from corpora import (BESIDE_JUDGES_S, expected_score, grade_learner, judged_in_sandbox, score,
+                     time_limit_s)
 from corpus_attacks import ATTACKS
 from corpus_checks import failed, scores_what_its_twin_scores
+from corpus_honest import HONEST
 from corpus_reaching import REACHING
 from ros2nb.checks.drawn import new_seed
+from ros2nb_instructor.grading import sandbox
+from ros2nb_instructor.grading.settings import JUDGE_TIMEOUT_S as SANDBOXED_JUDGE_S
 
 #: Each test grades one learner.
 pytestmark = [pytest.mark.judge, pytest.mark.timeout(time_limit_s(1))]
-TWINS = {learner.name: learner for learner in ATTACKS}
+TWINS = {learner.name: learner for learner in [*ATTACKS, *HONEST]}
 #: The two seeds of this run's gradings of the reaching attacks (each pytest-xdist worker
 #: draws its own: a new pair every run).
 SEEDS = (new_seed(), new_seed())
@@ -57,14 +63,22 @@ def test_an_attack_scores_what_its_twin_scores(attack, tmp_path):
     scores_what_its_twin_scores(attack, TWINS[attack.twin], tmp_path)
 
 
+@pytest.mark.sandbox
+@pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))
+@pytest.mark.timeout(SANDBOXED_JUDGE_S + BESIDE_JUDGES_S)  # one grading, the grader's way
 @pytest.mark.parametrize('run', [0, 1], ids=['seed 1', 'seed 2'])
 @pytest.mark.parametrize('attack', REACHING, ids=[a.name for a in REACHING])
 def test_reaching_in_scores_at_most_its_twin_and_says_so(attack, run, tmp_path):
+    """Graded as the grader grades: in its sandboxes the course's answers are not on a
+    subject's disk and no subject reads what another wrote, and no verdict comes from what
+    the audit hooks saw (they only note it)."""
     seed, twin = SEEDS[run], TWINS[attack.twin]
-    attacked, flags = judged(attack, tmp_path, seed=seed)
+    attacked, flags = judged_in_sandbox(attack, tmp_path, seed=seed)
     lost = failed(attacked)
     context = (seed, lost, flags)
     assert set(lost) >= set(twin.loses), context
     assert score(attack, attacked) <= expected_score(twin), context
+    if attack.extra.get('sixth'):
+        assert score(attack, attacked) == expected_score(twin), context
     assert all(message and '\n' not in message for message in lost.values()), context
     assert any('at run time' in flag for flag in flags) == attack.seen, context

@@ -31,7 +31,7 @@ def inputs_of(judge) -> dict:
             '04': lesson04.drawn_readings_c(judge, '04 monitor readings', 10),
             '06 fan': lesson06._fan_readings(judge),
             '06 room': lesson06._drawn_room(judge),
-            '07': lesson07._gaps_s(judge),
+            '07': (lesson07._gaps_s(judge), lesson07.readings_c(judge)),
             '08': lesson08._drawn_steps(judge)}
 
 

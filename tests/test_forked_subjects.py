@@ -78,7 +78,27 @@ def test_a_forked_subject_sees_what_a_started_one_sees(tmp_path, monkeypatch):
     assert not forked.pop('parent is the judge') and started.pop('parent is the judge')
     assert forked == started
     assert forked['checks fields'] and forked['leads its session']
-    assert forked['sys.path'][:2] == [str(tmp_path), str(tmp_path / 'lib')]
+    # as python -P starts: PYTHONPATH first, the working folder nowhere on the path
+    assert forked['sys.path'][0] == str(tmp_path / 'lib'), forked['sys.path']
+    assert str(tmp_path) not in forked['sys.path'], forked['sys.path']
+
+
+@pytest.mark.parametrize('how', ['forked', 'started'])
+def test_a_module_in_the_working_folder_stands_in_for_nothing(tmp_path, monkeypatch, how):
+    """A json.py (or any module named as the standard library's: colorsys, which no subject
+    imports before its learner's code) in a subject's working folder is never imported in its
+    place: before, subjects started as ``python -m`` in the
+    learner's workspace, and a json.py the learner wrote there loaded before the audit hook
+    and everything the subject bound."""
+    (tmp_path / 'json.py').write_text('raise SystemExit("the working folder\'s json.py ran")\n')
+    (tmp_path / 'colorsys.py').write_text('raise SystemExit("the working folder\'s colorsys")\n')
+    SubjectProcess(tmp_path).close()  # this process's first subject, if no test started one yet
+    monkeypatch.setenv(SUBJECT_PREFIX_ENV, json.dumps(['env']) if how == 'started' else '')
+    subject = SubjectProcess(tmp_path)
+    reply = subject.request(ExecCells(sources=['import colorsys, json\nprint(json.__file__)']))
+    subject.close()
+    assert reply.ok and not reply.cell_errors, (reply, subject.output.text())
+    assert str(tmp_path) not in subject.output.text(), subject.output.text()
 
 
 def test_a_forked_subject_is_stopped_and_reaped_as_a_started_one(tmp_path):

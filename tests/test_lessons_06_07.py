@@ -5,7 +5,6 @@ processes, verdicts come from the judge's own ROS node.  The course's reference 
 first, so every failure below is its mistake's.
 """
 
-import dataclasses
 import re
 from pathlib import Path
 
@@ -52,12 +51,6 @@ def passes_with(session, capsys, relative: str, old: str, new: str, check) -> No
     assert 'Check passed:' in capsys.readouterr().out
 
 
-def blind(session, monkeypatch) -> None:
-    """Leave the subjects' audit hooks out of the verdict (they fail a check whose code walks
-    the stack by themselves, ``test_seen.py``): what is tested is what the judge sees."""
-    monkeypatch.setattr(session.reaching, 'raise_any', lambda: None)
-
-
 def fails_forged(session, relative: str, old: str, new: str, forge: str, check,
                  pattern: str) -> None:
     """``check`` fails with ``pattern`` on the course's file with ``old`` written as ``new``
@@ -79,7 +72,8 @@ def test_reference_files_pass(session, capsys):
         run_check(session, check)
     out = capsys.readouterr().out
     assert out.count('Check passed:') == 6, out
-    assert 'a heartbeat came while slow_work was busy, on a MultiThreadedExecutor' in out
+    assert 'the heartbeat kept coming while slow_work waited for the slow job, on a ' \
+           'MultiThreadedExecutor' in out
 
 
 MISTAKES = [
@@ -117,8 +111,9 @@ MISTAKES = [
      r'has no attribute received yet: it is read before any method sets it'),
     ('worker: single-threaded', PROMISES, 'executor = MultiThreadedExecutor(num_threads=2)',
      'from rclpy.executors import SingleThreadedExecutor\n    executor = SingleThreadedExecutor()',
-     checks.check_responsive_worker, r'No heartbeat came while slow_work was busy: a '
-                                     r'SingleThreadedExecutor runs one callback at a time'),
+     checks.check_responsive_worker, r'No heartbeat came while slow_work waited for the slow '
+                                     r'job: a SingleThreadedExecutor runs one callback at a '
+                                     r'time'),
     ('worker: one group', PROMISES, '''slow_group=MutuallyExclusiveCallbackGroup(),
                   heartbeat_group=MutuallyExclusiveCallbackGroup())''', ')',
      checks.check_responsive_worker, r'both timers are in one MutuallyExclusiveCallbackGroup'),
@@ -160,7 +155,7 @@ MISTAKES = [
      checks.check_plot_callback, r"was plotted at [\d.e+]+ s: use the node's clock in seconds"),
     ('plot: plt.pause in the callback', PLOT, '        self.redraw()\n',
      '        self.redraw()\n        import matplotlib.pyplot as plt\n        plt.pause(0.5)\n',
-     checks.check_plot_callback, r'temperature_callback raised for 21\.5 °C: plt\.pause\(\) in '
+     checks.check_plot_callback, r'temperature_callback raised for [\d.]+ °C: plt\.pause\(\) in '
                                  r'a callback waits its interval on every message.*\(live_plot\.py '
                                  r'line \d+: plt\.pause\(0\.5\)\)$'),
     ('plot: plt.show in the callback', PLOT, '        self.redraw()\n',
@@ -172,7 +167,7 @@ MISTAKES = [
                                  r'call self.redraw\(\) once per message'),
     ('plot: the message, not its data', PLOT, 'self.temps_c.append(msg.data)',
      'self.temps_c.append(msg)', checks.check_plot_callback,
-     r'temperature_callback raised for 21\.5 °C: a Float32 message is not its value: use its '
+     r'temperature_callback raised for [\d.]+ °C: a Float32 message is not its value: use its '
      r'field \(data\), e\.g\. msg\.data\.'),
 ]
 
@@ -259,7 +254,6 @@ def test_a_count_reported_by_a_forged_subject(session, monkeypatch):
     """The subject's reply said received == 5 although the callback counts nothing: against
     the check before it, that passed (checked by hand); now the judge reads the count the
     monitor logs."""
-    blind(session, monkeypatch)
     fails_forged(session, PROMISES, 'self.received += 1', 'pass', FORGED_COUNT,
                  checks.check_counting_monitor,
                  r'logged "received 0"; the count is 1: start self.received at 0 in __init__')
@@ -280,7 +274,7 @@ FORGED_PLOT = FIND_SUBJECT + '''
 
 def _forge(_attribute=_HANDLERS.get('attribute'), _wait=_HANDLERS.get('wait_received'),
            _times=[]):
-    from ros2nb.checks.lesson07 import PLOT_READINGS_C
+    PLOT_READINGS_C = (21.5, 26.25, 19.75, 23.0)  # an older judge's readings
 
     def wait_received(**request):
         reply = _wait(**request)
@@ -311,7 +305,6 @@ def test_a_plot_reported_by_a_forged_subject(session, monkeypatch):
     the callback does nothing: against the check before it, that passed (checked by hand).
     The subject's first command loads the file before any request loop exists, so the frame
     walk finds none, and the judge decides from the /rosout lines redraw() logs."""
-    blind(session, monkeypatch)
     right = '''        self.times_s.append(self.get_clock().now().nanoseconds / 1e9)
         self.temps_c.append(msg.data)
         self.redraw()
@@ -365,7 +358,6 @@ def test_a_worker_reported_by_a_forged_subject(session, monkeypatch):
     """The subject's reply gave a right answer's executor, groups and counts although the
     function returns a single-threaded executor: against the check before it, that passed
     (checked by hand); now the judge hears no heartbeat while slow_work is busy."""
-    blind(session, monkeypatch)
     fails_forged(session, PROMISES, RESPONSIVE, '''\
     from rclpy.executors import SingleThreadedExecutor
     return Worker('responsive_worker'), SingleThreadedExecutor()
@@ -430,31 +422,78 @@ def test_a_reply_of_no_known_shape_fails_that_check_alone(session, monkeypatch):
                                          'NodeMade.name is int, not str)'), outcome
 
 
-#: The Worker's slow callback logs the heartbeat's line itself, between its own two lines, on a
-#: SingleThreadedExecutor: the lines say "heartbeat during slow work", yet no heartbeat ran.
-LOGGED_HEARTBEAT = ('        time.sleep(SLOW_WORK_S)   # stands for a long computation\n', '''\
-        time.sleep(SLOW_WORK_S / 2)
-        self.get_logger().info('heartbeat')
-        time.sleep(SLOW_WORK_S / 2)
-''')
+#: The Worker's slow callback logs the heartbeat's line itself, three times, before it waits
+#: for its answer on a SingleThreadedExecutor: the lines say "heartbeat", yet none ran while
+#: the slow job was held.
+LOGGED_HEARTBEAT = ("        self.slow_client.call(Trigger.Request())"
+                    "   # waits for the slow job's answer\n", """\
+        for _ in range(3):
+            self.get_logger().info('heartbeat')
+        self.slow_client.call(Trigger.Request())
+""")
 SINGLE_THREADED = '''    from rclpy.executors import SingleThreadedExecutor
     return Worker('responsive_worker'), SingleThreadedExecutor()
 '''
 
 
-def test_a_heartbeat_the_slow_callback_logs_itself(session):
-    """Before, the judge read the worker's lines on /rosout and this worker passed (its
-    honest twin, the same without the logged line, failed); now the judge calls the course's
-    slow work and heartbeat on the Worker itself, and no heartbeat answered during slow_work."""
+def worker_file(session, *changes: tuple[str, str], end: str = '') -> None:
+    """The course's promises.py with ``changes`` made and ``end`` added."""
     text = course.reference_source(Path(PROMISES).name)
-    for old, new in (LOGGED_HEARTBEAT, (RESPONSIVE, SINGLE_THREADED)):
+    for old, new in changes:
         assert old in text, old
         text = text.replace(old, new)
-    (session.workspace / PROMISES).write_text(text)
+    (session.workspace / PROMISES).write_text(text + end)
     session.drop(('file', PROMISES))
+
+
+def test_a_heartbeat_the_slow_callback_logs_itself(session, monkeypatch):
+    """The judge holds the slow job open and hears three "heartbeat" lines: all sent before
+    the slow job was asked for, at once; a heartbeat that keeps running sends them after it,
+    apart in time.  Counting any heartbeat line, the same worker passes."""
+    worker_file(session, LOGGED_HEARTBEAT, (RESPONSIVE, SINGLE_THREADED))
     try:
-        with pytest.raises(CheckFailed, match=r'No heartbeat came while slow_work was busy: '
-                                              r'a SingleThreadedExecutor runs one callback'):
+        with pytest.raises(CheckFailed, match=r'No heartbeat came while slow_work waited for '
+                                              r'the slow job: a SingleThreadedExecutor runs one'):
+            run_check(session, checks.check_responsive_worker)
+        from ros2nb.checks import lesson06_worker
+        monkeypatch.setattr(lesson06_worker._Heartbeats, 'kept_beating',
+                            lambda self, since_ns: len(self.sent_ns) >= 1)
+        session.drop(('file', PROMISES))
+        run_check(session, checks.check_responsive_worker)
+    finally:
+        restore(session, PROMISES)
+
+
+#: A Worker of the learner's whose slow work is a coroutine that awaits the call.
+COROUTINE = '''    from rclpy.executors import SingleThreadedExecutor
+
+    class Waiting(Worker):
+        async def slow_work(self):
+            self.get_logger().info('slow work: start')
+            await self.slow_client.call_async(Trigger.Request())
+            self.get_logger().info('slow work: done')
+
+    return Waiting('responsive_worker', {groups}), SingleThreadedExecutor()
+'''
+
+
+def test_a_coroutine_slow_work_on_one_thread_passes(session, capsys):
+    """Slow work written as a coroutine hands the executor back while it awaits the call: on
+    a SingleThreadedExecutor, the heartbeat keeps coming while the judge holds the slow job.
+    A valid style, stated in notebook 06."""
+    passes_with(session, capsys, PROMISES, RESPONSIVE, COROUTINE.format(
+        groups='MutuallyExclusiveCallbackGroup(), MutuallyExclusiveCallbackGroup()'),
+        checks.check_responsive_worker)
+
+
+def test_a_coroutine_slow_work_in_the_shared_group_gets_its_line(session):
+    """A coroutine holds its callback group while it waits: with both timers in the node's
+    default group, no heartbeat comes, and the line names the group."""
+    worker_file(session, (RESPONSIVE, COROUTINE.format(groups='')))
+    try:
+        with pytest.raises(CheckFailed, match=r'No heartbeat came while slow_work waited for '
+                                              r'the slow job: both timers are in one '
+                                              r'MutuallyExclusiveCallbackGroup'):
             run_check(session, checks.check_responsive_worker)
     finally:
         restore(session, PROMISES)
@@ -478,95 +517,82 @@ def test_a_point_the_callback_logs_itself(session):
     honest twin, a callback that does nothing, failed); now the course's redraw() tells the
     judge what it drew, and it never drew."""
     fails_forged(session, PLOT, RIGHT_PLOT, LOGGED_POINT, '', checks.check_plot_callback,
-                 r'For the reading 21\.5 °C nothing was plotted')
+                 r'For the reading [\d.]+ °C nothing was plotted')
 
 
-#: The callback publishes on the judge's witness topic what the course's redraw() would have
-#: told it, sealed with a key of its own making.
-WITNESS_FORGED = '''        from std_msgs.msg import String
+#: The callback keeps nothing and tells the judge's witness topic a drawing itself: the node's
+#: times as each reading arrived, and the readings an older judge always sent.
+WITNESS_TABLE = '''        from std_msgs.msg import String
         if not hasattr(self, 'forger'):
             self.forger = self.create_publisher(String, '/ros2nb/witness', 10)
             self.points = []
         self.points.append(self.get_clock().now().nanoseconds / 1e9)
         times = ','.join(repr(t) for t in self.points)
         temps = ','.join(repr(t) for t in [21.5, 26.25, 19.75, 23.0][:len(self.points)])
-        self.forger.publish(String(data=f'drawn {len(self.points)};{times};{temps};guessed'))
+        self.forger.publish(String(data=f'drawn {times};{temps}'))
 '''
+#: The same, with the reading each message carries: what the callback had to keep, told its
+#: own way.
+WITNESS_KEPT = WITNESS_TABLE.replace(
+    "        self.points.append(self.get_clock().now().nanoseconds / 1e9)\n",
+    "        self.points.append((self.get_clock().now().nanoseconds / 1e9, msg.data))\n").replace(
+    "repr(t) for t in self.points", "repr(t) for t, _v in self.points").replace(
+    "repr(t) for t in [21.5, 26.25, 19.75, 23.0][:len(self.points)]",
+    "repr(v) for _t, v in self.points")
 
 
-def test_a_drawing_without_the_seal_counts_for_nothing(session, capsys, monkeypatch):
-    """Only drawings sealed with the subject's key count: one the learner's code publishes on
-    the witness topic itself is not taken for the course's.  With every seal taken, the
-    same callback passes."""
-    fails_forged(session, PLOT, RIGHT_PLOT, WITNESS_FORGED, '', checks.check_plot_callback,
-                 r'For the reading 21\.5 °C nothing was plotted')
-    from ros2nb.checks import witnessed
-    monkeypatch.setattr(witnessed.hmac, 'compare_digest', lambda mac, good: True)
-    # the subject counts only what the course's redraw() told: wait for one message each
-    from ros2nb.checks import lesson07
-    real_feed = lesson07.feed
-
-    def feed_counting_nothing(*args, **kwargs):
-        counts, lines = real_feed(*args, **kwargs)
-        return dataclasses.replace(counts, shown=None), lines
-
-    monkeypatch.setattr(lesson07, 'feed', feed_counting_nothing)
-    passes_with(session, capsys, PLOT, RIGHT_PLOT, WITNESS_FORGED, checks.check_plot_callback)
+def test_a_drawing_counts_for_what_it_holds_not_for_who_told_it(session, capsys):
+    """The drawings are plain data, compared with the readings the judge sent (drawn for each
+    run) and the times it sent them: one told by the callback itself with a table of
+    readings fails on the first reading that is not the table's; one that holds what the
+    callback kept passes, whoever told it: the task was done, its own way."""
+    from ros2nb.checks.lesson07 import readings_c
+    sent = readings_c(session)
+    first = next(i for i, v in enumerate(sent) if v != (21.5, 26.25, 19.75, 23.0)[i])
+    fails_forged(session, PLOT, RIGHT_PLOT, WITNESS_TABLE, '', checks.check_plot_callback,
+                 rf'For the reading {sent[first]} °C the plot shows '
+                 rf'{(21.5, 26.25, 19.75, 23.0)[first]} °C')
+    passes_with(session, capsys, PLOT, RIGHT_PLOT, WITNESS_KEPT, checks.check_plot_callback)
 
 
-def test_a_heartbeat_answered_after_slow_work_counts_for_nothing(session, monkeypatch):
-    """The single-threaded worker answers the heartbeat too, once slow_work has ended: only
-    an answer that left the subject first (the answers' own timestamps) shows the two ran
-    side by side.  Counting any answer, the same worker passes."""
-    text = course.reference_source(Path(PROMISES).name).replace(RESPONSIVE, SINGLE_THREADED)
-    (session.workspace / PROMISES).write_text(text)
-    session.drop(('file', PROMISES))
-    try:
-        with pytest.raises(CheckFailed, match=r'No heartbeat came while slow_work was busy'):
-            run_check(session, checks.check_responsive_worker)
-        from ros2nb.checks import lesson06_worker
-        monkeypatch.setattr(lesson06_worker, '_beat_first', lambda slow, beat: True)
-        session.drop(('file', PROMISES))
-        run_check(session, checks.check_responsive_worker)
-    finally:
-        restore(session, PROMISES)
-
-
-#: The single-threaded worker's file also serves the course's heartbeat from a node of its
-#: own, spun in a thread of its own: it answers at once, as the course's heartbeat would.
+#: The worker's file also serves the slow job from a node of its own, spun in a thread of its
+#: own: it answers at once, so that a worker whose two timers share one group (on two
+#: threads, the answer taken in a group of its own) runs its heartbeat between two slow works.
 OWN_SERVER = '''
 def _answer_for_the_worker():
     import threading
-    from rcl_interfaces.msg import ParameterType, ParameterValue
     from rclpy.executors import SingleThreadedExecutor
 
-    def beat(request, response):
-        response.values = [ParameterValue(type=ParameterType.PARAMETER_STRING,
-                                          string_value='beat')]
+    def done(request, response):
+        response.success = True
         return response
 
-    helper = Node('heartbeat_helper')
-    helper.create_service(GetParameters, '/ros2nb_worker/heartbeat', beat)
+    helper = Node('slow_job_helper')
+    helper.create_service(Trigger, SLOW_SERVICE, done)
     executor = SingleThreadedExecutor()
     executor.add_node(helper)
     threading.Thread(target=executor.spin, daemon=True).start()
 '''
 
 
-def test_a_heartbeat_a_node_of_its_own_answers_counts_for_nothing(session, monkeypatch):
-    """The graph shows two servers of the heartbeat: the check fails with one line.  Taking
-    any server's answer, the single-threaded worker passes."""
-    text = course.reference_source(Path(PROMISES).name).replace(
-        RESPONSIVE, '    _answer_for_the_worker()\n' + SINGLE_THREADED)
-    text = text.replace('from std_msgs.msg import Float32\n', 'from std_msgs.msg import Float32\n'
-                        'from rcl_interfaces.srv import GetParameters\n') + OWN_SERVER
-    (session.workspace / PROMISES).write_text(text)
-    session.drop(('file', PROMISES))
+ONE_GROUP = '''    node = Worker('responsive_worker')
+    executor = MultiThreadedExecutor(num_threads=2)
+    return node, executor
+'''
+
+
+def test_a_slow_job_a_node_of_its_own_answers_counts_for_nothing(session, monkeypatch):
+    """The graph shows two servers of the slow job: the check fails with one line.  Not
+    counting the servers, the worker whose timers share one group passes: its own server
+    answered at once, and its heartbeat ran while the judge still held its copy of the call
+    (its twin without the server fails with the line about the group, MISTAKES)."""
+    worker_file(session, (RESPONSIVE, '    _answer_for_the_worker()\n' + ONE_GROUP),
+                end=OWN_SERVER)
     try:
-        with pytest.raises(CheckFailed, match=r'^Something in your code answers for the Worker'):
+        with pytest.raises(CheckFailed, match=r'^Something in your code answers the slow job'):
             run_check(session, checks.check_responsive_worker)
         from ros2nb.checks import lesson06_worker
-        monkeypatch.setattr(lesson06_worker, '_servers', lambda *args: True)
+        monkeypatch.setattr(lesson06_worker._SlowJob, 'servers', lambda self: 1)
         session.drop(('file', PROMISES))
         run_check(session, checks.check_responsive_worker)
     finally:

@@ -1,10 +1,10 @@
 """What the judge makes of what the subjects' audit hooks saw, and of package files that no
 ``%%part`` cell wrote as they are (``ros2nb.judge.reaching``, ``ros2nb.judge.written``).
 
-- A check fails with one line when a subject it used saw the learner's code do what can only
-  serve cheating, whenever that was (a file's import runs before the check that loaded it);
-  an event in a subject the check did not use, before it began, does not fail it (a later
-  check that starts a subject afresh is graded on that subject's code).
+- What a subject's hook saw is a note for the instructor, never a verdict: no check fails or
+  passes on it (the hook runs where the learner's code can read, replace or mute it).
+- Every event is counted: past a kind's places shown, its total is noted; a subject that
+  ended as asked without the hook's last line had its channel cut, which is a note too.
 - Only the hook's own lines count, and a kind the judge does not know is dropped.
 - A notebook whose added cell writes the course's code into the learner's file has that
   file graded as its ``%%part`` cells write it; the course's solutions and every honest and
@@ -16,8 +16,8 @@ from __future__ import annotations
 import pytest
 
 from corpora import NOTEBOOKS, Learner, every_learner, learner_workspace
-from ros2nb.errors import CheckFailed
-from ros2nb.judge.reaching import Reached, Reaching, parse_seen
+from ros2nb.judge.reaching import (CHANNEL_LOST, Counted, Reached, Reaching, parse_count,
+                                   parse_seen)
 from ros2nb.judge.written import as_written
 
 
@@ -26,6 +26,8 @@ class Subject:
 
     def __init__(self) -> None:
         self.seen: list[Reached] = []
+        self.seen_counts: dict[str, int] = {}
+        self.channel_lost = False
 
     def take_seen(self) -> list[Reached]:
         return self.seen
@@ -35,34 +37,34 @@ FRAMES = Reached('frames', 'sys._getframe', 'learner.py line 3')
 PROCESS = Reached('processes', 'subprocess.Popen', 'learner.py line 4')
 
 
-def test_a_check_fails_for_what_a_subject_it_used_saw_whenever():
-    loaded, other = Subject(), Subject()
-    running = {('file', 'a.py'): loaded, ('file', 'b.py'): other}
-    reaching = Reaching(running)
-    loaded.seen.append(FRAMES)  # at import, before any check
-    reaching.forget()
-    reaching.use(other)
-    reaching.raise_any()  # the check used only the other subject: nothing against it
-    reaching.forget()
-    reaching.use(loaded)
-    with pytest.raises(CheckFailed, match=r'^Your code reads stack frames.*sys\._getframe, '
-                                          r'learner\.py line 3.*report\.$'):
-        reaching.raise_any()
-
-
-def test_an_event_during_a_check_fails_it_and_one_that_only_shows_never_does():
+def test_what_a_hook_saw_is_noted_never_a_verdict():
+    """Reaching has nothing that fails a check: it only words notes, each once, in order."""
     subject = Subject()
     reaching = Reaching({('file', 'a.py'): subject})
-    reaching.forget()
-    subject.seen.append(PROCESS)
-    reaching.raise_any()  # starting a process is shown, never failed
-    subject.seen.append(FRAMES)
-    with pytest.raises(CheckFailed):
-        reaching.raise_any()
+    assert not hasattr(reaching, 'raise_any')
+    subject.seen += [PROCESS, FRAMES, FRAMES]
     assert reaching.flags() == [
         'learner.py line 4: at run time, starts another process (subprocess.Popen)',
         "learner.py line 3: at run time, reads stack frames, the course's among them "
         '(sys._getframe)']
+
+
+def test_a_flood_of_one_kind_is_counted_and_a_cut_channel_noted():
+    """A subject whose code added 64 audit hooks and read frames 1000 times: both kinds
+    noted with their totals; and a subject that ended as asked without the hook's last line
+    (its pipe closed or redirected) gets the note that says so."""
+    flooding, cut = Subject(), Subject()
+    flooding.seen = [FRAMES, Reached('hooks', 'sys.addaudithook', 'learner.py line 9')]
+    flooding.seen_counts = {'frames': 1000, 'hooks': 64}
+    cut.channel_lost = True
+    reaching = Reaching({('file', 'a.py'): flooding})
+    reaching.keep(cut)
+    notes = reaching.flags()
+    assert "at run time, reads stack frames, the course's among them: 1000 times in all " \
+        '(1 places shown)' in notes, notes
+    assert 'at run time, adds an audit hook of its own: 64 times in all (1 places shown)' \
+        in notes, notes
+    assert notes[-1] == CHANNEL_LOST, notes
 
 
 @pytest.mark.parametrize('line, read', [
@@ -74,6 +76,16 @@ def test_an_event_during_a_check_fails_it_and_one_that_only_shows_never_does():
 ])
 def test_only_the_hooks_own_lines_count(line, read):
     assert parse_seen(line) == read
+
+
+@pytest.mark.parametrize('line, read', [
+    (b'SEEN\tcount\thooks\t128', Counted('hooks', {'hooks': 128})),
+    (b'SEEN\tend\tframes=3,hooks=64,unknown=2\t', Counted('end', {'frames': 3, 'hooks': 64})),
+    (b'SEEN\tcount\tunknown\t4', None),
+    (b'SEEN\tframes\tsys._getframe\tx', None),
+])
+def test_counts_and_the_last_line_are_read(line, read):
+    assert parse_count(line) == read
 
 
 #: A cell added after 04's callback: it writes the course's rule into the file's part 4.

@@ -162,3 +162,50 @@ def test_a_disguised_copy_and_a_copy_in_an_added_cell_are_listed(tmp_path):
         ('04-monitor-callback-answer', course, 'disguises-it'),
         ('04-monitor-callback-answer (an added cell)', course, 'adds-a-cell'),
         ('04-monitor-callback-answer (an added cell)', 'adds-a-cell', 'disguises-it')}, rows
+
+
+def test_every_pair_at_the_threshold_is_listed_by_copydetects_own_measure(tmp_path):
+    """Two classmates of 03 whose constructors share few distinct fingerprints, yet copydetect
+    finds 0.98 of one in the other and 0.88 back (its shares count the characters its matches
+    cover): listed.  A count of the fingerprints in common had ruled the pair out unmeasured."""
+    import nbformat
+    from corpora import every_learner
+    from grading_samples import NB03, written_by
+    from ros2nb_instructor.grading.similarity import alike
+    from ros2nb_instructor.paths import NOTEBOOKS as HANDED_OUT
+    corpus, handed = every_learner(), {}
+    for who, name in (('one', '03 a timer of 1 (an int)'),
+                      ('two', '03 dead code: the timer under if False')):
+        path = tmp_path / who / f'{NB03}.ipynb'
+        path.parent.mkdir()
+        nbformat.write(written_by(corpus[name]), path)
+        handed[who] = path
+    pairs, _common = alike('03', None, handed, HANDED_OUT / f'{NB03}.ipynb')
+    assert [(p.cell, p.first, p.second) for p in pairs] == [
+        ('03-sensor-constructor-answer', 'one', 'two')], pairs
+    assert pairs[0].ratio >= 0.85, pairs
+
+
+def test_the_honest_corpus_as_a_class_lists_no_two_classmates(tmp_path):
+    """Every honest learner of tests/corpus_honest.py as one class per notebook, each with
+    their other cells as handed out: no pair of classmates is listed.  Two 09 learners whose
+    three small profiles, names set aside, share 26 characters ("def f(): return v") came to
+    0.87 and 0.60: too little in common to tell a copy from chance (MIN_CHARS)."""
+    import nbformat
+    from corpus_honest import HONEST
+    from grading_samples import NOTEBOOKS_BY_NUMBER, SOLUTION, written_by
+    from ros2nb_instructor.grading.similarity import COURSE, alike
+    from ros2nb_instructor.paths import NOTEBOOKS as HANDED_OUT
+    by_notebook: dict[str, dict[str, Path]] = {}
+    for index, learner in enumerate(HONEST):
+        notebook = NOTEBOOKS_BY_NUMBER[learner.notebook]
+        path = tmp_path / f'honest-{index}' / f'{notebook}.ipynb'
+        path.parent.mkdir(exist_ok=True)
+        nbformat.write(written_by(learner), path)
+        by_notebook.setdefault(notebook, {})[learner.name] = path
+    between = []
+    for notebook, handed in sorted(by_notebook.items()):
+        pairs, _common = alike(notebook[:2], SOLUTION[notebook], handed,
+                               HANDED_OUT / f'{notebook}.ipynb')
+        between += [pair for pair in pairs if COURSE not in (pair.first, pair.second)]
+    assert between == [], between

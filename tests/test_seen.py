@@ -113,3 +113,17 @@ os.write = lambda *a: 0
 import ros2nb.rules
 ''')
     assert ('answer_module', 'ros2nb.rules', '8') in found, found
+
+
+def test_a_flood_of_one_kind_mutes_no_other(tmp_path):
+    """64 audit hooks of the learner's own, then an import of the course's rule: the hooks
+    are counted past their places shown, and the import is still seen.  Before, the hook's
+    64 lines in all went to the hooks and the import was never told."""
+    found = seen(tmp_path, '''
+import sys
+for _ in range(64):
+    sys.addaudithook(lambda event, args: None)
+import ros2nb.rules
+''')
+    assert ('answer_module', 'ros2nb.rules', '5') in found, found
+    assert sum(kind == 'hooks' for kind, _what, _line in found) == 1, found  # one place

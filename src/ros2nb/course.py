@@ -67,8 +67,10 @@ PROMISES_FILE = f'src/{PACKAGE}/{PACKAGE}/promises.py'
 COUNTING_CLASS, WORKER_CLASS = 'CountingMonitor', 'Worker'
 WORKER_FUNCTION, ROOMS_FUNCTION = 'responsive_worker', 'room_arguments'
 HEARTBEAT_PERIOD_S = 0.1      # the worker's quick timer: 10 Hz
-SLOW_PERIOD_S = 0.5           # the worker's slow timer ...
-SLOW_WORK_S = 0.45            # ... whose callback works (sleeps) this long
+SLOW_PERIOD_S = 0.5           # the worker's slow timer, whose callback waits for ...
+SLOW_SERVICE = 'slow_job'     # ... the answer of this service (std_srvs/srv/Trigger), ...
+SLOW_WORK_S = 0.45            # ... which works this long before it answers
+WORKER_NODE = 'responsive_worker'
 ROOMS = ('kitchen', 'attic')
 
 # ------------------------------------------------------------------ notebook 07: a live plot

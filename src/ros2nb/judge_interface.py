@@ -14,7 +14,8 @@ import contextlib
 import io
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, ContextManager, Optional, Protocol, TypeVar
+from typing import (TYPE_CHECKING, Any, Callable, ContextManager, Optional, Protocol, Sequence,
+                    TypeVar)
 
 from .errors import CheckFailed, LearnerCodeError, NotDecided, Ros2nbError
 from .processes import Process
@@ -83,11 +84,6 @@ class Line:
 
 class Subject(Protocol):
     """A process of the judge's that runs the learner's code (:mod:`ros2nb.subject`)."""
-
-    @property
-    def seal(self) -> str:
-        """The key this subject seals notebook 07's drawings with (sent with its first
-        command, before any learner code ran there; :mod:`ros2nb.checks.witnessed`)."""
 
     def request(self, command: Command[R], *, timeout: float = ...) -> R:
         """Send ``command`` (:mod:`ros2nb.subject_interface`) and return its typed reply.
@@ -254,12 +250,14 @@ class Judge(Protocol):
         """
 
     def run(self, argv: list[str], *, seconds: float, cwd: Path,
-            env: Optional[dict[str, str]] = None, what: Optional[str] = None
-            ) -> tuple[int, str]:
+            env: Optional[dict[str, str]] = None, what: Optional[str] = None,
+            writable: Sequence[Path] = ()) -> tuple[int, str]:
         """Run a program of the learner's to its end; its exit code and output.
 
         :param seconds: what it gets: of its work while it works, of the wall clock while
             it waits.
+        :param writable: folders of the judge's it is to write (a build's); it may write
+            its own folder and no other.
         :raises ros2nb.judge.subjects.SubjectHung: when it still runs after them.
         """
 
@@ -277,6 +275,10 @@ class Judge(Protocol):
 
         :raises CheckFailed: when the learner's code took a name over meanwhile.
         """
+
+    def fresh_folder(self, prefix: str) -> ContextManager[Path]:
+        """A new, empty folder of the judge's that the subjects and programs started while it
+        is open may write (read what they left with :meth:`taken_back`); removed afterwards."""
 
     def taken_back(self, folder: Path) -> ContextManager[Path]:
         """A private copy of the files the learner's code left in ``folder`` (links refused).

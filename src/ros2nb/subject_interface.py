@@ -44,17 +44,11 @@ class Command(Generic[R]):
 
 @dataclass(frozen=True)
 class LoadFile(Command[Loaded]):
-    """The first command: import the learner's file ``path`` as module ``module``.
-
-    ``seal``: the key notebook 07's drawings are sealed with (:attr:`ros2nb.judge.subjects.
-    SubjectProcess.seal`), taken out before the learner's code is loaded
-    (:func:`ros2nb.subject.shown.make_sealer`); every first command carries one.
-    """
+    """The first command: import the learner's file ``path`` as module ``module``."""
 
     op: ClassVar[str] = 'load_file'
     path: str
     module: str
-    seal: str = field(default='', kw_only=True)
 
 
 @dataclass(frozen=True)
@@ -63,7 +57,6 @@ class ExecCells(Command[CellsRun]):
 
     op: ClassVar[str] = 'exec_cells'
     sources: list[str]
-    seal: str = field(default='', kw_only=True)  # as :class:`LoadFile`'s
 
 
 @dataclass(frozen=True)
@@ -164,24 +157,15 @@ class Serve(Command[Counts]):
 
 @dataclass(frozen=True)
 class Worker(Command[WorkerSpun]):
-    """Notebook 06: spin the executor of the learner's ``name()`` with the course's slow
-    work and heartbeat in place of its two timers' callbacks, as the services ``services``
-    (slow, quick) in the same callback groups, the slow one telling ``topic`` when it
-    starts; wait ``seconds`` at most for the judge's subscription.  The judge calls the
-    services and times the answers itself (:mod:`ros2nb.checks.lesson06_worker`)."""
+    """Notebook 06: spin the executor the learner's ``name()`` returns with the node it
+    returns, on the wall clock, as it is: once the node's service clients have found their
+    servers (``seconds`` at most), for the slow job is the judge's to answer.  The judge
+    holds the slow job open and listens for the heartbeat meanwhile
+    (:mod:`ros2nb.checks.lesson06_worker`)."""
 
     op: ClassVar[str] = 'worker'
     name: str
-    topic: str
-    services: list[str]
     seconds: float
-
-
-@dataclass(frozen=True)
-class WorkerRelease(Command[Reply]):
-    """Let the course's slow work end (the judge saw what it waited for)."""
-
-    op: ClassVar[str] = 'worker_release'
 
 
 @dataclass(frozen=True)
@@ -193,9 +177,9 @@ class WorkerStop(Command[WorkerStopped]):
 
 @dataclass(frozen=True)
 class PlotShown(Command[PlotWitnessed]):
-    """Notebook 07: the course's ``redraw()`` on the node's class, telling ``topic`` each
-    drawing sealed with the first command's ``seal``; wait ``seconds`` at most for the
-    judge's subscription."""
+    """Notebook 07: the course's ``redraw()`` on the node's class, telling ``topic`` what
+    each drawing drew, as plain data; wait ``seconds`` at most for the judge's
+    subscription."""
 
     op: ClassVar[str] = 'plot_shown'
     topic: str
@@ -236,7 +220,7 @@ LOADERS: dict[str, type[Command[Any]]] = {LoadFile.op: LoadFile, ExecCells.op: E
 #: Every command the command loop serves, by its ``op``.
 COMMANDS: dict[str, type[Command[Any]]] = {command.op: command for command in (
     StandIns, Call, NewNode, GetCounts, Run, SetAttribute, WaitMatched, WaitPublishers,
-    WaitReceived, Serve, Worker, WorkerRelease, WorkerStop, PlotShown, RoomNodes,
+    WaitReceived, Serve, Worker, WorkerStop, PlotShown, RoomNodes,
     QosEndpoint, QosAcked)}
 
 
@@ -255,7 +239,6 @@ class Serves(Protocol):
     def wait_received(self, command: WaitReceived) -> Counts: ...
     def serve(self, command: Serve) -> Counts: ...
     def worker(self, command: Worker) -> WorkerSpun: ...
-    def worker_release(self, command: WorkerRelease) -> Reply: ...
     def worker_stop(self, command: WorkerStop) -> WorkerStopped: ...
     def plot_shown(self, command: PlotShown) -> PlotWitnessed: ...
     def room_nodes(self, command: RoomNodes) -> RoomsMade: ...

@@ -148,10 +148,11 @@ class WorkerSpun(Reply):
 
     :ivar undefined: no such function; ``error``: what it raised; ``returned``: what it
         returned instead of ``(node, executor)``; ``timers``: the node's timers, fewer than
-        two; ``unmatched``: the witness never reached the judge.
-    :ivar name: the node's name; ``namespace``: its namespace (where the judge finds its
-        services); ``executor``: its class name; ``threads``: a MultiThreadedExecutor's;
-        ``groups``: ``(callback, group class, group number)``.
+        two; ``unmatched``: its service clients never found their servers.
+    :ivar name: the node's name; ``namespace``: its namespace; ``executor``: its class name;
+        ``threads``: a MultiThreadedExecutor's; ``groups``: ``(callback, group class, group
+        number)``; ``coroutines``: the timers' callbacks that are coroutines.  Only the
+        words of a failure the judge saw: nothing here earns a point.
     """
 
     undefined: bool = False
@@ -163,6 +164,7 @@ class WorkerSpun(Reply):
     executor: Optional[str] = None
     threads: Optional[int] = None
     groups: list[tuple[str, str, int]] = field(default_factory=list)
+    coroutines: list[str] = field(default_factory=list)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -175,10 +177,9 @@ class WorkerStopped(Reply):
 @dataclass(frozen=True, kw_only=True)
 class PlotWitnessed(Reply):
     """:class:`PlotShown`'s reply: ``ok`` once the witness reached the judge; ``shown``
-    counts what it told; ``tampered``: something bound the sealer before the subject did."""
+    counts what it told (only how long the judge waits)."""
 
     shown: Optional[int] = None
-    tampered: bool = False
 
 
 @dataclass(frozen=True, kw_only=True)

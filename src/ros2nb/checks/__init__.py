@@ -91,20 +91,14 @@ def _run_once(body: Any, judge: Optional[Judge], args: tuple[Any, ...],
         return body(judge, *args, **kwargs)
     # A flood of the learner's code fails the check it happened in, whatever the check made
     # of what was left (the judge ended the flooding processes): its line says what happened.
-    # So does code that reached into the course as it ran (the subjects' audit hooks), first.
-    reaching = getattr(judge, 'reaching', None)
+    # (What the subjects' audit hooks saw is only noted for the instructor: no check relies
+    # on it, ros2nb.judge.reaching.)
     observer.floods.forget()
-    if reaching is not None:
-        reaching.forget()
     try:
         message = body(judge, *args, **kwargs)
     except BaseException:
-        if reaching is not None:
-            reaching.raise_any()
         observer.floods.raise_any()
         raise
-    if reaching is not None:
-        reaching.raise_any()
     observer.floods.raise_any()
     return message
 

@@ -40,10 +40,15 @@ def check_readings_c(seed: Optional[int] = None) -> list[float]:
 
 @contextlib.contextmanager
 def fresh_path(judge: Optional[Judge], name: str) -> Iterator[Path]:
-    """A bag folder that does not exist yet, in the judge's scratch folder (None: the kernel's
-    temporary one); removed with what the learner's function put beside it once the check
-    is done."""
-    folder = owned_folder('ros2nb-bag-', judge.scratch if judge is not None else None)
+    """A bag folder that does not exist yet, in a folder of the judge's that the subjects it
+    starts meanwhile may write (:meth:`ros2nb.judge.session.Session.fresh_folder`; None: in
+    the kernel's temporary folder, named for this process); removed with what the learner's
+    function put beside it once the check is done."""
+    if judge is not None:
+        with judge.fresh_folder('ros2nb-bag-') as given:
+            yield given / name
+        return
+    folder = owned_folder('ros2nb-bag-')
     try:
         yield folder / name
     finally:

@@ -2,12 +2,14 @@
 
 Part of :mod:`ros2nb.checks`.  The judge creates the learner's ``PlotFeeder`` (from
 ``live_plot.py``) in a subject, with the course's own ``redraw()`` in place of the given one
-(part 1): it tells the judge every point it drew, as the node's lists held them, sealed with
-a key only the judge and the subject's sealer know (:mod:`.witnessed`).  The judge moves its own
-clock on between readings it publishes from its own node, so it knows, for every reading it
-sent, whether the plot was redrawn, and with which times and values.  A line the node logs
-decides nothing (any code can print one); the file, read as text, only picks the words of a
-failure the judge has seen.
+(part 1): it tells the judge, as plain data, every point it drew, as the node's lists held them
+(:mod:`.witnessed`).  The judge moves its own clock on between readings it publishes from its
+own node, draws the times of those steps for each run, and compares every drawing with the
+readings it sent and the times it sent them: a drawing counts only when it holds every
+reading so far, each with the time it arrived on the node's clock, which no code can tell
+without keeping the readings as they arrive.  Nothing in the learner's process holds a key or
+decides: a line the node logs decides nothing (any code can print one); the file, read as
+text, only picks the words of a failure the judge has seen.
 """
 
 from __future__ import annotations
@@ -26,14 +28,18 @@ from .drawn import chooser
 from .file_nodes import feed, new_node, reach
 from .source import ClassSource
 from .verdicts import endpoint_verdict, node_name_verdict
-from .witnessed import WITNESS_TOPIC, sealed, told_to
+from .witnessed import WITNESS_TOPIC, drawings, told_to
 
-#: Readings the check publishes (°C); exact in Float32.
-PLOT_READINGS_C = (21.5, 26.25, 19.75, 23.0)
+#: Readings the check publishes: this many, drawn for each run in steps of ``READING_STEP_C``
+#: (exact in Float32) between the clamp's bounds, no two alike.
+PLOT_READINGS, READING_STEP_C = 4, 0.25
 #: Steps of the judge's clock between two readings (s).
 READING_GAP_S = 1.0
 #: How close a drawn reading must be to the one sent (°C): Float32 keeps about 7 digits.
 READING_TOLERANCE_C = 0.006
+#: Seconds the subject may sit idle (or work, in CPU seconds) after a reading of which the
+#: course's redraw() told nothing, while the judge listens for a drawing told another way.
+UNTOLD_PATIENCE_S = 2.0
 #: Whole seconds of the judge's clock before the first reading, and between two readings,
 #: drawn for each run (a point's time is then no table's: the first never comes at 1 s).
 FIRST_GAP_S, NEXT_GAP_S = (2, 9), (1, 4)
@@ -43,21 +49,32 @@ def _gaps_s(judge: Judge) -> list[int]:
     """Simulated seconds before each reading, drawn for this run (:mod:`.drawn`)."""
     source = chooser(judge, '07 reading times')
     return [source.randint(*(FIRST_GAP_S if k == 0 else NEXT_GAP_S))
-            for k in range(len(PLOT_READINGS_C))]
+            for k in range(PLOT_READINGS)]
+
+
+def readings_c(judge: Judge) -> list[float]:
+    """The readings the check publishes (°C), drawn for this run (:mod:`.drawn`): a drawing
+    holds them only when the callback kept what each message carried."""
+    steps = round((course.MAX_TEMPERATURE_C - course.MIN_TEMPERATURE_C) / READING_STEP_C)
+    chosen = chooser(judge, '07 readings').sample(range(steps + 1), PLOT_READINGS)
+    return [course.MIN_TEMPERATURE_C + k * READING_STEP_C for k in chosen]
 
 
 def _drawn(judge: Judge, subject: Subject, info: NodeMade, value: float, counts: Counts
            ) -> tuple[Counts, list[dict[str, Any]]]:
-    """Feed one reading and return the subject's counts after it and what the course's
-    redraw() drew meanwhile (each sealed redraw: its ``times_s`` and ``temps_c``)."""
+    """Feed one reading and return the subject's counts after it and what was drawn
+    meanwhile (each drawing told: its ``times_s`` and ``temps_c``)."""
     heard = told_to(judge)
     mark, before = len(heard), counts.shown
     counts, _lines = feed(judge, subject, info, value, counts, 'temperature_callback.')
     after = counts.shown
-    # as many messages as the subject says it told (none: no wait; it says nothing: one)
+    # as many messages as the subject says it told (it says nothing: one); where it says
+    # none, what anything else in it told, until it sits idle a moment: a drawing counts for
+    # what it holds, whoever told it
     expected = 1 if before is None or after is None else after - before
-    judge.observer.wait_until(lambda: len(heard) - mark >= expected, ARRIVAL_TIMEOUT_S)
-    return counts, sealed(heard, mark, subject.seal)
+    judge.observer.wait_until(lambda: len(heard) - mark >= max(expected, 1),
+                              ARRIVAL_TIMEOUT_S if expected else UNTOLD_PATIENCE_S)
+    return counts, drawings(heard, mark)
 
 
 def _plot_callback(judge: Judge) -> str:
@@ -69,22 +86,19 @@ def _plot_callback(judge: Judge) -> str:
     endpoint_verdict(info.name, found, 'subscription', '/' + course.TOPIC, course.MESSAGE_TYPE)
     shown = subject.request(PlotShown(topic=WITNESS_TOPIC, seconds=ARRIVAL_TIMEOUT_S),
                             timeout=ARRIVAL_TIMEOUT_S + 30)
-    if shown.tampered:
-        raise CheckFailed("Something in your code used the grader's sealer before the grader "
-                          'did: feed the plot only from temperature_callback, with redraw().')
     if not shown.ok:
         raise CheckFailed("The plot's witness never reached the grader: is the machine very "
                           'busy? Run this check again.')
     reach(judge, subject, info.name)
     counts: Counts = dataclasses.replace(info, shown=shown.shown)
     sent: list[tuple[float, float]] = []
-    for value, gap_s in zip(PLOT_READINGS_C, _gaps_s(judge)):
+    for value, gap_s in zip(readings_c(judge), _gaps_s(judge)):
         judge.clock.drive(subject, Run(seconds=gap_s), step_s=READING_GAP_S,
                           limit_s=gap_s, what=course.PLOT_CLASS)
         sent.append((judge.clock.now_s, value))
         counts, drawn = _drawn(judge, subject, info, value, counts)
         _point_verdict(judge, sent, drawn)
-    return (f'each of {len(PLOT_READINGS_C)} readings was plotted once, at the time it arrived '
+    return (f'each of {PLOT_READINGS} readings was plotted once, at the time it arrived '
             'on the node\'s clock (the grader\'s simulated time), with its value.')
 
 
@@ -137,10 +151,10 @@ def _unplotted_cause(judge: Judge) -> str:
 def check_plot_callback(judge: Judge) -> str:
     """Check part 2 of ``live_plot.py``: the callback that feeds the live plot.
 
-    The judge publishes 4 readings to your ``PlotFeeder``, at times of its clock drawn for
-    this run; its ``redraw()`` is the course's own (as given in part 1), telling the grader
-    every point it draws: every reading plotted once, with its value and the node's simulated
-    time when it arrived.
+    The judge publishes 4 readings to your ``PlotFeeder``, their values and the times of its
+    clock drawn for this run; its ``redraw()`` is the course's own (as given in part 1),
+    telling the grader every point it draws: every reading plotted once, with its value and
+    the node's simulated time when it arrived.
 
     Introduced in ``07-live-plot.ipynb``.
 

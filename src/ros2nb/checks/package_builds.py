@@ -131,7 +131,8 @@ def build_copy(judge: Judge, *, setup_py: Optional[str] = None,
     colcon = venv_tool('colcon')
     if colcon is None:
         raise Ros2nbError('colcon is not installed: run `make lab` or `make test`.')
-    code, output = judge.run([colcon, 'build'], seconds=300, cwd=ws, what='colcon build')
+    code, output = judge.run([colcon, 'build'], seconds=300, cwd=ws, what='colcon build',
+                             writable=[ws])
     if code != 0:  # a console_scripts string setuptools cannot read says more than its error
         held = [n for n, given in (('setup.py', setup_py), ('setup.cfg', setup_cfg))
                 if given is None and PLACEHOLDER in (TEXT.read(source / n) or '')]

@@ -1,4 +1,4 @@
-"""The files a judge hands its subjects, and those it takes back from them.
+"""The files a judge hands its subjects, those it takes back from them, and their folders.
 
 Part of the judge (:mod:`ros2nb.judge`; :class:`~ros2nb.judge.session.Session` calls these
 with its scratch folder, which the subjects may write, and the descriptor it opened on it
@@ -14,11 +14,13 @@ import os
 import secrets
 import shutil
 import stat
+import tempfile
 from pathlib import Path
 from typing import Iterator
 
 from ..errors import CheckFailed
 from ..temporary import owned_folder
+from .subjects import home_and_tmp
 
 #: Most bytes :func:`taken_back` copies out of one folder (an hour's bag is < 1 MiB).
 MAX_TAKEN_BACK_BYTES = 64 << 20
@@ -115,3 +117,38 @@ def taken_back(scratch: Path, scratch_fd: int, folder: Path) -> Iterator[Path]:
         for fd in opened:
             os.close(fd)
         shutil.rmtree(private, ignore_errors=True)
+
+
+def own_folder(top: Path) -> Path:
+    """A new folder in ``top`` for one subject or program: its working folder, with its home
+    and temporary files.  Only it may write there (while grading, its sandbox shows it no
+    other process's), and no later process reads it."""
+    folder = Path(tempfile.mkdtemp(prefix='own-', dir=top))
+    for part in home_and_tmp(folder):
+        part.mkdir()
+    return folder
+
+
+def at_home(env: dict[str, str], folder: Path) -> dict[str, str]:
+    """``env`` with its home and temporary folder in ``folder`` (what lay under its old home
+    moves with it: ROS's logs, matplotlib's folder)."""
+    home, tmp = home_and_tmp(folder)
+    old = env.get('HOME', '')
+    moved = {name: str(home) + value[len(old):] for name, value in env.items()
+             if old and (value == old or value.startswith(old + os.sep))}
+    return {**env, **moved, 'HOME': str(home), 'TMPDIR': str(tmp)}
+
+
+@contextlib.contextmanager
+def outbox(scratch: Path, open_now: list[Path], prefix: str) -> Iterator[Path]:
+    """A new, empty folder in ``scratch``, kept in ``open_now`` while it is open (the session
+    lets the processes it starts meanwhile write it), removed afterwards with what they put
+    there."""
+    folder = Path(tempfile.mkdtemp(prefix=prefix, dir=scratch))
+    folder.chmod(0o755)
+    open_now.append(folder)
+    try:
+        yield folder
+    finally:
+        open_now.remove(folder)
+        shutil.rmtree(folder, ignore_errors=True)

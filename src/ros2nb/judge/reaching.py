@@ -1,52 +1,47 @@
-"""What the learner's code reached for while it ran in a subject, and what the judge makes of it.
+"""What the learner's code reached for while it ran in a subject: notes for the instructor.
 
 Part of the judge (:mod:`ros2nb.judge`).  Each subject's audit hook (:mod:`ros2nb.subject.seen`)
 writes a line on the judge's pipe for every event the learner's code caused that reaches into
 the course or the process: stack frames, the garbage collector's objects, a function's code,
 the course's answer files and modules, code compiled or loaded at run time, raw memory, other
-processes.  The judge reads those lines (:meth:`ros2nb.judge.subjects.SubjectProcess.take_ack`)
-and decides here what each means:
+processes, audit hooks of its own; past a kind's first places, its count; and, as the subject
+ends, every kind's count.  The judge reads those lines
+(:meth:`ros2nb.judge.subjects.SubjectProcess.take_ack`) and makes each a note for the instructor
+(``report.html``, the learner's feedback box).
 
-- every one is a flag for the instructor (``report.html``, the learner's feedback box);
-- the kinds that can only serve cheating fail the check that ran the code, with one line
-  (:meth:`Reaching.raise_any`, called by :func:`ros2nb.checks.run_check` after each check).
-
-A line only ever costs the learner: their code can write more of them, never take one back
-(each is written the moment the event happens).  The text scan (:mod:`ros2nb.judge.flags`)
-stays a second opinion.
+A detector only: no check fails or passes on it, and its silence proves nothing (the hook runs
+in the learner's process, where code can read, replace or mute anything).  What decides a
+point is observed from outside that process (docs/decisions.md).  A subject that ended on
+``quit`` without its last line had its channel closed or redirected: that is a note too.  The
+text scan (:mod:`ros2nb.judge.flags`) is a second opinion.
 """
 
 from __future__ import annotations
 
 from typing import Any, NamedTuple, Optional
 
-from ..errors import CheckFailed
-
 #: How a line of the audit hook starts on a subject's pipe (:data:`ros2nb.subject.seen.MARK`).
 SEEN_PREFIX = b'SEEN\t'
-#: Lines kept per subject at most (the hook writes at most 64).
-MAX_SEEN = 64
-#: What each kind of event means: the words of its flag, and whether it can only serve
-#: cheating (then the check fails).  Reading compiled code or frames, walking the garbage
-#: collector, opening or importing the course's answers, compiling or loading code at run
-#: time and raw memory lead to what the course keeps from the learner's code; starting
-#: other processes and adding an audit hook are only shown.
-KINDS: dict[str, tuple[str, bool]] = {
-    'frames': ("reads stack frames, the course's among them", True),
-    'objects': ("walks the garbage collector's objects, the course's among them", True),
-    'code': ("reads a function's compiled code or a frame", True),
-    'answer_file': ("opens or lists the course's answer files", True),
-    'answer_module': ("imports the course's answer module", True),
-    'compiled': ('compiles or loads code at run time', True),
-    'memory': ('reads or writes memory directly (ctypes)', True),
-    'processes': ('starts another process', False),
-    'hooks': ('adds an audit hook of its own', False),
+#: Places kept per kind and subject at most (:data:`ros2nb.subject.seen.PER_KIND`).
+PER_KIND = 8
+#: The second field of a count line and of the last line (:mod:`ros2nb.subject.seen`).
+COUNT, END = 'count', 'end'
+#: What each kind of event is, in the words of its note.
+KINDS: dict[str, str] = {
+    'frames': "reads stack frames, the course's among them",
+    'objects': "walks the garbage collector's objects, the course's among them",
+    'code': "reads a function's compiled code or a frame",
+    'answer_file': "opens or lists the course's answer files",
+    'answer_module': "imports the course's answer module",
+    'compiled': 'compiles or loads code at run time',
+    'memory': 'reads or writes memory directly (ctypes)',
+    'processes': 'starts another process',
+    'hooks': 'adds an audit hook of its own',
 }
-#: The line of a check whose subject saw the learner's code do something that can only serve
-#: cheating: what it did, where, and that the instructor sees it.
-REFUSED = ('Your code {does} ({what}, {where}) while the grader ran it: a graded part may use '
-           'only what the lessons teach, so this check earns nothing; your instructor sees '
-           'this in the report.')
+#: The note for a subject that ended as asked without the hook's last line.
+CHANNEL_LOST = ('the process that ran your code ended without its last audit line: something '
+                'in it closed or redirected its channel to the grader, so what it reached for '
+                'may be missing here')
 
 
 class Reached(NamedTuple):
@@ -62,22 +57,56 @@ class Reached(NamedTuple):
     where: str
 
 
-def parse_seen(line: bytes) -> Optional[Reached]:
-    """One line of the audit hook (``SEEN<TAB>kind<TAB>what<TAB>where``), or None when it is
-    not one (the learner's code may write anything on the pipe; an unknown kind is dropped)."""
+class Counted(NamedTuple):
+    """A kind's count so far (``kind`` one of :data:`KINDS`), or, as the last line
+    (``kind`` :data:`END`), every kind's count."""
+
+    kind: str
+    counts: dict[str, int]
+
+
+def _fields(line: bytes) -> Optional[tuple[str, str, str]]:
     try:
-        mark, kind, what, where = line.decode('utf-8', 'replace').split('\t')
+        mark, first, second, third = line.decode('utf-8', 'replace').split('\t')
     except ValueError:
         return None
-    if mark + '\t' != SEEN_PREFIX.decode() or kind not in KINDS:
+    return (first, second, third) if mark + '\t' == SEEN_PREFIX.decode() else None
+
+
+def parse_seen(line: bytes) -> Optional[Reached]:
+    """One event line of the audit hook (``SEEN<TAB>kind<TAB>what<TAB>where``), or None when
+    it is not one (the learner's code may write anything on the pipe; an unknown kind is
+    dropped)."""
+    fields = _fields(line)
+    if fields is None or fields[0] not in KINDS:
         return None
+    kind, what, where = fields
     return Reached(kind, what[:300], where[:300])
 
 
+def parse_count(line: bytes) -> Optional[Counted]:
+    """A count line (``SEEN<TAB>count<TAB>kind<TAB>N``) or the last line
+    (``SEEN<TAB>end<TAB>kind=N,...<TAB>``), or None."""
+    fields = _fields(line)
+    if fields is None:
+        return None
+    first, second, third = fields
+    if first == COUNT and second in KINDS and third.isdigit():
+        return Counted(second, {second: int(third)})
+    if first != END:
+        return None
+    counts = {}
+    for part in filter(None, second.split(',')):
+        kind, _, number = part.partition('=')
+        if kind in KINDS and number.isdigit():
+            counts[kind] = int(number)
+    return Counted(END, counts)
+
+
 def flag_of(reached: Reached) -> str:
-    """The instructor's flag for one event (as :mod:`ros2nb.judge.flags` words its own)."""
+    """The instructor's note for one event (as :mod:`ros2nb.judge.flags` words its own)."""
     where = _short(reached.where) or 'its code'
-    return f'{where}: at run time, {KINDS[reached.kind][0]} ({reached.what})'
+    return f'{where}: at run time, {KINDS[reached.kind]} ({reached.what})'
 
 
 def _short(where: str) -> str:
@@ -87,8 +116,7 @@ def _short(where: str) -> str:
 
 
 class Reaching:
-    """What the learner's code reached for in a session's subjects, and which checks used
-    the subjects that saw it.
+    """What the learner's code reached for in a session's subjects.
 
     :param subjects: the session's running subjects, by key (read as they go).
     """
@@ -97,15 +125,11 @@ class Reaching:
         self._subjects = subjects
         #: Every event seen, with the subject that saw it, in order of reading.
         self.found: list[tuple[Any, Reached]] = []
-        #: The subjects the current check used (:meth:`forget` empties it).
-        self.used: list[Any] = []
-        self._mark = 0
+        #: Each subject's counts (by kind), for the subjects read so far, by id.
+        self._counts: dict[int, dict[str, int]] = {}
+        #: Subjects that ended as asked without the hook's last line.
+        self._lost = 0
         self._noted: dict[int, int] = {}  # id of a subject -> its events already kept
-
-    def use(self, subject: Any) -> None:
-        """The current check uses ``subject``: what it saw counts against the check."""
-        if all(subject is not other for other in self.used):
-            self.used.append(subject)
 
     def keep(self, subject: Any) -> None:
         """Keep what ``subject`` (a :class:`~ros2nb.judge.subjects.SubjectProcess`, running or
@@ -113,6 +137,10 @@ class Reaching:
         done = self._noted.get(id(subject), 0)
         self.found.extend((subject, event) for event in subject.seen[done:])
         self._noted[id(subject)] = len(subject.seen)
+        self._counts[id(subject)] = dict(getattr(subject, 'seen_counts', {}))
+        if getattr(subject, 'channel_lost', False) and not getattr(subject, '_lost_noted', False):
+            subject._lost_noted = True
+            self._lost += 1
 
     def _gather(self) -> None:
         """Read what every running subject's audit hook wrote so far."""
@@ -120,28 +148,21 @@ class Reaching:
             subject.take_seen()
             self.keep(subject)
 
-    def forget(self) -> None:
-        """A check begins: what came before it counts against it only through the subjects
-        it uses."""
-        self._gather()
-        self._mark = len(self.found)
-        self.used.clear()
-
-    def raise_any(self) -> None:
-        """Raise for the first event that can only serve cheating, seen during this check or
-        in a subject it used.
-
-        :raises CheckFailed: with :data:`REFUSED`'s line.
-        """
-        self._gather()
-        for index, (subject, event) in enumerate(self.found):
-            if KINDS[event.kind][1] and (index >= self._mark or
-                                         any(subject is used for used in self.used)):
-                what = '/'.join(event.what.split('/')[-2:])  # a file of the course's: its name
-                raise CheckFailed(REFUSED.format(does=KINDS[event.kind][0], what=what,
-                                                 where=_short(event.where) or 'in your code'))
-
     def flags(self) -> list[str]:
-        """Every event seen, as flags for the instructor (each once)."""
+        """Every event seen, as notes for the instructor (each once), each kind's events
+        past its places shown counted, and a note for each channel lost."""
         self._gather()
-        return list(dict.fromkeys(flag_of(event) for _subject, event in self.found))
+        notes = list(dict.fromkeys(flag_of(event) for _subject, event in self.found))
+        shown: dict[str, int] = {}
+        for _subject, event in self.found:
+            shown[event.kind] = shown.get(event.kind, 0) + 1
+        totals: dict[str, int] = {}
+        for counts in self._counts.values():
+            for kind, total in counts.items():
+                totals[kind] = totals.get(kind, 0) + total
+        for kind, total in totals.items():
+            if total > shown.get(kind, 0) and kind in KINDS:
+                notes.append(f'at run time, {KINDS[kind]}: {total} times in all '
+                             f'({shown.get(kind, 0)} places shown)')
+        notes += [CHANNEL_LOST] * min(self._lost, 1)
+        return notes

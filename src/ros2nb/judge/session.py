@@ -11,9 +11,10 @@ import os
 import shutil
 import subprocess
 import sys
+import tempfile
 from importlib import resources
 from pathlib import Path
-from typing import Any, Callable, ContextManager, Optional
+from typing import Any, Callable, ContextManager, Optional, Sequence
 
 from rclpy.publisher import Publisher
 from rclpy.qos import QoSProfile, ReliabilityPolicy
@@ -36,7 +37,7 @@ from .observer import Observer
 from .reaching import Reaching
 from .stand_ins import source_of
 from .written import workspace_files
-from .subjects import (Output, SubjectHung, SubjectProcess, home_and_tmp, subject_env,
+from .subjects import (HANDED, Output, SubjectHung, SubjectProcess, python_start, subject_env,
                        subject_prefix, subjects_folder)
 
 
@@ -59,19 +60,30 @@ class Session:
         #: the seed of this run's drawn inputs (:mod:`ros2nb.checks.drawn`): a grading run's,
         #: or a fresh one, drawn here, after the subjects' fork server started.
         self.seed = new_seed() if seed is None else seed
+        # What the subjects and programs see of the judge's (SUBJECTS_FOLDER_ENV): its inputs
+        # for them, which they read (``handed/``), and a folder of each one's own, which only
+        # it writes and which goes when it ends: nothing one of them wrote reaches the next.
         shared = subjects_folder()
-        self.scratch = owned_folder('ros2nb-judge-', home_and_tmp(shared)[1] if shared else None)
+        self._top = shared or owned_folder('ros2nb-judge-')
+        self._own_top = shared is None
+        (self._top / HANDED).mkdir(mode=0o755, exist_ok=True)
+        self.scratch = Path(tempfile.mkdtemp(prefix='ros2nb-judge-', dir=self._top / HANDED))
+        self.scratch.chmod(0o755)
         # Opened before any subject runs: what the judge writes there for them goes through
         # this descriptor, never through a path a subject may have changed since.
         self._scratch_fd = os.open(self.scratch, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW)
+        #: Folders of the judge's the learner's code is to write into now (a bag), given to
+        #: the subjects and programs started while they are open (:meth:`fresh_folder`).
+        self._outboxes: list[Path] = []
         self._observer: Optional[Observer] = None
         self._clock: Optional[JudgeClock] = None
         self._subjects: dict[tuple[Any, ...], SubjectProcess] = {}
         self._programs: list[Process] = []  # the learner's programs (start, start_program)
+        self._folders: dict[int, Path] = {}  # a subject's or program's pid -> its own folder
         self._probe: Optional[Publisher] = None
         self.builds: dict[str, Path] = {}
-        #: What the learner's code reached for in the subjects (their audit hooks): flags,
-        #: and a failed check where it can only serve cheating (:mod:`.reaching`).
+        #: What the learner's code reached for in the subjects (their audit hooks): notes for
+        #: the instructor, never a verdict (:mod:`.reaching`).
         self.reaching = Reaching(self._subjects)
 
     @property
@@ -112,27 +124,60 @@ class Session:
         if subject is None or subject.proc.poll() is not None:
             if subject is not None:  # it ended: what it saw stays (reaching)
                 self._end(key)
+            self._apart(key)
             _ = self.clock  # published before any subject runs: it starts on the judge's time
             where = workspace or self.workspace
             heard = self.observer.counts()
-            subject = SubjectProcess(where, env=subject_env({
-                WORKSPACE_ENV: str(where), JUDGE_TOPICS_ENV: json.dumps(sorted(heard[0]))}))
+            folder = self._own_folder()
+            subject = SubjectProcess(folder, env=subject_env({
+                WORKSPACE_ENV: str(where), JUDGE_TOPICS_ENV: json.dumps(sorted(heard[0]))},
+                folder), writable=[folder, *self._outboxes])
+            self._folders[subject.proc.pid] = folder
             subject.heard_base = heard
             subject.while_waiting = self.observer.floods.raise_any
             self._subjects[key] = subject
-            self.reaching.use(subject)
             try:
                 load(subject)
             except BaseException:
                 self._end(key)
                 raise
-        self.reaching.use(subject)
         return subject
+
+    def _own_folder(self) -> Path:
+        """A new folder for one subject or program (:func:`.handed.own_folder`)."""
+        return handed.own_folder(self._top)
+
+    def _remove_folder(self, pid: int) -> None:
+        """The process ``pid`` ended: no later one reads what it wrote.  While grading, its
+        sandbox showed it no folder of another process's, and what it wrote stays for the
+        grader, who removes the judge's folder; elsewhere its folder is removed now."""
+        folder = self._folders.pop(pid, None)
+        if folder is not None and self._own_top:
+            shutil.rmtree(folder, ignore_errors=True)
+
+    def _apart(self, key: tuple[Any, ...]) -> None:
+        """End the subjects that must not run beside the one about to start for ``key``: each
+        that holds the course's stand-ins, and every one when the new one will hold them, so
+        that no learner's code runs beside the course's version of a part it is graded on."""
+        def holds(known: tuple[Any, ...]) -> bool:
+            return known[:1] == ('file',) and known[2:3] == ('+',)
+
+        for known in [k for k in self._subjects if k != key and (holds(k) or holds(key))]:
+            self._end(known)
+
+    def fresh_folder(self, prefix: str) -> ContextManager[Path]:
+        """A new, empty folder of the judge's that the subjects and programs started while it
+        is open may write (a bag the learner's function records), removed afterwards with
+        all they put there (:func:`.handed.outbox`); read what they left with
+        :meth:`taken_back`."""
+        return handed.outbox(self.scratch, self._outboxes, prefix)
 
     def working_pids(self) -> list[int]:
         """The processes of this session's subjects and of the learner's programs it started
         that still run: those whose work every wait of the judge's attends to."""
-        self._programs = [proc for proc in self._programs if proc.poll() is None]
+        for proc in [proc for proc in self._programs if proc.poll() is not None]:
+            self._programs.remove(proc)
+            self._remove_folder(proc.pid)
         return [proc.pid for proc in (*(s.proc for s in self._subjects.values()),
                                       *self._programs) if proc.poll() is None]
 
@@ -153,6 +198,7 @@ class Session:
         """End the subject ``key``; what its audit hook saw stays with :attr:`reaching`."""
         subject = self._subjects.pop(key)
         subject.close()
+        self._remove_folder(subject.proc.pid)
         self.reaching.keep(subject)
 
     def drop_all(self) -> None:
@@ -228,25 +274,37 @@ class Session:
                 given[relative] = reference_files.joinpath(Path(relative).name).read_bytes()
         return self.hand_over('caught-up-', given)
 
-    def start(self, argv: list[str], *, cwd: Path,
-              env: Optional[dict[str, str]] = None) -> tuple[subprocess.Popen[str], Output]:
-        """Start a program of the learner's (sandboxed while grading) in a session of its own.
+    def start(self, argv: list[str], *, cwd: Path, env: Optional[dict[str, str]] = None,
+              writable: Sequence[Path] = ()) -> tuple[subprocess.Popen[str], Output]:
+        """Start a program of the learner's (sandboxed while grading) in a session of its own,
+        with a folder of its own for its home and temporary files.
 
-        :param env: the program's whole environment (default :func:`subject_env`).  While
-            grading it is set inside the sandbox, never on the sandbox's own command: an
-            environment a learner's build gave (``PATH``, ``LD_PRELOAD``) must not choose or
-            load the program that sandboxes theirs.
+        :param env: the program's whole environment (default :func:`subject_env`), its home
+            and temporary folder moved to its own.  While grading it is set inside the
+            sandbox, never on the sandbox's own command: an environment a learner's build
+            gave (``PATH``, ``LD_PRELOAD``) must not choose or load the program that sandboxes
+            theirs.
+        :param writable: folders of the judge's the program is to write (a build's), besides
+            its own.
         :return: the process, and its output (stdout and stderr), collected as it comes.
         """
         working.say(f'starting {Path(argv[0]).name}')
-        prefix = subject_prefix()
-        if prefix and env is not None:
+        folder = self._own_folder()
+        env = handed.at_home(env, folder) if env is not None else subject_env(None, folder)
+        prefix = subject_prefix([folder, *self._outboxes, *writable])
+        popen_env: Optional[dict[str, str]] = env
+        if prefix:
             argv = [sys.executable, '-I', '-c', SET_ENV_AND_EXEC, json.dumps(env), *argv]
-            env = None
-        proc = subprocess.Popen([*prefix, *argv], cwd=cwd, env=env or subject_env(),
-                                text=True, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                                stderr=subprocess.STDOUT, start_new_session=True)
+            popen_env = None
+        try:
+            proc = subprocess.Popen([*prefix, *argv], cwd=cwd, env=popen_env, text=True,
+                                    stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                                    stderr=subprocess.STDOUT, start_new_session=True)
+        except BaseException:
+            shutil.rmtree(folder, ignore_errors=True)
+            raise
         self._programs.append(proc)
+        self._folders[proc.pid] = folder
         return proc, Output(proc.stdout)
 
     def start_program(self, path: Path, stand_in: Optional[str] = None
@@ -261,22 +319,30 @@ class Session:
         args = [str(path), *([stand_in] if stand_in else [])]
         working.say(f'starting main() of {path.name}, as ros2 run does')
         if subject_prefix():
-            return self.start([sys.executable, '-m', 'ros2nb.subject.program', *args],
+            return self.start([*python_start(), '-m', 'ros2nb.subject.program', *args],
                               cwd=self.workspace)
-        proc = fork_program(args, str(self.workspace), subject_env())
+        folder = self._own_folder()
+        try:
+            proc = fork_program(args, str(self.workspace), subject_env(None, folder))
+        except BaseException:
+            shutil.rmtree(folder, ignore_errors=True)
+            raise
         self._programs.append(proc)
+        self._folders[proc.pid] = folder
         return proc, Output(proc.stdout)
 
     def run(self, argv: list[str], *, seconds: float, cwd: Path,
-            env: Optional[dict[str, str]] = None, what: Optional[str] = None) -> tuple[int, str]:
+            env: Optional[dict[str, str]] = None, what: Optional[str] = None,
+            writable: Sequence[Path] = ()) -> tuple[int, str]:
         """Run a program of the learner's (sandboxed while grading); return code and output.
 
         :param seconds: what the program gets (:func:`~ros2nb.processes.wait_patiently`):
             seconds of its work while it works, of the wall clock while it waits.
         :param what: the program as its failure names it (default: its file's name).
+        :param writable: folders of the judge's it is to write, besides its own (:meth:`start`).
         :raises SubjectHung: when it had them and still runs.
         """
-        proc, output = self.start(argv, cwd=cwd, env=env)
+        proc, output = self.start(argv, cwd=cwd, env=env, writable=writable)
         working.say(f'running {what or Path(argv[0]).name}')
         code = wait_patiently(proc, seconds)
         if code is None:
@@ -312,9 +378,14 @@ class Session:
         if hurried:
             self._end_flood()  # every process of the learner's code, ended and reaped now
         self.drop_all()
+        for proc in self._programs:
+            if proc.poll() is None:
+                kill_process_group(proc)
         if hurried:
-            shutil.rmtree(self.scratch, ignore_errors=True)
+            shutil.rmtree(self._top if self._own_top else self.scratch, ignore_errors=True)
         if self._observer is not None:
             self._observer.close()
         os.close(self._scratch_fd)
-        shutil.rmtree(self.scratch, ignore_errors=True)
+        self._folders.clear()
+        shutil.rmtree(self._top if self._own_top else self.scratch, ignore_errors=True)
+

@@ -175,8 +175,11 @@ STAND_INS: dict[str, tuple[str, Callable[..., Any]]] = {
 HELPERS: dict[str, tuple[Callable[..., Any], ...]] = {
     'sensor_callback': (_publisher_on, _constructing), 'fan_callback': (_publisher_on,),
     'monitor_callback': (monitor_status,)}
-#: The names every stand-in's code may use, imported in the subject (no answer among them).
+#: The names every stand-in's code may use, imported in the subject (no answer among them);
+#: its annotations are text, whatever the code that compiles it (a compile the learner's
+#: code wrapped passes on none of the command loop's future flags).
 PREAMBLE = """\
+from __future__ import annotations
 import random
 import sys
 import types

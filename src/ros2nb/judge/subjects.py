@@ -9,18 +9,16 @@ sandbox command (``ROS2NB_SUBJECT_PREFIX``) and cannot see, signal or trace the 
 from __future__ import annotations
 
 import contextlib
-import dataclasses
 import itertools
 import json
 import os
-import secrets
 import select
 import subprocess
 import sys
 import threading
 import time
 from pathlib import Path
-from typing import Any, Callable, Optional, TypeVar
+from typing import Any, Callable, Optional, Sequence, TypeVar
 
 from .. import domains
 from ..errors import CheckFailed, NotDecided
@@ -28,17 +26,22 @@ from ..patience import Patience
 from ..processes import kill_process_group, stop_process_group
 from ..subject.judge_time import JUDGE_CLOCK_ENV
 from ..subject.forked import SUBJECT_PREFIX_ENV, fork_subject, has_server
-from ..subject_interface import Command, ExecCells, LoadFile, reply_type, wire
+from ..subject_interface import Command, reply_type, wire
 from ..subject_replies import Reply
 from ..typed_json import decoded
-from .reaching import MAX_SEEN, SEEN_PREFIX, Reached, parse_seen
+from .reaching import END, PER_KIND, SEEN_PREFIX, Reached, parse_count, parse_seen
 
-#: The folder the subjects may write (while grading, the only one): their home
-#: (``home/``), their temporary files (``tmp/``), and what the session shares with them
-#: (builds, bags, files it feeds to the learner's functions).  The judge's own cwd, home
-#: and temporary files stay out of their reach.  Unset (outside grading), subjects share
-#: the judge's home and the session uses a temporary folder.
+#: The folder the judge keeps what its subjects and the learner's programs see (while
+#: grading, given by the grader; else a temporary folder of the session's): the judge's
+#: inputs for them, which they may read (``handed/``: builds, bags, files it feeds to the
+#: learner's functions), and a folder of its own for each process (its home, its temporary
+#: files, its working folder), which only that process may write and which goes when it ends
+#: (:class:`ros2nb.judge.session.Session`).  The judge's own cwd, home and temporary files
+#: stay out of their reach.
 SUBJECTS_FOLDER_ENV = 'ROS2NB_SUBJECTS_FOLDER'
+#: The part of :data:`SUBJECTS_FOLDER_ENV` the judge's subjects and programs may read (the
+#: grader's sandbox shows them this one and each process its own folder, nothing else of it).
+HANDED = 'handed'
 #: Seconds a subject may take to answer one command before it counts as hanging: CPU
 #: seconds while it works, wall-clock seconds while it waits (ros2nb.patience.Patience).
 REPLY_TIMEOUT_S = 30.0
@@ -54,34 +57,48 @@ R = TypeVar('R', bound=Reply)
 _STARTED = itertools.count()
 
 
-def subject_prefix() -> list[str]:
-    """The sandbox command every subject runs under (empty outside grading)."""
+def subject_prefix(writable: Sequence[Path] = ()) -> list[str]:
+    """The sandbox command a subject or program runs under (empty outside grading), with
+    ``writable`` (its own folder, and the judge's folders it is to write) bound for writing:
+    nothing else of the judge's folder is writable, or visible but ``handed/``."""
     value = os.environ.get(SUBJECT_PREFIX_ENV)
-    return json.loads(value) if value else []
+    prefix = json.loads(value) if value else []
+    if not prefix or prefix[-1] != '--':  # not bubblewrap's (a test's ``env``): as it is
+        return prefix
+    binds = [arg for path in writable for arg in ('--bind', str(path), str(path))]
+    return [*prefix[:-1], *binds, prefix[-1]]  # before its closing '--'
+
+
+def python_start() -> list[str]:
+    """``python`` as a subject or program is started: isolated from its working folder
+    (``-P``, Python 3.11 on; before, the subject takes that folder off ``sys.path`` itself,
+    first thing), so that no module there stands in for the standard library's."""
+    return [sys.executable, *(['-P'] if sys.version_info >= (3, 11) else [])]
 
 
 def subjects_folder() -> Optional[Path]:
-    """The folder the judge's subjects may write (:data:`SUBJECTS_FOLDER_ENV`), if one is set."""
+    """The folder of the judge's subjects (:data:`SUBJECTS_FOLDER_ENV`), if one is set."""
     value = os.environ.get(SUBJECTS_FOLDER_ENV)
     return Path(value) if value else None
 
 
 def home_and_tmp(folder: Path) -> tuple[Path, Path]:
-    """The subjects' home and temporary folder in the folder they may write (the grader
-    makes both before the judge starts)."""
+    """The home and temporary folder of a process in its own folder."""
     return folder / 'home', folder / 'tmp'
 
 
-def subject_env(extra: Optional[dict[str, str]] = None) -> dict[str, str]:
-    """The environment of a subject: the judge's domain, field checks on, plain logs.
+def subject_env(extra: Optional[dict[str, str]] = None,
+                folder: Optional[Path] = None) -> dict[str, str]:
+    """The environment of a subject or program: the judge's domain, field checks on, plain
+    logs.
 
-    With a :func:`subjects_folder`, the subject's ``HOME`` is its ``home/`` (every variable
-    the judge has under its own home moves there too: ROS's logs, IPython's and Jupyter's
+    With its own ``folder``, its ``HOME`` is that folder's ``home/`` (every variable the
+    judge has under its own home moves there too: ROS's logs, IPython's and Jupyter's
     folders) and its ``TMPDIR`` is its ``tmp/``.
     """
     env = {k: v for k, v in os.environ.items()
            if k not in (SUBJECT_PREFIX_ENV, SUBJECTS_FOLDER_ENV)}
-    folder, own_home = subjects_folder(), os.environ.get('HOME', '')
+    own_home = os.environ.get('HOME', '')
     if folder is not None:
         home, tmp = home_and_tmp(folder)
         for name, value in env.items():
@@ -155,24 +172,29 @@ class SubjectProcess:
     """A running ``ros2nb.subject``: one JSON command, one JSON reply; and, while its nodes
     run on the judge's clock, one acknowledgement per step (:mod:`ros2nb.judge.clock`)."""
 
-    def __init__(self, workspace: Path, env: Optional[dict[str, str]] = None) -> None:
+    def __init__(self, cwd: Path, env: Optional[dict[str, str]] = None,
+                 writable: Sequence[Path] = ()) -> None:
+        """Start a subject in ``cwd`` (a folder of its own: it may write there), with ``env``
+        (default :func:`subject_env`); while grading, ``writable`` are the folders its sandbox
+        lets it write (its own, and those the judge gives it to write into)."""
         to_subject, self._commands = os.pipe()
         self._replies, from_subject = os.pipe()
         self._acks, acks_from_subject = os.pipe()
         os.set_blocking(self._acks, False)
-        prefix, environment, first = subject_prefix(), env or subject_env(), next(_STARTED) == 0
+        prefix, environment = subject_prefix(writable), env or subject_env()
+        first = next(_STARTED) == 0
         try:
             if prefix or (first and not has_server()):  # sandboxed, or the first: afresh
-                argv = [*prefix, sys.executable, '-m', 'ros2nb.subject', str(to_subject),
+                argv = [*prefix, *python_start(), '-m', 'ros2nb.subject', str(to_subject),
                         str(from_subject)]
                 self.proc: Any = subprocess.Popen(
-                    argv, cwd=workspace, env={**environment, JUDGE_CLOCK_ENV: str(
+                    argv, cwd=cwd, env={**environment, JUDGE_CLOCK_ENV: str(
                         acks_from_subject)}, text=True, stdin=subprocess.DEVNULL,
                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True,
                     pass_fds=(to_subject, from_subject, acks_from_subject))
             else:  # forked from a process that has imported ROS: no imports of its own
                 self.proc = fork_subject((to_subject, from_subject, acks_from_subject),
-                                         str(workspace), environment, JUDGE_CLOCK_ENV)
+                                         str(cwd), environment, JUDGE_CLOCK_ENV)
         finally:
             for fd in (to_subject, from_subject, acks_from_subject):
                 os.close(fd)
@@ -181,17 +203,19 @@ class SubjectProcess:
         self._ack_buffer = b''
         #: The newest well-formed acknowledgement of a step (None before the first).
         self.last_ack: Optional[dict] = None
-        #: The key the subject seals notebook 07's drawings with (:mod:`ros2nb.subject.shown`),
-        #: sent with the first command, before any learner code runs there.
-        self.seal = secrets.token_hex(32)
-        self._sealed = False
         #: What the subject last said it waits for on the judge's side (the judge's clock,
         #: :data:`~ros2nb.subject.judge_time.WAITING_FOR_CLOCK`), or None: idle there, it is
         #: not the learner's code that hangs.
         self.waiting_for: Optional[str] = None
         #: What the learner's code reached for, as the subject's audit hook wrote it on the
-        #: same pipe (:mod:`ros2nb.judge.reaching`), in order.
+        #: same pipe (:mod:`ros2nb.judge.reaching`), in order: each kind's first places.
         self.seen: list[Reached] = []
+        #: Each kind's count of events, as the hook told it (past its places, and at the end).
+        self.seen_counts: dict[str, int] = {}
+        #: Whether the hook's last line came (:data:`~ros2nb.judge.reaching.END`).
+        self.seen_ended = False
+        #: Whether the subject ended as asked without that line: its channel was cut.
+        self.channel_lost = False
         #: What the judge had heard when this process started: messages per watched topic,
         #: /rosout lines per logger (set by the session that starts it).
         self.heard_base: tuple[dict[str, int], dict[str, int]] = ({}, {})
@@ -201,11 +225,7 @@ class SubjectProcess:
 
     def send(self, command: Command[Any]) -> None:
         """Send one command (its reply comes later: :meth:`poll_reply`, read with
-        :meth:`reply_to`); the first, which loads the learner's code, carries :attr:`seal`."""
-        if not self._sealed:
-            self._sealed = True
-            if isinstance(command, (LoadFile, ExecCells)):
-                command = dataclasses.replace(command, seal=self.seal)
+        :meth:`reply_to`)."""
         try:
             os.write(self._commands, (json.dumps(wire(command)) + '\n').encode())
         except BrokenPipeError:
@@ -277,9 +297,14 @@ class SubjectProcess:
             if not line.startswith(SEEN_PREFIX):
                 kept.append(line)
                 continue
-            reached = parse_seen(line)
-            if reached is not None and len(self.seen) < MAX_SEEN:
+            reached, counted = parse_seen(line), parse_count(line)
+            if reached is not None and \
+                    sum(event.kind == reached.kind for event in self.seen) < PER_KIND:
                 self.seen.append(reached)
+            elif counted is not None:
+                for kind, total in counted.counts.items():
+                    self.seen_counts[kind] = max(total, self.seen_counts.get(kind, 0))
+                self.seen_ended = self.seen_ended or counted.kind == END
         return kept
 
     def request(self, command: Command[R], *, timeout: float = REPLY_TIMEOUT_S) -> R:
@@ -350,6 +375,10 @@ class SubjectProcess:
             pass
         stop_process_group(self.proc)
         self.take_seen()  # what its audit hook wrote last
+        # It ended as asked, on ``quit``, yet its hook's last line never came: something in it
+        # closed or redirected the pipe (a note).  A subject the judge ended says nothing:
+        # sandboxed, the exit code is its sandbox's, whose end kills it at once.
+        self.channel_lost = not self.seen_ended and self.proc.returncode == 0
         for fd in (self._replies, self._acks):
             with contextlib.suppress(OSError):
                 os.close(fd)

@@ -48,6 +48,12 @@ from .trials import Trials
 
 #: Exit code when a command could not even be read.
 PROTOCOL_ERROR = 3
+#: What the command loop compiles, runs and speaks with, bound when this module is imported,
+#: before the learner's code is loaded: a ``compile``, ``exec`` or ``json`` the learner's
+#: code replaces later (on ``builtins``, on the ``json`` module) changes nothing here.  They
+#: keep no secret: what the stand-ins' code holds is the course's version of a part this
+#: subject does not grade, and nothing this process writes reaches another (its own folder).
+_COMPILE, _EXEC, _LOADS, _DUMPS = compile, exec, json.loads, json.dumps
 #: Longest wait for a message in one round of :meth:`Subject.wait_received` (s): a message
 #: ends the wait at once.
 RECEIVE_WAIT_S = 0.05
@@ -109,7 +115,7 @@ def load(command: Command[Any]) -> tuple[dict[str, Any], Reply]:
         # its lines for tracebacks and explanations, as a kernel keeps a cell's
         linecache.cache[name] = (len(text), None, text.splitlines(keepends=True), name)
         try:
-            exec(compile(text, name, 'exec'), namespace)
+            _EXEC(_COMPILE(text, name, 'exec'), namespace)
         except BaseException as error:  # the learner's cell may raise anything
             errors.append(described(error))
     return namespace, CellsRun(ok=True, cell_errors=errors)
@@ -118,9 +124,8 @@ def load(command: Command[Any]) -> tuple[dict[str, Any], Reply]:
 class Subject(Trials):
     """The state of this process: the learner's namespace, their node, the runtime."""
 
-    def __init__(self, namespace: dict[str, Any], sealer: Any = None) -> None:
+    def __init__(self, namespace: dict[str, Any]) -> None:
         self.namespace = namespace
-        self._sealer = sealer  # notebook 07's (:func:`.shown.make_sealer`)
         self._stand_ins: dict[str, tuple[str, Any]] = {}  # name -> (method, function)
         self.rt: Optional[Runtime] = None
         self.node: Optional[Node] = None
@@ -149,7 +154,7 @@ class Subject(Trials):
         once the learner's code is loaded: kept here, on no module and under no name that
         code imports."""
         made: dict[str, Any] = {'__name__': 'ros2nb stand-ins'}
-        exec(compile(command.source, STAND_IN_FILE, 'exec'), made)  # noqa: S102 - the judge's
+        _EXEC(_COMPILE(command.source, STAND_IN_FILE, 'exec'), made)  # the judge's code
         self._stand_ins = dict(made['STAND_INS'])
         return Reply(ok=True)
 
@@ -309,7 +314,8 @@ def _on_sigterm(signum: int, _frame: Any) -> None:
     raise Ended
 
 
-def serve(commands: Any, replies: Any, namespace: dict[str, Any], sealer: Any = None) -> None:
+def serve(commands: Any, replies: Any, namespace: dict[str, Any],
+          noted: Callable[[], None] = lambda: None) -> None:
     """Answer one JSON reply per JSON command until ``quit`` or end of input; then, or on
     SIGTERM, take the runtime's nodes down, so that the process's DDS participant tells the
     judge it leaves.
@@ -321,10 +327,10 @@ def serve(commands: Any, replies: Any, namespace: dict[str, Any], sealer: Any = 
     learner's code that swallows the signal (a bare ``except``) is ended by the SIGKILL that
     follows, as before.
 
-    :param sealer: notebook 07's sealer, made before the learner's code was loaded
-        (:func:`.shown.make_sealer`).
+    :param noted: writes the audit hook's last line, every kind's count (:func:`.seen.install`),
+        once the loop is done: a subject that ends without it had its channel cut.
     """
-    subject = Subject(namespace, sealer)
+    subject = Subject(namespace)
     served: Serves = subject  # the type checker holds every command's method to its types
     handlers: dict[str, Callable[[Any], Reply]] = {op: getattr(served, op) for op in COMMANDS}
     ended = False
@@ -332,7 +338,7 @@ def serve(commands: Any, replies: Any, namespace: dict[str, Any], sealer: Any = 
     try:
         try:
             for line in commands:
-                request = json.loads(line)
+                request = _LOADS(line)
                 if request.get('op') == 'quit':
                     break
                 try:
@@ -344,12 +350,13 @@ def serve(commands: Any, replies: Any, namespace: dict[str, Any], sealer: Any = 
                     reply = Reply(ok=False, error=described(error))
                 if _ending:
                     raise Ended
-                replies.write(json.dumps(wire(reply)) + '\n')
+                replies.write(_DUMPS(wire(reply)) + '\n')
                 replies.flush()
         finally:
             signal.signal(signal.SIGTERM, signal.SIG_DFL)  # from here on, SIGTERM ends at once
     except Ended:  # raised where the main thread was: what it held (rclpy's wait) let go
         ended = True
+    noted()
     if subject.rt is not None:
         subject.rt.shutdown()
     if ended:

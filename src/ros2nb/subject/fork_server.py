@@ -107,8 +107,8 @@ def _reap(status: dict[int, int]) -> None:
 
 
 def _become(request: dict, kept: list[int], out: int) -> NoReturn:
-    """In the forked child: become ``python -m MODULE ARGS`` (the request's) started in its
-    folder with its environment, then run it to its end (this never returns).
+    """In the forked child: become ``python -P -m MODULE ARGS`` (the request's) started in
+    its folder with its environment, then run it to its end (this never returns).
 
     :param kept: the child's own pipes (a subject's command, reply and acknowledgement).
     :param out: where its standard output and error go.
@@ -135,7 +135,9 @@ def _become(request: dict, kept: list[int], out: int) -> NoReturn:
     for module in list(sys.modules.values()):
         if 'ros_python_check_fields' in getattr(module, '__dict__', {}):
             setattr(module, 'ros_python_check_fields', wanted)  # rosidl's module global
-    sys.path[:] = [cwd, *filter(None, env.get('PYTHONPATH', '').split(os.pathsep)),
+    # As ``python -P`` starts: the working folder is not on the path (no module of the
+    # learner's there stands in for the standard library's)
+    sys.path[:] = [*filter(None, env.get('PYTHONPATH', '').split(os.pathsep)),
                    *request['site_path']]
     from ..processes import end_this_process
     if request['module'] == SUBJECT:

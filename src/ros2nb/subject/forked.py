@@ -7,7 +7,7 @@ A subject spends most of its CPU time starting: Python, ``rclpy`` (with PyYAML a
 message types) and ``ros2nb`` take most of a short subject's CPU time to import and start
 (docs/decisions.md), and ``make test`` starts hundreds.  A fork server
 (:mod:`ros2nb.subject.fork_server`) holds those imports and forks each child from there:
-the child is then the process ``python -m ros2nb.subject`` (or ``python -m
+the child is then the process ``python -P -m ros2nb.subject`` (or ``python -P -m
 ros2nb.subject.program``) would be (its own session, working folder, environment,
 ``sys.path`` and output pipe), without the imports.
 
@@ -193,7 +193,7 @@ def _started_server() -> ForkServer:
 
 def fork_subject(fds: tuple[int, int, int], cwd: str, env: dict[str, str],
                  clock_env: str) -> ForkedProcess:
-    """Fork ``python -m ros2nb.subject IN OUT`` from the fork server.
+    """Fork ``python -P -m ros2nb.subject IN OUT`` from the fork server.
 
     :param fds: the subject's command, reply and acknowledgement pipes (this process keeps
         its own copies: close them after the call, as after ``Popen(pass_fds=...)``).
@@ -209,7 +209,7 @@ def fork_subject(fds: tuple[int, int, int], cwd: str, env: dict[str, str],
 
 
 def fork_program(args: list[str], cwd: str, env: dict[str, str]) -> ForkedProcess:
-    """Fork ``python -m ros2nb.subject.program ARGS`` (a learner's ``main()``) from the fork
+    """Fork ``python -P -m ros2nb.subject.program ARGS`` (a learner's ``main()``) from the fork
     server, in a session of its own, with exactly ``env``; its output is ``stdout``.
 
     Introduced in ``03-write-the-publisher.ipynb`` (main() stopped with Ctrl+C).

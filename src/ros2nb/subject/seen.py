@@ -1,27 +1,31 @@
-"""What the learner's code reaches for in a subject, seen as it runs (a CPython audit hook).
+"""What the learner's code reaches for in a subject, noted as it runs (a CPython audit hook).
 
-Part of :mod:`ros2nb.subject`; introduced with grading (``docs/instructors.md``).  Before the
-learner's code is loaded, the subject installs an audit hook (PEP 578, ``sys.addaudithook``:
-no Python code can remove it).  The hook watches the events that reach into the course or
-into the process: stack frames, the garbage collector's objects, a function's code, the
-course's answer files and modules, code compiled or loaded at run time, raw memory
-(``ctypes``), other processes.  Each event the learner's code caused is written at once, as
-one line, on the judge's pipe (the one the runtime acknowledges the judge's clock on), so
-nothing the code does afterwards takes it back; the judge turns each kind into a flag, and the
-kinds that can only serve cheating fail the check (:mod:`ros2nb.judge.reaching`).
+Part of :mod:`ros2nb.subject`; introduced with grading (``docs/instructors.md``).  A detector,
+never a barrier: no check relies on it, and its silence proves nothing (CPython's own
+documentation says audit hooks are no sandbox; code can read, replace or mute anything in its
+own process).  What decides a point is observed from outside this process
+(docs/decisions.md); this only tells the instructor what the learner's code reached for.
+
+Before the learner's code is loaded, the subject installs an audit hook (PEP 578,
+``sys.addaudithook``: no Python code can remove it).  The hook watches the events that reach
+into the course or into the process: stack frames, the garbage collector's objects, a
+function's code, the course's answer files and modules, code compiled or loaded at run time,
+raw memory (``ctypes``), other processes, audit hooks of its own.  Each event the learner's
+code caused is written at once, as one line, on the judge's pipe (the one the runtime
+acknowledges the judge's clock on); the judge turns each into a note for the instructor
+(:mod:`ros2nb.judge.reaching`).  Every event is counted: a kind's first :data:`PER_KIND`
+places are written, then its count at each power of two, so that code that floods one kind
+mutes no other; the subject's last line (:data:`END`, written by its command loop as it
+ends) gives every count, and a subject that ended without it had its channel closed or
+redirected, which is itself a note.
 
 Whose code caused an event is read off the stack: a frame is the learner's unless its file is
 the Python installation's, the venv's, ros2nb's own or the course's stand-ins.  An event a
 library raises on the learner's behalf (rclpy's logger reading its caller's frame, a
 ``namedtuple`` naming its module) is the library's; the few modules that hand frames or code
 to their caller (``inspect``, ``dis``, ``traceback``'s stack walks, ``logging.currentframe``,
-``ctypes``) pass it on to theirs.
-
-The hook keeps everything it uses in its own closures, bound before the learner's code runs:
-no module's name, no builtin and no global that code could replace later changes what it
-sees.  A hook does not see everything (reading ``__closure__``, ``__globals__`` or
-``object.__subclasses__()``, setting a class's attribute), so what decides a point never
-lives in this process (docs/decisions.md).
+``ctypes``) pass it on to theirs.  The hook keeps what it uses in its own closures, bound
+before the learner's code runs, so that replacing a name later changes nothing it sees.
 """
 
 from __future__ import annotations
@@ -38,9 +42,13 @@ from .out_of_reach import ANSWERS
 MARK = 'SEEN'
 #: The file name the stand-ins' code is compiled under (:mod:`.commands`): the course's.
 STAND_IN_FILE = '<ros2nb stand-in>'
-#: Lines written at most (one per kind, event and place): a loop that walks the garbage
-#: collector in every callback must not fill the judge's pipe.
-MAX_LINES = 64
+#: Places written at most per kind (each kind, event and place once): a loop that walks the
+#: garbage collector in every callback must not fill the judge's pipe, and code that floods
+#: one kind (64 audit hooks of its own) must not use up what another kind is told with.
+PER_KIND = 8
+#: The second field of a line that counts a kind's events past :data:`PER_KIND` (its total
+#: so far, at each power of two), and of the last line, every kind's total.
+COUNT, END = 'count', 'end'
 #: Restricted attributes whose reading raises ``object.__getattr__`` (CPython 3.11).
 CODE_ATTRIBUTES = frozenset({'__code__', 'f_code', 'gi_code', 'cr_code', 'ag_code', 'tb_frame',
                              'gi_frame', 'cr_frame', 'ag_frame'})
@@ -118,22 +126,35 @@ def _attribution() -> tuple[Callable[[Any], bool], Callable[..., Any], Callable[
     return learners, innermost, anyone
 
 
-def _teller(write: Callable[[str], Any]) -> Callable[[str, str, Any], None]:
-    """``tell(kind, what, frame)``: one line on the judge's pipe, once per kind, event and
-    place, at most :data:`MAX_LINES`."""
+def _teller(write: Callable[[str], Any]) -> tuple[Callable[[str, str, Any], None],
+                                                  Callable[[], None]]:
+    """``tell(kind, what, frame)``: count the event; write one line on the judge's pipe once
+    per kind, event and place, for the first :data:`PER_KIND` places of each kind, then the
+    kind's count at each power of two.  ``end()``: the last line, every kind's count."""
     written: set = set()
-    mark, limit, length, cut = MARK, MAX_LINES, len, 300
+    places: dict[str, int] = {}
+    counts: dict[str, int] = {}
+    mark, limit, cut, count_mark, end_mark = MARK, PER_KIND, 300, COUNT, END
+
+    def line(*parts: str) -> None:
+        write('\t'.join(part.replace('\t', ' ').replace('\n', ' ')[:cut]
+                        for part in (mark, *parts)) + '\n')
 
     def tell(kind: str, what: str, frame: Any) -> None:
+        total = counts[kind] = counts.get(kind, 0) + 1
         where = f'{frame.f_code.co_filename} line {frame.f_lineno}' if frame is not None else ''
         key = (kind, what, where)
-        if key in written or length(written) >= limit:
-            return
-        written.add(key)
-        write('\t'.join(part.replace('\t', ' ').replace('\n', ' ')[:cut]
-                        for part in (mark, kind, what, where)) + '\n')
+        if key not in written and places.get(kind, 0) < limit:
+            written.add(key)
+            places[kind] = places.get(kind, 0) + 1
+            line(kind, what, where)
+        elif total > limit and total & (total - 1) == 0:
+            line(count_mark, kind, str(total))
 
-    return tell
+    def end() -> None:
+        line(end_mark, ','.join(f'{kind}={total}' for kind, total in counts.items()), '')
+
+    return tell, end
 
 
 def _examiner(tell: Callable[[str, str, Any], None]) -> Callable[[str, tuple, Any], None]:
@@ -186,9 +207,12 @@ def _examiner(tell: Callable[[str, str, Any], None]) -> Callable[[str, tuple, An
     return examine
 
 
-def make_hook(write: Callable[[str], Any]) -> Callable[[str, tuple], None]:
-    """The audit hook, writing each event the learner's code caused with ``write``."""
-    examine, getframe, attribute = _examiner(_teller(write)), sys._getframe, getattr
+def make_hook(write: Callable[[str], Any]) -> tuple[Callable[[str, tuple], None],
+                                                    Callable[[], None]]:
+    """The audit hook, writing each event the learner's code caused with ``write``, and the
+    function that writes the last line (every kind's count)."""
+    tell, end = _teller(write)
+    examine, getframe, attribute = _examiner(tell), sys._getframe, getattr
     watched, busy = WATCHED, threading.local()
 
     def hook(event: str, args: tuple) -> None:
@@ -204,20 +228,25 @@ def make_hook(write: Callable[[str], Any]) -> Callable[[str, tuple], None]:
         finally:
             busy.on = False
 
-    return hook
+    return hook, end
 
 
-def install(fd: Optional[int]) -> None:
+def install(fd: Optional[int]) -> Callable[[], None]:
     """Install the hook, writing to the judge's pipe ``fd`` (nothing when this process has
-    none: a subject started by hand).  Call it before the learner's code is loaded."""
+    none: a subject started by hand).  Call it before the learner's code is loaded.
+
+    :return: what writes the last line (:data:`END`), called as the subject ends.
+    """
     if fd is None:
-        return
+        return lambda: None
     write, encode = os.write, str.encode
 
     def send(line: str) -> None:
         try:
             write(fd, encode(line, 'utf-8', 'backslashreplace'))
         except OSError:
-            pass  # the judge went away, or the code closed the pipe (the judge sees that)
+            pass  # the judge went away, or the code closed the pipe (the judge notes that)
 
-    sys.addaudithook(make_hook(send))
+    hook, end = make_hook(send)
+    sys.addaudithook(hook)
+    return end

@@ -11,6 +11,8 @@ that the judge can say why what it saw went wrong.
 
 from __future__ import annotations
 
+import inspect
+import os
 import threading
 import time
 from typing import Any, Optional
@@ -24,13 +26,14 @@ from std_msgs.msg import Float32, Int32
 from ..endpoints import node_endpoints
 from ..explain.exceptions import describe_error
 from ..explain.ros_settings import zero_depth_refused
-from ..runtime.rates import callback_groups
+from ..patience import wait_for_work
+from ..runtime.rates import callback_groups, track_calls
 from ..subject_interface import (PlotShown, QosAcked, QosEndpoint, RoomNodes, Worker,
-                                 WorkerRelease, WorkerStop)
+                                 WorkerStop)
 from ..subject_replies import (CallbackFailure, PlotWitnessed, QosMade, Reply, RoomsMade,
                                WorkerSpun, WorkerStopped)
 from .replies import described, encode
-from .shown import Shown, plot_redraw, worker_services
+from .shown import Shown, plot_redraw
 
 #: The node that makes an endpoint with the learner's QoS profile (notebook 09).
 QOS_NODE = 'qos_answer'
@@ -57,23 +60,22 @@ class Trials:
     rooms: list[Node]
     node: Optional[Node]
     _spun: Optional[tuple[Node, Executor, threading.Thread, threading.Event,
-                          list[CallbackFailure], Shown, threading.Event]]
+                          list[CallbackFailure], list[Any]]]
     _qos: Optional[tuple[Node, Any]]
     _plot_shown: Optional[Shown] = None
-    _sealer: Any = None
 
     def _runtime(self) -> Any:  # provided by Subject
         raise NotImplementedError
 
     # ------------------------------------------------------------ notebook 06
     def worker(self, command: Worker) -> WorkerSpun:
-        """Call the learner's ``name()`` for ``(node, executor)``; stop the Worker's two timers
-        and put the course's slow work and heartbeat in their place, as the services
-        ``services`` in the same callback groups (:func:`.shown.worker_services`, telling
-        ``topic``); spin the learner's executor on the wall clock in a thread until
-        :meth:`worker_stop`.  The judge calls the services and times the answers itself.
+        """Call the learner's ``name()`` for ``(node, executor)`` and spin that executor with
+        that node, as it is, on the wall clock, in a thread until :meth:`worker_stop`: once
+        the node's service clients have found their servers (``seconds`` at most: a request
+        sent before would be lost), for the slow job is the judge's to answer.
 
-        ``seconds``: how long to wait, at most, for the judge's subscription to match.
+        Nothing of the course's runs in the worker: the judge holds its slow job open and
+        listens for the heartbeat meanwhile, from outside this process.
         """
         function = self.namespace.get(command.name)
         if not callable(function):
@@ -87,73 +89,61 @@ class Trials:
                 and isinstance(made[1], Executor)):
             return WorkerSpun(ok=False, returned=encode(made))
         node, executor = made
+        timers = list(node.timers)
         facts: dict[str, Any] = {'name': node.get_name(), 'namespace': node.get_namespace(),
                                  'executor': type(executor).__name__,
                                  'threads': getattr(executor, '_num_threads', None),
-                                 'groups': callback_groups(node)}
-        timers = sorted(node.timers, key=lambda timer: timer.timer_period_ns)
+                                 'groups': callback_groups(node),
+                                 'coroutines': [getattr(t.callback, '__name__', '?')
+                                                for t in timers
+                                                if inspect.iscoroutinefunction(t.callback)]}
         if len(timers) < 2:
             return WorkerSpun(ok=False, timers=len(timers), **facts)
-        shown = Shown(command.topic)
-        if not shown.reaches_judge(command.seconds):
-            shown.close()
+        # Discovery is this process's work: waited for while it works or waits for a CPU, and
+        # given up after ``seconds`` of sitting idle (ros2nb.patience), never of a busy machine.
+        if not wait_for_work(lambda: all(c.service_is_ready() for c in node.clients),
+                             [os.getpid()], command.seconds):
             return WorkerSpun(ok=False, unmatched=True, **facts)
-        for timer in timers:  # the learner's own callbacks no longer run
-            timer.cancel()
-        stop, release = threading.Event(), threading.Event()
+        stop = threading.Event()
         failures: list[CallbackFailure] = []
+        calls: list[Any] = []
+        for client in node.clients:  # to end, at the stop, a call no executor can answer
+            track_calls(client, calls)
         thread = threading.Thread(target=_spin, args=(node, executor, stop, failures),
                                   name='ros2nb-subject-worker', daemon=True)
-
-        def dispatching() -> set[Optional[int]]:
-            pool = getattr(getattr(executor, '_executor', None), '_threads', ())
-            return {thread.ident, *(worker.ident for worker in list(pool))}
-
-        # the slowest timer is slow_work's, the quickest heartbeat's (part 3: 0.5 s, 0.1 s)
-        slow, quick = command.services
-        worker_services(node, (slow, quick),
-                        (timers[-1].callback_group, timers[0].callback_group), shown,
-                        release, dispatching)
         executor.add_node(node)
-        self._spun = (node, executor, thread, stop, failures, shown, release)
+        self._spun = (node, executor, thread, stop, failures, calls)
         thread.start()
         return WorkerSpun(ok=True, **facts)
-
-    def worker_release(self, command: WorkerRelease) -> Reply:
-        """Let the course's slow work end (the judge has seen what it waited for)."""
-        if self._spun is not None:
-            self._spun[6].set()
-        return Reply(ok=True)
 
     def worker_stop(self, command: WorkerStop) -> WorkerStopped:
         """Stop spinning the learner's worker; the first failure of its callbacks, if any."""
         if self._spun is None:
             return WorkerStopped(ok=True)
-        node, executor, thread, stop, failures, shown, release = self._spun
+        node, executor, thread, stop, failures, calls = self._spun
         self._spun = None
-        release.set()
         stop.set()
+        # A callback that waits for a call's answer its executor can never take (a
+        # SingleThreadedExecutor, or every thread of one waiting) returns once it is cancelled.
+        for future in list(calls):
+            future.cancel()
         thread.join()
         executor.shutdown(timeout_sec=5)
         node.destroy_node()
-        shown.close()
         return WorkerStopped(ok=True, failure=failures[0] if failures else None)
 
     # ------------------------------------------------------------ notebook 07
     def plot_shown(self, command: PlotShown) -> PlotWitnessed:
         """Put the course's ``redraw()`` (:func:`.shown.plot_redraw`, telling ``topic`` what
-        the sealer sealed) in place of the given one on the class of the node made last, bind
-        the sealer to that node, and wait (at most ``seconds``) for the judge's subscription
-        on ``topic`` to match.  ``tampered``: something bound the sealer before."""
-        if self.node is None or self._sealer is None:
+        it drew) in place of the given one on the class of the node made last, and wait (at
+        most ``seconds``) for the judge's subscription on ``topic`` to match."""
+        if self.node is None:
             return PlotWitnessed(ok=False)
         if self._plot_shown is not None:
             self._plot_shown.close()
         self._plot_shown = shown = Shown(command.topic)
-        if self._sealer.send(('bind', self.node)) is None:
-            return PlotWitnessed(ok=False, tampered=True)
         # the learner's class, not Node
-        setattr(type(self.node), 'redraw', plot_redraw(shown, self._sealer))
+        setattr(type(self.node), 'redraw', plot_redraw(shown))
         return PlotWitnessed(ok=shown.reaches_judge(command.seconds), shown=shown.told)
 
     def room_nodes(self, command: RoomNodes) -> RoomsMade:

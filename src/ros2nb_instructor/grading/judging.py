@@ -21,7 +21,7 @@ import nbformat
 
 from ros2nb import nbmeta
 from ros2nb.checks.drawn import SEED_OPTION
-from ros2nb.judge.subjects import SUBJECTS_FOLDER_ENV, home_and_tmp
+from ros2nb.judge.subjects import HANDED, SUBJECTS_FOLDER_ENV
 
 from ..paths import ROOT, SOLUTIONS
 from . import sandbox
@@ -70,10 +70,12 @@ def judge_notebook(scratch: Scratch, notebook: str, submitted: nbformat.Notebook
     for path in (source, given / 'submission.ipynb'):
         path.chmod(0o644)
     # The judge's own files (home, temporary files) and the subjects' are apart: a subject
-    # may write only under subjects/, so nothing the judge later loads, imports or reads as
-    # its own (its cwd is `given`, sys.path[0] of `python -m`; its home) is the learner's.
+    # or program may write only a folder of its own under subjects/ (the judge binds it in
+    # for it), and read the judge's inputs in subjects/handed/; so nothing the judge later
+    # loads, imports or reads as its own (its cwd is `given`, sys.path[0] of `python -m`;
+    # its home) is the learner's, and nothing one of them wrote reaches the next.
     own, subjects = folder / 'judge', folder / 'subjects'
-    for part in (own / 'home', own / 'tmp', *home_and_tmp(subjects)):
+    for part in (own / 'home', own / 'tmp', subjects / HANDED):
         part.mkdir(parents=True)
     argv = judge_argv(source, given / 'submission.ipynb', settings)
     env = sandbox_env(own / 'home', ROS2NB_WORKSPACE=str(workspace),
@@ -84,7 +86,7 @@ def judge_notebook(scratch: Scratch, notebook: str, submitted: nbformat.Notebook
         if settings.sandboxed:
             env['FASTDDS_BUILTIN_TRANSPORTS'] = 'UDPv4'  # judge and subjects: own /dev/shm each
             env['ROS2NB_SUBJECT_PREFIX'] = json.dumps(sandbox.inner_prefix(  # the course may
-                readable=[workspace, ROOT / 'src'], writable=[subjects],  # be under /tmp too
+                readable=[workspace, ROOT / 'src', subjects / HANDED],  # be under /tmp too
                 hidden=[*ANSWER_FOLDERS, own, given]))
             # The judge may read the course's reference nodes (a notebook handed in alone runs
             # on them where it relies on an earlier one's, as catch_up promises); its subjects

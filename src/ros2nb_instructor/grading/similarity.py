@@ -164,17 +164,21 @@ def _fingerprint(text: str, boilerplate: object = None) -> Any:
 
 
 def _ratio(a: Any, b: Any) -> float:
-    """How alike two fingerprinted parts are (0-1): the larger share of either found in the
-    other (a copy padded with dead code keeps the share of the original found in it); 0 when
-    the smaller share is under :data:`FLOOR` (one holds far more than the other: an answer
-    that builds on a few lines everyone writes, such as a ``main()`` with an executor)."""
+    """How alike two fingerprinted parts are (0-1), by copydetect's own measure: the larger
+    share of either found in the other (a copy padded with dead code keeps the share of the
+    original found in it); 0 when the smaller share is under :data:`FLOOR` (one holds far
+    more than the other: an answer that builds on a few lines everyone writes, such as a
+    ``main()`` with an executor), or when what the two have in common covers fewer than
+    :data:`MIN_CHARS` characters of filtered code (too little to tell a copy from chance, as
+    a part that small is too little to compare alone)."""
     from copydetect import compare_files
     if not a.hashes or not b.hashes:
         return 0.0
-    if len(a.hashes & b.hashes) < FLOOR * min(len(a.hashes), len(b.hashes)):
-        return 0.0  # too few fingerprints in common for the shares below to reach FLOOR
-    _overlap, shares, _slices = compare_files(a, b)
-    return float(max(shares)) if min(shares) >= FLOOR else 0.0
+    # Every pair is measured: copydetect's shares count the characters its matches cover,
+    # which a few fingerprints in common can cover, so a count of the fingerprints in common
+    # is no bound on them (docs/decisions.md).
+    overlap, shares, _slices = compare_files(a, b)
+    return float(max(shares)) if min(shares) >= FLOOR and overlap >= MIN_CHARS else 0.0
 
 
 def fingerprints(cells: list[dict], course: Course, small: set[str]) -> dict[str, Any]:
