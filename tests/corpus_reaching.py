@@ -323,8 +323,11 @@ def _04(name: str, find: str, seen: bool) -> Learner:
 
 
 REACHING = [
-    _06('its executor starts a thread that calls the course\'s callbacks',
-        WORKER_THREAD_CALLS, seen=False, flagged=False),
+    # Concurrency of another kind, which docs/decisions.md's row for 06 accepts: the heartbeat
+    # keeps coming while the judge holds the slow job, so it scores what honest workers score.
+    Learner('06 attack: its executor starts a thread that calls the course\'s callbacks', '06',
+            {'responsive-worker': WORKER_THREAD_CALLS}, seen=False, flagged=False,
+            twin='06 a worker made in one line, one reentrant group'),
     _06('the witness forged with what the stack frames hold',
         FORGER.format(find=FIND_IN_FRAMES), seen=True),
     _06('the witness forged with the garbage collector\'s objects',
@@ -339,7 +342,10 @@ REACHING = [
     Learner('07 attack: drawings forged with the sealer from redraw()\'s closure', '07',
             {'plot-callback': PLOT_FORGED.format(find=PLOT_FIND_IN_CLOSURE)}, seen=False,
             twin='07 twin: a callback that does nothing', flagged=True),
-    _04('the rule from the refusing finder, or past it', RULE_FROM_FINDER, seen=True),
+    # Not seen at run time: in the grader's sandbox the rules are on no disk, and a failed
+    # importlib.import_module raises no audit event (only __import__ does); the hook only
+    # detects, and its silence proves nothing.  The score is the twin's all the same.
+    _04('the rule from the refusing finder, or past it', RULE_FROM_FINDER, seen=False),
     _04('the rule\'s file read and run', RULE_FROM_FILE, seen=True),
     _04('the rule\'s file loaded under another name', RULE_UNDER_ANOTHER_NAME, seen=True),
     _04('the rule from any module that holds it', RULE_FROM_MODULES, seen=False),
