@@ -21,12 +21,12 @@ import os
 import shutil
 import signal
 import sys
-import tempfile
 from pathlib import Path
 
 import pytest
 
 from ros2nb import domains
+from ros2nb.temporary import owned_folder
 
 # A shell's background job (`make test &` in a script) starts with Ctrl+C ignored, and every
 # process started from it inherits that: the tests that press Ctrl+C (for a node process, for
@@ -36,7 +36,8 @@ if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
 os.environ.pop('ROS_DOMAIN_ID', None)
 os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
 domains.use_discovery_profile()  # the tests' own nodes find peers as the course's processes do
-_SCRATCH = Path(tempfile.mkdtemp(prefix='ros2nb-test-'))
+# Named for this process (each xdist worker makes its own): a killed run's is swept later.
+_SCRATCH = owned_folder('ros2nb-test-')
 os.environ['ROS2NB_WORKSPACE'] = str(_SCRATCH / 'ROS2_and_RL_Tutorials')
 os.environ['IPYTHONDIR'] = str(_SCRATCH / 'ipython')
 os.environ['JUPYTER_RUNTIME_DIR'] = str(_SCRATCH / 'jupyter-runtime')

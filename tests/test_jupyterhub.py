@@ -376,9 +376,10 @@ def source(cell: dict) -> str:
 
 
 # ------------------------------------------------------------------------- the class
-PROBE = ('import json, os, sys; print(json.dumps({k: os.environ.get(k) for k in '
+PROBE = ('import glob, json, os, sys, matplotlib; print(json.dumps({k: os.environ.get(k) for k in '
          '("ROS_DOMAIN_ID", "ROS2NB_WORKSPACE", "HOME")} | {"prefix": sys.prefix, '
-         '"cwd": os.getcwd()}))')
+         '"cwd": os.getcwd(), "font lists": glob.glob(matplotlib.get_cachedir() + '
+         '"/fontlist-*.json")}))')
 
 
 @dataclass
@@ -455,6 +456,9 @@ def test_each_learner_runs_in_the_course_venv_with_own_workspace_and_no_ros_doma
                                                 'ROS2_and_RL_Tutorials')
         assert Path(probe['cwd']) == home / 'ros2-course' / 'notebooks'
         assert Path(probe['prefix']).resolve() == (ROOT / '.venv').resolve()
+        # Without it, a first plot on a busy server shows "Matplotlib is building the font cache".
+        assert probe['font lists'], (
+            f"{learner}'s matplotlib font list was not built before the kernel started")
 
 
 def test_each_learner_has_own_copy_of_the_learner_notebooks(class_run):

@@ -223,7 +223,9 @@ class Patience:
     from running is not the trees' idle time either.  So an idle interval counts only the
     part of it that the watcher's most delayed thread did not stand on the run queue (its
     CPU time never counts: a judge busy with other subjects would make every program it
-    waits on look busy).
+    waits on look busy), and at most two looks of it: a watcher kept from looking longer
+    (by its own work, or by a thread of its process that holds the GIL while the machine
+    starves it) was late, which says nothing of the trees.
 
     Introduced in ``03-write-the-publisher.ipynb`` (how long the judge waits for a subject).
 
@@ -273,7 +275,11 @@ class Patience:
         cpu, queued, ready = tree_work(self.pids, skip=_this_thread())
         self._held.look()
         if not ready and cpu + queued - busy_then < BUSY_SHARE * (now - then):
-            self.idle_s += now - then - self._held.take(now - then)
+            # Looks come a LOOK_S apart; of a longer interval, what is beyond two looks was the
+            # watcher's lateness (its own work, or a thread of its process the machine starves
+            # holding the GIL it needs), not the trees' waiting, as before the first look.
+            interval = min(now - then, 2 * LOOK_S)
+            self.idle_s += interval - self._held.take(interval)
         self._look = (now, cpu + queued)
         self._verdict = cpu - self.cpu_at_start >= self.limit_s or self.idle_s >= self.limit_s
         return self._verdict

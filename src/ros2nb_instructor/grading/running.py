@@ -112,10 +112,13 @@ class Running:
         Its wall time counts what it worked and waited, not the time the machine kept it
         from running (the most one of its threads stood ready on the run queue, look by
         look: :class:`ros2nb.patience.HeldBack`): on a busy machine, or at a small share of
-        a CPU, a notebook that does its honest work slowly is not a hang.  Without a cgroup
-        to list its threads, the wall clock alone counts."""
-        held = HeldBack(lambda: run_queue_seconds(cgroups_of.threads(self._cgroups))) \
-            if self._cgroups else None
+        a CPU, a notebook that does its honest work slowly is not a hang.  The launcher's
+        own process counts from the start: until it has joined the cgroups (its interpreter
+        starting, on a loaded machine for seconds) they list no thread at all.  Without a
+        cgroup to list its threads, the wall clock alone counts."""
+        launcher = self.process.pid  # single-threaded: its one thread's id is its pid
+        held = HeldBack(lambda: run_queue_seconds(
+            [launcher, *cgroups_of.threads(self._cgroups)])) if self._cgroups else None
         counted, looked = 0.0, time.monotonic()
         while not self._stopping.wait(CPU_LOOK_S):
             now = time.monotonic()

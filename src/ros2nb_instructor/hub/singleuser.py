@@ -15,7 +15,10 @@ JupyterHub's spawner runs this as the learner, with ``HOME`` set to the learner'
    (``ROS2NB_WORKSPACE``, which ros2nb reads);
 3. gives the server the learner's Jupyter configuration (no nbgrader instructor tools, no
    news pop-up, no Extension Manager: ``environment/jupyter-learner``);
-4. puts the course's venv first on ``PATH`` and becomes ``jupyterhub-singleuser`` with the
+4. builds matplotlib's font list in the learner's cache if it is not there, so that their first
+   plot does not show "Matplotlib is building the font cache" (matplotlib says so when building
+   takes over 5 s, as on a busy server);
+5. puts the course's venv first on ``PATH`` and becomes ``jupyterhub-singleuser`` with the
    arguments the hub passed.
 
 ``make hub`` first runs it as ``ros2nb-hub-singleuser --check``: when the hub runs as root (so
@@ -72,6 +75,15 @@ def learner_environment(env: MutableMapping[str, str], folder: Path, venv_bin: P
     lab.learner_environment(env)  # nbgrader's instructor tools, news and Extension Manager off
 
 
+def build_font_cache() -> None:
+    """Have matplotlib build the learner's font list now (``~/.cache/matplotlib``), if missing.
+
+    Building it is matplotlib's own work at its first import of ``font_manager``; done here, the
+    server's log shows any "building the font cache" line instead of the learner's first plot.
+    """
+    import matplotlib.font_manager  # noqa: F401 - the import builds and saves the font list
+
+
 def closed_to_others(path: Path, *, need: int) -> Optional[Path]:
     """Return the first folder on the way to ``path``, or ``path``, that other users cannot use.
 
@@ -120,6 +132,7 @@ def main(argv: Optional[list[str]] = None) -> NoReturn:
     for line in copy_missing_notebooks(NOTEBOOKS, folder):
         print(f'ros2-course: {line}', file=sys.stderr)
     learner_environment(os.environ, folder, venv_bin)
+    build_font_cache()
     os.execv(server, [str(server), *argv])
 
 
