@@ -34,13 +34,13 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path[:0] = [str(ROOT), str(ROOT / 'tests')]  # the root's conftest: the tests' set-up
 
 from mutation_cells import answers  # noqa: E402
-from mutation_operators import OPERATORS, mutants  # noqa: E402
+from mutation_mistakes import OPERATORS, mutants  # noqa: E402
 from mutation_verdicts import verdict  # noqa: E402
 
 PR_SET_CHILD_SUBREAPER = 36  # linux/prctl.h
 #: Relative cost of one mutant's checks, by notebook (what runs longest goes first).
 COST = {'05': 6, '10': 5, '06': 3, '03': 3, '04': 2, '08': 2, '07': 2}
-KINDS = ('killed well', 'survived (equivalent)', 'survived (weak)', 'bad')
+KINDS = ('killed well', 'passes', 'survived (equivalent)', 'survived (weak)', 'bad')
 
 
 def _one(number: str, out: Path, chosen: list[str]) -> int:
