@@ -10,8 +10,10 @@ judge's subject.  Introduced in ``03-write-the-publisher.ipynb``.
 
 from __future__ import annotations
 
+import ast
 import builtins
 import inspect
+import textwrap
 import linecache
 import re
 from types import FrameType
@@ -20,7 +22,7 @@ from typing import Any, Optional
 from ..errors import Ros2nbError, UsageError
 from .frames import frames_of, learner_frame
 from .names import (declared, import_of, learners_functions, place, raising_text,
-                    similar, stored)
+                    similar, stored, stored_near)
 
 _CONSTRUCTOR_ARGUMENTS = re.compile(r'Invalid arguments passed to constructor: '
                                     r'(?:dict_keys\(\[(?P<keys>[^\]]*)\]\)|(?P<names>.+))')
@@ -42,6 +44,11 @@ def _unset_attribute(obj: Any, name: str, owner: str) -> Optional[str]:
         return None
     for code in methods:
         line = stored(code, name, 'STORE_FAST')
+        if line is not None and linecache.getline(code.co_filename, line).lstrip().startswith(
+                ('def ', 'async def ')):
+            return (f'{owner} has no method {name}: it is written inside {code.co_name} '
+                    f'({place(code, line)}), indented one level too deep: indent its def as '
+                    f'{code.co_name}\'s is, so that it belongs to the class.')
         if line is not None:
             return (f'{owner} has no attribute {name}: {code.co_name} sets a local name '
                     f'{name} ({place(code, line)}), which is gone when it returns: write '
@@ -61,10 +68,41 @@ def _unset_attribute(obj: Any, name: str, owner: str) -> Optional[str]:
             f'none is called {name}: set self.{name} in __init__ (or write the method).')
 
 
+_NO_SUCH_ATTRIBUTE = re.compile(r"^'(\w+)' object has no attribute '(\w+)'")
+
+
+def _field_set(exc: AttributeError) -> Optional[str]:
+    """``msg.dta = ...``: a message's field set under a name it does not have (Python names
+    no object for a failed assignment: the message is found among the frame's values)."""
+    found = _NO_SUCH_ATTRIBUTE.match(_first_line(exc))
+    frame = learner_frame(exc)
+    if found is None or frame is None:
+        return None
+    owner, name = found.groups()
+    for value in frame.f_locals.values():
+        if type(value).__name__ == owner:
+            return _message_field(type(value), name)
+    return None
+
+
+def _message_field(cls: type, name: str) -> Optional[str]:
+    """The line for a field a message of ``cls`` does not have, or None for no message."""
+    fields = getattr(cls, 'get_fields_and_field_types', None)
+    if fields is None:
+        return None
+    has = list(fields())
+    meant = similar(name, has) or (has[0] if len(has) == 1 else None)
+    hint = f': write {meant}' if meant else ''
+    return f'a {cls.__name__} message has no field {name} (its fields: {", ".join(has)}){hint}.'
+
+
 def _attribute(exc: AttributeError) -> Optional[str]:
     name, obj = getattr(exc, 'name', None), getattr(exc, 'obj', None)
     if not name or obj is None:
-        return None
+        return _field_set(exc)
+    field = None if isinstance(obj, type) else _message_field(type(obj), name)
+    if field:
+        return field
     owner = obj.__name__ if isinstance(obj, type) or hasattr(obj, '__file__') and hasattr(
         obj, '__name__') else type(obj).__name__
     if not isinstance(obj, type) and not hasattr(obj, '__file__'):
@@ -82,21 +120,26 @@ def _name(exc: NameError, frame: FrameType) -> str:
     if not name:
         quoted = re.match(r"name '(\w+)'", _first_line(exc))
         name = quoted.group(1) if quoted else '?'
-    visible = {*frame.f_locals, *frame.f_globals, *vars(builtins)}
     if name == 'self':  # self.NAME in a plain function: the notebook's own names are plain
         used = re.search(r'\bself\.(\w+)', linecache.getline(frame.f_code.co_filename,
                                                              frame.f_lineno))
         plain = used.group(1) if used else 'the name'
         return (f"name 'self' is not defined: {frame.f_code.co_name}() is a function, not a "
                 f'method of a node, so there is no self: write {plain}, not self.{plain}.')
-    meant = similar(name, visible)
+    spelt = stored_near(frame.f_code, name)
+    if spelt is not None:
+        other, line = spelt
+        return (f"name '{name}' is not defined, but {other} is ({place(frame.f_code, line)}): "
+                'spell a name the same where it is set and where it is used.')
+    own = similar(name, {*frame.f_locals, *frame.f_globals})
+    imported = import_of(name)
+    if imported and not own:
+        return (f"name '{name}' is not defined: import it at the top of the file (or cell), "
+                f'{imported}.')
+    meant = own or similar(name, vars(builtins))
     if meant:
         return (f"name '{name}' is not defined: did you mean {meant}? Names must match "
                 'exactly.')
-    imported = import_of(name)
-    if imported:
-        return (f"name '{name}' is not defined: import it at the top of the file (or cell), "
-                f'{imported}.')
     return (f"name '{name}' is not defined where this line runs: define it (or import it) "
             'before, or check its spelling.')
 
@@ -122,18 +165,50 @@ def _constructor_arguments(exc: AssertionError) -> Optional[str]:
 
 
 def _unset_local(exc: UnboundLocalError, frame: FrameType) -> str:
-    """A name the function sets (which makes it local everywhere in it) used before that."""
+    """A name the function sets (which makes it local everywhere in it) used before that:
+    set in some branches of an ``if`` only, set after its use, or imported late."""
     quoted = re.search(r"'(\w+)'", _first_line(exc))
     name = quoted.group(1) if quoted else '?'
+    function = frame.f_code.co_name
     line = stored(frame.f_code, name, 'STORE_FAST')
+    text = linecache.getline(frame.f_code.co_filename, line).strip() if line else ''
+    if text.startswith(('import ', 'from ')):
+        return (f'{name} is used before {function} imports it ({place(frame.f_code, line)}): '
+                'import it at the top of the file instead.')
+    if line is not None and line < frame.f_lineno and _in_branch(frame, line):
+        return (f'{name} has no value here: {function} sets it only in some branches of an '
+                'if/elif/else, not in the one this call took: set it in every branch.')
     where = f' ({place(frame.f_code, line)})' if line is not None else ''
-    return (f'{name} is used before {frame.f_code.co_name} sets it{where}: a name the '
-            f'function sets is its own local name everywhere in it; set it first, or, for an '
-            f'import, import it at the top of the file.')
+    return (f'{name} is used before {function} sets it{where}: a name the function sets is '
+            'its own local name everywhere in it: set it before this line.')
+
+
+def _in_branch(frame: FrameType, line: int) -> bool:
+    """Whether ``line`` of the frame's function is inside an ``if`` (or ``elif``/``else``)."""
+    try:
+        lines, first = inspect.getsourcelines(frame.f_code)
+        tree = ast.parse(textwrap.dedent(''.join(lines)))
+    except (OSError, TypeError, SyntaxError):
+        return False
+    return any(isinstance(node, ast.If) and node.lineno + first - 1 < line
+               <= node.end_lineno + first - 1 for node in ast.walk(tree))
 
 
 _MISSING = re.compile(r"^(?P<called>[\w.]+)\(\) missing \d+ required positional "
                       r"arguments?: (?P<names>.+)$")
+
+
+def _class_for_instance(exc: TypeError, frame: FrameType) -> Optional[tuple[str, type]]:
+    """``(name, cls)``: a local name of the frame that holds a class where an instance was
+    meant (``node = TemperatureSensor``, then ``node.destroy_node()``: no self), or None."""
+    found = _MISSING.match(_first_line(exc))
+    if found is None or re.findall(r"'(\w+)'", found['names']) != ['self']:
+        return None
+    method = found['called'].rpartition('.')[2]
+    for name, value in frame.f_locals.items():
+        if isinstance(value, type) and callable(getattr(value, method, None)):
+            return name, value
+    return None
 
 
 def _missing_arguments(exc: TypeError, frame: FrameType) -> Optional[str]:
@@ -141,6 +216,11 @@ def _missing_arguments(exc: TypeError, frame: FrameType) -> Optional[str]:
     found = _MISSING.match(_first_line(exc))
     if found is None:
         return None
+    held = _class_for_instance(exc, frame)
+    if held is not None:
+        name, cls = held
+        return (f'{name} holds the class {cls.__name__}, not one made from it: create it with '
+                f'parentheses, {name} = {cls.__name__}().')
     called = found['called'].removesuffix('.__init__').rpartition('.')[2]
     names = ', '.join(re.findall(r"'(\w+)'", found['names']))
     return (f'{called}() was called without {names}: give it every argument it needs, in '
@@ -194,6 +274,10 @@ def cause_place(exc: BaseException) -> Optional[str]:
     frame = learner_frame(exc)
     if frame is None or not isinstance(exc, (TypeError, ValueError)):
         return None
+    held = _class_for_instance(exc, frame) if isinstance(exc, TypeError) else None
+    if held is not None:  # where the name was given the class
+        line = stored(frame.f_code, held[0], 'STORE_FAST')
+        return place(frame.f_code, line) if line is not None else None
     used = re.search(r"get_parameter\(\s*'(\w+)'", raising_text(exc))
     owner = frame.f_locals.get('self')
     if used is None or owner is None:

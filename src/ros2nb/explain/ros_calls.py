@@ -97,9 +97,9 @@ def wrong_arguments(exc: BaseException) -> Optional[str]:
     wrong = [name for name in CALLS[call] if not KINDS[name][0](values[name])]
     if not wrong:
         return None
-    got = ' and '.join(f'{shown(values[name])} came where {KINDS[name][1].split(" (")[0]} '
-                       'belongs' for name in wrong)
-    kinds = [KINDS[name][1] for name in CALLS[call]]
+    got = ' and '.join(f'{shown(values[name])} {"came " if i == 0 else ""}where '
+                       f'{KINDS[name][1].split(" (")[0]} belongs' for i, name in enumerate(wrong))
+    kinds = [KINDS[name][1].split(' (')[0] for name in CALLS[call]]
     order = f'{", ".join(kinds[:-1])} and {kinds[-1]}'
     belongs = any(KINDS[other][0](values[name]) for name in wrong for other in CALLS[call]
                   if other != name)
