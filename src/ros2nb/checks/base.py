@@ -159,11 +159,13 @@ def passed(message: str) -> None:
     print(f'Check passed: {message}')
 
 
-def call_learner(function: Callable[..., Any], *args: Any) -> Any:
+def call_learner(function: Callable[..., Any], *args: Any, label: str = '') -> Any:
     """Call the learner's function in the kernel: NotImplementedError becomes one line, and
     any other error the learner's code raised a failure through their own frames only (or
     the one line of a known mistake), never a traceback through the check, rclpy or rosbags.
 
+    :param label: the call as the line names it (``record_hour(bag_path)``, as the grader's
+        line does); ``NAME()`` when empty.
     :raises CheckFailed: (or :class:`LearnerCodeError`) for an error in the learner's code.
     """
     try:
@@ -177,8 +179,8 @@ def call_learner(function: Callable[..., Any], *args: Any) -> Any:
                               'replace "raise NotImplementedError()" with your code and run its '
                               'cell again.') from None
         # their frames only, or the one line of a known mistake
-        raise learner_error(f'{function.__name__}()', LearnerError(**describe_error(error))
-                            ) from None
+        raise learner_error(label or f'{function.__name__}()',
+                            LearnerError(**describe_error(error))) from None
 
 
 #: What a part an earlier notebook left unwritten raises where it is used.
