@@ -85,7 +85,8 @@ EXCUSES: tuple[Excuse, ...] = (
            '05-setup-cfg | statement deleted | [develop] and its line'),
     Excuse(('local, not attribute | self.timer = -> timer =',
             'local, not attribute | self.subscription = -> subscription =',
-            'name one edit away | .subscription -> .subsciption'),
+            'name one edit away | .subscription -> .subsciption',
+            'name one edit away | .timer -> .timr'),
            "rclpy's node keeps every timer and subscription it made (node.timers, "
            'node.subscriptions), whatever self keeps: it works the same under any name or none, '
            'as the notebooks say',

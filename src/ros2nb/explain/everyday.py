@@ -140,8 +140,8 @@ def _name(exc: NameError, frame: FrameType) -> str:
     if meant:
         return (f"name '{name}' is not defined: did you mean {meant}? Names must match "
                 'exactly.')
-    return (f"name '{name}' is not defined where this line runs: define it (or import it) "
-            'before, or check its spelling.')
+    return (f"name '{name}' is not defined where this line runs: no line before it sets "
+            f'{name}: set it first, or check its spelling.')
 
 
 def _constructor_arguments(exc: AssertionError) -> Optional[str]:
