@@ -99,6 +99,9 @@ EXCUSES: tuple[Excuse, ...] = (
            "spin ends, and the process's exit destroys the node: nothing that the grader, or "
            'anyone, can observe differs',
            '03-sensor-main | statement deleted | node.destroy_node() (line 15)'),
+    Excuse(("wrong value type | PUBLISH_PERIOD_S -> '1.0'",),
+           "rclpy's create_timer reads its period with float(): '1.0' is a period of 1.0 s",
+           "03-sensor-constructor | wrong value type | PUBLISH_PERIOD_S -> '1.0' (line 13)"),
     Excuse(('constant changed | QUEUE_DEPTH -> 5',),
            'a queue of 5 keeps what a queue of 10 keeps here: at one reading a second nothing '
            'waits in it (the depth matters only to a subscription that falls behind)',
@@ -282,9 +285,11 @@ def names_change(outcome: dict, text: str) -> bool:
            for _place, text_part in quoted_lines(text.split('\n')) if text_part):
         return True
     said = {w.lower() for w in _words(text)}
+    # a changed value (a constant) changes no name: the names of its line say where it is
+    affected = outcome['affected'] or sorted(_words(' '.join(changed)) - {'self'})
     if any(name in text if ' ' in name else any(
             word == part or (len(part) >= 4 and word.startswith(part))
-            for part in _parts(name) for word in said) for name in outcome['affected']):
+            for part in _parts(name) for word in said) for name in affected):
         return True
     written = set().union(*(_numbers_in(line) for line in changed)) if changed else set()
     return bool(written & _numbers_in(_unquoted(text)))

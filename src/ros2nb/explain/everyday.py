@@ -103,6 +103,10 @@ def _attribute(exc: AttributeError) -> Optional[str]:
     field = None if isinstance(obj, type) else _message_field(type(obj), name)
     if field:
         return field
+    if inspect.ismethod(obj) or inspect.isfunction(obj) or inspect.isbuiltin(obj):
+        called = f'self.{obj.__name__}' if inspect.ismethod(obj) else obj.__name__
+        return (f'{called} is a method, not what it returns: call it, '
+                f'{called}().{name}, with the parentheses.')
     owner = obj.__name__ if isinstance(obj, type) or hasattr(obj, '__file__') and hasattr(
         obj, '__name__') else type(obj).__name__
     if not isinstance(obj, type) and not hasattr(obj, '__file__'):
