@@ -119,8 +119,9 @@ class Outcome:
 
 class Produced:
     """What the learner's code produced while one check ran, as the judge's observer heard
-    it: every message's value and every number of every log line from the mark on, and how
-    many messages and lines came (a count a line may state)."""
+    it: every message's value (and the step from the one before) and every number of every
+    log line from the mark on, and how many messages and lines came (a count a line may
+    state)."""
 
     def __init__(self, session: Session) -> None:
         self.observer = session.observer
@@ -133,8 +134,10 @@ class Produced:
         for topic, heard in list(self.observer.heard.items()):
             new = heard[self.marks.get(topic, 0):]
             counts.append(len(new))
-            found.update(float(h.value) for h in new
-                         if isinstance(h.value, (int, float)) and not isinstance(h.value, bool))
+            values = [float(h.value) for h in new
+                      if isinstance(h.value, (int, float)) and not isinstance(h.value, bool)]
+            found.update(values)
+            found.update(b - a for a, b in zip(values, values[1:]))  # a step of the walk
         for line in self.observer.logs[self.log_mark:]:
             found.update(float(n) for n in NUMBER.findall(line.text))
         found.update(float(n) for n in range(max(counts) + 1))  # a count, or which one

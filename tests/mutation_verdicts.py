@@ -135,9 +135,10 @@ _FRAME = re.compile(r'^\s*File "(?P<file>[^"]+)", line (?P<line>\d+)')
 #: A number as a line states it (``-0.63``, ``1e+07``, ``22``), not part of a name.
 NUMBER = re.compile(r'(?<![\w.])[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?(?![\w.]*\w)')
 #: What a line may number without the learner's code producing it: its lines, parts,
-#: notebooks, exit codes, arguments' positions.
+#: notebooks, exit codes, arguments' positions, and what the grader itself set or sent.
 _COUNTING = re.compile(r'(?:\bline|\blines|\bpart|\bparts|\bnotebook|\bcode|\bReading|'
-                       r'\bargument|Challenge|\bstep)s? ?$', re.I)
+                       r'\bargument|Challenge|\bstep)s? ?$|(?:\bgrader set [\w.]+ to|'
+                       r'\bfor(?: a reading of)?) ?$', re.I)
 _MEANT = re.compile(r'did you mean (?:self\.)?([\w.]+)')
 #: A line that is only Python's own error (its kind, its message).
 _PYTHONS_OWN = re.compile(r'^(?:NameError|TypeError|AttributeError|ValueError|KeyError|'
