@@ -181,7 +181,7 @@ def _unquoted(text: str) -> str:
     text it quotes in quotation marks (a log line, a name): what the line itself says."""
     for pattern in _QUOTED:
         text = pattern.sub(' ', text)
-    return re.sub(r'"[^"]*"|\'[^\']*\'|`[^`]*`', ' ', text)
+    return re.sub(r'(?<!\w)(?:"[^"]*"|\'[^\']*\'|`[^`]*`)(?!\w)', ' ', text)
 
 
 def stated_numbers(lines: list[str], every: bool = False) -> list[tuple[float, float]]:

@@ -167,6 +167,12 @@ def _callback_problem(judge: Judge, run: SensorRun, seconds: float) -> None:
     logged = log_format_problem(run)
     if logged is not None:
         raise logged
+    made = judge.observer.count_endpoints(run.info.name, run.info.namespace, 'publisher', TOPIC)
+    if made > 1:  # each call makes another, and publishes on it: the readings still arrive
+        raise CheckFailed(f'{run.info.name} has {made} publishers on {TOPIC} after '
+                          f'{len(run.readings)} readings: publish_temperature makes a new one '
+                          'each time it runs: create it once, in __init__, and publish with '
+                          'self.publisher_.')
 
 
 def _walk_not_kept(judge: Judge) -> Optional[CheckFailed]:

@@ -85,8 +85,9 @@ def _call(judge: Optional[Judge], function: Any, label: str, *args: Any,
         result = call_learner(function, *args, label=label)
     rt = current_runtime()
     if stops is not None and rt is not None and rt.nodes:
-        left = sorted(rt.nodes)  # named as the grader names the node it waits for
-        running = stops if any(n.rsplit('/', 1)[-1] == stops for n in left) else ', '.join(left)
+        remaining = sorted(rt.nodes)  # named as the grader names the node it waits for
+        running = stops if any(n.rsplit('/', 1)[-1] == stops for n in remaining) \
+            else ', '.join(remaining)
         rt.stop()  # the next check's call must start with no node of this one
         raise CheckFailed(_LEFT_RUNNING.format(label=label, node=running))
     return result

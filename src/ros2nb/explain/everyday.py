@@ -258,10 +258,15 @@ def _unexpected_keyword(exc: TypeError, frame: FrameType) -> Optional[str]:
             f'{", ".join(takes) or "none"}).')
 
 
-def _operands(text: str, frame: FrameType, kinds: set[str]) -> str:
+def _operands(exc: BaseException, text: str, frame: FrameType, kinds: set[str]) -> str:
     """``low_c >= high_c`` with a str on one side: which names on the line hold what."""
-    line = linecache.getline(frame.f_code.co_filename, frame.f_lineno)
-    held = [f'{name} is {value!r} ({type(value).__name__})'
+    line = raising_text(exc) or linecache.getline(frame.f_code.co_filename, frame.f_lineno)
+    quoted = re.search(r"""(['"])(-?\d+(?:\.\d+)?)\1""", line) if 'str' in kinds else None
+    if quoted:  # a number written in quotes is text
+        return (f'TypeError: {text}: {quoted.group(0)} is text, not a number: write '
+                f'{quoted.group(2)} without the quotes.')
+    held = [f'{name} is {value!r}' if isinstance(value, str) else
+            f'{name} is a {type(value).__name__}'
             for name, value in frame.f_locals.items()
             if re.search(rf'\b{name}\b', line) and type(value).__name__ in kinds
             and len(repr(value)) <= 40]
@@ -324,7 +329,7 @@ def everyday_explanation(exc: BaseException) -> Optional[str]:
             return found
     operands = _OPERANDS.search(text) if isinstance(exc, TypeError) else None
     if operands:
-        return _operands(text, frame, set(operands.groups()))
+        return _operands(exc, text, frame, set(operands.groups()))
     if isinstance(exc, KeyError):
         return (f'KeyError: {text}: the line reads a key that is not there: check its '
                 'spelling, or read it with .get(key, default).')
