@@ -21,6 +21,7 @@ from __future__ import annotations
 import ast
 import configparser
 import copy
+import dataclasses
 import difflib
 import textwrap
 from dataclasses import dataclass, field
@@ -408,15 +409,17 @@ def _deleted(cell: Cell) -> Iterator[Mutant]:
             else:
                 text = '\n'.join(cell.lines[:first] + cell.lines[last + 1:])
             shown = ast.unparse(statement).split('\n')[0][:60]
+            returned = {'return'} if isinstance(statement, ast.Return) else set()
             yield make(cell.answer, 'statement deleted', f'{shown} (line {first + 1})', text,
-                       affected=frozenset(names_in(statement)))
+                       affected=frozenset(names_in(statement) | returned))
 
 
 def _returns(cell: Cell) -> Iterator[Mutant]:
     for node in cell.nodes(ast.Return):
         if node.value is not None:
-            yield _replaced(cell, node, ast.Expr(node.value), 'return removed',
-                            f'return {ast.unparse(node.value)[:40]}')
+            found = _replaced(cell, node, ast.Expr(node.value), 'return removed',
+                              f'return {ast.unparse(node.value)[:40]}')
+            yield dataclasses.replace(found, affected=found.affected | {'return'})
 
 
 def _locals(cell: Cell) -> Iterator[Mutant]:

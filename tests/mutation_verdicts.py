@@ -122,6 +122,9 @@ THROUGH_LIBRARIES = ('site-packages', '/ros2nb/', 'rclpy/', '_rclpy', 'pybind11'
                      'incompatible function arguments', 'The grader could not finish',
                      '<locals>')
 MOST_LINES = 3
+#: Whole numbers up to this count what a check sent or heard (a burst's messages, their
+#: numbers, readings, lines): a line may state them; a measurement (a decimal) it may not.
+MOST_COUNTED = 100
 #: Most characters of one answer's lines together: a line a learner reads at a glance.
 MOST_CHARS = 400
 #: Phrases that say nothing about the learner's code: what is wrong, or what to do.
@@ -303,7 +306,8 @@ def _numbers_verdict(outcome: dict, shown: dict, text: str) -> list[str]:
                | course_numbers())
     return [f'it states {value:g}, a number the learner\'s code never produced'
             for value, tolerance in stated_numbers(text.split('\n'))
-            if not any(abs(value - n) <= tolerance for n in allowed)]
+            if not (tolerance >= 0.5 and 0 <= value <= MOST_COUNTED)  # a count, an index
+            and not any(abs(value - n) <= tolerance for n in allowed)]
 
 
 def path_verdict(outcome: dict, shown: dict, *, judged: bool = True) -> tuple[str, list[str]]:
