@@ -398,8 +398,8 @@ def _blocks(tree: ast.AST) -> Iterator[list[ast.stmt]]:
 def _deleted(cell: Cell) -> Iterator[Mutant]:
     for block in _blocks(cell.tree):
         for statement in block:
-            if not cell.written(statement) or (isinstance(statement, ast.Expr)
-                                               and isinstance(statement.value, ast.Constant)):
+            if not cell.written(statement) or isinstance(statement, ast.Pass) or (
+                    isinstance(statement, ast.Expr) and isinstance(statement.value, ast.Constant)):
                 continue
             first, col, last, _end = cell.span(statement)
             if len(block) == 1:  # the block keeps a statement
