@@ -23,12 +23,10 @@ from ..errors import Ros2nbError, UsageError
 from .frames import frames_of, learner_frame
 from .names import (declared, import_of, learners_functions, place, raising_text,
                     similar, stored, stored_near)
+from .values import filled_wrongly, wrong_kind
 
 _CONSTRUCTOR_ARGUMENTS = re.compile(r'Invalid arguments passed to constructor: '
                                     r'(?:dict_keys\(\[(?P<keys>[^\]]*)\]\)|(?P<names>.+))')
-#: Python's refusal of two values an operator cannot take together.
-_OPERANDS = re.compile(r"(?:not supported between instances of|unsupported operand type\(s\) "
-                       r"for \S+:) '(\w+)' and '(\w+)'")
 
 
 def _first_line(exc: BaseException) -> str:
@@ -258,23 +256,6 @@ def _unexpected_keyword(exc: TypeError, frame: FrameType) -> Optional[str]:
             f'{", ".join(takes) or "none"}).')
 
 
-def _operands(exc: BaseException, text: str, frame: FrameType, kinds: set[str]) -> str:
-    """``low_c >= high_c`` with a str on one side: which names on the line hold what."""
-    line = raising_text(exc) or linecache.getline(frame.f_code.co_filename, frame.f_lineno)
-    quoted = re.search(r"""(['"])(-?\d+(?:\.\d+)?)\1""", line) if 'str' in kinds else None
-    if quoted:  # a number written in quotes is text
-        return (f'TypeError: {text}: {quoted.group(0)} is text, not a number: write '
-                f'{quoted.group(2)} without the quotes.')
-    held = [f'{name} is {value!r}' if isinstance(value, str) else
-            f'{name} is a {type(value).__name__}'
-            for name, value in frame.f_locals.items()
-            if re.search(rf'\b{name}\b', line) and type(value).__name__ in kinds
-            and len(repr(value)) <= 40]
-    shown = f': here {", ".join(held)}' if held else ''
-    return (f'TypeError: {text}{shown}: find where the value of the wrong kind comes from, '
-            'and give the line two values it can take together.')
-
-
 def cause_place(exc: BaseException) -> Optional[str]:
     """``FILE line N: source`` of the learner's line that caused ``exc`` where that is not
     the line that raised it, or None.  A parameter's value of the wrong kind (None: declared
@@ -283,6 +264,9 @@ def cause_place(exc: BaseException) -> Optional[str]:
     frame = learner_frame(exc)
     if frame is None or not isinstance(exc, (TypeError, ValueError)):
         return None
+    filled = filled_wrongly(exc, frame) if isinstance(exc, TypeError) else None
+    if filled is not None:  # the line that filled the list, not the one that read it
+        return filled[3]
     held = _class_for_instance(exc, frame) if isinstance(exc, TypeError) else None
     if held is not None:  # where the name was given the class
         line = stored(frame.f_code, held[0], 'STORE_FAST')
@@ -327,9 +311,10 @@ def everyday_explanation(exc: BaseException) -> Optional[str]:
         found = _unexpected_keyword(exc, frame) or _missing_arguments(exc, frame)
         if found:
             return found
-    operands = _OPERANDS.search(text) if isinstance(exc, TypeError) else None
-    if operands:
-        return _operands(exc, text, frame, set(operands.groups()))
+    if isinstance(exc, TypeError):
+        found = wrong_kind(exc, frame)
+        if found:
+            return found
     if isinstance(exc, KeyError):
         return (f'KeyError: {text}: the line reads a key that is not there: check its '
                 'spelling, or read it with .get(key, default).')
