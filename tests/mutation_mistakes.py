@@ -430,12 +430,14 @@ def _blocking(cell: Cell) -> Iterator[Mutant]:
 
 
 def _twice(cell: Cell) -> Iterator[Mutant]:
-    """A statement that creates an entity (or hands a node over) written twice."""
+    """A statement that creates an entity (or hands a node over) written twice (a callback
+    registered twice is no entity: rclpy asks it twice, the same)."""
     for node in ast.walk(cell.tree):
         for statement in getattr(node, 'body', []) if isinstance(node, (
                 ast.FunctionDef, ast.With, ast.Module)) else []:
             calls = [n for n in ast.walk(statement) if isinstance(n, ast.Call)
-                     and isinstance(n.func, ast.Attribute) and n.func.attr in CREATORS]
+                     and isinstance(n.func, ast.Attribute) and n.func.attr in CREATORS
+                     and n.func.attr != 'add_on_set_parameters_callback']
             if not calls or not _written_statement(cell, statement) or _compound(statement):
                 continue
             first, last = _lines(cell, statement)

@@ -147,7 +147,8 @@ NUMBER = re.compile(r'(?<![\w.])[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?(?![\w.]*\w)')
 #: notebooks, exit codes, arguments' positions, and what the grader itself set or sent.
 _COUNTING = re.compile(r'(?:\bline|\blines|\bpart|\bparts|\bnotebook|\bcode|\bReading|'
                        r'\bargument|Challenge|\bstep)s? ?$|(?:\bgrader set [\w.]+ to|'
-                       r'\bfor(?: a reading of)?) ?$', re.I)
+                       r'\bsetting [\w.]+ to|\bwhile [\w.]+ is|\bfor(?: a reading of)?) ?$',
+                       re.I)
 _MEANT = re.compile(r'did you mean (?:self\.)?([\w.]+)')
 #: A line that is only Python's own error (its kind, its message).
 _PYTHONS_OWN = re.compile(r'^(?:NameError|TypeError|AttributeError|ValueError|KeyError|'

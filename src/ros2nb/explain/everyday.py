@@ -271,12 +271,15 @@ def cause_place(exc: BaseException) -> Optional[str]:
     if held is not None:  # where the name was given the class
         line = stored(frame.f_code, held[0], 'STORE_FAST')
         return place(frame.f_code, line) if line is not None else None
-    used = re.search(r"get_parameter\(\s*'(\w+)'", raising_text(exc))
+    used = re.findall(r"get_parameter\(\s*'(\w+)'", raising_text(exc))
     owner = frame.f_locals.get('self')
-    if used is None or owner is None:
+    if not used or owner is None:
         return None
+    parameters = getattr(owner, '_parameters', {})
+    wrong = [name for name in used if not isinstance(  # the one holding no number, if known
+        getattr(parameters.get(name), 'value', 0.0), (int, float))] or used
     for code in learners_functions(type(owner)):
-        line = declared(code, used.group(1))
+        line = declared(code, wrong[0])
         if line is not None:
             return place(code, line)
     return None
