@@ -147,7 +147,8 @@ NUMBER = re.compile(r'(?<![\w.])[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?(?![\w.]*\w)')
 #: notebooks, exit codes, arguments' positions, and what the grader itself set or sent.
 _COUNTING = re.compile(r'(?:\bline|\blines|\bpart|\bparts|\bnotebook|\bcode|\bReading|'
                        r'\bargument|Challenge|\bstep)s? ?$|(?:\bgrader set [\w.]+ to|'
-                       r'\bsetting [\w.]+ to|\bwhile [\w.]+ is|\bfor(?: a reading of)?) ?$',
+                       r'\bsetting [\w.]+ to|\bwhile [\w.]+ is|\bparam set [\w.]+|'
+                       r'\bfor(?: a reading of)?) ?$',
                        re.I)
 _MEANT = re.compile(r'did you mean (?:self\.)?([\w.]+)')
 #: A line that is only Python's own error (its kind, its message).
@@ -202,10 +203,12 @@ def stated_numbers(lines: list[str], every: bool = False) -> list[tuple[float, f
     found = []
     for line in lines:
         text = line if every else _unquoted(line)
+        given: set[float] = set()  # what the grader set or sent, named again later in the line
         for match in NUMBER.finditer(text):
-            if not every and _COUNTING.search(text[:match.start()]):
-                continue
             shown = match.group()
+            if not every and (_COUNTING.search(text[:match.start()]) or float(shown) in given):
+                given.add(float(shown))
+                continue
             decimals = len(shown.split('.')[1].split('e')[0]) if '.' in shown else 0
             found.append((float(shown), 0.5 * 10 ** -decimals + 1e-9))
     return found
