@@ -243,9 +243,9 @@ def _order_swapped(cell: Cell, block: list[ast.stmt]) -> Iterator[Mutant]:
                    affected=frozenset(names_in(a, b)))
 
 
-#: Calls whose order counts whatever names they share: ROS brought up, a seed, nodes handed over
-#: and spun, stopped.
-ORDERED_CALLS = ('init', 'seed', 'add', 'spin', 'stop', 'start')
+#: Calls whose order counts whatever names they share: ROS brought up, nodes spun, stopped,
+#: a bag recorded or played (a seed or a node handed over counts only before these).
+ORDERED_CALLS = ('init', 'spin', 'stop', 'start', 'bag_record', 'bag_play')
 
 
 def _depend(a: ast.stmt, b: ast.stmt) -> bool:
@@ -430,14 +430,15 @@ def _blocking(cell: Cell) -> Iterator[Mutant]:
 
 
 def _twice(cell: Cell) -> Iterator[Mutant]:
-    """A statement that creates an entity (or hands a node over) written twice (a callback
-    registered twice is no entity: rclpy asks it twice, the same)."""
+    """A statement that creates an entity of a node written twice (a callback registered twice
+    is none: rclpy asks it twice, the same; nor is a node handed over twice: ros2nb.add
+    replaces a node of the same name, as notebook 00 says)."""
     for node in ast.walk(cell.tree):
         for statement in getattr(node, 'body', []) if isinstance(node, (
                 ast.FunctionDef, ast.With, ast.Module)) else []:
             calls = [n for n in ast.walk(statement) if isinstance(n, ast.Call)
                      and isinstance(n.func, ast.Attribute) and n.func.attr in CREATORS
-                     and n.func.attr != 'add_on_set_parameters_callback']
+                     and n.func.attr not in ('add_on_set_parameters_callback', 'add')]
             if not calls or not _written_statement(cell, statement) or _compound(statement):
                 continue
             first, last = _lines(cell, statement)
@@ -519,18 +520,25 @@ BEGINNER_OPERATORS: tuple[Callable[[Cell], Iterator[Mutant]], ...] = (
 # ------------------------------------------------------------------ runs in another order
 def _earlier(answer: Answer) -> Optional[tuple[str, str]]:
     """``(what, plan)`` for the cell before the answer it needs: the part before a
-    ``%%part`` answer (``'part 3'``), or the set-up cell that binds names the answer uses."""
+    ``%%part`` answer (``'part 3'``), or the set-up cell that binds names the answer's
+    functions use (those no other cell before it binds too: a learner who skipped it still
+    has them; a name the cell itself needs to run is Python's to report, at once)."""
     if answer.is_part:
         number = int(answer.source.split('\n')[0].split()[2])
         return (f'part {number - 1} not run', f'skip part {number - 1}') if number > 1 \
             else None
     try:
-        used = {n.id for n in ast.walk(ast.parse(answer.source)) if isinstance(n, ast.Name)}
+        tree = ast.parse(answer.source)
     except SyntaxError:
         return None
-    for index, text in sorted(setup_cells(answer.notebook).items(), reverse=True):
-        needed = sorted(bound_names(text) & used - bound_names(answer.source))
-        if index < answer.index and needed:
+    used = {n.id for f in ast.walk(tree) if isinstance(f, ast.FunctionDef)  # when it is called
+            for n in ast.walk(f) if isinstance(n, ast.Name)}
+    before = {i: bound_names(t) for i, t in setup_cells(answer.notebook).items()
+              if i < answer.index}
+    for index in sorted(before, reverse=True):
+        others = set().union(*(names for i, names in before.items() if i != index))
+        needed = sorted(before[index] & used - bound_names(answer.source) - others)
+        if needed:
             return f'the cell binding {", ".join(needed)} not run', f'skip {" ".join(needed)}'
     return None
 
