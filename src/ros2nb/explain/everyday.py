@@ -114,6 +114,10 @@ def _attribute(exc: AttributeError) -> Optional[str]:
     meant = similar(name, dir(obj))
     if meant:
         return f"{owner} has no attribute {name}: did you mean {meant}? Names must match exactly."
+    held = [a for a in dir(obj) if not a.startswith('_')
+            and not callable(getattr(obj, a, None))][:8]  # what it holds, by name
+    if held and not isinstance(obj, type):
+        return f'{owner} has no attribute {name}: a {owner} holds {", ".join(held)}.'
     return f'{owner} has no attribute {name}: check the name against what {owner} offers.'
 
 
