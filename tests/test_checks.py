@@ -222,9 +222,10 @@ def test_an_error_in_the_learners_code_is_one_line_at_their_line(session):
         restore(session, PUB)
     shown = caught.value._render_traceback_()
     assert not isinstance(caught.value, LearnerCodeError) and len(shown) == 1, shown
-    assert re.search(r"publish_temperature raised: name 'mgs' is not defined: did you mean msg\? "
-                     r'Names must match exactly\. \(temperature_publisher\.py line \d+: '
-                     r'self\.publisher_\.publish\(mgs\)\)', shown[0]), shown
+    assert re.search(r"publish_temperature raised: name 'mgs' is not defined, but msg is "
+                     r'\(temperature_publisher\.py line \d+: msg = Float32\(\)\): spell a name the '
+                     r'same where it is set and where it is used\. \(temperature_publisher\.py '
+                     r'line \d+: self\.publisher_\.publish\(mgs\)\)', shown[0]), shown
 
 
 MONITOR_MISTAKES = [

@@ -432,8 +432,8 @@ def test_an_error_inside_the_learners_bag_reader_in_10(ros):
             '    readings = {}\n'
             "    return readings['temperature']\n")
     line = ros.one_line('ros2nb.checks.check_readings(read_temperatures)',
-                        "read_temperatures() raised: KeyError: 'temperature': the line reads a "
-                        'key that is not there: check its spelling, or read it with '
+                        "read_temperatures(bag_path) raised: KeyError: 'temperature': the line "
+                        'reads a key that is not there: check its spelling, or read it with '
                         '.get(key, default).', "(cell line 3: return readings['temperature'])")
     assert 'ros2nb/checks' not in line and 'site-packages' not in line, line
 

@@ -123,9 +123,9 @@ def _slow_callback_verdict(fastest_s: float, readings: int) -> None:
     callback of its node: notebook 06 says to answer each reading at once."""
     if fastest_s >= SLOW_CALLBACK_S:
         raise CheckFailed(f'The fan controller took {SLOW_CALLBACK_S:g} s or more to answer each '
-                          f'of {readings} readings: temperature_callback waits (a '
-                          'time.sleep?), and meanwhile every other callback of its node waits '
-                          'too (section 4): publish the command at once, without waiting.')
+                          f'of {readings} readings: temperature_callback waits (a loop, or a '
+                          'wait?), and meanwhile every other callback of its node waits too '
+                          '(section 4): publish the command at once, without waiting.')
 
 
 @judged
