@@ -119,14 +119,14 @@ def _compared(before: Path, after: list[tuple[dict, str, list[str]]]) -> list[st
     """A table of the counts by notebook, before (the outcomes in ``before``) and after."""
     then = _judged(before)
     lines = ['## Before and after', '', f'Before: the outcomes in `{before}`.', '',
-             '| notebook | mutants | killed well | survived (equivalent / weak) | bad |',
-             '|---|---|---|---|---|']
+             '| notebook | mutants | killed well | passes | survived (equivalent / weak) | bad |',
+             '|---|---|---|---|---|---|']
     for number in sorted({o['notebook'] for o, _k, _w in then + after}):
         cells = []
         for judged in (then, after):
             kinds = Counter(k for o, k, _w in judged
                             if o['notebook'] == number and o['operator'] != 'none')
-            cells.append((sum(kinds.values()), kinds['killed well'],
+            cells.append((sum(kinds.values()), kinds['killed well'], kinds['passes'],
                           f'{kinds["survived (equivalent)"]} / {kinds["survived (weak)"]}',
                           kinds['bad']))
         lines.append(f'| {number} | ' + ' | '.join(f'{a} → {b}' for a, b in zip(*cells)) + ' |')
@@ -160,15 +160,16 @@ def report(out: Path, wall_s: float = 0.0, cpu_s: float = 0.0,
         if item[0]['operator'] != 'none':
             by_notebook[item[0]['notebook']].append(item)
     lines += ['## Totals by notebook and operator', '',
-              '| notebook | operator | mutants | killed well | survived (equivalent / weak) '
-              '| bad |', '|---|---|---|---|---|---|']
+              '| notebook | operator | mutants | killed well | passes | survived (equivalent / '
+              'weak) | bad |', '|---|---|---|---|---|---|---|']
     for number, items in sorted(by_notebook.items()):
         for operator in OPERATORS:
             kinds = Counter(kind for o, kind, _ in items if o['operator'] == operator)
             if kinds:
                 lines.append(f'| {number} | {operator} | {sum(kinds.values())} | '
-                             f'{kinds["killed well"]} | {kinds["survived (equivalent)"]} / '
-                             f'{kinds["survived (weak)"]} | {kinds["bad"]} |')
+                             f'{kinds["killed well"]} | {kinds["passes"]} | '
+                             f'{kinds["survived (equivalent)"]} / {kinds["survived (weak)"]} | '
+                             f'{kinds["bad"]} |')
     for number, items in sorted(by_notebook.items()):
         lines += ['', f'## Notebook {number}', '']
         for o, kind, why in items:
