@@ -185,11 +185,12 @@ def passed(message: str) -> None:
     print(f'Check passed: {message}')
 
 
-def call_learner(function: Callable[..., Any], *args: Any) -> Any:
+def call_learner(function: Callable[..., Any], *args: Any, label: str = '') -> Any:
     """Call the learner's function in the kernel: NotImplementedError becomes one line, and
     any other error the learner's code raised a failure through their own frames only (or
     the one line of a known mistake), never a traceback through the check, rclpy or rosbags.
 
+    :param label: the call as the line names it; :func:`called_as` when empty.
     :raises CheckFailed: (or :class:`LearnerCodeError`) for an error in the learner's code.
     """
     try:
@@ -203,8 +204,18 @@ def call_learner(function: Callable[..., Any], *args: Any) -> Any:
                               'replace "raise NotImplementedError()" with your code and run its '
                               'cell again.') from None
         # their frames only, or the one line of a known mistake
-        raise learner_error(f'{function.__name__}()', LearnerError(**describe_error(error))
-                            ) from None
+        raise learner_error(label or called_as(function),
+                            LearnerError(**describe_error(error))) from None
+
+
+def called_as(function: Callable[..., Any]) -> str:
+    """``NAME(PARAMETERS)``: a learner's function as a check's line names its call
+    (``package_dependencies(package_xml)``), in the kernel as from the grader."""
+    try:
+        names = ', '.join(inspect.signature(function).parameters)
+    except (TypeError, ValueError):
+        names = ''
+    return f'{getattr(function, "__name__", "the function")}({names})'
 
 
 #: What a part an earlier notebook left unwritten raises where it is used.

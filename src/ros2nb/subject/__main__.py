@@ -13,6 +13,7 @@ import os
 import signal
 import sys
 
+from ..explain.blocking import guard_sleep
 from ..explain.plots import guard_pyplot
 from ..processes import die_with_parent, end_this_process
 from ..subject_interface import LOADERS, command_of, wire
@@ -28,6 +29,7 @@ def main(argv: list[str]) -> int:
     judge_time.install()  # the judge's pipe and time: this process's alone, never a child's
     seen.install(judge_time.JudgeTime.pipe())  # before anything of the learner's runs
     guard_pyplot()  # plt.pause / plt.show in a callback: the learner's one line
+    guard_sleep()  # time.sleep in a callback: at once, not after minutes of the grader's clock
     if len(argv) != 2:
         print('Usage: python -m ros2nb.subject IN_FD OUT_FD (started by ros2nb.judge).',
               file=sys.stderr)
