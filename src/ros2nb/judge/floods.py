@@ -126,7 +126,6 @@ class Floods:
         self._observer.take_stale()
         self.forget()
 
-
     def _both(self) -> Optional[str]:
         """The line of a node that floods a topic and /rosout together (each call publishes
         and logs): which of the two passed the limit first is a race, so the line names both
