@@ -6,6 +6,7 @@ import os
 import re
 import shutil
 import stat
+import sys
 import tempfile
 from pathlib import Path
 
@@ -189,3 +190,35 @@ def test_the_service_says_each_learner_their_own_due_date(tmp_path):
     assert said.class_due == '2020-10-05T23:59:00+02:00' and said.due == '2099-10-05T23:59:00+02:00'
     assert said.late_by == ''
     assert schedule.status(store, when, 'grace', notebook).class_due is None
+
+
+def test_the_hub_will_not_start_while_learners_could_read_the_extensions(tmp_path, monkeypatch):
+    """Every learner can read the course folder on the hub; extensions.toml there names
+    learners and their dates, so make hub's check refuses it open to others, in one line."""
+    monkeypatch.setattr(launcher, 'COURSE', tmp_path)
+    private = tmp_path / 'extensions.toml'
+    private.write_text('[ada]\n"03" = { days = 2 }\n')
+    private.chmod(0o644)
+    said = launcher.check_learners_can_use_course(Path(sys.executable))
+    assert said == (f'Learners can read {private} (every learner\'s extensions): make it yours '
+                    f'alone, chmod 600 {private}, then start the hub again.')
+    private.chmod(0o600)
+    assert launcher.extensions_open_to_learners(tmp_path) is None
+
+
+def test_hand_in_outside_the_hub_or_of_no_notebook_is_one_line(monkeypatch, tmp_path):
+    from ros2nb.hand_ins import HandInError, hand_in
+    monkeypatch.delenv('ROS2NB_HAND_IN_URL', raising=False)
+    monkeypatch.setenv('ROS2NB_WORK', str(tmp_path))
+    shutil.copyfile(ROOT / 'notebooks' / SHIPPED[3], tmp_path / SHIPPED[3])
+    with pytest.raises(HandInError) as outside:
+        hand_in(SHIPPED[3][:2])
+    assert str(outside.value) == ("This lab is not on the course's hub, so there is no hand-in "
+                                  "server here: hand your notebook in through your course's "
+                                  "platform")
+    with pytest.raises(HandInError, match=r"^'99' is no notebook of the course: write its "):
+        hand_in('99')
+    monkeypatch.setenv('ROS2NB_HAND_IN_URL', 'http://127.0.0.1:9/services/hand-in/')
+    monkeypatch.setenv('JUPYTERHUB_API_TOKEN', 'x')
+    with pytest.raises(HandInError, match=r' is not there: open and save 04-'):
+        hand_in(4)

@@ -9,7 +9,7 @@ platform, whose clock counts there.
 
 The service's answers are typed here, once (:class:`NotebookStatus`, :class:`Standing`):
 the service writes them, the kernel reads them back with :mod:`ros2nb.typed_json`.  No ROS
-import.  Introduced in ``00-setup-and-the-pubsub-idea.ipynb``'s "How you hand in".
+import.  Introduced in ``00-setup-and-the-pubsub-idea.ipynb`` ("Your progress").
 """
 
 from __future__ import annotations
@@ -123,14 +123,13 @@ def _ask(method: str, path: str, body: Optional[bytes] = None,
                           'minute; if it keeps failing, tell your instructor') from None
 
 
-def hand_in(notebook: Union[str, int]) -> NotebookStatus:
+def hand_in(notebook: Union[str, int]) -> None:
     """Hand in your notebook ``notebook`` as last saved (save it first: Ctrl+S), and print
     when the hub recorded it and how that compares with your due date.
 
     Introduced in ``00-setup-and-the-pubsub-idea.ipynb``.
 
     :param notebook: its number (``"03"`` or ``3``) or name.
-    :return: what the hub now knows of it.
     :raises HandInError: outside the hub, for a notebook that is not in your work folder,
         or when the hub refuses or does not answer; the message says what to do.
     """
@@ -149,7 +148,6 @@ def hand_in(notebook: Union[str, int]) -> NotebookStatus:
         raise HandInError(f'The hand-in server answered something else ({error}): tell your '
                           'instructor') from None
     print(said(status))
-    return status
 
 
 def standing() -> Optional[Standing]:

@@ -143,7 +143,8 @@ def progress(check: bool = False) -> None:
         notes = {status.notebook: due_line(status) for status in hub.notebooks}
         released = [status.notebook for status in hub.notebooks if status.feedback]
         if released:
-            link = (f'Your feedback ({len(released)} notebooks)', hub.feedback_url)
+            pages = f'{len(released)} page{"" if len(released) == 1 else "s"}'
+            link = (f'Your feedback ({pages}, one per notebook)', hub.feedback_url)
     graded_parts.show_table(graded_parts.rows(all_parts, states, notes), caption, link)
 
 

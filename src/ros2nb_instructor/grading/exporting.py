@@ -6,8 +6,9 @@ the hand-in times from what grading kept of each learner (``grading/learners.jso
 lateness from ``course.toml`` and ``extensions.toml`` as they are now (:mod:`.deadlines`,
 the one place that decides it).  ``DUE_BY=`` chooses the notebooks: those the class has due by
 then.  A notebook a learner has not handed in is 0 once it is due for them and blank until
-then (an extension moves that); a blank is "no mark yet" on every platform, so an import in
-mid-term lowers nobody's grade.  The layout of each platform's file is :mod:`.lms`'s.
+then (an extension moves that), and blank if it has no due date; a blank is "no mark yet" on
+every platform, so an import in mid-term lowers nobody's grade.  The layout of each
+platform's file is :mod:`.lms`'s.
 
 The same export is an nbgrader export plugin (:class:`CanvasExport`, :class:`MoodleExport`,
 :class:`CourseExport`: nbgrader's ``ExportPlugin``, ``export(gradebook)``), so
@@ -57,7 +58,9 @@ def mark(learner: Learner, notebook: str, raw: Optional[float], points: float,
          settings: CourseSettings, extensions: Extensions, now: datetime.datetime) -> Mark:
     """``learner``'s mark of ``notebook``: its score after lateness if they handed it in
     (``raw``: nbgrader's, manual points included), else 0 once it is due for them (their
-    extension's due date, or the class's, by ``now``) and blank until then."""
+    extension's due date, or the class's, by ``now``) and blank until then; a notebook
+    without a due date is never due, so blank (a platform's final score counts a blank as 0
+    at the end, its current score leaves it out)."""
     extension = extensions.of(learner.name, notebook)
     if notebook in learner.files:
         late = assess(settings, notebook, raw or 0.0, learner.handed_in.get(notebook), extension)
@@ -65,7 +68,9 @@ def mark(learner: Learner, notebook: str, raw: Optional[float], points: float,
                 f'extension {late.extension()}' if late.extension() else '']
         return Mark(late.final, '; '.join(s for s in said if s))
     due = extension or settings.due.get(notebook)
-    if due is not None and due > now:
+    if due is None:
+        return Mark(None, 'not handed in, no due date')
+    if due > now:
         return Mark(None, f'not due yet (due {due.isoformat(sep=" ", timespec="minutes")})')
     return Mark(0.0, f'not handed in: 0 of {points:g} points')
 

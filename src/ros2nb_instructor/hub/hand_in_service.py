@@ -120,9 +120,11 @@ class Feedback(Learners):
 
 
 def application(store: Store, schedule: Schedule, prefix: str) -> web.Application:
-    """The service's tornado application under ``prefix`` (``/services/hand-in/``)."""
+    """The service's tornado application under ``prefix`` (``/services/hand-in/``); its own
+    address leads to the learner's feedback."""
     given = {'store': store, 'schedule': schedule}
     return web.Application([
+        (prefix, web.RedirectHandler, {'url': f'{prefix}feedback/'}),
         (f'{prefix}api/hand-ins', HandIns, given),
         (f'{prefix}api/hand-ins/([0-9][0-9]-[a-z0-9-]+)', HandIns, given),
         (f'{prefix}feedback/?', Feedback, given),
