@@ -237,6 +237,18 @@ def test_a_mark_is_blank_until_due_and_0_after(tmp_path):
         [], ['left out (not due by 2026-10-04T23:59:00+00:00): 00, 01'])
 
 
+def test_make_export_refuses_in_one_line_and_writes_nothing(tmp_path):
+    export = str(Path(sys.executable).with_name('ros2nb-export'))
+    for args, said in ((['--due-by', '2026-10-20'], "DUE_BY: '2026-10-20' is not a time with its "
+                                                    'offset: write ISO 8601'),
+                       ([], 'holds no grading to export: run make grade first')):
+        done = subprocess.run([export, 'csv', '--grading', str(tmp_path / 'grading'), *args],
+                              capture_output=True, text=True, timeout=600)
+        assert done.returncode == 2 and done.stdout.count('\n') == 1, done.stdout
+        assert said in done.stdout, done.stdout
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_each_roster_mistake_is_one_line(tmp_path):
     (tmp_path / 'roster.csv').write_text('learner,login\nada,\nbo,b\nbo,b2\n')
     with pytest.raises(roster.RosterProblem) as problem:
@@ -352,3 +364,43 @@ def extended_then_exported(tmp_path: Path, out: Path) -> None:
     by_id = {row[2]: row[5] for row in exported[2:]}
     assert by_id == {'S-1': '0.5', 'S-2': '0.9', 'S-3': ''}, exported  # manual; daily; not due
     assert 'graded' not in done.stdout.replace('graded, not in the roster', '')
+    the_other_exports(tmp_path, out, exported)
+
+
+def the_other_exports(tmp_path: Path, out: Path, canvas: list[list[str]]) -> None:
+    """Moodle's and the plain CSV from the same gradebook, and nbgrader's own ``nbgrader
+    export`` with the course's plugin writing Canvas's file again, the same (before, it
+    wrote only the header rows)."""
+    export = Path(sys.executable).with_name('ros2nb-export')
+    common = ['--grading', str(out), '--settings', str(tmp_path / 'daily.toml'),
+              '--extensions', str(tmp_path / 'extensions.toml'), '--due-by',
+              '2026-10-10T00:00:00Z']
+    moodle = subprocess.run([str(export), 'moodle', '--roster', str(tmp_path / 'roster.csv'),
+                             *common], capture_output=True, text=True, timeout=600)
+    assert moodle.returncode == 0, moodle.stdout + moodle.stderr
+    assert f"whose maximum grade is its points ({NB01} 1)" in moodle.stdout
+    rows = read_back(out / 'export' / 'moodle.csv')
+    assert rows[0][5:] == [NB01, f'Feedback for {NB01}']
+    assert {row[2]: row[5:] for row in rows[1:]} == {
+        'S-1': ['0.5', '0.5 of 1 points'],
+        'S-2': ['0.9', '0.9 of 1 points; handed in 1 day after the due date (timestamp.txt): '
+                       '0.1 points off'],
+        'S-3': ['', 'not due yet (due 2026-10-12 23:59+00:00)']}, rows
+    plain = subprocess.run([str(export), 'csv', *common], capture_output=True, text=True,
+                           timeout=600)
+    assert plain.returncode == 0, plain.stdout + plain.stderr
+    totals = {row[0]: row[-1] for row in read_back(out / 'export' / 'csv.csv')[1:]}
+    assert totals['on-time'] == '0.5' and totals['past-cutoff'] == '1', totals
+    (out / 'export' / 'canvas.csv').unlink()
+    course = out / 'nbgrader'
+    nbgrader = subprocess.run(
+        [str(Path(sys.executable).with_name('nbgrader')), 'export',
+         '--exporter=ros2nb_instructor.grading.exporting.CanvasExport',
+         f'--CanvasExport.roster={tmp_path / "roster.csv"}',
+         f'--CanvasExport.settings={tmp_path / "daily.toml"}',
+         f'--CanvasExport.extensions={tmp_path / "extensions.toml"}',
+         '--CanvasExport.due_by=2026-10-10T00:00:00Z', f'--CourseDirectory.root={course}',
+         f'--CourseDirectory.db_url=sqlite:///{course / "gradebook.db"}'],
+        cwd=course, capture_output=True, text=True, timeout=600)
+    assert nbgrader.returncode == 0, nbgrader.stdout + nbgrader.stderr
+    assert read_back(out / 'export' / 'canvas.csv') == canvas

@@ -185,6 +185,12 @@ def main(argv: Optional[list[str]] = None) -> int:
     parser.add_argument('--due-by', metavar='TIME', help=f'such as {EXAMPLE_DUE_BY}')
     args = parser.parse_args(argv)
     grading = args.grading.resolve()
+    try:
+        if args.due_by:
+            parse_time(args.due_by, 'DUE_BY')
+    except TimeProblem as problem:
+        print(problem)
+        return 2
     if not (grading / 'learners.json').is_file():
         print(f'{grading} holds no grading to export: run make grade first '
               '(or name the grading with GRADING=folder)')
@@ -199,10 +205,7 @@ def main(argv: Optional[list[str]] = None) -> int:
     try:
         with Gradebook(gradebook_url(grading / 'nbgrader')) as gradebook:
             plugin.export(gradebook)
-    except (SettingsProblem, ExtensionsProblem, RosterProblem) as problem:
-        print(problem)
-        return 2
-    except TimeProblem as problem:
+    except (SettingsProblem, ExtensionsProblem, RosterProblem, TimeProblem) as problem:
         print(problem)
         return 2
     for line in plugin.said:
