@@ -21,7 +21,6 @@ from __future__ import annotations
 import datetime
 import json
 import re
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Mapping
 
@@ -31,8 +30,6 @@ HANDED_IN = 'handed-in.json'
 TIMESTAMP = 'timestamp.txt'
 #: Where a hand-in time read from a platform zip's entry comes from.
 ZIP_ENTRY = 'zip entry'
-#: What a time from the hand-in service is said to come from (feedback pages, notes).
-SERVER = "the hub's clock"
 #: An example of a time the grader reads, for the line of a mistake.
 EXAMPLE = '2026-10-05T23:30:00+02:00'
 #: Largest record read (a class's record is a few hundred bytes per learner).
@@ -43,18 +40,6 @@ _TIME = re.compile(r'(\d{4})-(\d{2})-(\d{2})[T ](\d{2}):(\d{2})(?::(\d{2})(?:\.(
 
 class TimeProblem(ValueError):
     """A hand-in time the grader does not read: the message is one line saying what to write."""
-
-
-@dataclass(frozen=True)
-class HandIn:
-    """When one notebook was handed in, and where that time comes from.
-
-    :ivar at: the time, aware (its own offset kept).
-    :ivar source: :data:`SERVER`, :data:`HANDED_IN`, :data:`TIMESTAMP` or :data:`ZIP_ENTRY`.
-    """
-
-    at: datetime.datetime
-    source: str
 
 
 def parse_time(text: str, where: str) -> datetime.datetime:
