@@ -25,6 +25,7 @@ from nbgrader.plugins import LateSubmissionPlugin
 from traitlets import Enum, Float
 
 from . import due_dates
+from .mistakes import Mistakes
 
 #: The penalties a policy may have: none, or a share of the score per day or hour begun.
 PENALTIES = ('none', 'per-day', 'per-hour')
@@ -44,12 +45,8 @@ POLICY_KEYS = {'penalty': 'one of "none", "per-day", "per-hour"',
 ZONE_KEYS = ('time_zone', 'zip_time_zone')
 
 
-class SettingsProblem(Exception):
+class SettingsProblem(Mistakes):
     """The settings file cannot be used: ``lines`` holds one line per mistake."""
-
-    def __init__(self, lines: list[str]) -> None:
-        super().__init__('\n'.join(lines))
-        self.lines = lines
 
 
 @dataclass(frozen=True)

@@ -33,18 +33,15 @@ from ..paths import EXTENSIONS
 from . import due_dates
 from .course_settings import read_toml
 from .deadlines import CourseSettings
+from .mistakes import Mistakes
 
 __all__ = ['EXTENSIONS', 'Extensions', 'ExtensionsProblem', 'NONE', 'read_extensions']
 #: The units a relative extension may be given in.
 UNITS = ('days', 'hours')
 
 
-class ExtensionsProblem(Exception):
+class ExtensionsProblem(Mistakes):
     """The extensions file cannot be used: ``lines`` holds one line per mistake."""
-
-    def __init__(self, lines: list[str]) -> None:
-        super().__init__('\n'.join(lines))
-        self.lines = lines
 
 
 @dataclass(frozen=True)

@@ -15,6 +15,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Mapping
 
+from .mistakes import Mistakes
+
 #: The roster's columns: ``learner`` (the folder's name) and the platform's ids.
 ROSTER_COLUMNS = ('learner', 'name', 'first_name', 'last_name', 'lms_id', 'sis_id', 'login',
                   'email', 'section')
@@ -25,12 +27,8 @@ MATCHED_BY = {'canvas': ('lms_id', 'sis_id', 'login'), 'moodle': ('sis_id', 'log
 UNIQUE = ('lms_id', 'sis_id', 'login', 'email')
 
 
-class RosterProblem(Exception):
+class RosterProblem(Mistakes):
     """The roster cannot be used: ``lines`` holds one line per mistake."""
-
-    def __init__(self, lines: list[str]) -> None:
-        super().__init__('\n'.join(lines))
-        self.lines = lines
 
 
 @dataclass(frozen=True)

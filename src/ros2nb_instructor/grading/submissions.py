@@ -19,6 +19,7 @@ from typing import Any, Optional
 import nbformat
 
 from .hand_in_times import HANDED_IN, TIMESTAMP, TimeProblem, read_record, read_timestamp
+from .mistakes import Mistakes
 
 #: Characters nbgrader cannot have in a student id: it builds glob patterns from ids, and
 #: reads a list of ids to leave out as one comma-separated string.
@@ -125,13 +126,9 @@ def _times(entry: Path, learner: 'Learner', notebooks: list[str]) -> None:
                                   for n, t in read_record(record, notebooks).items()})
 
 
-class SubmissionProblem(Exception):
+class SubmissionProblem(Mistakes):
     """Submissions the grader will not guess at: ``lines`` holds one line per mistake (a
     hand-in time it does not read), each saying what to write; nothing is graded."""
-
-    def __init__(self, lines: list[str]) -> None:
-        super().__init__('\n'.join(lines))
-        self.lines = lines
 
 
 def find_learners(folder: Path, notebooks: list[str]) -> tuple[list[Learner], list[str]]:
