@@ -25,7 +25,7 @@ import os
 import sys
 import traceback
 from pathlib import Path
-from typing import Any, Callable, Iterator
+from typing import Any, Callable, Iterator, Mapping, Sequence
 
 from .. import course, graded_parts, working
 from ..errors import CheckFailed, NotDecided, Ros2nbError
@@ -33,6 +33,7 @@ from ..explain.exceptions import describe_error
 from ..judge_interface import learner_error
 from ..subject_replies import LearnerError
 from ..terminal.workspace import current_workspace
+from . import evidence
 from .dispatch import INTERRUPTED, ask_judge
 
 #: A check's body: ``body(judge, *learner_things) -> the passed sentence``.
@@ -48,10 +49,11 @@ JUDGED: set[str] = set()
 
 
 @contextlib.contextmanager
-def _progress_kept(check: str) -> Iterator[None]:
+def _progress_kept(check: str, notebook: int = 0, args: Sequence[Any] = ()) -> Iterator[None]:
     """In the kernel: keep the check's outcome in the learner's progress
-    (:mod:`ros2nb.graded_parts`), and end with its line there.  A check that could not run,
-    or was interrupted, keeps nothing; while grading nothing is kept."""
+    (:mod:`ros2nb.graded_parts`), with what it ran on (:mod:`.evidence`: the ``notebook``'s
+    files, the learner's ``args``), and end with its line there.  A check that could not
+    run, or was interrupted, keeps nothing; while grading nothing is kept."""
     if os.environ.get(course.GRADING_ENV):
         yield
         return
@@ -61,14 +63,14 @@ def _progress_kept(check: str) -> Iterator[None]:
             yield
     except CheckFailed as failure:
         if not str(failure).startswith(INTERRUPTED):
-            _kept(check, False, str(failure))
+            _kept(check, False, str(failure), evidence.taken(notebook, args))
         raise
     lines = out.getvalue().strip().splitlines()
-    _kept(check, True, lines[-1] if lines else '')
+    _kept(check, True, lines[-1] if lines else '', evidence.taken(notebook, args))
 
 
-def _kept(check: str, ok: bool, line: str) -> None:
-    graded_parts.remember(check, ok, line)
+def _kept(check: str, ok: bool, line: str, ran_on: Mapping[str, Any]) -> None:
+    graded_parts.remember(check, ok, line, evidence=ran_on)
     try:
         said = graded_parts.outcome_line(check, ok, graded_parts.parts())
     except OSError:  # the course's notebooks are not beside ros2nb: no table to point at
@@ -127,8 +129,10 @@ def _register(body: Body, call: Callable[..., None]) -> Callable[..., None]:
 def judged(body: Body) -> Callable[[], None]:
     """Register ``body(judge)`` as a check that runs only in a judge; return the notebook's
     function, which asks a judge process to run it by name."""
+    notebook = int(body.__module__.rpartition('lesson')[2][:2] or 0)
+
     def call() -> None:
-        with _progress_kept(body.__name__):
+        with _progress_kept(body.__name__, notebook):
             ask_judge(body.__name__)
 
     JUDGED.add(body.__name__)
@@ -144,7 +148,7 @@ def direct(body: Body) -> Callable[..., None]:
     def call(*args: Any, **kwargs: Any) -> None:
         _running.append(notebook)
         try:
-            with _progress_kept(body.__name__):
+            with _progress_kept(body.__name__, notebook, args):
                 with working.shown(body.__name__):
                     message = decided(lambda: body(None, *args, **kwargs), lambda: None)
                 passed(message)
