@@ -97,10 +97,7 @@ def _options(argv: Optional[list[str]]) -> argparse.Namespace:
 
 def _share(text: str) -> float:
     """``--cpu-share``'s value: CPUs, more than 0 and at most this machine's."""
-    try:
-        share = float(text)
-    except ValueError:
-        share = -1.0
+    share = float(text) if text.replace('.', '', 1).isdigit() else -1.0
     if not 0 < share <= (os.cpu_count() or 1):
         raise argparse.ArgumentTypeError(
             f'{text!r} is no share of this machine\'s {os.cpu_count() or 1} CPUs: give a '
