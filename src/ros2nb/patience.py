@@ -254,13 +254,14 @@ class Patience:
         self._held = HeldBack(self._watcher_threads)
 
     def _watcher_threads(self) -> dict[int, float]:
-        """Each thread of the watcher's process (but the one that looks): its seconds on the
-        run queue so far.  Nothing when the watcher is one of the trees (then its time on
-        the run queue is the trees' work already)."""
-        me = _this_thread()
-        if me[0] in self.pids:
+        """Each thread of the watcher's process, the one that looks included (kept from
+        running, it looks late, and the interval grows by time nobody waited): its seconds
+        on the run queue so far.  Nothing when the watcher is one of the trees (then its time
+        on the run queue is the trees' work already)."""
+        pid = os.getpid()
+        if pid in self.pids:
             return {}
-        return {task: delay for task, _state, delay in _threads(me[0]) if task != me[1]}
+        return {task: delay for task, _state, delay in _threads(pid)}
 
     def exhausted(self) -> bool:
         """True once the trees have had their limit (call it every fraction of a second: it
