@@ -192,6 +192,24 @@ def test_the_service_says_each_learner_their_own_due_date(tmp_path):
     assert schedule.status(store, when, 'grace', notebook).class_due is None
 
 
+def test_the_service_counts_the_grace_as_the_grader_does(tmp_path):
+    """A hand-in within the policy's grace is on time for the grader: the service said
+    "late by" for it.  Past the grace it says how late."""
+    import datetime
+    from ros2nb_instructor.hub import schedule
+    notebook = SHIPPED[3][:-6]
+    store = hand_in_store.Store(tmp_path / 'store')
+    store.hand_in('ada', notebook, NOTEBOOK_BYTES)
+    handed_in = store.handed_in('ada')[notebook]
+    for grace, after_s, late in ((15, 5 * 60, False), (15, 20 * 60, True)):
+        due = (handed_in - datetime.timedelta(seconds=after_s)).astimezone(datetime.timezone.utc)
+        (tmp_path / 'course.toml').write_text(
+            f'[late]\ngrace_minutes = {grace}\n'
+            f'[notebooks.{notebook}]\ndue = {due.strftime("%Y-%m-%dT%H:%M:%SZ")}\n')
+        when = schedule.Schedule(tmp_path / 'course.toml', tmp_path / 'extensions.toml')
+        assert bool(schedule.status(store, when, 'ada', notebook).late_by) is late, (grace, after_s)
+
+
 def test_the_hub_will_not_start_while_learners_could_read_the_extensions(tmp_path, monkeypatch):
     """Every learner can read the course folder on the hub; extensions.toml there names
     learners and their dates, so make hub's check refuses it open to others, in one line."""

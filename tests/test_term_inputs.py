@@ -39,6 +39,23 @@ due = 2026-10-26T23:59:00
 '''
 
 
+#: The guide's own course.toml (docs/instructors.md), 05 due Oct 19 with no late work.
+GUIDE_AS_WRITTEN = f'''[late]
+penalty = "per-day"
+percent = 10
+cap_percent = 50
+grace_minutes = 15
+cutoff_hours = 168
+without_time = "on-time"
+time_zone = "Europe/Berlin"
+[notebooks.{NB03}]
+due = 2026-10-05T23:59:00
+[notebooks.{NB05}]
+due = 2026-10-19T23:59:00+02:00
+cutoff_hours = 0
+'''
+
+
 def settings(tmp_path: Path, text: str) -> deadlines.CourseSettings:
     (tmp_path / 'course.toml').write_text(text)
     return course_settings.read_settings(tmp_path / 'course.toml', NOTEBOOKS)
@@ -93,7 +110,8 @@ def test_a_hand_in_time_is_iso_8601_with_its_offset(text, expected):
 
 
 @pytest.mark.parametrize('text', ['2026-10-05 23:30:00 +0200', '2026-10-05 23:30:00 CEST',
-                                  '05/10/2026', '2026-10-05T23:30:00', '2026-13-05T23:30:00Z'])
+                                  '05/10/2026', '2026-10-05T23:30:00', '2026-13-05T23:30:00Z',
+                                  '2026-10-05T23:30:00+02:99', '2026-10-05T23:30:00+24:00'])
 def test_any_other_hand_in_time_is_refused_with_one_line(text):
     """Before, nbgrader's lenient parser read +0200 as 23:26:40 UTC, CEST as UTC and
     05/10/2026 as May 10: each moved a notebook across its due date without a word."""
@@ -127,7 +145,7 @@ def test_the_guides_staggered_example_scores_each_notebook_by_its_own_time(tmp_p
     """03 handed in on Oct 5, 05 on Oct 18, recorded per notebook (the hub's handed-in.json):
     both on time.  With one timestamp.txt (Oct 18) for the folder, 03 was twelve days late,
     past the cutoff: 0 of 6."""
-    course = settings(tmp_path, GUIDE)
+    course = settings(tmp_path, GUIDE_AS_WRITTEN)
     times = {NB03: datetime.datetime(2026, 10, 5, 20, 0, tzinfo=UTC),
              NB05: datetime.datetime(2026, 10, 18, 9, 0, tzinfo=UTC)}
     a_folder(tmp_path, 'ada', **{HANDED_IN: record_text(times)})
@@ -216,3 +234,21 @@ def test_canvas_submissions_zip_is_taken_in_through_the_roster(tmp_path):
     assert refused == [f'strangerx_999_5003_{NB03}.ipynb: Canvas user 999 is not in the roster '
                        '(lms_id column): add their row (ROSTER=roster.csv), not graded']
     assert times == {}
+
+
+def test_an_export_leaves_blank_what_is_not_yet_due_or_not_scored(tmp_path):
+    """A DUE_BY still to come made every notebook due by it due now (0 for who had not
+    handed in yet), and a notebook handed in without a score in the gradebook was 0."""
+    from ros2nb_instructor.grading.exporting import deciding_time, mark
+    from ros2nb_instructor.grading.submissions import Learner
+    course = settings(tmp_path, GUIDE)
+    soon = datetime.datetime.now(UTC) + datetime.timedelta(days=400)
+    assert deciding_time(soon) < soon
+    assert deciding_time(course.due[NB03]) == course.due[NB03]
+    absent = Learner('absent', 'absent')
+    not_yet = course.due[NB03] - datetime.timedelta(days=1)
+    assert mark(absent, NB03, None, 6, course, extensions.NONE, not_yet).score is None
+    assert mark(absent, NB03, None, 6, course, extensions.NONE, course.due[NB03]).score == 0.0
+    unscored = Learner('unscored', 'unscored', files={NB03: tmp_path / f'{NB03}.ipynb'})
+    said = mark(unscored, NB03, None, 6, course, extensions.NONE, course.due[NB03])
+    assert said.score is None and "no score in the gradebook" in said.feedback, said

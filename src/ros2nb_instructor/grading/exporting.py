@@ -54,6 +54,13 @@ def notebooks_due_by(settings: CourseSettings, notebooks: list[str],
                   if left else [])
 
 
+def deciding_time(due_by: Optional[datetime.datetime]) -> datetime.datetime:
+    """The time that decides what is due (aware): now, or ``due_by`` when it came earlier;
+    a ``due_by`` still to come makes nothing due before its time."""
+    now = datetime.datetime.now(datetime.timezone.utc)
+    return min(due_by, now) if due_by else now
+
+
 def mark(learner: Learner, notebook: str, raw: Optional[float], points: float,
          settings: CourseSettings, extensions: Extensions, now: datetime.datetime) -> Mark:
     """``learner``'s mark of ``notebook``: its score after lateness if they handed it in
@@ -63,7 +70,9 @@ def mark(learner: Learner, notebook: str, raw: Optional[float], points: float,
     at the end, its current score leaves it out)."""
     extension = extensions.of(learner.name, notebook)
     if notebook in learner.files:
-        late = assess(settings, notebook, raw or 0.0, learner.handed_in.get(notebook), extension)
+        if raw is None:  # handed in, yet nbgrader's gradebook holds no score of it
+            return Mark(None, 'handed in, no score in the gradebook: grade it, then export')
+        late = assess(settings, notebook, raw, learner.handed_in.get(notebook), extension)
         said = [f'{late.final:g} of {points:g} points', late.note,
                 f'extension {late.extension()}' if late.extension() else '']
         return Mark(late.final, '; '.join(s for s in said if s))
@@ -108,7 +117,7 @@ def export(grading: Path, platform: str, roster: Optional[Roster], settings: Cou
     course = grading / 'nbgrader'
     notebooks = sorted(p.stem for p in (course / 'source' / ASSIGNMENT).glob('*.ipynb'))
     chosen, said = notebooks_due_by(settings, notebooks, due_by)
-    now = due_by or datetime.datetime.now(datetime.timezone.utc)
+    now = deciding_time(due_by)
     folder = grading / 'export'
     folder.mkdir(exist_ok=True)
     with Gradebook(gradebook_url(course)) as gradebook:

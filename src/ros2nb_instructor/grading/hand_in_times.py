@@ -35,7 +35,7 @@ EXAMPLE = '2026-10-05T23:30:00+02:00'
 #: Largest record read (a class's record is a few hundred bytes per learner).
 MAX_RECORD_BYTES = 100_000
 _TIME = re.compile(r'(\d{4})-(\d{2})-(\d{2})[T ](\d{2}):(\d{2})(?::(\d{2})(?:\.(\d{1,6}))?)?'
-                   r'(Z|[+-]\d{2}:\d{2}| UTC)')
+                   r'(Z|[+-](?:[01]\d|2[0-3]):[0-5]\d| UTC)')
 
 
 class TimeProblem(ValueError):

@@ -80,8 +80,13 @@ class HandIns(Learners):
 
     def get(self) -> None:
         learner = self.learner()
-        self.reply(Standing(learner, tuple(status(self.store, self.schedule, learner, n)
-                                           for n in self.store.notebooks),
+        try:
+            notebooks = tuple(status(self.store, self.schedule, learner, n)
+                              for n in self.store.notebooks)
+        except TimeProblem as why:  # the store's record, not the learner's doing
+            raise web.HTTPError(500, f'{why}: ask your instructor to look at the hand-in '
+                                     'store') from None
+        self.reply(Standing(learner, notebooks,
                             f'{os.environ.get("JUPYTERHUB_SERVICE_PREFIX", "/")}feedback/'))
 
     def post(self, notebook: str) -> None:

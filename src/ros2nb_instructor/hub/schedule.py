@@ -57,8 +57,9 @@ def status(store: Store, schedule: Schedule, learner: str, notebook: str,
     due = extension or settings.due.get(notebook)
     handed_in = store.handed_in(learner).get(notebook)
     late = ''
-    if due is not None and handed_in is not None and handed_in > due:
-        late = late_by((handed_in - due).total_seconds())
+    if due is not None and handed_in is not None \
+            and (handed_in - due).total_seconds() > settings.policy(notebook).grace_minutes * 60:
+        late = late_by((handed_in - due).total_seconds())  # within the grace: on time
     return NotebookStatus(
         notebook, handed_in.isoformat() if handed_in else None,
         saved.isoformat() if saved else None, due.isoformat() if due else None,
