@@ -26,7 +26,8 @@ NB03, NB05 = '03-write-the-publisher', '05-entry-points-and-run'
 NOTEBOOKS = ['00-setup-and-the-pubsub-idea', '01-create-a-workspace', NB03, NB05]
 BERLIN = zoneinfo.ZoneInfo('Europe/Berlin')
 UTC = datetime.timezone.utc
-#: The guide's example: 03 due Oct 5, 05 due Oct 19, 10 % a day begun, 0 after a week.
+#: A term like the guide's: 03 due Oct 5, 05 due Oct 26 (the day after summer time ends in
+#: Berlin), 10 % a day begun, 0 after a week.
 GUIDE = f'''[late]
 penalty = "per-day"
 percent = 10
