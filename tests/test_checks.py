@@ -412,7 +412,8 @@ def test_entry_point_checks(session, package_files):
                                      r'module is written with dots')
     entries("'temperature_publisher = sensor_simulator.publisher:main',", SUBSCRIBER_ENTRY + ',')
     fails(session, checks.check_entry_points, r'did not start main\(\) of '
-                                     r'sensor_simulator.temperature_publisher: .*'
+                                     r'sensor_simulator.temperature_publisher \(ModuleNotFound'
+                                     r"Error: No module named 'sensor_simulator.publisher'\): "
                                      r'temperature_publisher = sensor_simulator.publisher:main: '
                                      r'it should start main\(\) in '
                                      r'sensor_simulator/temperature_publisher.py')
