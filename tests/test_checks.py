@@ -33,6 +33,11 @@ PUB, SUB = course.PUBLISHER_FILE, course.SUBSCRIBER_FILE
 ANSWER_CODE = ('create_publisher(', 'create_timer(', 'create_subscription(', 'random.uniform(',
                'max(MIN_TEMPERATURE_C', '.publish(msg)', 'elif ', 'rclpy.spin(node)')
 MESSAGES: list[str] = []
+#: A line of the learner's own code as a message quotes it, ``(FILE line N: CODE)``, at the
+#: end or mid-sentence: theirs, which a message may show, not the answer.  It ends at the
+#: ``)`` that a word, a comma, a full stop or the message's end follows (the code's own
+#: parentheses, even unbalanced in a line cut short, stay inside).
+THEIR_LINE = re.compile(r' \((?:cell|[\w.]+\.py) line \d+: .*?\)(?=[,.:;]?(?:\s|$))')
 
 
 def strangers(session) -> list[str]:
@@ -452,7 +457,7 @@ def test_setup_cfg_checks(session, package_files, capsys):
 def test_no_message_prints_the_answer():
     assert len(MESSAGES) >= len(SENSOR_MISTAKES) + len(MONITOR_MISTAKES)
     for message in MESSAGES:
-        own_line = re.sub(r' \((?:cell|[\w.]+\.py) line \d+: .*\)$', '', message)  # theirs
+        own_line = re.sub(THEIR_LINE, '', message)
         assert not any(code in own_line for code in ANSWER_CODE), message
 
 
