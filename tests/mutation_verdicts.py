@@ -294,6 +294,16 @@ def _parts(name: str) -> set[str]:
     return {name.lower(), *(w.lower() for w in words if len(w) >= 4)}
 
 
+#: A command-line flag (``--ros-args``, ``-r``): a name no word of a line is, said whole.
+_FLAG = re.compile(r'-+[A-Za-z][\w-]*')
+
+
+def _says_flag(flag: str, text: str) -> bool:
+    """Whether ``text`` says ``flag`` as a whole, not inside a longer one (``-r`` inside
+    ``--ros-args``)."""
+    return re.search(rf'(?<![\w-]){re.escape(flag)}(?![\w-])', text) is not None
+
+
 def names_change(outcome: dict, text: str) -> bool:
     """Whether ``text`` names what the mutant changed: it quotes a changed line, says a name
     (or a word of a name) the mutant changed, or a number it wrote."""
@@ -305,9 +315,9 @@ def names_change(outcome: dict, text: str) -> bool:
     said = {w.lower() for w in _words(text)}
     # a changed value (a constant) changes no name: the names of its line say where it is
     affected = outcome['affected'] or sorted(_words(' '.join(changed)) - {'self'})
-    if any(name in text if ' ' in name else any(
-            word == part or (len(part) >= 4 and word.startswith(part))
-            for part in _parts(name) for word in said) for name in affected):
+    if any(name in text if ' ' in name else _says_flag(name, text) if _FLAG.fullmatch(name)
+           else any(word == part or (len(part) >= 4 and word.startswith(part))
+                    for part in _parts(name) for word in said) for name in affected):
         return True
     written = set().union(*(_numbers_in(line) for line in changed)) if changed else set()
     return bool(written & _numbers_in(_unquoted(text)))

@@ -21,6 +21,7 @@ from mutation_verdicts import (EXCUSES, MOST_EXCUSES, equivalent, names_change, 
 SENSOR_CALLBACK = next(a for a in answers('03') if a.key == '03-sensor-callback')
 SENSOR_CONSTRUCTOR = next(a for a in answers('03') if a.key == '03-sensor-constructor')
 MONITOR_CALLBACK = next(a for a in answers('04') if a.key == '04-monitor-callback')
+ROOM_ARGUMENTS = next(a for a in answers('06') if a.key == '06-room-arguments')
 
 
 def shown(*error: str, produced: tuple[float, ...] = ()) -> dict:
@@ -184,6 +185,24 @@ def test_a_line_names_the_change_by_a_word_of_a_changed_name():
     assert names_change(case, 'the timer fires every 0.5 s')       # the number it wrote
     assert names_change(case, 'give the timer PUBLISH_PERIOD_S')   # the name it changed
     assert not names_change(case, 'No reading arrived on /temperature')
+
+
+def test_a_line_names_a_flag_the_mutant_changed_as_it_was_written():
+    """A flag is no word of a line: the line that shows the learner's '--ro-args' names the
+    change; '-r' is not named by a line that says only '--ros-args', which holds it."""
+    old = "return ['--ros-args', '-r', f'__ns:=/{room}']"
+    line = ("CheckFailed: room_arguments('kitchen') returned ['--ro-args', '-r', "
+            "'__ns:=/kitchen']: a node reads only the arguments after '--ros-args'; start "
+            'the list with it.')
+    typo = outcome(ROOM_ARGUMENTS, 'name one edit away', old,
+                   old.replace('--ros-args', '--ro-args'), shown(line),
+                   affected=('--ro-args', '--ros-args'))
+    assert verdict(typo) == ('killed well', [])
+    swapped = outcome(ROOM_ARGUMENTS, 'arguments swapped', old,
+                      "return ['-r', '--ros-args', f'__ns:=/{room}']", shown(),
+                      affected=('-r',))
+    assert not names_change(swapped, "start the list with '--ros-args'")
+    assert names_change(swapped, "a rule after -r, not '--ros-args'")
 
 
 def test_each_excuse_names_its_reason_and_a_witness_the_run_makes():
