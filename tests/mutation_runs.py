@@ -27,11 +27,13 @@ import os
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Iterator, Optional
+from typing import Any, Iterator, Optional
 
 from ros2nb import checks, course
 from ros2nb.judge.graded_cells import grade
 from ros2nb.judge.session import Session
+from ros2nb.judge.subjects import SubjectProcess
+from ros2nb.subject_replies import Called, Encoded
 from ros2nb.temporary import temporary_folder
 from ros2nb.judge_interface import captured
 
@@ -70,8 +72,9 @@ class Shown:
     ename: str = ''
     hung: bool = False
     #: Numbers the learner's code produced while the check ran, as the judge heard them (the
-    #: values of its messages, the numbers in its log lines, how many of each), of those a
-    #: shown line states (:func:`mutation_verdicts.stated_numbers`).
+    #: values of its messages, the numbers in its log lines, how many of each, what its
+    #: functions returned), of those a shown line states
+    #: (:func:`mutation_verdicts.stated_numbers`).
     produced: list[float] = field(default_factory=list)
     #: Seconds of the wall clock the check took (the learner's wait for its answer).
     seconds: float = 0.0
@@ -117,16 +120,56 @@ class Outcome:
     seconds: float = 0.0
 
 
+#: What the learner's functions returned to the judge (each :class:`Call`'s reply, in
+#: order) while :func:`_returns_kept` keeps them.
+RETURNED: list[Encoded] = []
+
+
+@contextlib.contextmanager
+def _returns_kept() -> Iterator[None]:
+    """Keep in :data:`RETURNED` what every subject's learner function returns (a check of
+    10's ``read_temperatures`` quotes the times it returned: numbers the learner's code
+    produced that no topic or log carried)."""
+    reply_to = SubjectProcess.reply_to
+
+    def kept(command: Any, data: Any) -> Any:
+        reply = reply_to(command, data)
+        if isinstance(reply, Called):
+            RETURNED.extend(o.result for o in reply.outputs if o.result is not None)
+        return reply
+
+    SubjectProcess.reply_to = staticmethod(kept)
+    try:
+        yield
+    finally:
+        SubjectProcess.reply_to = staticmethod(reply_to)
+        RETURNED.clear()
+
+
+def _numbers_of(value: Any) -> Iterator[float]:
+    """The numbers in a returned value (:class:`Encoded`): itself, its items', its text's."""
+    if isinstance(value, Encoded):
+        yield from _numbers_of(value.value)
+    elif isinstance(value, list):
+        for item in value:
+            yield from _numbers_of(item)
+    elif isinstance(value, (int, float)) and not isinstance(value, bool):
+        yield float(value)
+    elif isinstance(value, str):
+        yield from (float(n) for n in NUMBER.findall(value))
+
+
 class Produced:
-    """What the learner's code produced while one check ran, as the judge's observer heard
-    it: every message's value (and the step from the one before) and every number of every
-    log line from the mark on, and how many messages and lines came (a count a line may
-    state)."""
+    """What the learner's code produced while one check ran, as the judge heard it: every
+    message's value (and the step from the one before) and every number of every log line
+    from the mark on, how many messages and lines came (a count a line may state), and the
+    numbers its functions returned to the judge (:data:`RETURNED`)."""
 
     def __init__(self, session: Session) -> None:
         self.observer = session.observer
         self.marks = {topic: len(heard) for topic, heard in self.observer.heard.items()}
         self.log_mark = len(self.observer.logs)
+        self.returned_mark = len(RETURNED)
 
     def numbers(self) -> set[float]:
         found: set[float] = set()
@@ -141,6 +184,8 @@ class Produced:
         for line in self.observer.logs[self.log_mark:]:
             found.update(float(n) for n in NUMBER.findall(line.text))
         found.update(float(n) for n in range(max(counts) + 1))  # a count, or which one
+        for value in RETURNED[self.returned_mark:]:
+            found.update(_numbers_of(value))
         return found
 
 
@@ -364,7 +409,7 @@ def run_notebook(number: str, out: Path, chosen: Optional[set[str]] = None,
     when ``baseline``); write each outcome to ``out`` as a JSON line as it comes; return
     them."""
     found = []
-    with temporary_folder(f'mutants-{number}') as root:
+    with temporary_folder(f'mutants-{number}') as root, _returns_kept():
         run = NotebookRun(number, Path(root))
         try:
             with out.open('w') as written:

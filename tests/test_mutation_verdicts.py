@@ -10,11 +10,16 @@ answers that are good.  Pure logic: no kernel, no judge.
 from __future__ import annotations
 
 import copy
+from types import SimpleNamespace
 
 import pytest
 
+from ros2nb.judge.subjects import SubjectProcess
+from ros2nb.subject_interface import Call
+
 from mutation_cells import answers
 from mutation_mistakes import mutants
+from mutation_runs import RETURNED, Produced, _returns_kept
 from mutation_verdicts import (EXCUSES, MOST_EXCUSES, equivalent, names_change, stated_numbers,
                                verdict)
 
@@ -203,6 +208,23 @@ def test_a_line_names_a_flag_the_mutant_changed_as_it_was_written():
                       affected=('-r',))
     assert not names_change(swapped, "start the list with '--ros-args'")
     assert names_change(swapped, "a rule after -r, not '--ros-args'")
+
+
+def test_what_a_learners_function_returned_is_what_their_code_produced():
+    """10's read_temperatures with 1e6 for 1e9 returns times [0.0, 1000.0, 2000.0, ...],
+    and the check quotes them: numbers of the learner's code that no topic or log carried,
+    kept from the subject's reply while the run keeps them."""
+    times = {'type': 'list', 'value': [{'type': 'float', 'value': t} for t in (0.0, 1e3, 2e3)]}
+    data = {'ok': True, 'outputs': [{'result': {'type': 'tuple', 'value': [
+        times, {'type': 'str', 'value': 'at 22.5 C'}]}}]}
+    session = SimpleNamespace(observer=SimpleNamespace(heard={}, logs=[]))  # nothing heard
+    with _returns_kept():
+        produced = Produced(session)
+        SubjectProcess.reply_to(Call(name='read_temperatures', inputs=[[]]), data)
+        assert {0.0, 1000.0, 2000.0, 22.5} <= produced.numbers()
+    assert RETURNED == []  # and nothing is kept after the run
+    SubjectProcess.reply_to(Call(name='read_temperatures', inputs=[[]]), data)
+    assert RETURNED == []
 
 
 def test_each_excuse_names_its_reason_and_a_witness_the_run_makes():
