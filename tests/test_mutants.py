@@ -64,8 +64,7 @@ SAMPLE: dict[str, list[str]] = {
         '04-monitor-constructor | self. added | TOPIC -> self.TOPIC (line 12)',
         '04-monitor-constructor | wrong message type | Float32 -> Float64'
         ' (line 12)',
-        '04-monitor-main | name one edit away | TemperatureMonitor ->'
-        ' TempratureMonitor (line 7)',
+        '04-monitor-main | name one edit away | node -> nde (line 7)',
         '04-monitor-main | statement deleted | node = TemperatureMonitor()'
         ' (line 7)',
     ],
@@ -111,7 +110,7 @@ SAMPLE: dict[str, list[str]] = {
         '08-monitor-parameters | self. dropped |'
         ' self.add_on_set_parameters_callback ->'
         ' add_on_set_parameters_callback (line 21)',
-        '08-threshold-callback | name one edit away | parameters -> paramters'
+        '08-threshold-callback | name one edit away | parameter -> paramter'
         ' (line 7)',
         '08-threshold-callback | comparison flipped | low_c >= high_c -> low_c'
         ' <= high_c (line 10)',
@@ -161,7 +160,7 @@ def test_a_sample_of_mutants_is_answered_well(number, tmp_path):
 
 #: The planted mutant: a name one letter off in 03's constructor, which the check answers in
 #: one line at the learner's line.
-PLANTED = '03-sensor-constructor | name one edit away | TOPIC -> TOIC (line 12)'
+PLANTED = '03-sensor-constructor | name one edit away | QUEUE_DEPTH -> QUEU_DEPTH (line 12)'
 
 
 def test_a_planted_bad_explanation_fails_the_sample(tmp_path, monkeypatch):
@@ -177,5 +176,6 @@ def test_a_planted_bad_explanation_fails_the_sample(tmp_path, monkeypatch):
                 getattr(module, 'learner_error', None) is original:
             monkeypatch.setattr(module, 'learner_error', traceback_instead)
     outcomes = run_notebook('03', Path(tmp_path) / 'planted.jsonl', {PLANTED}, baseline=False)
-    with pytest.raises(AssertionError, match='TOIC'):
+    assert [o['ident'] for o in outcomes] == [PLANTED]  # the operators still make it
+    with pytest.raises(AssertionError, match='QUEU_DEPTH'):
         answered_well(outcomes)
