@@ -24,7 +24,7 @@ export UV_SYSTEM_CERTS := 1
 # numpy (rclpy's message types), and none of them does linear algebra (docs/decisions.md).
 export OPENBLAS_NUM_THREADS := 1
 
-.PHONY: image image-tool lab lab-instructor check test setup bytecode sandbox-tool browser-tool axe-tool graph-tool grading-course solutions learner-notebooks bench grade clean docs mistakes
+.PHONY: image image-tool lab lab-instructor check test setup bytecode sandbox-tool browser-tool axe-tool graph-tool grading-course solutions learner-notebooks bench grade export clean docs mistakes
 
 setup: $(STAMP)
 
@@ -166,8 +166,15 @@ mistakes: $(STAMP) bytecode
 # Grade a class: SUBMISSIONS is a folder of <learner-id>/NN-*.ipynb or a platform .zip.
 # Output goes to grading/ (git-ignored); FORCE=1 replaces an earlier grading/.
 grade: $(STAMP) bytecode sandbox-tool
-	@test -n "$(SUBMISSIONS)" || { echo "Usage: make grade SUBMISSIONS=DIR (DIR/<learner>/NN-title.ipynb) or SUBMISSIONS=class.zip [FORCE=1] [NO_SANDBOX=1] [SEED=N] [SCHEDULER=tcp://host:8786] [SETTINGS=course.toml] [EXPORT=canvas|moodle|csv ROSTER=roster.csv] [LEARNER=name]"; exit 2; }
-	$(VENV)/bin/ros2nb-grade "$(SUBMISSIONS)" $(if $(FORCE),--force) $(if $(NO_SANDBOX),--no-sandbox) $(if $(SEED),--seed $(SEED)) $(if $(SCHEDULER),--scheduler "$(SCHEDULER)") $(if $(SETTINGS),--settings "$(SETTINGS)") $(if $(EXPORT),--export "$(EXPORT)") $(if $(ROSTER),--roster "$(ROSTER)") $(if $(LEARNER),--learner "$(LEARNER)")
+	@test -n "$(SUBMISSIONS)" || { echo "Usage: make grade SUBMISSIONS=DIR (DIR/<learner>/NN-title.ipynb) or SUBMISSIONS=class.zip [FORCE=1] [NO_SANDBOX=1] [SEED=N] [SCHEDULER=tcp://host:8786] [SETTINGS=course.toml] [EXTENSIONS=extensions.toml] [EXPORT=canvas|moodle|csv ROSTER=roster.csv] [LEARNER=name]"; exit 2; }
+	$(VENV)/bin/ros2nb-grade "$(SUBMISSIONS)" $(if $(FORCE),--force) $(if $(NO_SANDBOX),--no-sandbox) $(if $(SEED),--seed $(SEED)) $(if $(SCHEDULER),--scheduler "$(SCHEDULER)") $(if $(SETTINGS),--settings "$(SETTINGS)") $(if $(EXTENSIONS),--extensions "$(EXTENSIONS)") $(if $(EXPORT),--export "$(EXPORT)") $(if $(ROSTER),--roster "$(ROSTER)") $(if $(LEARNER),--learner "$(LEARNER)")
+
+# A learning platform's grade file from the existing grading (nothing graded again: the
+# formgrader's manual points are kept): grading/export/<EXPORT>.csv. DUE_BY= exports the
+# notebooks due by then (ISO 8601 with its offset); what is not yet due is blank, never 0.
+export: $(STAMP)
+	@test -n "$(EXPORT)" || { echo "Usage: make export EXPORT=canvas|moodle|csv [ROSTER=roster.csv] [DUE_BY=2026-10-20T00:00:00+02:00] [GRADING=grading] [SETTINGS=course.toml] [EXTENSIONS=extensions.toml]"; exit 2; }
+	@$(VENV)/bin/ros2nb-export "$(EXPORT)" $(if $(ROSTER),--roster "$(ROSTER)") $(if $(DUE_BY),--due-by "$(DUE_BY)") $(if $(GRADING),--grading "$(GRADING)") $(if $(SETTINGS),--settings "$(SETTINGS)") $(if $(EXTENSIONS),--extensions "$(EXTENSIONS)")
 
 clean:
 	rm -rf $(VENV) .cache .jupyter
@@ -196,15 +203,17 @@ image:
 
 # ---- Classroom server: JupyterHub on this machine (docs/classroom-server.md) --------------
 # `make hub` (as root): JupyterHub on 127.0.0.1:8000 for the local users of the Unix group
-# ros2-course (settings: environment/jupyterhub_config.py). `make hub-collect CLASS=DIR`
-# copies their notebooks to DIR/<user>/ for `make grade SUBMISSIONS=DIR`.
+# ros2-course (settings: environment/jupyterhub_config.py), with its hand-in service.
+# `make hub-collect CLASS=DIR` copies what each learner handed in, with the hub's time of
+# each, to DIR/<user>/ for `make grade SUBMISSIONS=DIR` (HOMES=1: their work folders as they
+# are, no times); `make hub-feedback` gives each learner their own feedback pages.
 # configurable-http-proxy comes from npm, pinned, into .cache/node (never globally);
 # `make test` installs it when npm can, and otherwise goes on (tests/test_jupyterhub.py skips).
 CHP_VERSION := 4.6.3
 CHP_PREFIX  := $(HERE)/.cache/node
 CHP_STAMP   := $(CHP_PREFIX)/.installed-$(CHP_VERSION)
 
-.PHONY: hub hub-proxy hub-proxy-if-possible hub-collect
+.PHONY: hub hub-proxy hub-proxy-if-possible hub-collect hub-feedback
 
 hub-proxy: $(CHP_STAMP)
 
@@ -223,6 +232,9 @@ hub: $(STAMP) $(CHP_STAMP)
 	$(VENV)/bin/jupyterhub -f environment/jupyterhub_config.py
 
 hub-collect: $(STAMP)
-	@test -n "$(CLASS)" || { echo "Usage: make hub-collect CLASS=DIR, then make grade SUBMISSIONS=DIR"; exit 2; }
-	$(VENV)/bin/ros2nb-hub-collect "$(CLASS)"
+	@test -n "$(CLASS)" || { echo "Usage: make hub-collect CLASS=DIR [HOMES=1] [STORE=folder], then make grade SUBMISSIONS=DIR"; exit 2; }
+	$(VENV)/bin/ros2nb-hub-collect "$(CLASS)" $(if $(HOMES),--from-homes) $(if $(STORE),--store "$(STORE)")
+
+hub-feedback: $(STAMP)
+	$(VENV)/bin/ros2nb-hub-feedback $(if $(GRADING),"$(GRADING)") $(if $(STORE),--store "$(STORE)")
 # ---- end of the classroom-server block ----------------------------------------------------

@@ -13,12 +13,12 @@ import contextlib
 import io
 import random
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 import ros2nb
 from ros2nb.terminal.files import import_file
+from ros2nb.temporary import owned_folder
 
 REFERENCE = Path(ros2nb.__file__).parent / 'reference'
 HOUR_S = 3600
@@ -33,7 +33,7 @@ def main(repeats: int) -> None:
     _quiet(ros2nb.start, sim_time=True)
     pub = import_file(REFERENCE / 'temperature_publisher.py')
     sub = import_file(REFERENCE / 'temperature_subscriber.py')
-    folder = Path(tempfile.mkdtemp(prefix='ros2nb-bench-bag-'))
+    folder = owned_folder('ros2nb-bench-bag-')
     bag = folder / 'hour'
     random.seed(10)
     _quiet(ros2nb.add, pub.TemperatureSensor())

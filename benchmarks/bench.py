@@ -49,10 +49,11 @@ import shutil
 import statistics
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 from typing import Iterator
+
+from ros2nb.temporary import temporary_folder
 
 ROOT = Path(__file__).resolve().parent.parent
 PEERS = Path(__file__).resolve().parent / 'peers.py'
@@ -85,7 +86,7 @@ def both(what: str) -> tuple[float, float]:
 def grading_seconds_per_notebook(folder: str) -> float:
     """Grade one learner who handed in every notebook of ``folder``; seconds per notebook."""
     notebooks = sorted((ROOT / folder).glob('*.ipynb'))
-    with tempfile.TemporaryDirectory(prefix='ros2nb-bench-') as tmp:
+    with temporary_folder('bench') as tmp:
         learner = Path(tmp) / 'class' / 'learner'
         learner.mkdir(parents=True)
         for notebook in notebooks:
@@ -134,7 +135,7 @@ def grade_class(learners: int, workers: int = 0) -> tuple[float, float, int, str
         every process started, notebooks graded, and how many scored full marks (``k of n``).
     """
     notebooks = sorted((ROOT / 'solutions').glob('*.ipynb'))
-    with tempfile.TemporaryDirectory(prefix='ros2nb-bench-') as tmp:
+    with temporary_folder('bench') as tmp:
         for number in range(1, learners + 1):
             learner = Path(tmp) / 'class' / f'learner{number:02d}'
             learner.mkdir(parents=True)

@@ -24,9 +24,10 @@ import shutil
 import statistics
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
+
+from ros2nb.temporary import temporary_folder
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
@@ -72,7 +73,7 @@ def main() -> int:
     kind = options.kind
     solutions = sorted((ROOT / 'solutions').glob('*.ipynb'))
     measured: dict[str, list[tuple[float, float]]] = {'two alone': [], 'with flooder': []}
-    with tempfile.TemporaryDirectory(prefix='ros2nb-flood-') as tmp:
+    with temporary_folder('flood') as tmp:
         for rep in range(options.reps):
             for label in measured:
                 root = Path(tmp) / f'{rep}-{label.replace(" ", "-")}'

@@ -20,9 +20,10 @@ import collections
 import os
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
+
+from ros2nb.temporary import temporary_folder
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / 'tests'))
@@ -96,7 +97,7 @@ def main(learners: list[str]) -> int:
     if unknown:
         print(f'no such learner in tests/grading_samples.py: {", ".join(unknown)}')
         return 2
-    with tempfile.TemporaryDirectory(prefix='ros2nb-profile-') as tmp:
+    with temporary_folder('profile') as tmp:
         root = Path(tmp)
         decoy = root / 'elsewhere' / 'gradebook.db'
         decoy.parent.mkdir()

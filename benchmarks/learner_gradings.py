@@ -14,9 +14,10 @@ from __future__ import annotations
 import argparse
 import statistics
 import sys
-import tempfile
 import time
 from pathlib import Path
+
+from ros2nb.temporary import temporary_folder
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
@@ -39,7 +40,7 @@ def main() -> int:
     print(f'{options.learner}: | run | wall s | busy CPU-s | lost |')
     for run in range(1, options.runs + 1):
         began, cpu = time.monotonic(), busy_cpu_s()
-        with tempfile.TemporaryDirectory(prefix='ros2nb-bench-') as root:
+        with temporary_folder('bench') as root:
             lost = sorted(failed(grade_learner(learner, Path(root))))
         walls.append(time.monotonic() - began)
         print(f'| {run} | {walls[-1]:.1f} | {busy_cpu_s() - cpu:.1f} | '

@@ -24,9 +24,10 @@ import json
 import os
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
+
+from ros2nb.temporary import temporary_folder
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
@@ -121,7 +122,7 @@ def main() -> int:
     options = parser.parse_args()
     top = options.top
     root = HERE.parent
-    with tempfile.TemporaryDirectory(prefix='ros2nb-profile-') as tmp:
+    with temporary_folder('profile') as tmp:
         log = Path(tmp) / 'tests.jsonl'
         env = dict(os.environ, PYTEST_ADDOPTS='-p timing_plugin', **{LOG_ENV: str(log)},
                    PYTHONPATH=os.pathsep.join(filter(None, [str(HERE),

@@ -26,9 +26,10 @@ import re
 import shutil
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
+
+from ros2nb.temporary import temporary_folder
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
@@ -105,7 +106,7 @@ def main() -> int:
     burners = [subprocess.Popen([sys.executable, '-c', 'while True: pass'])
                for _ in range(options.burners)]
     try:
-        with tempfile.TemporaryDirectory(prefix='ros2nb-notebook-cpu-') as tmp:
+        with temporary_folder('notebook-cpu') as tmp:
             class_folder(Path(tmp) / 'class', options.learners, options.corpus)
             started = time.monotonic()
             tasks = group and (group / 'tasks' if (group / 'tasks').exists()

@@ -32,10 +32,11 @@ import os
 import random
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 from types import ModuleType
+
+from ros2nb.temporary import owned_folder
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / 'src'))
@@ -48,7 +49,7 @@ SEED = 2024
 
 def reference_module(name: str) -> ModuleType:
     """Import the course's reference node file ``name`` (e.g. ``temperature_publisher``)."""
-    folder = Path(tempfile.mkdtemp(prefix='ros2nb-bench-'))
+    folder = owned_folder('ros2nb-bench-')
     path = folder / f'{name}.py'
     path.write_text(course.reference_source(f'{name}.py'))
     spec = importlib.util.spec_from_file_location(name, path)
@@ -198,7 +199,7 @@ def first_message_kernel() -> float:
 
 def first_message_processes() -> float:
     from ros2nb import domains
-    folder = Path(tempfile.mkdtemp(prefix='ros2nb-bench-'))
+    folder = owned_folder('ros2nb-bench-')
     files = []
     for name in ('temperature_publisher', 'temperature_subscriber'):
         files.append(folder / f'{name}.py')

@@ -16,8 +16,9 @@ from __future__ import annotations
 
 import argparse
 import sys
-import tempfile
 from pathlib import Path
+
+from ros2nb.temporary import owned_folder
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / 'tests'))
@@ -35,7 +36,7 @@ def line(cell) -> str:
 
 
 def walk(import_again: bool, gc_off: bool) -> None:
-    ws = Path(tempfile.mkdtemp(prefix='ros2nb-walk-10-')) / 'ws'
+    ws = owned_folder('ros2nb-walk-10-') / 'ws'
     kernel = Kernel(ws)
     try:
         kernel.run(CATCH_UP_10)

@@ -7,6 +7,13 @@ runs first, as the learner: it copies the learner notebooks that are missing int
 ``~/ros2-course/notebooks/`` and gives the learner the ROS workspace
 ``~/ros2-course/workspace/ROS2_and_RL_Tutorials``.
 
+The hand-in service (``ros2nb_instructor.hub.hand_in_service``, a managed service at
+``/services/hand-in/``, run by the hub as root) keeps what each learner hands in with
+``ros2nb.hand_in("03")`` and the time by its own clock, in the store
+``<state>/handed-in/`` that only root can read or change; it shows each learner their own
+feedback once ``make hub-feedback`` released it.  Learners' tokens and logins may reach it
+(``access:services!service=hand-in``); each learner's server is told its address.
+
 Settings come from the environment (``make hub VARIABLE=value`` sets them too):
 
 ==========================  =====================  ==========================================
@@ -17,6 +24,8 @@ ROS2_COURSE_HUB_PORT        8000                   port the learners open in the
 ROS2_COURSE_HUB_GROUP       ros2-course            Unix group whose members may log in
 ROS2_COURSE_HUB_ADMINS      (nobody)               instructors' user names, space-separated
 ROS2_COURSE_HUB_STATE       <course>/.cache/hub    database, cookie secret, proxy pid file
+ROS2_COURSE_HUB_HANDED_IN   <state>/handed-in      the hand-in store (root's alone)
+ROS2_COURSE_HUB_HAND_IN_PORT 8090                  the hand-in service's port on 127.0.0.1
 ==========================  =====================  ==========================================
 
 The hub's own API listens on 127.0.0.1:8081 and the proxy's API on 127.0.0.1:8001; the
@@ -46,6 +55,11 @@ START_TIMEOUT_S = 90
 #: Only these variables of the hub's environment reach the learners' servers. ROS_DOMAIN_ID
 #: is left out on purpose, so that two learners never share a ROS domain.
 KEPT_VARIABLES = ['PATH', 'LANG', 'LC_ALL', 'JUPYTERHUB_SINGLEUSER_APP']
+#: The hand-in service's name (its address is /services/hand-in/).
+HAND_IN = 'hand-in'
+#: What a learner's server token may do: the hub's default for a server, and hand in.
+SERVER_TOKEN_SCOPES = ['users:activity!user', 'access:servers!server',
+                       f'access:services!service={HAND_IN}']
 
 
 def setting(name: str, default: str) -> str:
@@ -66,6 +80,8 @@ for required, fix in ((COURSE_PYTHON, 'make setup'), (PROXY, 'make hub-proxy')):
         sys.exit(f'{required} is missing: run `{fix}` in {COURSE}, then start the hub again.')
 
 STATE = state_folder()
+HAND_IN_URL = f"http://127.0.0.1:{setting('HAND_IN_PORT', '8090')}"
+HANDED_IN = Path(setting('HANDED_IN', str(STATE / 'handed-in'))).resolve()
 
 # --- who may log in: Unix users of one group, passwords checked by PAM
 c.JupyterHub.authenticator_class = 'pam'
@@ -89,8 +105,18 @@ c.Spawner.default_url = '/lab/tree/notebooks'
 c.Spawner.env_keep = KEPT_VARIABLES
 # OPENBLAS_NUM_THREADS: numpy's BLAS threads spin at import in every ROS process (rclpy's message
 # types import numpy), on cores the whole class shares; the course does no linear algebra.
-c.Spawner.environment = {'ROS_AUTOMATIC_DISCOVERY_RANGE': 'LOCALHOST', 'OPENBLAS_NUM_THREADS': '1'}
+c.Spawner.environment = {'ROS_AUTOMATIC_DISCOVERY_RANGE': 'LOCALHOST', 'OPENBLAS_NUM_THREADS': '1',
+                         'ROS2NB_HAND_IN_URL': f'{HAND_IN_URL}/services/{HAND_IN}/'}
 c.Spawner.args = [f'--MappingKernelManager.cull_idle_timeout={KERNEL_IDLE_TIMEOUT_S}',
                   '--MappingKernelManager.cull_interval=300']
 c.Spawner.start_timeout = START_TIMEOUT_S
 c.Spawner.http_timeout = START_TIMEOUT_S
+
+# --- the hand-in service: each hand-in kept with the time by its clock, where learners cannot
+# write; learners' logins and their servers' tokens may reach it (and nothing else of it)
+c.JupyterHub.services = [{
+    'name': HAND_IN, 'url': HAND_IN_URL, 'oauth_no_confirm': True,
+    'command': [str(COURSE_PYTHON), '-m', 'ros2nb_instructor.hub.hand_in_service',
+                '--store', str(HANDED_IN), '--settings', str(COURSE / 'course.toml')]}]
+c.JupyterHub.extra_user_scopes = {f'access:services!service={HAND_IN}'}
+c.Spawner.server_token_scopes = SERVER_TOKEN_SCOPES

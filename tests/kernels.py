@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Optional
 
-from jupyter_client.manager import start_new_kernel
+from jupyter_client.manager import KernelManager
 
 from waiting import wait_until
 
@@ -64,6 +64,10 @@ class CellHung(AssertionError):
     """A cell that neither finished nor worked for the seconds it was given."""
 
 
+def _raise_dead() -> bool:
+    raise RuntimeError('the kernel died while it started')
+
+
 class Kernel:
     """A real ``python3`` kernel with the test process's environment (no ROS domain of its
     own: the kernel claims one), the given workspace and ``env`` on top."""
@@ -73,7 +77,20 @@ class Kernel:
         if workspace is not None:
             environment['ROS2NB_WORKSPACE'] = str(workspace)
         environment.update(env)
-        self.manager, self.client = start_new_kernel(kernel_name='python3', env=environment)
+        self.manager = KernelManager(kernel_name='python3')
+        self.manager.start_kernel(env=environment)
+        self.client = self.manager.client()
+        self.client.start_channels()
+
+        def ready() -> bool:  # a kernel queued for a CPU is slow, not gone
+            try:
+                self.client.wait_for_ready(timeout=1)
+            except RuntimeError:
+                return not self.manager.is_alive() and _raise_dead()
+            return True
+
+        if not wait_until(ready):
+            raise RuntimeError('the kernel never answered while it had its patience')
 
     def run(self, code: str, seconds: float = 600) -> Cell:
         """Run a cell; what it sent.

@@ -1,13 +1,14 @@
 """Mutants of the course's answers: each a plausible mistake, made by a fixed operator.
 
-:func:`mutants` takes an answer cell (:class:`mutation_cells.Answer`) and returns its mutants.
+Each operator takes an answer cell (:class:`mutation_cells.Answer`, as :class:`Cell`) and
+makes its mutants (:func:`mutation_mistakes.mutants` gathers them with the beginners' ones).
 Python answers are rewritten through the standard :mod:`ast`: an operator finds a node among
 the lines the learner writes, builds the node the mistake would make, and the cell's text at
 that node's position (``lineno``/``col_offset``, as ast gives it) is replaced by
 ``ast.unparse`` of the new node; everything else in the cell stays as it was.  05's setup.cfg
 is rewritten through :mod:`configparser`.  No regular expression touches the text.
 
-Operators (:data:`OPERATORS`): a name one edit away (identifiers, topic and parameter
+Operators (:data:`CLASSIC`): a name one edit away (identifiers, topic and parameter
 strings, entry points), ``self.`` dropped or added, positional arguments swapped, a constant
 changed, a comparison flipped or loosened, a statement deleted, a ``return`` removed, a local
 assigned instead of an attribute, a method called where it should be passed, an import
@@ -20,15 +21,15 @@ from __future__ import annotations
 import ast
 import configparser
 import copy
+import dataclasses
 import difflib
 import textwrap
 from dataclasses import dataclass, field
 from typing import Callable, Iterator, Optional
 
 from mutation_cells import Answer, answers, given_cells
-from mutation_tutorial import TUTORIAL
 
-OPERATORS = ('name one edit away', 'self. dropped', 'self. added', 'arguments swapped',
+CLASSIC = ('name one edit away', 'self. dropped', 'self. added', 'arguments swapped',
              'constant changed', 'comparison flipped', 'comparison loosened',
              'statement deleted', 'return removed', 'local, not attribute',
              'method called, not passed', 'import removed', 'wrong message type',
@@ -45,7 +46,7 @@ class Mutant:
     """One mistake in one answer cell.
 
     :ivar answer: the answer cell it changes.
-    :ivar operator: one of :data:`OPERATORS`.
+    :ivar operator: one of :data:`mutation_mistakes.OPERATORS`.
     :ivar what: the change in a few words, e.g. ``'TOPIC' -> 'TOIC' (line 12)``.
     :ivar source: the mutated cell.
     :ivar changed: the lines (0-based, of ``source``) the mutant changed or added; empty
@@ -54,6 +55,11 @@ class Mutant:
         learner's that uses one of them shows the mutant's effect.
     :ivar given: given cells of the notebook the mutant changes too (an import removed from
         part 1), by index, with their new text.
+    :ivar plan: how the lab runs the cell, for a run in another order
+        (:data:`mutation_mistakes.RUNS`): ``'twice'``, ``'skip part N'`` or ``'skip NAMES'``
+        (an earlier cell not run), ``'again'`` (after ``first`` failed its check); empty
+        for a mutant of the text.
+    :ivar first: the cell run (and checked) before the answer, for ``'again'``.
     """
 
     answer: Answer
@@ -63,6 +69,8 @@ class Mutant:
     changed: tuple[int, ...]
     affected: frozenset[str]
     given: dict = field(default_factory=dict, hash=False, compare=False)
+    plan: str = ''
+    first: str = ''
 
     @property
     def ident(self) -> str:
@@ -183,7 +191,8 @@ def apply(lines: list[str], edits: list[Edit]) -> str:
 
 
 def make(answer: Answer, operator: str, what: str, new_source: str,
-         given: Optional[dict] = None, affected: frozenset[str] = frozenset()) -> Mutant:
+         given: Optional[dict] = None, affected: frozenset[str] = frozenset(), *,
+         plan: str = '', first: str = '') -> Mutant:
     """A mutant whose cell is ``new_source``: its changed lines found by difflib."""
     old, new = answer.source.split('\n'), new_source.split('\n')
     changed, removed = [], []
@@ -196,7 +205,8 @@ def make(answer: Answer, operator: str, what: str, new_source: str,
     if not affected:
         added = '\n'.join(new[i] for i in changed)
         affected = frozenset(_names('\n'.join(removed)) ^ _names(added))
-    return Mutant(answer, operator, what, new_source, tuple(changed), affected, given or {})
+    return Mutant(answer, operator, what, new_source, tuple(changed), affected, given or {},
+                  plan, first)
 
 
 def _node_edit(cell: Cell, node: ast.AST, new: ast.AST) -> Edit:
@@ -388,8 +398,8 @@ def _blocks(tree: ast.AST) -> Iterator[list[ast.stmt]]:
 def _deleted(cell: Cell) -> Iterator[Mutant]:
     for block in _blocks(cell.tree):
         for statement in block:
-            if not cell.written(statement) or (isinstance(statement, ast.Expr)
-                                               and isinstance(statement.value, ast.Constant)):
+            if not cell.written(statement) or isinstance(statement, ast.Pass) or (
+                    isinstance(statement, ast.Expr) and isinstance(statement.value, ast.Constant)):
                 continue
             first, col, last, _end = cell.span(statement)
             if len(block) == 1:  # the block keeps a statement
@@ -399,15 +409,17 @@ def _deleted(cell: Cell) -> Iterator[Mutant]:
             else:
                 text = '\n'.join(cell.lines[:first] + cell.lines[last + 1:])
             shown = ast.unparse(statement).split('\n')[0][:60]
+            returned = {'return'} if isinstance(statement, ast.Return) else set()
             yield make(cell.answer, 'statement deleted', f'{shown} (line {first + 1})', text,
-                       affected=frozenset(names_in(statement)))
+                       affected=frozenset(names_in(statement) | returned))
 
 
 def _returns(cell: Cell) -> Iterator[Mutant]:
     for node in cell.nodes(ast.Return):
         if node.value is not None:
-            yield _replaced(cell, node, ast.Expr(node.value), 'return removed',
-                            f'return {ast.unparse(node.value)[:40]}')
+            found = _replaced(cell, node, ast.Expr(node.value), 'return removed',
+                              f'return {ast.unparse(node.value)[:40]}')
+            yield dataclasses.replace(found, affected=found.affected | {'return'})
 
 
 def _locals(cell: Cell) -> Iterator[Mutant]:
@@ -606,34 +618,3 @@ def _ini_mutants(answer: Answer) -> Iterator[Mutant]:
                        variant(set_value(section, key, value.replace('/lib/', '/bin/'))))
             yield make(answer, 'tutorial mistake', f'{key} with dashes (the older template)',
                        variant(renamed_key(section, key, key.replace('_', '-'))))
-
-
-# ------------------------------------------------------------------ all of them
-def _spread(found: list[Mutant], most: int) -> list[Mutant]:
-    """At most ``most`` of ``found``, evenly spread over it (always the same ones)."""
-    if len(found) <= most:
-        return found
-    step = len(found) / most
-    return [found[int(i * step)] for i in range(most)]
-
-
-def mutants(answer: Answer, most: int = PER_OPERATOR) -> list[Mutant]:
-    """The mutants of ``answer``: at most ``most`` per operator, the same ones every run,
-    none that leaves the cell as it was, none twice."""
-    if answer.is_ini:
-        made = list(_ini_mutants(answer))
-    else:
-        cell = Cell(answer)
-        made = [m for operator in PYTHON_OPERATORS for m in operator(cell)]
-    made += [make(answer, 'tutorial mistake', what, text(answer))
-             for key, what, text in TUTORIAL if key == answer.key]
-    chosen, seen = [], {answer.source + '[]'}
-    for operator in OPERATORS:
-        of_it = []
-        for mutant in made:
-            fingerprint = mutant.source + repr(sorted(mutant.given.items()))
-            if mutant.operator == operator and fingerprint not in seen:
-                seen.add(fingerprint)
-                of_it.append(mutant)
-        chosen += _spread(of_it, most)
-    return chosen

@@ -27,18 +27,23 @@ import os
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Iterator, Optional
+from typing import Any, Iterator, Optional
 
 from ros2nb import checks, course
 from ros2nb.judge.graded_cells import grade
 from ros2nb.judge.session import Session
+from ros2nb.judge.subjects import SubjectProcess
+from ros2nb.subject_replies import Called, Encoded
 from ros2nb.temporary import temporary_folder
 from ros2nb.judge_interface import captured
 
 from judging import judging_env
 from kernels import Cell, CellHung, Kernel
-from mutation_cells import Answer, MARKERS, answers, notebook, own_names, setup_cells
-from mutation_operators import Mutant, mutants
+from mutation_cells import (Answer, MARKERS, answers, bound_names, notebook, own_names,
+                            setup_cells)
+from mutation_mistakes import mutants
+from mutation_operators import Mutant
+from mutation_verdicts import NUMBER, stated_numbers
 
 #: The seed of every session's drawn inputs: the same inputs every run.
 SEED = 65
@@ -66,6 +71,13 @@ class Shown:
     error: list[str] = field(default_factory=list)
     ename: str = ''
     hung: bool = False
+    #: Numbers the learner's code produced while the check ran, as the judge heard them (the
+    #: values of its messages, the numbers in its log lines, how many of each, what its
+    #: functions returned), of those a shown line states
+    #: (:func:`mutation_verdicts.stated_numbers`).
+    produced: list[float] = field(default_factory=list)
+    #: Seconds of the wall clock the check took (the learner's wait for its answer).
+    seconds: float = 0.0
 
     @property
     def failed(self) -> bool:
@@ -106,6 +118,75 @@ class Outcome:
     grading: Shown
     file_text: str = ''
     seconds: float = 0.0
+
+
+#: What the learner's functions returned to the judge (each :class:`Call`'s reply, in
+#: order) while :func:`_returns_kept` keeps them.
+RETURNED: list[Encoded] = []
+
+
+@contextlib.contextmanager
+def _returns_kept() -> Iterator[None]:
+    """Keep in :data:`RETURNED` what every subject's learner function returns (a check of
+    10's ``read_temperatures`` quotes the times it returned: numbers the learner's code
+    produced that no topic or log carried)."""
+    reply_to = SubjectProcess.reply_to
+
+    def kept(command: Any, data: Any) -> Any:
+        reply = reply_to(command, data)
+        if isinstance(reply, Called):
+            RETURNED.extend(o.result for o in reply.outputs if o.result is not None)
+        return reply
+
+    SubjectProcess.reply_to = staticmethod(kept)
+    try:
+        yield
+    finally:
+        SubjectProcess.reply_to = staticmethod(reply_to)
+        RETURNED.clear()
+
+
+def _numbers_of(value: Any) -> Iterator[float]:
+    """The numbers in a returned value (:class:`Encoded`): itself, its items', its text's."""
+    if isinstance(value, Encoded):
+        yield from _numbers_of(value.value)
+    elif isinstance(value, list):
+        for item in value:
+            yield from _numbers_of(item)
+    elif isinstance(value, (int, float)) and not isinstance(value, bool):
+        yield float(value)
+    elif isinstance(value, str):
+        yield from (float(n) for n in NUMBER.findall(value))
+
+
+class Produced:
+    """What the learner's code produced while one check ran, as the judge heard it: every
+    message's value (and the step from the one before) and every number of every log line
+    from the mark on, how many messages and lines came (a count a line may state), and the
+    numbers its functions returned to the judge (:data:`RETURNED`)."""
+
+    def __init__(self, session: Session) -> None:
+        self.observer = session.observer
+        self.marks = {topic: len(heard) for topic, heard in self.observer.heard.items()}
+        self.log_mark = len(self.observer.logs)
+        self.returned_mark = len(RETURNED)
+
+    def numbers(self) -> set[float]:
+        found: set[float] = set()
+        counts = [len(self.observer.logs) - self.log_mark]
+        for topic, heard in list(self.observer.heard.items()):
+            new = heard[self.marks.get(topic, 0):]
+            counts.append(len(new))
+            values = [float(h.value) for h in new
+                      if isinstance(h.value, (int, float)) and not isinstance(h.value, bool)]
+            found.update(values)
+            found.update(b - a for a, b in zip(values, values[1:]))  # a step of the walk
+        for line in self.observer.logs[self.log_mark:]:
+            found.update(float(n) for n in NUMBER.findall(line.text))
+        found.update(float(n) for n in range(max(counts) + 1))  # a count, or which one
+        for value in RETURNED[self.returned_mark:]:
+            found.update(_numbers_of(value))
+        return found
 
 
 def _without_markers(text: str) -> str:
@@ -161,14 +242,20 @@ class NotebookRun:
         return self._run(source)
 
     # ------------------------------------------------------------------ the two paths
-    def _lab_check(self, answer: Answer) -> Shown:
+    def _lab_check(self, answer: Answer) -> tuple[Shown, set[float]]:
+        began = time.monotonic()
         if not answer.judged:
-            return self._run(answer.check_source)
+            shown = self._run(answer.check_source)
+            shown.seconds = round(time.monotonic() - began, 1)
+            return shown, set()
         self.session.drop_all()
+        produced = Produced(self.session)
         with judging_env(self.root / 'lab'):
             outcome = captured(lambda: checks.run_check(answer.check_name, self.session))
         self.session.drop_all()
-        return Shown.of_outcome(outcome)
+        shown = Shown.of_outcome(outcome)
+        shown.seconds = round(time.monotonic() - began, 1)
+        return shown, produced.numbers()
 
     def _submission(self, mutant: Optional[Mutant]) -> dict:
         nb = copy.deepcopy(notebook(self.number))
@@ -181,21 +268,25 @@ class NotebookRun:
             cell['source'] = _without_markers(text)
         return nb
 
-    def _grading_check(self, answer: Answer, mutant: Optional[Mutant]) -> Shown:
+    def _grading_check(self, answer: Answer, mutant: Optional[Mutant]
+                       ) -> tuple[Shown, set[float]]:
         from corpora import write_parts
         nb = self._submission(mutant)
         source = notebook(self.number)
         graded = {'cells': [c for c in source['cells']
                             if 'grading-context' in c.get('metadata', {}).get('tags', [])]
                   + [source['cells'][answer.check_index]], 'metadata': source['metadata']}
+        began = time.monotonic()
         with self._grading() as ws, contextlib.redirect_stdout(io.StringIO()):
             if not ws.exists():  # what the notebook's own cells made, then its parts
                 course.catch_up(MADE_BY.get(int(self.number), int(self.number)))
             write_parts(nb)
+            produced = Produced(self.session)
             result = grade(graded, nb, self.session)[answer.check_id]
-        if result['passed']:
-            return Shown(lines=list(result['lines']))
-        return Shown.of_outcome(result)
+        shown = Shown(lines=list(result['lines'])) if result['passed'] \
+            else Shown.of_outcome(result)
+        shown.seconds = round(time.monotonic() - began, 1)
+        return shown, produced.numbers()
 
     # ------------------------------------------------------------------ going through it
     def run(self, chosen: Optional[set[str]] = None, baseline: bool = True
@@ -234,13 +325,28 @@ class NotebookRun:
         forgotten = sorted(own_names(answer))  # as when the learner first runs the cell
         if forgotten:
             self._run(f'for _name in {forgotten!r}:\n    globals().pop(_name, None)')
+        plan = mutant.plan if mutant else ''
+        if plan == 'again':  # a mistake first, its check failed, then the answer
+            self._answer_cell(answer, mutant.first)
+            self._lab_check(answer)
+        restore = self._skip(answer, plan)
         cell = self._answer_cell(answer, source)
-        lab = self._lab_check(answer)
+        if plan == 'twice':
+            cell = self._answer_cell(answer, source)
+        lab, lab_numbers = self._lab_check(answer)
         file_text = self._file_text(answer)
-        for index in given:
+        for index in [*given, *restore]:
             self._run(self._cell(index))
         self._run(RESET)
-        grading = self._grading_check(answer, mutant)
+        grading, grading_numbers = self._grading_check(answer, mutant)
+        # A check in the kernel is heard by no judge: what the grader's run of the same code
+        # produced stands for it (the two must say the same anyway), with what the kernel
+        # printed.
+        printed = {float(n) for line in [*cell.lines, *lab.lines] for n in NUMBER.findall(line)}
+        lab_numbers = lab_numbers if answer.judged else grading_numbers | printed
+        shown_numbers = stated_numbers([*lab.error, *grading.error], every=True)
+        for shown, numbers in ((lab, lab_numbers), (grading, grading_numbers)):
+            shown.produced = sorted(_matching(numbers, shown_numbers))
         return Outcome(
             ident=mutant.ident if mutant else f'{answer.key} | none | the answer as written',
             notebook=self.number, answer=answer.key,
@@ -251,18 +357,50 @@ class NotebookRun:
             written=[list(r) for r in answer.regions], cell=cell, lab=lab, grading=grading,
             file_text=file_text, seconds=round(time.monotonic() - began, 1))
 
-    def _file_text(self, answer: Answer) -> str:
-        """The learner's file the answer's part went into, as the check read it."""
-        if not answer.is_part:
-            return ''
+    def _skip(self, answer: Answer, plan: str) -> list[int]:
+        """Undo an earlier cell for a run with it not run (``'skip part N'``: the part taken
+        out of the file's saved parts; ``'skip NAMES'``: the names it bound forgotten);
+        return the cells that redo it."""
+        if not plan.startswith('skip '):
+            return []
+        cells = notebook(self.number)['cells']
+        if plan.startswith('skip part '):
+            number = plan.split()[-1]
+            target = answer.source.split('\n')[0].split()[1]
+            index = next(i for i, c in enumerate(cells) if ''.join(c['source']).startswith(
+                f'%%part {target} {number}\n'))
+            record = self.lab_ws / '.ros2nb-parts.json'
+            saved = json.loads(record.read_text())
+            relative = str(self._file(answer).relative_to(self.lab_ws))
+            saved.get(relative, {}).pop(number, None)
+            record.write_text(json.dumps(saved, indent=1, sort_keys=True) + '\n')
+            return [index]
+        names = plan.split()[1:]
+        self._run(f'for _name in {names!r}:\n    globals().pop(_name, None)')
+        return [max(i for i, text in setup_cells(self.number).items()
+                    if i < answer.index and set(names) & bound_names(text))]
+
+    def _file(self, answer: Answer) -> Path:
+        """The learner's file a ``%%part`` answer goes into."""
         name = answer.source.split('\n')[0].split()[1].strip('{}')
-        path = self.lab_ws / getattr(course, {'PUBLISHER': 'PUBLISHER_FILE',
+        return self.lab_ws / getattr(course, {'PUBLISHER': 'PUBLISHER_FILE',
                                               'SUBSCRIBER': 'SUBSCRIBER_FILE',
                                               'SETUP_PY': 'SETUP_PY_FILE',
                                               'SETUP_CFG': 'SETUP_CFG_FILE',
                                               'FAN': 'FAN_FILE', 'PROMISES': 'PROMISES_FILE',
                                               'LIVE_PLOT': 'LIVE_PLOT_FILE'}[name])
+
+    def _file_text(self, answer: Answer) -> str:
+        """The learner's file the answer's part went into, as the check read it."""
+        if not answer.is_part:
+            return ''
+        path = self._file(answer)
         return path.read_text() if path.is_file() else ''
+
+
+def _matching(numbers: set[float], stated: list[tuple[float, float]]) -> set[float]:
+    """Those of ``numbers`` a stated number (value, tolerance) may be."""
+    return {n for n in numbers for value, tolerance in stated if abs(n - value) <= tolerance}
 
 
 def run_notebook(number: str, out: Path, chosen: Optional[set[str]] = None,
@@ -271,7 +409,7 @@ def run_notebook(number: str, out: Path, chosen: Optional[set[str]] = None,
     when ``baseline``); write each outcome to ``out`` as a JSON line as it comes; return
     them."""
     found = []
-    with temporary_folder(f'mutants-{number}') as root:
+    with temporary_folder(f'mutants-{number}') as root, _returns_kept():
         run = NotebookRun(number, Path(root))
         try:
             with out.open('w') as written:

@@ -33,6 +33,11 @@ PUB, SUB = course.PUBLISHER_FILE, course.SUBSCRIBER_FILE
 ANSWER_CODE = ('create_publisher(', 'create_timer(', 'create_subscription(', 'random.uniform(',
                'max(MIN_TEMPERATURE_C', '.publish(msg)', 'elif ', 'rclpy.spin(node)')
 MESSAGES: list[str] = []
+#: A line of the learner's own code as a message quotes it, ``(FILE line N: CODE)``, at the
+#: end or mid-sentence: theirs, which a message may show, not the answer.  It ends at the
+#: ``)`` that a word, a comma, a full stop or the message's end follows (the code's own
+#: parentheses, even unbalanced in a line cut short, stay inside).
+THEIR_LINE = re.compile(r' \((?:cell|[\w.]+\.py) line \d+: .*?\)(?=[,.:;]?(?:\s|$))')
 
 
 def strangers(session) -> list[str]:
@@ -90,6 +95,10 @@ def test_reference_nodes_pass(session, capsys):
     assert out.count('Check passed:') == 6
 
 
+#: The reference sensor's callback, part 4, as written.
+PUBLISH_METHOD = course.reference_source(Path(PUB).name).split('    def publish_temperature')[1]
+PUBLISH_METHOD = '    def publish_temperature' + PUBLISH_METHOD.split('\n\n\ndef main')[0]
+
 SENSOR_MISTAKES = [
     ('placeholder', "        self.publisher_ = self.create_publisher",
      "        raise NotImplementedError()\n        self.publisher_ = self.create_publisher",
@@ -103,15 +112,16 @@ SENSOR_MISTAKES = [
      checks.check_sensor_constructor, r'uses std_msgs/msg/Float64, but the topic carries '
                                       r'std_msgs/msg/Float32'),
     ('period', 'PUBLISH_PERIOD_S = 1.0 ', 'PUBLISH_PERIOD_S = 2.0 ',
-     checks.check_sensor_constructor, r'Readings came 2 s apart on the grader.s clock; the sensor '
-                                      r'publishes every 1.0 s: give the timer PUBLISH_PERIOD_S'),
+     checks.check_sensor_constructor, r'3 readings in 6 s of the grader.s clock; the sensor '
+                                      r'publishes one every 1.0 s \(6 in 6 s\): give the timer '
+                                      r'PUBLISH_PERIOD_S'),
     ('period a little short', 'PUBLISH_PERIOD_S = 1.0 ', 'PUBLISH_PERIOD_S = 0.99 ',
-     checks.check_sensor_constructor, r'A reading came 0.999 s after the sensor started on the '
-                                      r'grader.s clock, off its whole periods of 1.0 s: use '
+     checks.check_sensor_constructor, r'The readings came between the grader.s whole seconds: '
+                                      r'the timer.s period is not 1.0 s: give the timer '
                                       r'PUBLISH_PERIOD_S'),
     ('period a little long', 'PUBLISH_PERIOD_S = 1.0 ', 'PUBLISH_PERIOD_S = 1.02 ',
-     checks.check_sensor_constructor, r'A reading came 1.999 s after the sensor started on the '
-                                      r'grader.s clock, off its whole periods of 1.0 s'),
+     checks.check_sensor_constructor, r'The readings came between the grader.s whole seconds: '
+                                      r'the timer.s period is not 1.0 s'),
     ('start value', 'self.temperature = START_TEMPERATURE_C', 'self.temperature = 0.0',
      checks.check_sensor_constructor, r'The first reading is 18.00 °C: the walk '
                                       r'starts at START_TEMPERATURE_C = 22.0 °C \(set '
@@ -164,6 +174,32 @@ SENSOR_MISTAKES = [
      checks.check_sensor_main, r'exited with code 1 after Ctrl\+C \(Ctrl\+C had already shut '
                                r'rclpy down\): shut down with rclpy.try_shutdown\(\) instead '
                                r'of rclpy.shutdown\(\)'),
+    ('a timer of 0.5 s', 'self.create_timer(PUBLISH_PERIOD_S, self.publish_temperature)',
+     'self.create_timer(0.5, self.publish_temperature)',
+     checks.check_sensor_constructor, r'^\d+ readings in 6 s of the grader.s clock; the sensor '
+                                      r'publishes one every 1.0 s \(6 in 6 s\)'),
+    ('the walk kept in a local', 'self.temperature = max(MIN_TEMPERATURE_C,',
+     'temperature = max(MIN_TEMPERATURE_C,',
+     checks.check_sensor_callback, r'publish_temperature never changes self.temperature: it sets '
+                                   r'a local name temperature \(temperature_publisher.py line '
+                                   r'\d+: temperature = max\(MIN_TEMPERATURE_C,\), which is gone '
+                                   r'when it returns, so self.temperature stays where __init__ '
+                                   r'set it'),
+    ('a second of sleep in the timer callback', ('import random\n', '        step = random'),
+     ('import random\nimport time\n', '        time.sleep(1.0)\n        step = random'),
+     checks.check_sensor_callback, r'publish_temperature raised: time.sleep\(1.0\) in a callback '
+                                   r'holds its node up.*\(temperature_publisher.py line \d+: '
+                                   r'time.sleep\(1.0\)\)'),
+    ('part 4 indented into __init__', PUBLISH_METHOD, '\n'.join(
+        '    ' + line if line else line for line in PUBLISH_METHOD.split('\n')),
+     checks.check_sensor_callback, r'TemperatureSensor has no method publish_temperature: it '
+                                   r'is written inside __init__ \(temperature_publisher.py '
+                                   r'line \d+: def publish_temperature\(self\):\), indented '
+                                   r'one level too deep'),
+    ('the class, not a node, in main()', 'node = TemperatureSensor()', 'node = TemperatureSensor',
+     checks.check_sensor_main, r'node holds the class TemperatureSensor, not one made from it: '
+                               r'create it with parentheses, node = TemperatureSensor\(\)\. '
+                               r'\(temperature_publisher.py line \d+: node = TemperatureSensor\)'),
     ("the tutorial's main", '''    except (KeyboardInterrupt, ExternalShutdownException):
         pass  # Ctrl+C or a shutdown from outside: leave quietly
     finally:
@@ -191,9 +227,10 @@ def test_an_error_in_the_learners_code_is_one_line_at_their_line(session):
         restore(session, PUB)
     shown = caught.value._render_traceback_()
     assert not isinstance(caught.value, LearnerCodeError) and len(shown) == 1, shown
-    assert re.search(r"publish_temperature raised: name 'mgs' is not defined: did you mean msg\? "
-                     r'Names must match exactly\. \(temperature_publisher\.py line \d+: '
-                     r'self\.publisher_\.publish\(mgs\)\)', shown[0]), shown
+    assert re.search(r"publish_temperature raised: name 'mgs' is not defined, but msg is "
+                     r'\(temperature_publisher\.py line \d+: msg = Float32\(\)\): spell a name the '
+                     r'same where it is set and where it is used\. \(temperature_publisher\.py '
+                     r'line \d+: self\.publisher_\.publish\(mgs\)\)', shown[0]), shown
 
 
 MONITOR_MISTAKES = [
@@ -205,9 +242,9 @@ MONITOR_MISTAKES = [
      'Float32, TOPIC, QUEUE_DEPTH, self.temperature_callback)',
      checks.check_monitor_constructor, r'TemperatureMonitor\(\) raised: create_subscription got '
                                        r'its arguments in the wrong order: 10 came where the '
-                                       r'callback belongs and self\.temperature_callback came '
+                                       r'callback belongs and self\.temperature_callback '
                                        r'where the queue depth belongs; it takes the message '
-                                       r'type \(Float32\), the topic'),
+                                       r'type, the topic, the callback and the queue depth'),
     ('the message for its value', 'temperature_c = msg.data', 'temperature_c = msg',
      checks.check_monitor_callback, r'temperature_callback raised for 19.99 °C: a Float32 message '
                                     r'is not its value: use its field \(data\), e.g. msg.data'),
@@ -380,7 +417,8 @@ def test_entry_point_checks(session, package_files):
                                      r'module is written with dots')
     entries("'temperature_publisher = sensor_simulator.publisher:main',", SUBSCRIBER_ENTRY + ',')
     fails(session, checks.check_entry_points, r'did not start main\(\) of '
-                                     r'sensor_simulator.temperature_publisher: .*'
+                                     r'sensor_simulator.temperature_publisher \(ModuleNotFound'
+                                     r"Error: No module named 'sensor_simulator.publisher'\): "
                                      r'temperature_publisher = sensor_simulator.publisher:main: '
                                      r'it should start main\(\) in '
                                      r'sensor_simulator/temperature_publisher.py')
@@ -419,7 +457,7 @@ def test_setup_cfg_checks(session, package_files, capsys):
 def test_no_message_prints_the_answer():
     assert len(MESSAGES) >= len(SENSOR_MISTAKES) + len(MONITOR_MISTAKES)
     for message in MESSAGES:
-        own_line = re.sub(r' \((?:cell|[\w.]+\.py) line \d+: .*\)$', '', message)  # theirs
+        own_line = re.sub(THEIR_LINE, '', message)
         assert not any(code in own_line for code in ANSWER_CODE), message
 
 

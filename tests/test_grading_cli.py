@@ -109,6 +109,27 @@ def test_bad_input_gets_one_line(tmp_path):
     again = grade(str(tmp_path / 'class'), '--out', str(tmp_path / 'g2'))
     assert again.returncode == 2 and 'FORCE=1' in again.stdout
     assert (tmp_path / 'g2' / 'grades.csv').read_text() == 'manual work\n'  # untouched
+    # A term's inputs: a time the grader will not guess at, a roster row an unquoted comma
+    # shifts, an extension of a learner nobody knows; each one line, the earlier grading kept.
+    (tmp_path / 'class' / 'ada').mkdir()
+    shutil.copy(SOLUTION[NB01], tmp_path / 'class' / 'ada' / f'{NB01}.ipynb')
+    stamp = tmp_path / 'class' / 'ada' / 'timestamp.txt'
+    (tmp_path / 'roster.csv').write_text('learner,name,sis_id\nada,Lovelace, Ada,S-1\n')
+    (tmp_path / 'extensions.toml').write_text('[adda]\n"01" = { days = 1 }\n')
+    (tmp_path / 'course.toml').write_text(f'[notebooks.{NB01}]\ndue = 2026-10-05T23:59:00Z\n')
+    cases = [('2026-10-05 23:30:00 CEST', [],
+              "timestamp.txt: '2026-10-05 23:30:00 CEST' is not a time with its offset"),
+             ('2026-10-05T23:30:00Z', ['--roster', str(tmp_path / 'roster.csv')],
+              'roster.csv line 2: 4 fields where the header has 3'),
+             ('2026-10-05T23:30:00Z', ['--extensions', str(tmp_path / 'extensions.toml')],
+              "no learner 'adda' in the submissions or the roster")]
+    for time, extra, said in cases:
+        stamp.write_text(time)
+        refused = grade(str(tmp_path / 'class'), '--out', str(tmp_path / 'g2'), '--force',
+                        '--settings', str(tmp_path / 'course.toml'), *extra)
+        assert refused.returncode == 2 and refused.stdout.count('\n') == 1, refused.stdout
+        assert said in refused.stdout, refused.stdout
+        assert (tmp_path / 'g2' / 'grades.csv').read_text() == 'manual work\n'
 
 
 def test_without_a_sandbox_grading_refuses_unless_told(tmp_path):

@@ -3,13 +3,16 @@
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import stat
+import sys
 from pathlib import Path
 
 import pytest
 
 from ros2nb_instructor.hub import collect as collector
+from ros2nb_instructor.hub import hand_in_store, release
 from ros2nb_instructor.hub import singleuser as launcher
 from ros2nb.temporary import owned_folder
 
@@ -108,3 +111,132 @@ def test_hub_check_finds_the_folder_that_keeps_learners_out():
         assert launcher.closed_to_others(python, need=stat.S_IXOTH) == python
     finally:
         shutil.rmtree(top)
+
+
+# ---------------------------------------------------------------- hand-ins on the hub
+NOTEBOOK_BYTES = (ROOT / 'notebooks' / SHIPPED[3]).read_bytes()
+
+
+def test_the_store_keeps_each_hand_in_with_its_own_time_and_refuses_the_rest(tmp_path):
+    """Each notebook its own time; handing one in again replaces that copy and time alone;
+    a name that is no course notebook, a file that is no notebook, and a user name the
+    grader cannot take as a folder are refused, one line each; root's alone."""
+    store = hand_in_store.Store(tmp_path / 'store')
+    first = store.hand_in('ada', SHIPPED[3][:-6], NOTEBOOK_BYTES)
+    other = store.hand_in('ada', SHIPPED[4][:-6], NOTEBOOK_BYTES)
+    again = store.hand_in('ada', SHIPPED[3][:-6], NOTEBOOK_BYTES + b' ')
+    times = store.handed_in('ada')
+    assert times == {SHIPPED[3][:-6]: again.at, SHIPPED[4][:-6]: other.at}
+    assert first.at <= other.at <= again.at and again.at.utcoffset().total_seconds() == 0
+    assert (tmp_path / 'store').stat().st_mode & 0o777 == 0o700
+    for learner, notebook, data, said in (
+            ('ada', '99-nothing', NOTEBOOK_BYTES, "'99-nothing' is no notebook of the course"),
+            ('ada', SHIPPED[3][:-6], b'not json', 'that is not a notebook'),
+            ('../eve', SHIPPED[3][:-6], NOTEBOOK_BYTES, 'is not a user name the store keeps')):
+        with pytest.raises(hand_in_store.Refused, match=re.escape(said)):
+            store.hand_in(learner, notebook, data)
+    log = (tmp_path / 'store' / 'hand-ins.log').read_text().splitlines()
+    assert len(log) == 3 and log[-1].endswith(f'ada {SHIPPED[3][:-6]} {len(NOTEBOOK_BYTES) + 1} '
+                                              'bytes')
+
+
+def test_collect_carries_each_notebooks_time_to_the_grader(tmp_path):
+    """make hub-collect copies what was handed in and handed-in.json beside it; the grader
+    reads each notebook's own time from there (as the server recorded it)."""
+    from ros2nb_instructor.grading.submissions import find_learners
+    store = hand_in_store.Store(tmp_path / 'store')
+    stored = store.hand_in('grace', SHIPPED[3][:-6], NOTEBOOK_BYTES)
+    results = collector.collect_handed_in(store, tmp_path / 'class')
+    assert results['grace'].copied == [SHIPPED[3]]
+    (learner,), refused = find_learners(tmp_path / 'class', [p[:-6] for p in SHIPPED])
+    assert refused == [] and learner.handed_in == {SHIPPED[3][:-6]: (stored.at, 'handed-in.json')}
+    assert (tmp_path / 'class' / 'grace' / SHIPPED[3]).read_bytes() == NOTEBOOK_BYTES
+
+
+def test_feedback_is_released_to_each_learner_alone(tmp_path):
+    """Each learner's pages go to their own folder of the store; a page is found by the
+    course's notebook names only, never by a path the request makes."""
+    grading = tmp_path / 'grading' / 'feedback'
+    for learner in ('ada', 'grace'):
+        (grading / learner).mkdir(parents=True)
+        (grading / learner / f'{SHIPPED[3][:-6]}.html').write_text(f'<p>{learner}</p>')
+    (grading / 'bad name').mkdir()
+    (grading / 'bad name' / f'{SHIPPED[3][:-6]}.html').write_text('x')
+    store = hand_in_store.Store(tmp_path / 'store')
+    said = release.release(tmp_path / 'grading', store)
+    assert said[::2] == ['ada: 1 page(s) released', 'grace: 1 page(s) released']
+    assert said[1].startswith("bad name: not released ('bad name' is not a user name")
+    assert store.page('ada', SHIPPED[3][:-6]) == b'<p>ada</p>'
+    assert store.page('grace', SHIPPED[3][:-6]) == b'<p>grace</p>'
+    assert store.feedback('ada') == [SHIPPED[3][:-6]]
+    assert store.page('ada', f'../grace/feedback/{SHIPPED[3][:-6]}') is None
+
+
+def test_the_service_says_each_learner_their_own_due_date(tmp_path):
+    """The class's due date, a learner's extension beside it, and how late a hand-in was,
+    from course.toml and extensions.toml as they are at the request."""
+    from ros2nb_instructor.hub import schedule
+    notebook = SHIPPED[3][:-6]
+    (tmp_path / 'course.toml').write_text(f'[late]\ntime_zone = "Europe/Berlin"\n'
+                                          f'[notebooks.{notebook}]\ndue = 2020-10-05T23:59:00\n')
+    when = schedule.Schedule(tmp_path / 'course.toml', tmp_path / 'extensions.toml')
+    store = hand_in_store.Store(tmp_path / 'store')
+    store.hand_in('ada', notebook, NOTEBOOK_BYTES)
+    said = schedule.status(store, when, 'ada', notebook)
+    assert said.due == '2020-10-05T23:59:00+02:00' and said.class_due is None
+    assert said.late_by and said.handed_in  # handed in years after the due date
+    (tmp_path / 'extensions.toml').write_text(f'[ada]\n"{notebook[:2]}" = 2099-10-05T23:59:00\n')
+    said = schedule.status(store, when, 'ada', notebook)
+    assert said.class_due == '2020-10-05T23:59:00+02:00' and said.due == '2099-10-05T23:59:00+02:00'
+    assert said.late_by == ''
+    assert schedule.status(store, when, 'grace', notebook).class_due is None
+
+
+def test_the_service_counts_the_grace_as_the_grader_does(tmp_path):
+    """A hand-in within the policy's grace is on time for the grader: the service said
+    "late by" for it.  Past the grace it says how late."""
+    import datetime
+    from ros2nb_instructor.hub import schedule
+    notebook = SHIPPED[3][:-6]
+    store = hand_in_store.Store(tmp_path / 'store')
+    store.hand_in('ada', notebook, NOTEBOOK_BYTES)
+    handed_in = store.handed_in('ada')[notebook]
+    for grace, after_s, late in ((15, 5 * 60, False), (15, 20 * 60, True)):
+        due = (handed_in - datetime.timedelta(seconds=after_s)).astimezone(datetime.timezone.utc)
+        (tmp_path / 'course.toml').write_text(
+            f'[late]\ngrace_minutes = {grace}\n'
+            f'[notebooks.{notebook}]\ndue = {due.strftime("%Y-%m-%dT%H:%M:%SZ")}\n')
+        when = schedule.Schedule(tmp_path / 'course.toml', tmp_path / 'extensions.toml')
+        assert bool(schedule.status(store, when, 'ada', notebook).late_by) is late, (grace, after_s)
+
+
+def test_the_hub_will_not_start_while_learners_could_read_the_extensions(tmp_path, monkeypatch):
+    """Every learner can read the course folder on the hub; extensions.toml there names
+    learners and their dates, so make hub's check refuses it open to others, in one line."""
+    monkeypatch.setattr(launcher, 'COURSE', tmp_path)
+    private = tmp_path / 'extensions.toml'
+    private.write_text('[ada]\n"03" = { days = 2 }\n')
+    private.chmod(0o644)
+    said = launcher.check_learners_can_use_course(Path(sys.executable))
+    assert said == (f'Learners can read {private} (every learner\'s extensions): make it yours '
+                    f'alone, chmod 600 {private}, then start the hub again.')
+    private.chmod(0o600)
+    assert launcher.extensions_open_to_learners(tmp_path) is None
+
+
+def test_hand_in_outside_the_hub_or_of_no_notebook_is_one_line(monkeypatch, tmp_path):
+    from ros2nb.hand_ins import HandInError, hand_in
+    monkeypatch.delenv('ROS2NB_HAND_IN_URL', raising=False)
+    monkeypatch.setenv('ROS2NB_WORK', str(tmp_path))
+    shutil.copyfile(ROOT / 'notebooks' / SHIPPED[3], tmp_path / SHIPPED[3])
+    with pytest.raises(HandInError) as outside:
+        hand_in(SHIPPED[3][:2])
+    assert str(outside.value) == ("This lab is not on the course's hub, so there is no hand-in "
+                                  "server here: hand your notebook in through your course's "
+                                  "platform")
+    with pytest.raises(HandInError, match=r"^'99' is no notebook of the course: write its "):
+        hand_in('99')
+    monkeypatch.setenv('ROS2NB_HAND_IN_URL', 'http://127.0.0.1:9/services/hand-in/')
+    monkeypatch.setenv('JUPYTERHUB_API_TOKEN', 'x')
+    with pytest.raises(HandInError, match=r' is not there: open and save 04-'):
+        hand_in(4)

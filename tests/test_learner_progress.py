@@ -10,6 +10,7 @@ page, made from the grader's own results.
 from __future__ import annotations
 
 import html
+import json
 import re
 from pathlib import Path
 
@@ -176,3 +177,48 @@ def test_progress_in_a_kernel_after_checks_pass_and_fail_and_after_a_restart(tmp
         assert checked['Challenge 1: Where is ~?'] == 'failed'  # takes a function: kept
     finally:
         kernel.close()
+
+
+def test_a_pass_goes_stale_when_its_file_or_its_code_changes(tmp_path, monkeypatch, capsys):
+    """A pass keeps what it ran on: 03's file, 01's function.  Once the file changes, or the
+    notebook as saved holds other code for the function, progress() says so (before, it
+    said "passed" whatever the learner changed since)."""
+    from ros2nb.checks import evidence
+    from ros2nb.terminal import workspace
+    work, ws = tmp_path / 'work', tmp_path / 'ws'
+    (ws / course.PUBLISHER_FILE).parent.mkdir(parents=True)
+    (ws / course.PUBLISHER_FILE).write_text('class TemperatureSensor: pass\n')
+    work.mkdir()
+    monkeypatch.setenv(graded_parts.RECORD_ENV, str(work / graded_parts.RECORD))
+    monkeypatch.setattr(workspace, '_current', ws)
+    namespace: dict = {}
+    exec(compile('def where():\n    return 1\n', str(tmp_path / 'cell.py'), 'exec'), namespace)
+    (tmp_path / 'cell.py').write_text('def where():\n    return 1\n')  # its source, for inspect
+    notebook = {'cells': [{'cell_type': 'code', 'source': 'def where():\n    return 1\n',
+                           'metadata': {}, 'outputs': [], 'execution_count': None}],
+                'metadata': {}, 'nbformat': 4, 'nbformat_minor': 5}
+    (work / '01-create-a-workspace.ipynb').write_text(json.dumps(notebook))
+    with base._progress_kept('check_sensor_constructor', 3):
+        print('Check passed: ...')
+    with base._progress_kept('check_expanded_path', 1, (namespace['where'],)):
+        print('Check passed: ...')
+    parts = {p.check: p for p in graded_parts.parts()}
+    kept = graded_parts.outcomes()
+    assert evidence.changed(parts['check_sensor_constructor'], kept['check_sensor_constructor'],
+                            work) is None
+    assert evidence.changed(parts['check_expanded_path'], kept['check_expanded_path'], work) \
+        is None
+    (ws / course.PUBLISHER_FILE).write_text('class TemperatureSensor: pass  # changed\n')
+    notebook['cells'][0]['source'] = 'def where():\n    return 2\n'
+    (work / '01-create-a-workspace.ipynb').write_text(json.dumps(notebook))
+    assert evidence.changed(parts['check_sensor_constructor'], kept['check_sensor_constructor'],
+                            work) == 'temperature_publisher.py changed since'
+    assert 'holds other code' in evidence.changed(parts['check_expanded_path'],
+                                                  kept['check_expanded_path'], work)
+    capsys.readouterr()
+    import ros2nb
+    ros2nb.progress()
+    text = capsys.readouterr().out
+    assert re.search(r'passed, then changed +2 +Part 3: the node class and its constructor', text)
+    assert re.search(r'passed, then changed +1 +Challenge 1: Where is ~\?', text)
+    assert 'Passed 0 of 43 points.' in text

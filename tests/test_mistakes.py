@@ -248,11 +248,13 @@ SENSOR_WITH = ("class Sensor(Node):\n    def __init__(self):\n        super().__
     ('self.create_timer(-1.0, self.tick)',
      ('create_timer got a negative period: give the period in seconds as a positive number',)),
     ("self.create_publisher(Float32, 'temperature')",
-     ('the queue depth (QoS) is missing after the topic',)),
+     ('create_publisher() was called without the queue depth: create_publisher takes the '
+      'message type, the topic and the queue depth, in that order.',)),
     ("self.create_publisher(Float32, 'temperature', -1)",
      ('the queue depth must be 0 or more (10 is usual)',)),
     ("self.create_publisher(Float32, 'temperature', qos_profile=10, depth=10)",
-     ("got an unexpected keyword argument 'depth': the calls are create_publisher(Float32,",)),
+     ('create_publisher() takes no argument depth: create_publisher takes the message type, '
+      'the topic and the queue depth',)),
     ("self.create_publisher(Float32, 'temperature', rclpy.qos.QoSProfile())",
      ('a QoSProfile needs its history depth: QoSProfile(depth=10)',)),
 ])
@@ -430,8 +432,8 @@ def test_an_error_inside_the_learners_bag_reader_in_10(ros):
             '    readings = {}\n'
             "    return readings['temperature']\n")
     line = ros.one_line('ros2nb.checks.check_readings(read_temperatures)',
-                        "read_temperatures() raised: KeyError: 'temperature': the line reads a "
-                        'key that is not there: check its spelling, or read it with '
+                        "read_temperatures(bag_path) raised: KeyError: 'temperature': the line "
+                        'reads a key that is not there: check its spelling, or read it with '
                         '.get(key, default).', "(cell line 3: return readings['temperature'])")
     assert 'ros2nb/checks' not in line and 'site-packages' not in line, line
 

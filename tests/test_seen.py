@@ -100,6 +100,21 @@ logger.RcutilsLogger('learner').info('a line of rclpy')
     assert found == [], found
 
 
+def test_an_error_python_cannot_raise_is_not_the_learners_compile(tmp_path):
+    """rclpy's Executor.__del__ raises on the executor a learner's call left half made
+    (a keyword one letter off); CPython's own report of that error compiles rclpy's source
+    line from C with the learner's frame on top, which the hook told as the learner's
+    compile: the subject reports it through Python's traceback module instead."""
+    found = seen(tmp_path, '''
+from rclpy.executors import MultiThreadedExecutor
+try:
+    MultiThreadedExecutor(num_thrads=2)
+except TypeError:
+    pass
+''')
+    assert found == [], found
+
+
 def test_what_the_code_replaces_afterwards_changes_nothing_it_sees(tmp_path):
     """The hook's lists and helpers were bound before the learner's code ran: emptying the
     answers' list, replacing a builtin and os.write leave it seeing the import."""

@@ -19,9 +19,12 @@ from pathlib import Path
 
 import pytest
 
-from ros2nb_instructor.grading import deadlines, feedback, lms, sandbox, term
-from ros2nb_instructor.grading.submissions import (TIMESTAMP, ZIP_ENTRY, Learner, find_learners,
-                                                   screen_zip)
+from ros2nb_instructor.grading import (course_settings, deadlines, due_dates, exporting, feedback,
+                                      lms, roster, sandbox, term)
+from ros2nb_instructor.grading.extensions import Extensions
+from ros2nb_instructor.grading.hand_in_times import TIMESTAMP, ZIP_ENTRY, parse_time
+from ros2nb_instructor.grading.submissions import Learner, find_learners
+from ros2nb_instructor.grading.zips import screen_zip
 
 NB01 = '01-create-a-workspace'
 NOTEBOOKS = ['00-setup-and-the-pubsub-idea', NB01]
@@ -58,7 +61,7 @@ EXPECTED = {'daily': {'on-time': (1, 0, 1), 'a-day-late': (1, 0.1, 0.9),
 def settings(tmp_path: Path, text: str) -> deadlines.CourseSettings:
     path = tmp_path / 'course.toml'
     path.write_text(text)
-    return deadlines.read_settings(path, NOTEBOOKS)
+    return course_settings.read_settings(path, NOTEBOOKS)
 
 
 @pytest.mark.parametrize('text, said', [
@@ -107,12 +110,11 @@ def test_the_feedback_box_shows_both_times_in_the_due_dates_zone(tmp_path):
 
 
 def deadlines_time(stamp: str) -> datetime.datetime:
-    from ros2nb_instructor.grading.submissions import read_timestamp
-    return read_timestamp(stamp)
+    return parse_time(stamp, TIMESTAMP)
 
 
 def test_no_settings_file_means_nothing_is_due(tmp_path):
-    course = deadlines.read_settings(tmp_path / 'none.toml', NOTEBOOKS)
+    course = course_settings.read_settings(tmp_path / 'none.toml', NOTEBOOKS)
     late = deadlines.assess(course, NB01, 1.0, None)
     assert (late.penalty, late.note, late.due) == (0.0, '', None)
 
@@ -133,7 +135,7 @@ def test_the_hand_in_time_comes_from_the_submission(tmp_path):
         made.writestr(zipfile.ZipInfo(f'cy/{NB01}.ipynb', (2026, 10, 6, 9, 30, 0)), '{}')
         made.writestr('cy/timestamp.txt', '2026-10-05 20:00:00 UTC')
     times: dict = {}
-    berlin = deadlines._zone('Europe/Berlin', '', [])
+    berlin = due_dates.zone('Europe/Berlin', '', [])
     screen_zip(archive, tmp_path / 'clean.zip', times, berlin)
     assert times['bo', f'{NB01}.ipynb'] == (datetime.datetime(2026, 10, 6, 9, 30, tzinfo=berlin),
                                             ZIP_ENTRY)
@@ -163,50 +165,94 @@ def read_back(path: Path) -> list[list[str]]:
 
 
 def a_table() -> lms.Table:
-    table = lms.Table(NOTEBOOKS, {NOTEBOOKS[0]: 1.0, NB01: 1.0})
-    table.scores = {'on-time': {NOTEBOOKS[0]: 1.0, NB01: 1.0}, 'a-day-late': {NB01: 0.9},
-                    'not-listed': {NB01: 1.0}}
-    return table
+    """Three learners' marks; a-day-late has no mark of 00 yet (not due for them)."""
+    return lms.Table(tuple(NOTEBOOKS), {NOTEBOOKS[0]: 1.0, NB01: 1.0}, {
+        'on-time': {NOTEBOOKS[0]: lms.Mark(1.0, '1 of 1 points'), NB01: lms.Mark(1.0)},
+        'a-day-late': {NOTEBOOKS[0]: lms.Mark(None, 'not due yet'),
+                       NB01: lms.Mark(0.9, '0.9 of 1 points; handed in 1 day late')},
+        '=HYPERLINK("http://x")': {NOTEBOOKS[0]: lms.Mark(0.0), NB01: lms.Mark(1.0)}})
 
 
 def test_canvas_columns(tmp_path):
-    """Student, ID, SIS User ID, SIS Login ID, Section, one column per notebook; the second
-    row Points Possible; the absent learner 0 with a note; the extra one listed apart."""
+    """Student, ID, SIS User ID, SIS Login ID, Section, one column per notebook, as Canvas's
+    importer reads them (canvas-lms lib/gradebook_importer.rb); the second row Points
+    Possible; blank, never 0, where a learner has no mark yet; a roster learner without
+    marks blank too; the one not in the roster listed apart, its name made inert."""
     (tmp_path / 'roster.csv').write_text(ROSTER)
-    roster = lms.read_roster(tmp_path / 'roster.csv', 'canvas')
-    said = lms.write('canvas', a_table(), roster, tmp_path / 'canvas.csv')
+    rows_of = roster.read_roster(tmp_path / 'roster.csv', 'canvas')
+    said = lms.write('canvas', a_table(), rows_of, tmp_path / 'canvas.csv')
     rows = read_back(tmp_path / 'canvas.csv')
     assert rows[0] == ['Student', 'ID', 'SIS User ID', 'SIS Login ID', 'Section', *NOTEBOOKS]
     assert rows[1] == ['Points Possible', '', '', '', '', '1', '1']
     assert rows[2:] == [['Lovelace, Ada', '101', 'S-1', 'ada', 'A', '1', '1'],
-                        ['Diddley, Bo', '102', 'S-2', 'bo', 'A', '0', '0.9'],
-                        ['Young, Cy', '103', 'S-3', 'cy', 'B', '0', '0']]
-    assert any('absent: in the roster, nothing handed in: 0 points' in line for line in said)
-    assert any(line.startswith('not-listed: handed in, not in the roster') for line in said)
-    assert read_back(tmp_path / 'not-in-roster.csv') == [['learner', *NOTEBOOKS, 'total'],
-                                                         ['not-listed', '0', '1', '1']]
+                        ['Diddley, Bo', '102', 'S-2', 'bo', 'A', '', '0.9'],
+                        ['Young, Cy', '103', 'S-3', 'cy', 'B', '', '']]
+    assert said == [f'=HYPERLINK("http://x"): graded, not in the roster: written to '
+                    f'{tmp_path / "not-in-roster.csv"}']
+    assert read_back(tmp_path / 'not-in-roster.csv') == [
+        ['learner', *NOTEBOOKS, 'total'], ['\'=HYPERLINK("http://x")', '0', '1', '1']]
 
 
 def test_moodle_and_plain_columns(tmp_path):
+    """Moodle: the user's columns, then each notebook and its "Feedback for" column (as
+    Moodle's own export names it); a CSV cannot carry an item's maximum, so one line says
+    which grade items the import needs."""
     (tmp_path / 'roster.csv').write_text(ROSTER)
-    roster = lms.read_roster(tmp_path / 'roster.csv', 'moodle')
-    lms.write('moodle', a_table(), roster, tmp_path / 'moodle.csv')
+    rows_of = roster.read_roster(tmp_path / 'roster.csv', 'moodle')
+    lms.write('moodle', a_table(), rows_of, tmp_path / 'moodle.csv')
     rows = read_back(tmp_path / 'moodle.csv')
     assert rows[0] == ['First name', 'Last name', 'ID number', 'Username', 'Email address',
-                       *NOTEBOOKS]
-    assert rows[1:] == [['Ada', 'Lovelace', 'S-1', 'ada', 'ada@example.org', '1', '1'],
-                        ['Bo', 'Diddley', 'S-2', 'bo', 'bo@example.org', '0', '0.9'],
-                        ['Cy', 'Young', 'S-3', 'cy', 'cy@example.org', '0', '0']]
+                       NOTEBOOKS[0], f'Feedback for {NOTEBOOKS[0]}', NB01, f'Feedback for {NB01}']
+    assert rows[1:] == [
+        ['Ada', 'Lovelace', 'S-1', 'ada', 'ada@example.org', '1', '1 of 1 points', '1', ''],
+        ['Bo', 'Diddley', 'S-2', 'bo', 'bo@example.org', '', 'not due yet', '0.9',
+         '0.9 of 1 points; handed in 1 day late'],
+        ['Cy', 'Young', 'S-3', 'cy', 'cy@example.org', '', '', '', '']]
+    assert lms.moodle_items(a_table()).startswith(
+        "Moodle: map each notebook's column to a grade item whose maximum grade is its points "
+        f'({NOTEBOOKS[0]} 1, {NB01} 1)')
     lms.write('csv', a_table(), None, tmp_path / 'plain.csv')
     assert read_back(tmp_path / 'plain.csv') == [
         ['learner', *NOTEBOOKS, 'total'], ['on-time', '1', '1', '2'],
-        ['a-day-late', '0', '0.9', '0.9'], ['not-listed', '0', '1', '1']]
+        ['a-day-late', '', '0.9', '0.9'], ['\'=HYPERLINK("http://x")', '0', '1', '1']]
+
+
+def test_a_mark_is_blank_until_due_and_0_after(tmp_path):
+    """Not handed in: blank while the notebook is not due for the learner (their extension
+    included), 0 once it is; handed in: the score after lateness."""
+    course = settings(tmp_path, DAILY)
+    granted = Extensions({('bo', NB01): DUE + datetime.timedelta(days=2)})
+    ada, bo = Learner('ada', 'ada'), Learner('bo', 'bo')
+    day_after = DUE + datetime.timedelta(days=1)
+    assert exporting.mark(ada, NB01, None, 1.0, course, granted, day_after) == \
+        lms.Mark(0.0, 'not handed in: 0 of 1 points')
+    assert exporting.mark(bo, NB01, None, 1.0, course, granted, day_after).score is None
+    assert exporting.mark(bo, NB01, None, 1.0, course, granted,
+                          DUE + datetime.timedelta(days=3)).score == 0.0
+    bo.files[NB01] = Path('x.ipynb')
+    bo.handed_in[NB01] = (day_after, TIMESTAMP)
+    handed = exporting.mark(bo, NB01, 1.0, 1.0, course, granted, day_after)
+    assert handed.score == 1.0 and 'extension to 2026-10-07 23:59:00+00:00' in handed.feedback
+    assert exporting.notebooks_due_by(course, NOTEBOOKS, DUE - datetime.timedelta(days=1)) == (
+        [], ['left out (not due by 2026-10-04T23:59:00+00:00): 00, 01'])
+
+
+def test_make_export_refuses_in_one_line_and_writes_nothing(tmp_path):
+    export = str(Path(sys.executable).with_name('ros2nb-export'))
+    for args, said in ((['--due-by', '2026-10-20'], "DUE_BY: '2026-10-20' is not a time with its "
+                                                    'offset: write ISO 8601'),
+                       ([], 'holds no grading to export: run make grade first')):
+        done = subprocess.run([export, 'csv', '--grading', str(tmp_path / 'grading'), *args],
+                              capture_output=True, text=True, timeout=600)
+        assert done.returncode == 2 and done.stdout.count('\n') == 1, done.stdout
+        assert said in done.stdout, done.stdout
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_each_roster_mistake_is_one_line(tmp_path):
     (tmp_path / 'roster.csv').write_text('learner,login\nada,\nbo,b\nbo,b2\n')
-    with pytest.raises(lms.RosterProblem) as problem:
-        lms.read_roster(tmp_path / 'roster.csv', 'canvas')
+    with pytest.raises(roster.RosterProblem) as problem:
+        roster.read_roster(tmp_path / 'roster.csv', 'canvas')
     lines = problem.value.lines
     assert len(lines) == 2, lines
     assert 'line 2: ada has none of the ids canvas matches by: write one of' in lines[0]
@@ -277,3 +323,84 @@ def test_a_class_under_two_policies_exported_and_one_learner_again(tmp_path):
     # The others are not graded again; the settings as they are now apply to the whole class.
     assert float(rows['past-cutoff']['score']) == pytest.approx(0.7)
     assert 'a-day-late graded' in again.stdout and 'on-time graded' not in again.stdout
+    extended_then_exported(tmp_path, tmp_path / 'daily')
+
+
+#: Past the cutoff, and given five more days (to Oct 10) after grading; absent, given a week.
+EXTENDED = f'[past-cutoff]\n{NB01} = {{ days = 5 }}\n[absent]\n"01" = {{ days = 7 }}\n'
+
+
+def extended_then_exported(tmp_path: Path, out: Path) -> None:
+    """After grading: the formgrader's manual points for on-time, an extension for
+    past-cutoff applied by grading that learner alone, then ``make export`` for Canvas from
+    the gradebook as it is, nothing graded again: the manual points, the extension, and a
+    blank (never 0) for absent, whose extended due date is after DUE_BY."""
+    from nbgrader.api import Gradebook
+    from ros2nb_instructor.paths import ASSIGNMENT, gradebook_url
+    with Gradebook(gradebook_url(out / 'nbgrader')) as gradebook:
+        graded = gradebook.find_grade('01-create-a-workspace-challenge-1-check', NB01,
+                                      ASSIGNMENT, 'on-time')
+        graded.manual_score = 0.5
+        gradebook.db.commit()
+    (tmp_path / 'extensions.toml').write_text(EXTENDED)
+    again = grade(tmp_path / 'class', '--out', out, '--settings', tmp_path / 'daily.toml',
+                  '--extensions', tmp_path / 'extensions.toml', '--roster', tmp_path / 'roster.csv',
+                  '--learner', 'past-cutoff', '--seed', 7)
+    assert again.returncode == 0, again.stdout + again.stderr
+    assert float(csv_rows(out)['past-cutoff']['score']) == 1.0
+    page = (out / 'feedback' / 'past-cutoff' / f'{NB01}.html').read_text()
+    assert '<th>extension</th><td>to 2026-10-10 23:59:00+00:00' in page, page
+    assert 'to 2026-10-10 23:59:00+00:00' in (out / 'report.html').read_text()
+    export = Path(sys.executable).with_name('ros2nb-export')
+    done = subprocess.run(
+        [str(export), 'canvas', '--grading', str(out), '--roster', str(tmp_path / 'roster.csv'),
+         '--settings', str(tmp_path / 'daily.toml'), '--extensions',
+         str(tmp_path / 'extensions.toml'), '--due-by', '2026-10-10T00:00:00Z'],
+        capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert 'left out (not due by 2026-10-10T00:00:00+00:00): 00, 02, 03' in done.stdout
+    exported = read_back(out / 'export' / 'canvas.csv')
+    assert exported[0][5:] == [NB01] and exported[1][5:] == ['1']  # one assignment, its points
+    by_id = {row[2]: row[5] for row in exported[2:]}
+    assert by_id == {'S-1': '0.5', 'S-2': '0.9', 'S-3': ''}, exported  # manual; daily; not due
+    assert 'graded' not in done.stdout.replace('graded, not in the roster', '')
+    the_other_exports(tmp_path, out, exported)
+
+
+def the_other_exports(tmp_path: Path, out: Path, canvas: list[list[str]]) -> None:
+    """Moodle's and the plain CSV from the same gradebook, and nbgrader's own ``nbgrader
+    export`` with the course's plugin writing Canvas's file again, the same (before, it
+    wrote only the header rows)."""
+    export = Path(sys.executable).with_name('ros2nb-export')
+    common = ['--grading', str(out), '--settings', str(tmp_path / 'daily.toml'),
+              '--extensions', str(tmp_path / 'extensions.toml'), '--due-by',
+              '2026-10-10T00:00:00Z']
+    moodle = subprocess.run([str(export), 'moodle', '--roster', str(tmp_path / 'roster.csv'),
+                             *common], capture_output=True, text=True, timeout=600)
+    assert moodle.returncode == 0, moodle.stdout + moodle.stderr
+    assert f"whose maximum grade is its points ({NB01} 1)" in moodle.stdout
+    rows = read_back(out / 'export' / 'moodle.csv')
+    assert rows[0][5:] == [NB01, f'Feedback for {NB01}']
+    assert {row[2]: row[5:] for row in rows[1:]} == {
+        'S-1': ['0.5', '0.5 of 1 points'],
+        'S-2': ['0.9', '0.9 of 1 points; handed in 1 day after the due date (timestamp.txt): '
+                       '0.1 points off'],
+        'S-3': ['', 'not due yet (due 2026-10-12 23:59+00:00)']}, rows
+    plain = subprocess.run([str(export), 'csv', *common], capture_output=True, text=True,
+                           timeout=600)
+    assert plain.returncode == 0, plain.stdout + plain.stderr
+    totals = {row[0]: row[-1] for row in read_back(out / 'export' / 'csv.csv')[1:]}
+    assert totals['on-time'] == '0.5' and totals['past-cutoff'] == '1', totals
+    (out / 'export' / 'canvas.csv').unlink()
+    course = out / 'nbgrader'
+    nbgrader = subprocess.run(
+        [str(Path(sys.executable).with_name('nbgrader')), 'export',
+         '--exporter=ros2nb_instructor.grading.exporting.CanvasExport',
+         f'--CanvasExport.roster={tmp_path / "roster.csv"}',
+         f'--CanvasExport.settings={tmp_path / "daily.toml"}',
+         f'--CanvasExport.extensions={tmp_path / "extensions.toml"}',
+         '--CanvasExport.due_by=2026-10-10T00:00:00Z', f'--CourseDirectory.root={course}',
+         f'--CourseDirectory.db_url=sqlite:///{course / "gradebook.db"}'],
+        cwd=course, capture_output=True, text=True, timeout=600)
+    assert nbgrader.returncode == 0, nbgrader.stdout + nbgrader.stderr
+    assert read_back(out / 'export' / 'canvas.csv') == canvas

@@ -33,6 +33,7 @@ from .terminal.workspace import create_workspace, current_workspace, tree
 #: never pays for importing the notebooks' checks or rosbags (docs/decisions.md), and never
 #: holds the course's rules (an answer) unless asked.
 _ON_FIRST_USE = {'checks': 'checks', 'progress': 'checks', 'rules': 'rules',
+                 'hand_in': 'hand_ins',
                  'figures': 'figures',
                  'Recording': 'terminal.bag',
                  'bag_info': 'terminal.bag', 'bag_play': 'terminal.bag',
@@ -53,7 +54,7 @@ __all__ = [
     'add', 'bag_info', 'bag_play', 'bag_record',
     'callback_groups', 'checks', 'colcon_build', 'course', 'create_workspace',
     'current_runtime', 'current_workspace', 'domains', 'figures', 'find_executable', 'graph_edges',
-    'graph_picture', 'import_file', 'message_type', 'node_list', 'param_describe',
+    'graph_picture', 'hand_in', 'import_file', 'message_type', 'node_list', 'param_describe',
     'param_dump', 'param_get', 'param_list', 'param_set', 'pkg_create', 'progress', 'qos',
     'record', 'rules',
     'ros2_run', 'ros2_start', 'run_and_interrupt', 'shutdown', 'source_workspace', 'spin',

@@ -92,6 +92,12 @@ MIN_PERIOD_S, MAX_PERIOD_S = 0.1, 10.0
 RECORD_S = 3600.0
 ROSOUT_TOPIC = '/rosout'
 
+#: Notebook number -> the package files its checks judge, as its ``%%part`` cells write them
+#: (a pass of one of its checks goes stale when one changes: ros2nb.checks.evidence).
+JUDGED_FILES = {3: (PUBLISHER_FILE,), 4: (SUBSCRIBER_FILE,), 5: (SETUP_PY_FILE, SETUP_CFG_FILE),
+                6: (FAN_FILE, PROMISES_FILE), 7: (LIVE_PLOT_FILE,),
+                8: (PUBLISHER_FILE, SUBSCRIBER_FILE)}
+
 #: Environment variable the grader sets: the course's reference code never stands in.
 GRADING_ENV = 'ROS2NB_GRADING'
 #: Notebook number -> what must exist before it starts.

@@ -37,6 +37,8 @@ WORK_ENV = 'ROS2NB_WORK'
 NOTEBOOKS = Path(__file__).resolve().parent.parent.parent / 'notebooks'
 #: A part's state, as the table says it.
 PASSED, FAILED, NOT_YET, HIDDEN = 'passed', 'failed', 'not yet', 'when handed in'
+#: A pass whose work changed since it passed (ros2nb.checks.evidence): run its check again.
+STALE = 'passed, then changed'
 #: A part's state on a feedback page, for a notebook the learner did not hand in.
 NOT_HANDED_IN = 'not handed in'
 _CHECK_CALL = re.compile(r'ros2nb\.checks\.(check_\w+)\(')
@@ -111,12 +113,14 @@ def outcomes(path: Optional[Path] = None) -> dict[str, dict]:
             and isinstance(value.get('passed'), bool)}
 
 
-def remember(check: str, passed: bool, line: str, path: Optional[Path] = None) -> None:
-    """Keep the outcome of ``check`` (replacing an earlier one); never fails a check: a
-    folder it cannot write only means the table will not know."""
+def remember(check: str, passed: bool, line: str, path: Optional[Path] = None, *,
+             evidence: Optional[Mapping[str, object]] = None) -> None:
+    """Keep the outcome of ``check`` (replacing an earlier one), with what it ran on
+    (``evidence``: ``files``, ``source``; :mod:`ros2nb.checks.evidence`); never fails a
+    check: a folder it cannot write only means the table will not know."""
     path = path or record_path()
     kept = outcomes(path)
-    kept[check] = {'passed': passed, 'line': line[:300],
+    kept[check] = {'passed': passed, 'line': line[:300], **(evidence or {}),
                    'at': datetime.datetime.now().astimezone().isoformat(timespec='seconds')}
     try:
         temporary = path.with_name(path.name + '.new')
@@ -151,12 +155,14 @@ def _points(points: float) -> str:
     return f'{points:g} point{"" if points == 1 else "s"}'
 
 
-def rows(all_parts: list[Part], states: Mapping[str, str]) -> list[dict]:
-    """One row per notebook, for the tables: its parts with their states, the points passed."""
+def rows(all_parts: list[Part], states: Mapping[str, str],
+         notes: Optional[Mapping[str, str]] = None) -> list[dict]:
+    """One row per notebook, for the tables: its parts with their states, the points passed,
+    and its ``notes`` line (when it is due and was handed in; '' for none)."""
     by_notebook: dict[str, list[Part]] = {}
     for part in all_parts:
         by_notebook.setdefault(part.notebook, []).append(part)
-    return [{'notebook': notebook,
+    return [{'notebook': notebook, 'note': (notes or {}).get(notebook, ''),
              'passed': sum(p.points for p in mine if states[p.grade_id] == PASSED),
              'points': sum(p.points for p in mine),
              'parts': [{'label': p.label, 'points': p.points, 'state': states[p.grade_id]}
@@ -169,7 +175,8 @@ def table_text(table: list[dict]) -> str:
     passed, total = sum(r['passed'] for r in table), sum(r['points'] for r in table)
     lines = [f'Passed {passed:g} of {total:g} points.']
     for row in table:
-        lines.append(f'{row["notebook"]}: {row["passed"]:g} of {row["points"]:g}')
+        note = f' ({row["note"]})' if row.get('note') else ''
+        lines.append(f'{row["notebook"]}: {row["passed"]:g} of {row["points"]:g}{note}')
         lines += [f'  {p["state"]:>14}  {p["points"]:g}  {p["label"]}' for p in row['parts']]
     return '\n'.join(lines)
 
@@ -181,7 +188,8 @@ _TABLE = '''\
 <tbody>
 {%- for row in table %}{% for part in row.parts %}
 <tr>{% if loop.first %}<th rowspan="{{ row.parts | length }}">{{ row.notebook }}<br>
-{{- row.passed | g }} of {{ row.points | g }}</th>{% endif -%}
+{{- row.passed | g }} of {{ row.points | g }}
+{%- if row.note %}<br><small>{{ row.note }}</small>{% endif %}</th>{% endif -%}
 <td>{{ part.label }}</td><td>{{ part.points | g }}</td>
 <td class="{{ part.state | replace(' ', '-') }}">{{ part.state }}</td></tr>
 {%- endfor %}{% endfor %}
@@ -189,19 +197,23 @@ _TABLE = '''\
 </table>'''
 
 
-def table_html(table: list[dict], caption: str) -> str:
-    """The table as HTML (escaped by jinja2): a row per part, grouped by notebook."""
+def table_html(table: list[dict], caption: str, link: Optional[tuple[str, str]] = None) -> str:
+    """The table as HTML (escaped by jinja2): a row per part, grouped by notebook; ``link``
+    (text, address), when given, is a line above it (the learner's feedback on the hub)."""
     from jinja2 import Environment  # only where a table is shown, never in a check's import
     environment = Environment(autoescape=True)
     environment.filters['g'] = lambda number: f'{number:g}'
-    return environment.from_string(_TABLE).render(table=table, caption=caption,
-                         passed=sum(r['passed'] for r in table),
-                         total=sum(r['points'] for r in table))
+    above = environment.from_string('<p><a href="{{ url }}" target="_blank">{{ text }}</a></p>\n'
+                                    ).render(text=link[0], url=link[1]) if link else ''
+    return above + environment.from_string(_TABLE).render(
+        table=table, caption=caption, passed=sum(r['passed'] for r in table),
+        total=sum(r['points'] for r in table))
 
 
-def show_table(table: list[dict], caption: str) -> None:
-    """Show the table: as HTML (with the text beside it) in a Jupyter kernel, else as text."""
-    text = f'{caption}. {table_text(table)}'
+def show_table(table: list[dict], caption: str, link: Optional[tuple[str, str]] = None) -> None:
+    """Show the table (and ``link``, :func:`table_html`): as HTML (with the text beside it)
+    in a Jupyter kernel, else as text."""
+    text = f'{caption}. {table_text(table)}' + (f'\n{link[0]}: {link[1]}' if link else '')
     try:
         from IPython import get_ipython
         from IPython.display import display
@@ -209,6 +221,6 @@ def show_table(table: list[dict], caption: str) -> None:
         print(text)
         return
     if getattr(get_ipython(), 'kernel', None) is not None:
-        display({'text/html': table_html(table, caption), 'text/plain': text}, raw=True)
+        display({'text/html': table_html(table, caption, link), 'text/plain': text}, raw=True)
     else:
         print(text)

@@ -170,6 +170,10 @@ class Observer(Protocol):
     def has_node(self, name: str) -> bool:
         """True when a running node called ``name`` (any namespace) owns an endpoint."""
 
+    def count_endpoints(self, name: str, namespace: str, kind: str, topic: str) -> int:
+        """How many ``kind`` endpoints (``'publisher'``, ``'subscription'``) the node
+        ``namespace/name`` owns on ``topic`` now, in the ROS graph."""
+
     def quiet_node(self) -> Node:
         """A node of the judge's that no thread spins (it takes only when told)."""
 

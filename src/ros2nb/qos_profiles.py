@@ -14,12 +14,14 @@ from rclpy.qos import (HistoryPolicy, QoSCompatibility, QoSPolicyKind, QoSProfil
                        qos_check_compatible)
 
 
-def describe(profile: QoSProfile) -> str:
-    """One line: ``RELIABLE, KEEP_LAST (10), VOLATILE``."""
-    if profile.history not in (HistoryPolicy.KEEP_LAST, HistoryPolicy.KEEP_ALL):
+def describe(profile: QoSProfile, kept: Optional[QoSProfile] = None) -> str:
+    """One line: ``RELIABLE, KEEP_LAST (10), VOLATILE``; with ``kept``, its history and depth
+    (discovery carries neither: a subject says what its profile keeps)."""
+    history = kept if kept is not None else profile
+    if history.history not in (HistoryPolicy.KEEP_LAST, HistoryPolicy.KEEP_ALL):
         return f'{profile.reliability.name}, {profile.durability.name}'  # as discovered
-    depth = f' ({profile.depth})' if profile.history == HistoryPolicy.KEEP_LAST else ''
-    return f'{profile.reliability.name}, {profile.history.name}{depth}, {profile.durability.name}'
+    depth = f' ({history.depth})' if history.history == HistoryPolicy.KEEP_LAST else ''
+    return f'{profile.reliability.name}, {history.history.name}{depth}, {profile.durability.name}'
 
 
 #: What to change for each kind of incompatibility rclpy names (a word of its reason).

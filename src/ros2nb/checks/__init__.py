@@ -30,8 +30,10 @@ from typing import Any, Optional
 
 from .. import graded_parts, working
 from ..errors import CheckFailed, Ros2nbError
+from ..hand_ins import HandInError, due_line, standing
 from ..judge_interface import Judge
 from ..on_first_use import loader
+from . import evidence
 
 #: Each lesson's checks, by the module that holds them.  A module loads on first use of one
 #: of its names (PEP 562): a notebook's kernel and its judge load their own lesson's
@@ -111,7 +113,11 @@ NOT_QUICK = ('check_entry_points', 'check_setup_cfg', 'check_package_runs')
 def progress(check: bool = False) -> None:
     """Show your progress: every graded part of the 11 notebooks, passed, failed or not yet,
     with its points, from the checks you ran in this lab (kept in your work folder,
-    :mod:`ros2nb.graded_parts`).  Only a guide: the grader runs every check itself.
+    :mod:`ros2nb.graded_parts`).  Only a guide: the grader runs every check itself.  A pass
+    whose file changed since (or whose code the notebook, as saved, no longer holds) says
+    ``passed, then changed``: run its check again.  On the course's hub it also shows when
+    each notebook is due (your extension's date, if you have one), when you handed it in
+    (``ros2nb.hand_in``), and a link to your feedback once it is released.
 
     Introduced in ``00-setup-and-the-pubsub-idea.ipynb``.
 
@@ -120,30 +126,51 @@ def progress(check: bool = False) -> None:
         notebook), so the table says how your files stand now.  Each takes a few seconds.
     :raises OSError: when the course's notebooks cannot be read (ros2nb outside the course).
     """
-    from . import base
     all_parts = graded_parts.parts()
     if check:
-        calls = {}
-        for part in all_parts:
-            if part.check in _MODULE_OF and part.check not in NOT_QUICK:
-                try:
-                    calls[part] = getattr(sys.modules[__name__], part.check)
-                except ImportError:  # a lesson whose library this Python lacks (rosbags)
-                    continue
-        quick = [part for part in calls if part.check in base.JUDGED]
-        with working.shown('progress(check=True)') as work:
-            for index, part in enumerate(quick, start=1):
-                work.say(f'{part.number} · {part.label} ({index} of {len(quick)})')
-                with contextlib.redirect_stdout(io.StringIO()):
-                    try:
-                        calls[part]()
-                    except (CheckFailed, Ros2nbError):  # its line is kept with its outcome
-                        pass
+        _check_again(all_parts)
     recorded = graded_parts.outcomes()
-    table = graded_parts.rows(all_parts, {p.grade_id: graded_parts.state(p, recorded)
-                                          for p in all_parts})
-    graded_parts.show_table(table, 'Your progress in this lab (the grader runs every check '
-                                   'itself)')
+    work = graded_parts.record_path().parent
+    states = {}
+    for part in all_parts:
+        states[part.grade_id] = graded_parts.state(part, recorded)
+        if states[part.grade_id] == graded_parts.PASSED and evidence.changed(
+                part, recorded[str(part.check)], work):
+            states[part.grade_id] = graded_parts.STALE
+    notes: dict[str, str] = {}
+    link, caption = None, 'Your progress in this lab (the grader runs every check itself)'
+    try:
+        hub = standing()
+    except HandInError as error:
+        hub, caption = None, f'{caption}; {error}'
+    if hub is not None:
+        notes = {status.notebook: due_line(status) for status in hub.notebooks}
+        released = [status.notebook for status in hub.notebooks if status.feedback]
+        if released:
+            pages = f'{len(released)} page{"" if len(released) == 1 else "s"}'
+            link = (f'Your feedback ({pages}, one per notebook)', hub.feedback_url)
+    graded_parts.show_table(graded_parts.rows(all_parts, states, notes), caption, link)
+
+
+def _check_again(all_parts: list[graded_parts.Part]) -> None:
+    """Run again the quick checks of the learner's files (:func:`progress`'s ``check``)."""
+    from . import base
+    calls = {}
+    for part in all_parts:
+        if part.check in _MODULE_OF and part.check not in NOT_QUICK:
+            try:
+                calls[part] = getattr(sys.modules[__name__], part.check)
+            except ImportError:  # a lesson whose library this Python lacks (rosbags)
+                continue
+    quick = [part for part in calls if part.check in base.JUDGED]
+    with working.shown('progress(check=True)') as work:
+        for index, part in enumerate(quick, start=1):
+            work.say(f'{part.number} · {part.label} ({index} of {len(quick)})')
+            with contextlib.redirect_stdout(io.StringIO()):
+                try:
+                    calls[part]()
+                except (CheckFailed, Ros2nbError):  # its line is kept with its outcome
+                    pass
 
 
 __all__ = ['CheckFailed', *sorted(_MODULE_OF), 'progress']

@@ -25,7 +25,7 @@ import os
 import sys
 import traceback
 from pathlib import Path
-from typing import Any, Callable, Iterator
+from typing import Any, Callable, Iterator, Mapping, Sequence
 
 from .. import course, graded_parts, working
 from ..errors import CheckFailed, NotDecided, Ros2nbError
@@ -33,6 +33,7 @@ from ..explain.exceptions import describe_error
 from ..judge_interface import learner_error
 from ..subject_replies import LearnerError
 from ..terminal.workspace import current_workspace
+from . import evidence
 from .dispatch import INTERRUPTED, ask_judge
 
 #: A check's body: ``body(judge, *learner_things) -> the passed sentence``.
@@ -48,10 +49,11 @@ JUDGED: set[str] = set()
 
 
 @contextlib.contextmanager
-def _progress_kept(check: str) -> Iterator[None]:
+def _progress_kept(check: str, notebook: int = 0, args: Sequence[Any] = ()) -> Iterator[None]:
     """In the kernel: keep the check's outcome in the learner's progress
-    (:mod:`ros2nb.graded_parts`), and end with its line there.  A check that could not run,
-    or was interrupted, keeps nothing; while grading nothing is kept."""
+    (:mod:`ros2nb.graded_parts`), with what it ran on (:mod:`.evidence`: the ``notebook``'s
+    files, the learner's ``args``), and end with its line there.  A check that could not
+    run, or was interrupted, keeps nothing; while grading nothing is kept."""
     if os.environ.get(course.GRADING_ENV):
         yield
         return
@@ -61,14 +63,14 @@ def _progress_kept(check: str) -> Iterator[None]:
             yield
     except CheckFailed as failure:
         if not str(failure).startswith(INTERRUPTED):
-            _kept(check, False, str(failure))
+            _kept(check, False, str(failure), evidence.taken(notebook, args))
         raise
     lines = out.getvalue().strip().splitlines()
-    _kept(check, True, lines[-1] if lines else '')
+    _kept(check, True, lines[-1] if lines else '', evidence.taken(notebook, args))
 
 
-def _kept(check: str, ok: bool, line: str) -> None:
-    graded_parts.remember(check, ok, line)
+def _kept(check: str, ok: bool, line: str, ran_on: Mapping[str, Any]) -> None:
+    graded_parts.remember(check, ok, line, evidence=ran_on)
     try:
         said = graded_parts.outcome_line(check, ok, graded_parts.parts())
     except OSError:  # the course's notebooks are not beside ros2nb: no table to point at
@@ -127,8 +129,10 @@ def _register(body: Body, call: Callable[..., None]) -> Callable[..., None]:
 def judged(body: Body) -> Callable[[], None]:
     """Register ``body(judge)`` as a check that runs only in a judge; return the notebook's
     function, which asks a judge process to run it by name."""
+    notebook = int(body.__module__.rpartition('lesson')[2][:2] or 0)
+
     def call() -> None:
-        with _progress_kept(body.__name__):
+        with _progress_kept(body.__name__, notebook):
             ask_judge(body.__name__)
 
     JUDGED.add(body.__name__)
@@ -144,7 +148,7 @@ def direct(body: Body) -> Callable[..., None]:
     def call(*args: Any, **kwargs: Any) -> None:
         _running.append(notebook)
         try:
-            with _progress_kept(body.__name__):
+            with _progress_kept(body.__name__, notebook, args):
                 with working.shown(body.__name__):
                     message = decided(lambda: body(None, *args, **kwargs), lambda: None)
                 passed(message)
@@ -185,11 +189,12 @@ def passed(message: str) -> None:
     print(f'Check passed: {message}')
 
 
-def call_learner(function: Callable[..., Any], *args: Any) -> Any:
+def call_learner(function: Callable[..., Any], *args: Any, label: str = '') -> Any:
     """Call the learner's function in the kernel: NotImplementedError becomes one line, and
     any other error the learner's code raised a failure through their own frames only (or
     the one line of a known mistake), never a traceback through the check, rclpy or rosbags.
 
+    :param label: the call as the line names it; :func:`called_as` when empty.
     :raises CheckFailed: (or :class:`LearnerCodeError`) for an error in the learner's code.
     """
     try:
@@ -203,8 +208,18 @@ def call_learner(function: Callable[..., Any], *args: Any) -> Any:
                               'replace "raise NotImplementedError()" with your code and run its '
                               'cell again.') from None
         # their frames only, or the one line of a known mistake
-        raise learner_error(f'{function.__name__}()', LearnerError(**describe_error(error))
-                            ) from None
+        raise learner_error(label or called_as(function),
+                            LearnerError(**describe_error(error))) from None
+
+
+def called_as(function: Callable[..., Any]) -> str:
+    """``NAME(PARAMETERS)``: a learner's function as a check's line names its call
+    (``package_dependencies(package_xml)``), in the kernel as from the grader."""
+    try:
+        names = ', '.join(inspect.signature(function).parameters)
+    except (TypeError, ValueError):
+        names = ''
+    return f'{getattr(function, "__name__", "the function")}({names})'
 
 
 #: What a part an earlier notebook left unwritten raises where it is used.

@@ -45,10 +45,11 @@ def check_endpoint(judge: Optional[Judge], node_class: Any, kind: str, topic: st
     :raises CheckFailed: naming what the node has instead.
     """
     if isinstance(node_class, AnswerRef) and judge is not None:
-        name, found = _answer_node_endpoints(judge, node_class)
+        name, found, made = _answer_node_endpoints(judge, node_class)
     else:
         name, found = _kernel_node_endpoints(node_class)
-    endpoint_verdict(name, found, kind, topic, type_name)
+        made = found
+    endpoint_verdict(name, found, kind, topic, type_name, made)
     return f'{name} has a {kind} on {topic} [{type_name}].'
 
 
@@ -64,7 +65,7 @@ def _kernel_node_endpoints(node_class: Any) -> tuple[str, list]:
         node.destroy_node()
 
 
-def _answer_node_endpoints(judge: Judge, ref: AnswerRef) -> tuple[str, list]:
+def _answer_node_endpoints(judge: Judge, ref: AnswerRef) -> tuple[str, list, list]:
     subject = judge.answer_subject(ref)
     reply = subject.request(NewNode(cls=ref.name))
     if reply.no_class:
@@ -74,4 +75,4 @@ def _answer_node_endpoints(judge: Judge, ref: AnswerRef) -> tuple[str, list]:
     if not reply.ok:
         raise raised(f'{ref.name}()', reply.error)
     found = judge.observer.endpoints(reply.name, reply.namespace, reply.endpoints)
-    return reply.name, found
+    return reply.name, found, list(reply.endpoints)

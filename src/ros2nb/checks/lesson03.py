@@ -11,6 +11,8 @@ failure the judge has already seen.
 
 from __future__ import annotations
 
+import ast
+from pathlib import Path
 from typing import Optional
 
 from .. import course
@@ -22,7 +24,7 @@ from .mains import run_main
 from .sensor_rules import (FLOAT32_TOLERANCE_C, log_format_problem, period_problem,
                            samples_verdict)
 from .sensor_runs import PROBE_S, TOPIC, SensorRun, run_sensor, sensor_run
-from .source import ClassSource
+from .source import TEXT, ClassSource
 from .verdicts import endpoint_verdict, node_name_verdict
 
 #: Simulated seconds the judge runs the sensor: for the constructor, the callback, each clamp
@@ -35,7 +37,8 @@ def _constructor_problem(judge: Judge, run: SensorRun, seconds: float) -> Option
     """What the constructor (part 3) got wrong, as the judge saw it: None when nothing."""
     try:
         node_name_verdict(run.info, course.SENSOR_NODE)
-        endpoint_verdict(run.info.name, run.found, 'publisher', TOPIC, course.MESSAGE_TYPE)
+        endpoint_verdict(run.info.name, run.found, 'publisher', TOPIC, course.MESSAGE_TYPE,
+                         run.info.endpoints)
     except CheckFailed as problem:
         return problem
     if run.problem is not None or not run.readings:
@@ -149,7 +152,7 @@ def _callback_run(judge: Judge, seconds: float, seed: int) -> SensorRun:
     return sensor_run(judge, stand_ins, seconds, probe_s=0.0, seed=seed)
 
 
-def _callback_problem(run: SensorRun, seconds: float) -> None:
+def _callback_problem(judge: Judge, run: SensorRun, seconds: float) -> None:
     """Raise for what the callback (part 4) got wrong in ``run``."""
     if run.problem is not None:
         raise run.problem
@@ -157,15 +160,44 @@ def _callback_problem(run: SensorRun, seconds: float) -> None:
         raise CheckFailed(f'publish_temperature ran but nothing arrived on {TOPIC}: put the new '
                           'reading into a Float32 message and publish it with the publisher '
                           'from __init__.')
-    samples_verdict(run.values, seconds=seconds)
-    problem = log_format_problem(run)
-    if problem is not None:
-        raise problem
+    try:
+        samples_verdict(run.values, seconds=seconds)
+    except CheckFailed as broken:
+        raise _walk_not_kept(judge) or broken
+    logged = log_format_problem(run)
+    if logged is not None:
+        raise logged
+    made = judge.observer.count_endpoints(run.info.name, run.info.namespace, 'publisher', TOPIC)
+    if made > 1:  # each call makes another, and publishes on it: the readings still arrive
+        raise CheckFailed(f'{run.info.name} has {made} publishers on {TOPIC} after '
+                          f'{len(run.readings)} readings: publish_temperature makes a new one '
+                          'each time it runs: create it once, in __init__, and publish with '
+                          'self.publisher_.')
+
+
+def _walk_not_kept(judge: Judge) -> Optional[CheckFailed]:
+    """The line for a walk the readings broke because publish_temperature never keeps its new
+    value in self.temperature (a local name instead, read after the fact), or None."""
+    source = ClassSource.read(judge.workspace, course.PUBLISHER_FILE, course.SENSOR_CLASS)
+    callback = source.method('publish_temperature') if source is not None else None
+    if callback is None or source is None or \
+            source.reaches_assignment('publish_temperature', 'temperature'):
+        return None
+    local = next((node for node in ast.walk(callback) if isinstance(node, ast.Assign) and any(
+        isinstance(t, ast.Name) and t.id == 'temperature' for t in node.targets)), None)
+    lines = (TEXT.read(judge.workspace / course.PUBLISHER_FILE) or '').splitlines()
+    where = (f'it sets a local name temperature ({Path(course.PUBLISHER_FILE).name} line '
+             f'{local.lineno}: {lines[local.lineno - 1].strip()}), which is gone when it returns, '
+             'so ') if local is not None and local.lineno <= len(lines) else ''
+    return CheckFailed(f'publish_temperature never changes self.temperature: {where}'
+                       'self.temperature stays where __init__ set it and every reading is one '
+                       'step from there: keep the new value, self.temperature = ..., so that '
+                       'the walk goes on from it.')
 
 
 def _sensor_callback(judge: Judge) -> str:
     run = _callback_run(judge, CALLBACK_RUN_S, sensor_seed(judge, '03 sensor callback'))
-    _callback_problem(run, CALLBACK_RUN_S)
+    _callback_problem(judge, run, CALLBACK_RUN_S)
     for number, start_c in enumerate(clamp_probes_c(judge)):
         seed = sensor_seed(judge, f'03 clamp probe {number}', start_c, CLAMP_RUN_S)
         probe = run_sensor(judge, run, CLAMP_RUN_S, probe_s=0.0, seed=seed, start_c=start_c)

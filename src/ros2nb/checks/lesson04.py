@@ -59,7 +59,7 @@ def check_monitor_main(judge: Judge) -> str:
 def _monitor_verdict(info: NodeMade, found: list[tuple[str, str, str]]) -> None:
     node_name_verdict(info, course.MONITOR_NODE)
     endpoint_verdict(info.name, found, 'subscription', '/' + course.TOPIC,
-                     course.MESSAGE_TYPE)
+                     course.MESSAGE_TYPE, info.endpoints)
 
 
 def _monitor(judge: Judge, stand_ins: tuple[str, ...] = ()) -> tuple[Subject, NodeMade]:

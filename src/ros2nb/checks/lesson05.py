@@ -82,15 +82,13 @@ def _runs(judge: Judge, ws: Path) -> Optional[str]:
                             or sensor.poll() is not None or monitor.poll() is not None,
                             ARRIVAL_TIMEOUT_S)
         if heard not in observer.lines_of(course.MONITOR_NODE, mark):
+            # the grader's stand-in there would have published the reading, or logged it
             if not any(round(h.value, 3) == given for h in readings[first:]):
                 name, out = course.PUBLISHER_EXECUTABLE, sensor_out
-                would = f'published {given}'
             else:
                 name, out = course.SUBSCRIBER_EXECUTABLE, monitor_out
-                would = f'logged the reading {given} it heard'
             return (f'ros2 run {course.PACKAGE} {name} did not start main() of '
-                    f'{course.PACKAGE}.{name}: the grader\'s stand-in there would have {would} '
-                    f'({last_line(out.text())}).')
+                    f'{course.PACKAGE}.{name} ({last_line(out.text())}).')
         codes = _stop([sensor, monitor])
         procs.clear()
     finally:
@@ -175,20 +173,37 @@ def _setup_cfg_cause(judge: Judge) -> Optional[str]:
     return None
 
 
+def _found_in_development_install(judge: Judge, setup_py: Optional[str]) -> Optional[str]:
+    """What ``ros2 run`` says of the package built with ``colcon build --symlink-install``
+    (setuptools' development install, which reads ``[develop]``), or None when it finds both
+    executables, as after a normal build."""
+    ws = build_copy(judge, setup_py=setup_py, symlink=True)
+    env = sourced(judge, ws)
+    for executable in (course.PUBLISHER_EXECUTABLE, course.SUBSCRIBER_EXECUTABLE):
+        try:
+            find_executable(course.PACKAGE, executable, env)
+        except Ros2nbError as error:
+            return (f'ros2 run {course.PACKAGE} {executable}: {error}, after colcon build '
+                    '--symlink-install.')
+    return None
+
+
 def _setup_cfg(judge: Judge) -> str:
     if PLACEHOLDER in (TEXT.read(package_source(judge) / 'setup.cfg') or '') or \
             saved_parts(judge.workspace, course.SETUP_CFG_FILE) == set():  # its cell: unwritten
         raise CheckFailed('The setup.cfg cell still holds the placeholder "raise '
                           'NotImplementedError()": write the two settings in its place and run it.')
+    setup_py: Optional[str] = None
     try:  # the learner's setup.py may be at fault
         problem = _runs(judge, build_copy(judge))
     except CheckFailed as failure:
         problem = str(failure)
     if problem is not None:  # with the course's setup.py, setup.cfg alone counts
-        built = build_copy(judge, setup_py=course_setup_py())
-        problem = _runs(judge, built)
-    else:
-        built = build_copy(judge)
+        setup_py = course_setup_py()
+        problem = _runs(judge, build_copy(judge, setup_py=setup_py))
+    built = build_copy(judge, setup_py=setup_py)
+    if problem is None:  # a development install reads [develop]: ros2 run finds it too
+        problem = _found_in_development_install(judge, setup_py)
     if problem is not None:
         raise CheckFailed(_setup_cfg_cause(judge) or
                           f'{problem} setup.cfg puts the executables where ros2 run looks: '
@@ -208,7 +223,9 @@ def check_setup_cfg(judge: Judge) -> str:
     """Check ``setup.cfg``: executables go to ``lib/sensor_simulator``, where ros2 run looks.
 
     Builds your package (with the course's setup.py when yours is at fault, so that only
-    setup.cfg counts) and starts both executables as ``ros2 run`` does.
+    setup.cfg counts) and starts both executables as ``ros2 run`` does; then again built with
+    ``colcon build --symlink-install``, a development install, which reads ``[develop]``
+    where a normal build reads ``[install]``.
 
     Introduced in ``05-entry-points-and-run.ipynb``.
 

@@ -63,9 +63,10 @@ def _fan_controller(judge: Judge) -> str:
     subject, info = new_node(judge, course.FAN_FILE, course.FAN_CLASS)
     node_name_verdict(info, course.FAN_NODE)
     found = judge.observer.endpoints(info.name, info.namespace, info.endpoints)
-    endpoint_verdict(info.name, found, 'subscription', '/' + course.TOPIC, course.MESSAGE_TYPE)
+    endpoint_verdict(info.name, found, 'subscription', '/' + course.TOPIC, course.MESSAGE_TYPE,
+                     info.endpoints)
     endpoint_verdict(info.name, found, 'publisher', '/' + course.FAN_TOPIC,
-                     course.FAN_MESSAGE_TYPE)
+                     course.FAN_MESSAGE_TYPE, info.endpoints)
     started_log_verdict(judge, info, mark, course.FAN_CLASS)  # the task's third step
     if not subject.request(WaitMatched(topic='/' + course.FAN_TOPIC,
                                        seconds=ARRIVAL_TIMEOUT_S)).ok:
@@ -78,8 +79,8 @@ def _fan_controller(judge: Judge) -> str:
     for value in readings:
         before, sent_before = len(commands), announced(counts, fan_topic)
         started = time.monotonic()
-        counts, _lines = feed(judge, subject, info, value, counts,
-                              'temperature_callback: is it the subscription\'s callback?')
+        counts, lines = feed(judge, subject, info, value, counts,
+                             'temperature_callback: is it the subscription\'s callback?')
         # Wait for as many commands as the subject says its callback published (none: no
         # wait; it says nothing: at least one); what arrived decides.
         after = announced(counts, fan_topic)
@@ -98,10 +99,21 @@ def _fan_controller(judge: Judge) -> str:
             raise CheckFailed(f'For {value} °C the fan controller published {bool(said[0])}; it '
                               f'should be {want}: the fan is on only when the reading is High, '
                               f'strictly above HIGH_ABOVE_C = {course.HIGH_ABOVE_C} °C.')
+        _log_verdict(value, bool(said[0]), lines)
     _slow_callback_verdict(min(answered_s), len(readings))
     return (f'{info.name} hears /{course.TOPIC} and publishes one command on '
             f'/{course.FAN_TOPIC} per reading, True only when High ({len(readings)} '
             'readings).')
+
+
+def _log_verdict(value: float, command: bool, lines: list[str]) -> None:
+    """The fan's log line is optional, but one that says on or off says what it published."""
+    for line in lines:
+        said = set(re.findall(r'\b(on|off)\b', line.lower()))
+        if len(said) == 1 and (said == {'on'}) != command:
+            raise CheckFailed(f'For {value} °C the fan controller published {command} but '
+                              f'logged "{line}": log what it published (command.data), or no '
+                              'line.')
 
 
 def _slow_callback_verdict(fastest_s: float, readings: int) -> None:
@@ -109,9 +121,9 @@ def _slow_callback_verdict(fastest_s: float, readings: int) -> None:
     callback of its node: notebook 06 says to answer each reading at once."""
     if fastest_s >= SLOW_CALLBACK_S:
         raise CheckFailed(f'The fan controller took {SLOW_CALLBACK_S:g} s or more to answer each '
-                          f'of {readings} readings: temperature_callback waits (a '
-                          'time.sleep?), and meanwhile every other callback of its node waits '
-                          'too (section 4): publish the command at once, without waiting.')
+                          f'of {readings} readings: temperature_callback waits (a loop, or a '
+                          'wait?), and meanwhile every other callback of its node waits too '
+                          '(section 4): publish the command at once, without waiting.')
 
 
 @judged
@@ -155,7 +167,8 @@ def _counting_monitor(judge: Judge) -> str:
         raise CheckFailed(f"{course.COUNTING_CLASS}('{name}') made a node called {info.name}: "
                           'pass the name it is given on to super().__init__(name).')
     found = observer.endpoints(info.name, info.namespace, info.endpoints)
-    endpoint_verdict(name, found, 'subscription', '/' + course.TOPIC, course.MESSAGE_TYPE)
+    endpoint_verdict(name, found, 'subscription', '/' + course.TOPIC, course.MESSAGE_TYPE,
+                     info.endpoints)
     lines_logged(judge, info, mark, info.started_lines)
     reach(judge, subject, name)
     counts: Counts = info

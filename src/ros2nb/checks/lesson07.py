@@ -113,7 +113,9 @@ def _point_verdict(judge: Judge, sent: list[tuple[float, float]],
                           f'{_unplotted_cause(judge)}')
     if len(drawn) > 1:
         raise CheckFailed(f'For the reading {value} °C the plot was redrawn {len(drawn)} times: '
-                          'call self.redraw() once per message, after appending.')
+                          'call self.redraw() once per message, after appending, from the one '
+                          'subscription __init__ makes (each subscription hands the callback '
+                          'every reading).')
     times_s, temps_c = drawn[0].get('times_s') or [], drawn[0].get('temps_c') or []
     if len(temps_c) != number:
         raise CheckFailed(f'After {number} readings the plot holds {len(temps_c)} points: append '

@@ -317,9 +317,9 @@ def _sensor_subscription(judge: Optional[Judge], make_profile: Any) -> str:
         profile = history = learner_profile(make_profile)
         got = qos.pair(SENSOR_QOS, profile, count=READINGS)
     sensor = qos.describe(SENSOR_QOS)
-    if not got.matched:
+    if not got.matched:  # as discovery reports it, with the history it keeps: the same here
         raise CheckFailed(f'Incompatible QoS: the sensor publishes with {sensor}, your '
-                          f'subscription asks for {qos.describe(profile)}; '
+                          f'subscription asks for {qos.describe(profile, history)}; '
                           f'{got.explanation or "they never matched."}')
     # What it keeps when it falls behind: its history's alone.  A best-effort subscription
     # keeps what arrived, which varies from run to run; made reliable, it keeps the same.

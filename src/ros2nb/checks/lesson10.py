@@ -82,10 +82,12 @@ def _call(judge: Optional[Judge], function: Any, label: str, *args: Any,
     if spin_s:  # the function runs nodes: none of an earlier cell's may run beside them
         _no_nodes_left(label)
     with contextlib.redirect_stdout(io.StringIO()):  # the verdict is the check's line alone
-        result = call_learner(function, *args)
+        result = call_learner(function, *args, label=label)
     rt = current_runtime()
     if stops is not None and rt is not None and rt.nodes:
-        running = ', '.join(sorted(rt.nodes))
+        remaining = sorted(rt.nodes)  # named as the grader names the node it waits for
+        running = stops if any(n.rsplit('/', 1)[-1] == stops for n in remaining) \
+            else ', '.join(remaining)
         rt.stop()  # the next check's call must start with no node of this one
         raise CheckFailed(_LEFT_RUNNING.format(label=label, node=running))
     return result

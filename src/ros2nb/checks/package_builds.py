@@ -98,9 +98,11 @@ def entry_point_syntax_cause(setup_py: Path) -> Optional[str]:
 
 
 def build_copy(judge: Judge, *, setup_py: Optional[str] = None,
-           setup_cfg: Optional[str] = None) -> Path:
+               setup_cfg: Optional[str] = None, symlink: bool = False) -> Path:
     """Build a copy of the learner's package with the grader's stand-in nodes (and the
-    course's setup.py or setup.cfg, when given); cached by what went in.
+    course's setup.py or setup.cfg, when given); cached by what went in.  With ``symlink``,
+    as ``colcon build --symlink-install`` (a development install, which reads setup.cfg's
+    ``[develop]``, where a normal one reads ``[install]``).
 
     :return: the copy's workspace (with ``install/``).
     :raises CheckFailed: with the build's cause in one line.
@@ -112,7 +114,7 @@ def build_copy(judge: Judge, *, setup_py: Optional[str] = None,
                    and (p.is_symlink() or p.is_file()))
     digest = sha256(b''.join(p.relative_to(source).as_posix().encode()
                              + (os.readlink(p).encode() if p.is_symlink() else p.read_bytes())
-                             for p in files) + repr((setup_py, setup_cfg)).encode()
+                             for p in files) + repr((setup_py, setup_cfg, symlink)).encode()
                     ).hexdigest()[:12]
     if digest in judge.builds:
         return judge.builds[digest]
@@ -131,7 +133,8 @@ def build_copy(judge: Judge, *, setup_py: Optional[str] = None,
     colcon = venv_tool('colcon')
     if colcon is None:
         raise Ros2nbError('colcon is not installed: run `make lab` or `make test`.')
-    code, output = judge.run([colcon, 'build'], seconds=300, cwd=ws, what='colcon build',
+    command = [colcon, 'build', *(['--symlink-install'] if symlink else [])]
+    code, output = judge.run(command, seconds=300, cwd=ws, what=' '.join(['colcon', *command[1:]]),
                              writable=[ws])
     if code != 0:  # a console_scripts string setuptools cannot read says more than its error
         held = [n for n, given in (('setup.py', setup_py), ('setup.cfg', setup_cfg))

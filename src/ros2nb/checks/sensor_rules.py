@@ -36,20 +36,22 @@ def period_problem(readings: list[tuple[float, float]], seconds: float) -> Optio
         count = times.count(together)
         return CheckFailed(f'{count} readings arrived at the same moment ({together:g} s of the '
                            'grader\'s clock): publish one message per timer call, from one timer.')
-    odd = next((gap for gap in gaps if not math.isclose(gap, period, abs_tol=1e-6)), None)
-    if odd is not None:
-        return CheckFailed(f'Readings came {odd:g} s apart on the grader\'s clock; the sensor '
-                           f'publishes every {period} s: give the timer PUBLISH_PERIOD_S.')
-    off = next((t for t in times if abs(t - round(t / period) * period) > 1e-6), None)
-    if off is not None:
-        return CheckFailed(f'A reading came {off:g} s after the sensor started on the grader\'s '
-                           f'clock, off its whole periods of {period} s: use PUBLISH_PERIOD_S.')
+    # The judge's clock moves in steps (and stops just before each whole one), so arrival
+    # times say only which step a reading came in: a count says the period, a time off the
+    # whole steps only that it is not one.
+    expected = round(seconds / period)
+    if abs(len(readings) - seconds / period) > 1:
+        return CheckFailed(f'{len(readings)} readings in {seconds:g} s of the grader\'s clock; '
+                           f'the sensor publishes one every {period} s ({expected} in '
+                           f'{seconds:g} s): give the timer PUBLISH_PERIOD_S.')
+    odd = any(not math.isclose(gap, period, abs_tol=1e-6) for gap in gaps) or any(
+        abs(t - round(t / period) * period) > 1e-6 for t in times)
+    if odd:
+        return CheckFailed(f'The readings came between the grader\'s whole seconds: the timer\'s '
+                           f'period is not {period} s: give the timer PUBLISH_PERIOD_S.')
     if times and times[0] > period + 1e-6:
         return CheckFailed(f'The first reading came after {times[0]:g} s; the timer fires every '
                            f'{period} s: give the timer PUBLISH_PERIOD_S.')
-    if abs(len(readings) - seconds / period) > 1:
-        return CheckFailed(f'{len(readings)} readings in {seconds:g} s; expected one every '
-                           f'{period} s: check the timer period.')
     return None
 
 

@@ -7,16 +7,22 @@ the node has and what it needs, and returns quietly when it is right.
 from __future__ import annotations
 
 import difflib
+from typing import Sequence
 
 from ..errors import CheckFailed
 from ..subject_replies import NodeMade
 
 
 def endpoint_verdict(node: str, found: list[tuple[str, str, str]], kind: str, topic: str,
-                      type_name: str) -> None:
-    """Raise CheckFailed unless ``found`` holds a ``kind`` on ``topic`` of ``type_name``."""
+                      type_name: str, made: Sequence[Sequence[str]] = ()) -> None:
+    """Raise CheckFailed unless ``found`` holds a ``kind`` on ``topic`` of ``type_name``, and
+    the node made (as ``made`` lists its endpoints, where it is given) only one."""
     mine = {t: ty for k, t, ty in found if k == kind}
     if mine.get(topic) == type_name:
+        count = [tuple(e) for e in made].count((kind, topic, type_name))
+        if count > 1:  # the graph shows one: the node's own list names the failure
+            raise CheckFailed(f'{node} made {count} {kind}s on {topic}, where one does: create '
+                              f'it once, in __init__.')
         return
     if topic in mine:
         raise CheckFailed(f'The {kind} of {node} on {topic} uses {mine[topic]}, but the topic '

@@ -10,8 +10,10 @@ judge's subject.  Introduced in ``03-write-the-publisher.ipynb``.
 
 from __future__ import annotations
 
+import ast
 import builtins
 import inspect
+import textwrap
 import linecache
 import re
 from types import FrameType
@@ -20,13 +22,11 @@ from typing import Any, Optional
 from ..errors import Ros2nbError, UsageError
 from .frames import frames_of, learner_frame
 from .names import (declared, import_of, learners_functions, place, raising_text,
-                    similar, stored)
+                    similar, stored, stored_near)
+from .values import filled_wrongly, wrong_kind
 
 _CONSTRUCTOR_ARGUMENTS = re.compile(r'Invalid arguments passed to constructor: '
                                     r'(?:dict_keys\(\[(?P<keys>[^\]]*)\]\)|(?P<names>.+))')
-#: Python's refusal of two values an operator cannot take together.
-_OPERANDS = re.compile(r"(?:not supported between instances of|unsupported operand type\(s\) "
-                       r"for \S+:) '(\w+)' and '(\w+)'")
 
 
 def _first_line(exc: BaseException) -> str:
@@ -42,6 +42,11 @@ def _unset_attribute(obj: Any, name: str, owner: str) -> Optional[str]:
         return None
     for code in methods:
         line = stored(code, name, 'STORE_FAST')
+        if line is not None and linecache.getline(code.co_filename, line).lstrip().startswith(
+                ('def ', 'async def ')):
+            return (f'{owner} has no method {name}: it is written inside {code.co_name} '
+                    f'({place(code, line)}), indented one level too deep: indent its def as '
+                    f'{code.co_name}\'s is, so that it belongs to the class.')
         if line is not None:
             return (f'{owner} has no attribute {name}: {code.co_name} sets a local name '
                     f'{name} ({place(code, line)}), which is gone when it returns: write '
@@ -61,10 +66,45 @@ def _unset_attribute(obj: Any, name: str, owner: str) -> Optional[str]:
             f'none is called {name}: set self.{name} in __init__ (or write the method).')
 
 
+_NO_SUCH_ATTRIBUTE = re.compile(r"^'(\w+)' object has no attribute '(\w+)'")
+
+
+def _field_set(exc: AttributeError) -> Optional[str]:
+    """``msg.dta = ...``: a message's field set under a name it does not have (Python names
+    no object for a failed assignment: the message is found among the frame's values)."""
+    found = _NO_SUCH_ATTRIBUTE.match(_first_line(exc))
+    frame = learner_frame(exc)
+    if found is None or frame is None:
+        return None
+    owner, name = found.groups()
+    for value in frame.f_locals.values():
+        if type(value).__name__ == owner:
+            return _message_field(type(value), name)
+    return None
+
+
+def _message_field(cls: type, name: str) -> Optional[str]:
+    """The line for a field a message of ``cls`` does not have, or None for no message."""
+    fields = getattr(cls, 'get_fields_and_field_types', None)
+    if fields is None:
+        return None
+    has = list(fields())
+    meant = similar(name, has) or (has[0] if len(has) == 1 else None)
+    hint = f': write {meant}' if meant else ''
+    return f'a {cls.__name__} message has no field {name} (its fields: {", ".join(has)}){hint}.'
+
+
 def _attribute(exc: AttributeError) -> Optional[str]:
     name, obj = getattr(exc, 'name', None), getattr(exc, 'obj', None)
     if not name or obj is None:
-        return None
+        return _field_set(exc)
+    field = None if isinstance(obj, type) else _message_field(type(obj), name)
+    if field:
+        return field
+    if inspect.ismethod(obj) or inspect.isfunction(obj) or inspect.isbuiltin(obj):
+        called = f'self.{obj.__name__}' if inspect.ismethod(obj) else obj.__name__
+        return (f'{called} is a method, not what it returns: call it, '
+                f'{called}().{name}, with the parentheses.')
     owner = obj.__name__ if isinstance(obj, type) or hasattr(obj, '__file__') and hasattr(
         obj, '__name__') else type(obj).__name__
     if not isinstance(obj, type) and not hasattr(obj, '__file__'):
@@ -74,6 +114,10 @@ def _attribute(exc: AttributeError) -> Optional[str]:
     meant = similar(name, dir(obj))
     if meant:
         return f"{owner} has no attribute {name}: did you mean {meant}? Names must match exactly."
+    held = [a for a in dir(obj) if not a.startswith('_')
+            and not callable(getattr(obj, a, None))][:8]  # what it holds, by name
+    if held and not isinstance(obj, type):
+        return f'{owner} has no attribute {name}: a {owner} holds {", ".join(held)}.'
     return f'{owner} has no attribute {name}: check the name against what {owner} offers.'
 
 
@@ -82,23 +126,28 @@ def _name(exc: NameError, frame: FrameType) -> str:
     if not name:
         quoted = re.match(r"name '(\w+)'", _first_line(exc))
         name = quoted.group(1) if quoted else '?'
-    visible = {*frame.f_locals, *frame.f_globals, *vars(builtins)}
     if name == 'self':  # self.NAME in a plain function: the notebook's own names are plain
         used = re.search(r'\bself\.(\w+)', linecache.getline(frame.f_code.co_filename,
                                                              frame.f_lineno))
         plain = used.group(1) if used else 'the name'
         return (f"name 'self' is not defined: {frame.f_code.co_name}() is a function, not a "
                 f'method of a node, so there is no self: write {plain}, not self.{plain}.')
-    meant = similar(name, visible)
+    spelt = stored_near(frame.f_code, name)
+    if spelt is not None:
+        other, line = spelt
+        return (f"name '{name}' is not defined, but {other} is ({place(frame.f_code, line)}): "
+                'spell a name the same where it is set and where it is used.')
+    own = similar(name, {*frame.f_locals, *frame.f_globals})
+    imported = import_of(name)
+    if imported and not own:
+        return (f"name '{name}' is not defined: import it at the top of the file (or cell), "
+                f'{imported}.')
+    meant = own or similar(name, vars(builtins))
     if meant:
         return (f"name '{name}' is not defined: did you mean {meant}? Names must match "
                 'exactly.')
-    imported = import_of(name)
-    if imported:
-        return (f"name '{name}' is not defined: import it at the top of the file (or cell), "
-                f'{imported}.')
-    return (f"name '{name}' is not defined where this line runs: define it (or import it) "
-            'before, or check its spelling.')
+    return (f"name '{name}' is not defined where this line runs: no line before it sets "
+            f'{name}: set it first, or check its spelling.')
 
 
 def _constructor_arguments(exc: AssertionError) -> Optional[str]:
@@ -122,18 +171,50 @@ def _constructor_arguments(exc: AssertionError) -> Optional[str]:
 
 
 def _unset_local(exc: UnboundLocalError, frame: FrameType) -> str:
-    """A name the function sets (which makes it local everywhere in it) used before that."""
+    """A name the function sets (which makes it local everywhere in it) used before that:
+    set in some branches of an ``if`` only, set after its use, or imported late."""
     quoted = re.search(r"'(\w+)'", _first_line(exc))
     name = quoted.group(1) if quoted else '?'
+    function = frame.f_code.co_name
     line = stored(frame.f_code, name, 'STORE_FAST')
+    text = linecache.getline(frame.f_code.co_filename, line).strip() if line else ''
+    if text.startswith(('import ', 'from ')):
+        return (f'{name} is used before {function} imports it ({place(frame.f_code, line)}): '
+                'import it at the top of the file instead.')
+    if line is not None and line < frame.f_lineno and _in_branch(frame, line):
+        return (f'{name} has no value here: {function} sets it only in some branches of an '
+                'if/elif/else, not in the one this call took: set it in every branch.')
     where = f' ({place(frame.f_code, line)})' if line is not None else ''
-    return (f'{name} is used before {frame.f_code.co_name} sets it{where}: a name the '
-            f'function sets is its own local name everywhere in it; set it first, or, for an '
-            f'import, import it at the top of the file.')
+    return (f'{name} is used before {function} sets it{where}: a name the function sets is '
+            'its own local name everywhere in it: set it before this line.')
+
+
+def _in_branch(frame: FrameType, line: int) -> bool:
+    """Whether ``line`` of the frame's function is inside an ``if`` (or ``elif``/``else``)."""
+    try:
+        lines, first = inspect.getsourcelines(frame.f_code)
+        tree = ast.parse(textwrap.dedent(''.join(lines)))
+    except (OSError, TypeError, SyntaxError):
+        return False
+    return any(isinstance(node, ast.If) and node.lineno + first - 1 < line
+               <= node.end_lineno + first - 1 for node in ast.walk(tree))
 
 
 _MISSING = re.compile(r"^(?P<called>[\w.]+)\(\) missing \d+ required positional "
                       r"arguments?: (?P<names>.+)$")
+
+
+def _class_for_instance(exc: TypeError, frame: FrameType) -> Optional[tuple[str, type]]:
+    """``(name, cls)``: a local name of the frame that holds a class where an instance was
+    meant (``node = TemperatureSensor``, then ``node.destroy_node()``: no self), or None."""
+    found = _MISSING.match(_first_line(exc))
+    if found is None or re.findall(r"'(\w+)'", found['names']) != ['self']:
+        return None
+    method = found['called'].rpartition('.')[2]
+    for name, value in frame.f_locals.items():
+        if isinstance(value, type) and callable(getattr(value, method, None)):
+            return name, value
+    return None
 
 
 def _missing_arguments(exc: TypeError, frame: FrameType) -> Optional[str]:
@@ -141,6 +222,11 @@ def _missing_arguments(exc: TypeError, frame: FrameType) -> Optional[str]:
     found = _MISSING.match(_first_line(exc))
     if found is None:
         return None
+    held = _class_for_instance(exc, frame)
+    if held is not None:
+        name, cls = held
+        return (f'{name} holds the class {cls.__name__}, not one made from it: create it with '
+                f'parentheses, {name} = {cls.__name__}().')
     called = found['called'].removesuffix('.__init__').rpartition('.')[2]
     names = ', '.join(re.findall(r"'(\w+)'", found['names']))
     return (f'{called}() was called without {names}: give it every argument it needs, in '
@@ -174,18 +260,6 @@ def _unexpected_keyword(exc: TypeError, frame: FrameType) -> Optional[str]:
             f'{", ".join(takes) or "none"}).')
 
 
-def _operands(text: str, frame: FrameType, kinds: set[str]) -> str:
-    """``low_c >= high_c`` with a str on one side: which names on the line hold what."""
-    line = linecache.getline(frame.f_code.co_filename, frame.f_lineno)
-    held = [f'{name} is {value!r} ({type(value).__name__})'
-            for name, value in frame.f_locals.items()
-            if re.search(rf'\b{name}\b', line) and type(value).__name__ in kinds
-            and len(repr(value)) <= 40]
-    shown = f': here {", ".join(held)}' if held else ''
-    return (f'TypeError: {text}{shown}: find where the value of the wrong kind comes from, '
-            'and give the line two values it can take together.')
-
-
 def cause_place(exc: BaseException) -> Optional[str]:
     """``FILE line N: source`` of the learner's line that caused ``exc`` where that is not
     the line that raised it, or None.  A parameter's value of the wrong kind (None: declared
@@ -194,12 +268,22 @@ def cause_place(exc: BaseException) -> Optional[str]:
     frame = learner_frame(exc)
     if frame is None or not isinstance(exc, (TypeError, ValueError)):
         return None
-    used = re.search(r"get_parameter\(\s*'(\w+)'", raising_text(exc))
+    filled = filled_wrongly(exc, frame) if isinstance(exc, TypeError) else None
+    if filled is not None:  # the line that filled the list, not the one that read it
+        return filled[3]
+    held = _class_for_instance(exc, frame) if isinstance(exc, TypeError) else None
+    if held is not None:  # where the name was given the class
+        line = stored(frame.f_code, held[0], 'STORE_FAST')
+        return place(frame.f_code, line) if line is not None else None
+    used = re.findall(r"get_parameter\(\s*'(\w+)'", raising_text(exc))
     owner = frame.f_locals.get('self')
-    if used is None or owner is None:
+    if not used or owner is None:
         return None
+    parameters = getattr(owner, '_parameters', {})
+    wrong = [name for name in used if not isinstance(  # the one holding no number, if known
+        getattr(parameters.get(name), 'value', 0.0), (int, float))] or used
     for code in learners_functions(type(owner)):
-        line = declared(code, used.group(1))
+        line = declared(code, wrong[0])
         if line is not None:
             return place(code, line)
     return None
@@ -234,9 +318,10 @@ def everyday_explanation(exc: BaseException) -> Optional[str]:
         found = _unexpected_keyword(exc, frame) or _missing_arguments(exc, frame)
         if found:
             return found
-    operands = _OPERANDS.search(text) if isinstance(exc, TypeError) else None
-    if operands:
-        return _operands(text, frame, set(operands.groups()))
+    if isinstance(exc, TypeError):
+        found = wrong_kind(exc, frame)
+        if found:
+            return found
     if isinstance(exc, KeyError):
         return (f'KeyError: {text}: the line reads a key that is not there: check its '
                 'spelling, or read it with .get(key, default).')

@@ -303,13 +303,31 @@ def _is_qos_mistake(exc: BaseException) -> bool:
             or text.startswith('Node.create_subscription()'))
 
 
+#: What create_publisher and create_subscription take, in order.
+_ENDPOINT_ORDER = {'create_publisher': 'the message type, the topic and the queue depth',
+                   'create_subscription': 'the message type, the topic, the callback and the '
+                                          'queue depth'}
+
+
+_ARGUMENTS = {'msg_type': 'the message type', 'topic': 'the topic', 'callback': 'the callback',
+              'qos_profile': 'the queue depth'}
+
+
 def _qos_advice(exc: BaseException) -> str:
-    """The queue depth (QoS) of create_publisher / create_subscription given wrongly."""
-    usage = ("create_publisher(Float32, 'temperature', 10) and create_subscription(Float32, "
-             "'temperature', self.callback, 10)")
+    """create_publisher / create_subscription given too few or too many arguments, or a
+    queue depth (QoS) below 0."""
     text = str(exc)
+    call = 'create_subscription' if 'create_subscription' in text else 'create_publisher'
+    takes = f'{call} takes {_ENDPOINT_ORDER[call]}, in that order'
     if 'history depth must be' in text:
-        return f'the queue depth must be 0 or more (10 is usual): {usage}.'
-    if "missing 1 required positional argument: 'qos_profile'" in text:
-        return f'the queue depth (QoS) is missing after the topic: {usage}.'
-    return f'{text.split(": ", 1)[-1]}: the calls are {usage}.'
+        return f'the queue depth must be 0 or more (10 is usual): {takes}.'
+    missing = re.search(r'missing \d+ required positional arguments?: (.+)$', text)
+    if missing:
+        names = [_ARGUMENTS.get(n, n) for n in re.findall(r"'(\w+)'", missing.group(1))]
+        named = ' and '.join([', '.join(names[:-1]), names[-1]] if len(names) > 1 else names)
+        return f'{call}() was called without {named}: {takes}.'
+    keyword = re.search(r"unexpected keyword argument '(\w+)'", text)
+    if keyword:
+        return f'{call}() takes no argument {keyword.group(1)}: {takes}.'
+    return f'{call}() was given other arguments than it takes: {takes}.'
+

@@ -62,3 +62,13 @@ def learner_frame(exc: BaseException) -> Optional[FrameType]:
     """The innermost frame of the learner's own code (a cell or their file), or None."""
     entry = learner_entry(exc)
     return entry.tb_frame if entry is not None else None
+
+
+def in_callback(frame: Optional[FrameType]) -> bool:
+    """True when an rclpy executor is running ``frame`` (it is a callback's, or called from
+    one)."""
+    while frame is not None:
+        if frame.f_code.co_filename.endswith(os.path.join('rclpy', 'executors.py')):
+            return True
+        frame = frame.f_back
+    return False

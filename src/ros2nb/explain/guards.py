@@ -144,11 +144,16 @@ def guard_endpoint_types(local_prefix: Callable[[], Optional[bytes]]) -> None:
         if getattr(original, _GUARDED, False):
             continue
 
-        def guarded(self: Any, msg_type: Any, topic: str, *args: Any,
-                    _original: Any = original, _kind: str = kind, **kwargs: Any) -> Any:
-            _refuse_other_type(self, _kind, msg_type, topic, local_prefix())
-            return _original(self, msg_type, topic, *args, **kwargs)
+        def guarded(self: Any, *args: Any, _original: Any = original, _kind: str = kind,
+                    **kwargs: Any) -> Any:
+            # rclpy's own signature refuses arguments left out or too many, in its own name
+            msg_type = args[0] if args else kwargs.get('msg_type')
+            topic = args[1] if len(args) > 1 else kwargs.get('topic')
+            if isinstance(topic, str):
+                _refuse_other_type(self, _kind, msg_type, topic, local_prefix())
+            return _original(self, *args, **kwargs)
 
         guarded.__doc__, guarded.__name__ = original.__doc__, method
+        guarded.__qualname__ = original.__qualname__
         setattr(guarded, _GUARDED, True)
         setattr(Node, method, guarded)

@@ -29,9 +29,9 @@ IMPORTS.update({'Node': 'from rclpy.node import Node', 'rclpy': 'import rclpy',
 
 def similar(name: str, candidates: Any) -> Optional[str]:
     """The candidate ``name`` was most likely meant to be (a typo away), or None; never one
-    that differs only in case from a lower-case name (``node`` is no typo of ``Node``)."""
+    that differs only in case (``node`` is no typo of ``Node``, ``Bool`` none of ``bool``)."""
     names = sorted({c for c in candidates if isinstance(c, str) and not c.startswith('__')
-                    and not (name.islower() and c.lower() == name)})
+                    and c.lower() != name.lower()})
     near = [c for c in names if len(name) > 2 and one_edit_apart(name, c)]  # msg, mgs
     found = near or difflib.get_close_matches(name, names, n=1, cutoff=0.75)
     return found[0] if found else None
@@ -82,6 +82,21 @@ def learners_functions(cls: type) -> Iterator[CodeType]:
             code = getattr(getattr(value, '__func__', value), '__code__', None)
             if isinstance(code, CodeType) and not is_library_file(code.co_filename):
                 yield code
+
+
+def stored_near(code: CodeType, name: str) -> Optional[tuple[str, int]]:
+    """``(other, line)``: a name one edit from ``name`` that ``code`` sets (a local, or a
+    name of the cell or file), and the line that sets it, or None: the learner's own
+    spelling of the name where it is set."""
+    line = None
+    for instruction in dis.get_instructions(code):
+        if instruction.starts_line is not None:
+            line = instruction.starts_line
+        if instruction.opname in ('STORE_FAST', 'STORE_NAME', 'STORE_GLOBAL') and \
+                isinstance(instruction.argval, str) and line is not None and \
+                one_edit_apart(name, instruction.argval):
+            return instruction.argval, line
+    return None
 
 
 def stored(code: CodeType, name: str, opname: str) -> Optional[int]:

@@ -53,8 +53,25 @@ def python_mistake(exc: BaseException, text: str) -> Optional[str]:
     if isinstance(exc, UnboundLocalError):
         return _attribute_without_self(frame, text)
     if isinstance(exc, TypeError):
-        return _fields_in_order(frame, text) or _callback_called(frame, text)
+        return (_fields_in_order(frame, text) or _callback_called(frame, text)
+                or _one_value_to_compare(frame, text))
     return None
+
+
+_NOT_ITERABLE = re.compile(r"^'(\w+)' object is not iterable")
+
+
+def _one_value_to_compare(frame: Any, text: str) -> Optional[str]:
+    """``max(MIN_TEMPERATURE_C)``: max or min given one number, which it takes for a list."""
+    found = _NOT_ITERABLE.match(text)
+    line = linecache.getline(frame.f_code.co_filename, frame.f_lineno)
+    called = re.search(r'\b(max|min)\(', line)
+    if found is None or called is None:
+        return None
+    function = called.group(1)
+    return (f'{function}() was given one {found.group(1)}: with one argument it looks for the '
+            f'{"largest" if function == "max" else "smallest"} item of a list; give it the '
+            f'values to compare, {function}(a, b).')
 
 
 def _method_without_self(frame: Any, text: str) -> Optional[str]:

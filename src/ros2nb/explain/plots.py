@@ -17,6 +17,7 @@ import sys
 from typing import Any, Optional
 
 from ..errors import Ros2nbError
+from .frames import in_callback
 
 PYPLOT = 'matplotlib.pyplot'
 _GUARDED = '_ros2nb_guarded'
@@ -61,16 +62,6 @@ def _shown_again(pyplot: Any) -> Optional[str]:
     return None
 
 
-def _in_callback() -> bool:
-    """True when an rclpy executor is running the code that called (a callback's)."""
-    frame: Any = sys._getframe(2)
-    while frame is not None:
-        if frame.f_code.co_filename.endswith('rclpy/executors.py'):
-            return True
-        frame = frame.f_back
-    return False
-
-
 def _guard(pyplot: Any) -> None:
     for name in ('pause', 'show'):
         original = getattr(pyplot, name)
@@ -78,7 +69,7 @@ def _guard(pyplot: Any) -> None:
             continue
 
         def guarded(*args: Any, _original: Any = original, _name: str = name, **kwargs: Any) -> Any:
-            if _in_callback():
+            if in_callback(sys._getframe(1)):
                 raise PlotInCallbackError(
                     f'plt.{_name}() in a callback {_WHY[_name]}: remove it; redraw() already '
                     'asks for a redraw without waiting (the plot updates between messages).')

@@ -52,6 +52,12 @@ KINDS: dict[str, tuple[Callable[[Any], bool], str]] = {
     'callback': (_callback, 'the callback (a method, without ())'),
     'timer_period_sec': (_seconds, 'the period in seconds (1.0)'),
 }
+#: What to give for a parameter given a value of the wrong kind.
+GIVE = {'qos_profile': 'a whole number, without quotes (QUEUE_DEPTH, 10)',
+        'timer_period_sec': 'a number of seconds, without quotes (PUBLISH_PERIOD_S, 1.0)',
+        'msg_type': 'the message type itself, without parentheses (Float32)',
+        'topic': "the topic's name as text (TOPIC, 'temperature')",
+        'callback': 'the method itself, without parentheses (self.publish_temperature)'}
 #: The rclpy calls a beginner writes, with their parameters in order.
 CALLS = {'declare_parameter': ('name', 'value', 'descriptor'),
          'deserialize': ('rawdata', 'typ'),  # rosbags' reader (notebook 10)
@@ -97,11 +103,14 @@ def wrong_arguments(exc: BaseException) -> Optional[str]:
     wrong = [name for name in CALLS[call] if not KINDS[name][0](values[name])]
     if not wrong:
         return None
-    got = ' and '.join(f'{shown(values[name])} came where {KINDS[name][1].split(" (")[0]} '
-                       'belongs' for name in wrong)
-    kinds = [KINDS[name][1] for name in CALLS[call]]
+    got = ' and '.join(f'{shown(values[name])} {"came " if i == 0 else ""}where '
+                       f'{KINDS[name][1].split(" (")[0]} belongs' for i, name in enumerate(wrong))
+    kinds = [KINDS[name][1].split(' (')[0] for name in CALLS[call]]
     order = f'{", ".join(kinds[:-1])} and {kinds[-1]}'
     belongs = any(KINDS[other][0](values[name]) for name in wrong for other in CALLS[call]
                   if other != name)
-    how = 'in the wrong order' if belongs else 'of the wrong kind'
-    return f'{call} got its arguments {how}: {got}; it takes {order}, in that order.'
+    if not belongs:  # a value of the wrong kind in its place: what that place takes
+        name = wrong[0]
+        return (f'{call} got {shown(values[name])} where {KINDS[name][1].split(" (")[0]} '
+                f'belongs: give {GIVE.get(name, KINDS[name][1])}.')
+    return f'{call} got its arguments in the wrong order: {got}; it takes {order}, in that order.'

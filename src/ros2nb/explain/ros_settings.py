@@ -104,6 +104,15 @@ def unset_parameter(exc: BaseException, text: str, frames: list[Any]) -> Optiona
         return ('declare_parameter got no default (None): rclpy cannot give a parameter with '
                 'a descriptor a type without one (PARAMETER_NOT_SET): pass its default value '
                 'as the second argument, before the descriptor.')
+    if isinstance(exc, (TypeError, ValueError)) and "'str'" in text:
+        for frame in reversed(frames):
+            parameters = getattr(frame.f_locals.get('self'), '_parameters', None)
+            texts = sorted((name, parameter.value) for name, parameter in (
+                parameters or {}).items() if isinstance(getattr(parameter, 'value', None), str)
+                and re.fullmatch(r'-?\d+(?:\.\d+)?', parameter.value))
+            if texts:
+                return (f"the parameter '{texts[0][0]}' holds the text {texts[0][1]!r}, not a "
+                        'number: declare it with its default as a number, without quotes.')
     if not isinstance(exc, TypeError) or 'NoneType' not in text:
         return None
     for frame in reversed(frames):
@@ -118,6 +127,8 @@ def unset_parameter(exc: BaseException, text: str, frames: list[Any]) -> Optiona
     return None
 
 
+_OUT_OF_RANGE = re.compile(r'Parameter (\w+) out of range Min: ([-\d.e+]+), Max: ([-\d.e+]+), '
+                           r'value: ([-\d.e+]+)')
 _WRONG_PARAMETER_TYPE = re.compile(r"Trying to set parameter '(\w+)' to '([^']*)' of type "
                                    r"'(\w+)', expecting type '(\w+)'")
 
@@ -132,6 +143,16 @@ def parameter_mistake(kind: str, text: str) -> Optional[str]:
         told apart by name and message alone, also from the last line a process printed.
     :param text: its message.
     """
+    if kind == 'ParameterAlreadyDeclaredException':
+        twice = re.findall(r"'(\w+)'", text)
+        return (f"the parameter '{twice[0] if twice else '?'}' is declared twice: declare each "
+                'parameter once, in __init__.')
+    ranged = _OUT_OF_RANGE.search(text) if kind == 'InvalidParameterValueException' else None
+    if ranged:
+        name, low, high, value = ranged.groups()
+        return (f"the value {value} of '{name}' is outside the range its descriptor allows, "
+                f'{low} to {high}: its floating_point_range must run from MIN_THRESHOLD_C '
+                '(from_value=) to MAX_THRESHOLD_C (to_value=).')
     if kind == 'ParameterNotDeclaredException':
         name = text.rsplit(': ', 1)[-1]
         return (f"the parameter '{name}' was read (or set) before it was declared: call "

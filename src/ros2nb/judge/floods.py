@@ -110,6 +110,7 @@ class Floods:
         line = self.line
         if line is None:
             return
+        line = self._both() or line
         self.on_flood()
         self.ended()
         raise Flooded(line)
@@ -125,12 +126,32 @@ class Floods:
         self._observer.take_stale()
         self.forget()
 
+    def _both(self) -> Optional[str]:
+        """The line of a node that floods a topic and /rosout together (each call publishes
+        and logs): which of the two passed the limit first is a race, so the line names both
+        once each is past half of it."""
+        with self._observer.changed:
+            busy = [(where, who, self._observer.now_ns - start)
+                    for (_source, where, who), (start, count) in self._windows.items()
+                    if count > FLOOD_LIMIT // 2]
+        logs = [b for b in busy if b[0] == '/rosout']
+        topics = [b for b in busy if b[0] != '/rosout']
+        if not logs or not topics:
+            return None
+        return flood_line(topics[0][1], logs[0][1], max(logs[0][2], topics[0][2]), both=True)
 
-def flood_line(where: str, who: str, span_ns: int) -> str:
+
+def flood_line(where: str, who: str, span_ns: int, both: bool = False) -> str:
     """The one line of a flood of ``who`` on ``where`` (``/rosout``: ``who`` is the logger),
-    counted over ``span_ns`` of the judge's clock."""
+    counted over ``span_ns`` of the judge's clock; with ``both``, of the logger ``who``
+    flooding the topic ``where`` and /rosout."""
     when = (f'in {span_ns / 1e9:g} s of the grader\'s clock' if span_ns else
             'while the grader\'s clock stood still')
+    if both:  # where: the topic, who: the logger
+        return (f'Your node {who} published on {where} and logged to /rosout over '
+                f'{FLOOD_LIMIT:,} messages {when} (a node of the course does each once per '
+                'reading or tick): look for a loop, or a timer made in a callback, that '
+                'publishes and logs without waiting for a timer.')
     if where == '/rosout':
         return (f'Your node {who} logged over {FLOOD_LIMIT:,} lines to /rosout {when} (a node '
                 'of the course logs one line per reading or tick): look for a loop that logs '

@@ -323,6 +323,18 @@ class Observer:
         """True when a running node called ``name`` (any namespace) is on the domain."""
         return any(n == name for n, _ns in self.live_nodes())
 
+    def count_endpoints(self, name: str, namespace: str, kind: str, topic: str) -> int:
+        """How many ``kind`` endpoints (``'publisher'`` or ``'subscription'``) the node
+        ``namespace/name`` owns on ``topic`` now, as DDS discovered them: the most one
+        process owns (a node of that name an earlier process left may linger a moment)."""
+        counts: dict[bytes, int] = {}
+        for found, on, info in self._endpoint_infos():
+            if found == kind and on == topic and info.node_name == name \
+                    and info.node_namespace == namespace:
+                owner = bytes(info.endpoint_gid[:PARTICIPANT_PREFIX_BYTES])
+                counts[owner] = counts.get(owner, 0) + 1
+        return max(counts.values(), default=0)
+
     def close(self) -> None:
         self._stop = True
         self.executor.wake()

@@ -30,6 +30,7 @@ _working_folder_off_the_path()
 import json  # noqa: E402 - only once the working folder is off the path
 import signal  # noqa: E402
 
+from ..explain.blocking import guard_sleep  # noqa: E402
 from ..explain.plots import guard_pyplot  # noqa: E402
 from ..processes import die_with_parent, end_this_process  # noqa: E402
 from ..subject_interface import LOADERS, command_of, wire  # noqa: E402
@@ -44,6 +45,7 @@ def main(argv: list[str]) -> int:
     judge_time.install()  # the judge's pipe and time: this process's alone, never a child's
     noted = seen.install(judge_time.JudgeTime.pipe())  # before anything of the learner's runs
     guard_pyplot()  # plt.pause / plt.show in a callback: the learner's one line
+    guard_sleep()  # time.sleep in a callback: at once, not after minutes of the grader's clock
     if len(argv) != 2:
         print('Usage: python -P -m ros2nb.subject IN_FD OUT_FD (started by ros2nb.judge).',
               file=sys.stderr)

@@ -33,6 +33,7 @@ from __future__ import annotations
 import os
 import sys
 import threading
+import traceback
 from pathlib import Path
 from typing import Any, Callable, Optional
 
@@ -249,4 +250,17 @@ def install(fd: Optional[int]) -> Callable[[], None]:
 
     hook, end = make_hook(send)
     sys.addaudithook(hook)
+    # CPython's own report of an exception it cannot raise (a __del__ of rclpy's, on an object
+    # the learner's call left half made) compiles rclpy's source line from C, with the
+    # learner's frame on top: the hook would tell that as the learner's compile.  Python's
+    # traceback module reports it the same, and compiles from its own frames.
+    sys.unraisablehook = _report_unraisable
     return end
+
+
+def _report_unraisable(unraisable: Any) -> None:
+    """Print an exception Python could not raise as CPython does, from Python's frames."""
+    message = unraisable.err_msg or 'Exception ignored in'
+    print(f'{message}: {unraisable.object!r}', file=sys.stderr)
+    traceback.print_exception(unraisable.exc_type, unraisable.exc_value,
+                              unraisable.exc_traceback, file=sys.stderr)

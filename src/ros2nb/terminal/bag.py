@@ -46,7 +46,7 @@ from ..errors import Ros2nbError, UsageError
 from ..runtime import QUIET_SUBSCRIPTION, current_runtime
 from .echo import message_type
 from .run import node_process_env
-from .topic import graph_topics, resolve
+from .topic import resolve
 
 #: The storage every bag of the course uses (rosbag2's default since Iron).
 STORAGE_ID = 'mcap'
@@ -162,25 +162,30 @@ def bag_record(output: Any, *topics: str) -> Recording:
         publisher already (its type is taken from the graph).
     :return: the running recording.
     :raises UsageError: for no topics, a topic that is not a name, a folder that exists,
-        or a topic nobody publishes.
+        or a topic nobody publishes (yet: a subscription alone does not count).
     """
     path = _bag_path(output)
     if not topics:
         raise UsageError("Name the topics to record, e.g. bag_record('hour', '/temperature').")
     wrong = [t for t in topics if not isinstance(t, str) or not t.strip()]
+    if wrong and isinstance(wrong[0], os.PathLike):  # the folder among the topics
+        raise UsageError("bag_record takes the bag's folder first, then the topics in quotes: "
+                         "bag_record(bag_path, '/temperature', '/rosout').")
     if wrong:
         raise UsageError(f'Topics are names in quotes, e.g. \'/temperature\' (got {wrong[0]!r}).')
     if path.exists():
         raise UsageError(f"Output folder '{path}' already exists: choose another name, or "
                          'delete the old bag first.')
-    known = graph_topics()
     types = {}
+    graph = current_runtime().node
     for topic in topics:
         name = resolve(topic)
-        if not known.get(name):
-            raise UsageError(f'{name} is not in the ROS graph yet: add the node that publishes '
-                             'it before recording (topic_list() shows the topics).')
-        types[name] = known[name][0]
+        # its publishers' type only: a subscription (a check listening) publishes nothing
+        published = sorted({info.topic_type for info in graph.get_publishers_info_by_topic(name)})
+        if not published:
+            raise UsageError(f'{name} has no publisher in the ROS graph yet: add the node that '
+                             'publishes it before recording (topic_list() shows the topics).')
+        types[name] = published[0]
     return Recording(path, types)
 
 

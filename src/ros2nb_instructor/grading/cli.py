@@ -56,8 +56,11 @@ from .learners import file_graded, grade_learner
 from .report import write_report
 from .scratch import grading_folder
 from .settings import CELL_TIMEOUT_S, JOBS, NOTEBOOK_CPU_S, NOTEBOOK_TIMEOUT_S, Settings
-from .submissions import Learner, find_learners
-from .term import add_options, export, forget, load_state, read_term, save_state, with_roster
+from .exporting import export
+from .hand_in_times import TimeProblem
+from .submissions import Learner, SubmissionProblem, find_learners
+from .term import (Term, add_options, forget, load_state, read_term, save_state, with_extensions,
+                   with_roster)
 
 if TYPE_CHECKING:
     from .cluster import Cluster
@@ -94,10 +97,7 @@ def _options(argv: Optional[list[str]]) -> argparse.Namespace:
 
 def _share(text: str) -> float:
     """``--cpu-share``'s value: CPUs, more than 0 and at most this machine's."""
-    try:
-        share = float(text)
-    except ValueError:
-        share = -1.0
+    share = float(text) if text.replace('.', '', 1).isdigit() else -1.0
     if not 0 < share <= (os.cpu_count() or 1):
         raise argparse.ArgumentTypeError(
             f'{text!r} is no share of this machine\'s {os.cpu_count() or 1} CPUs: give a '
@@ -325,22 +325,22 @@ def _grade_with(cluster: Optional['Cluster'], args: argparse.Namespace, submissi
         print(line)
     if term is None:
         return 2
-    refused: list[str] = []
-    times: dict = {}
-    if submissions.suffix == '.zip':
-        submissions, refused = collect_zip(submissions, course, times,
-                                           term.deadlines.zip_time_zone)
-    learners, not_learners = find_learners(submissions, notebooks)
-    for learner in learners:  # a platform zip's times, where its folder had no timestamp.txt
-        learner.handed_in.update({n: times[learner.name, p.name]
-                                  for n, p in learner.files.items() if n not in learner.handed_in
-                                  and (learner.name, p.name) in times})
-    refused += not_learners
+    try:
+        submissions, learners, refused = _find(submissions, course, notebooks, term)
+    except (SubmissionProblem, TimeProblem) as problem:
+        print(problem)
+        return 2
     for line in refused:
         print(f'not graded: {line}')
     if not learners:
         print(f'{submissions} has no learner folders (<learner>/NN-title.ipynb).')
         return 2
+    extended, mistakes = with_extensions(term, args, notebooks, learners)
+    for line in mistakes:
+        print(line)
+    if extended is None:
+        return 2
+    term = extended
     learners = with_roster(learners, term.roster)
     graded = learners
     if args.learner:
@@ -357,8 +357,11 @@ def _grade_with(cluster: Optional['Cluster'], args: argparse.Namespace, submissi
     else:
         _grade_all_on(cluster, course, graded, notebooks, learners)
     save_state(out, learners)
-    rows = write_results(course, out, learners, notebooks, term.deadlines)
-    export(term, course, out, learners, notebooks)
+    rows = write_results(course, out, learners, notebooks, term.deadlines, term.extensions)
+    if term.export:
+        for line in export(out, term.export, term.roster, term.deadlines, term.extensions,
+                           learners=learners):
+            print(f'export: {line}')
     _report(out, learners, rows, refused, settings.seed)
     try:
         write_report(out, learners, notebooks, rows, refused)
@@ -368,6 +371,27 @@ def _grade_with(cluster: Optional['Cluster'], args: argparse.Namespace, submissi
     print(f'wrote {args.out.resolve() / "grades.csv"} and {args.out.resolve() / "feedback"} in '
           f'{time.monotonic() - started:.0f} s')
     return 0
+
+
+def _find(submissions: Path, course: Path, notebooks: list[str], term: Term
+          ) -> tuple[Path, list[Learner], list[str]]:
+    """The learners of ``submissions`` (a folder, or a platform's zip taken in through
+    nbgrader's ``zip_collect``), with their hand-in times; also the folder they are in, and
+    one line per entry not graded.
+
+    :raises SubmissionProblem, TimeProblem: for a hand-in time the grader does not read.
+    """
+    refused: list[str] = []
+    times: dict = {}
+    if submissions.suffix == '.zip':
+        submissions, refused = collect_zip(submissions, course, times,
+                                           term.deadlines.zip_time_zone, term.canvas_learners())
+    learners, not_learners = find_learners(submissions, notebooks)
+    for learner in learners:  # a platform zip's times, where its folder had no timestamp.txt
+        learner.handed_in.update({n: times[learner.name, p.name]
+                                  for n, p in learner.files.items() if n not in learner.handed_in
+                                  and (learner.name, p.name) in times})
+    return submissions, learners, refused + not_learners
 
 
 if __name__ == '__main__':

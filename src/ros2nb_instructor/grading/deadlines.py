@@ -1,32 +1,31 @@
 """Due dates and the late policy: the course's settings file (``course.toml``), read and checked.
 
 Runs on the instructor's host.  The instructor writes, per notebook, when it is due (a date and
-time with its time zone) and what handing it in late costs; grading compares that with the time
-the submission itself says it was handed in (:mod:`.submissions`: nbgrader's ``timestamp.txt``,
-or a platform zip's entry times), never with the grader's clock.  The penalty is computed by a
+time with its offset, or in a named zone: :mod:`.due_dates`) and what handing it in late costs;
+a learner may have a later due date of their own (:mod:`.extensions`).  Grading compares that
+with the time the submission itself says it was handed in (:mod:`.hand_in_times`: the hub's
+hand-in record, nbgrader's ``timestamp.txt``, a platform zip's entry times), never with the
+grader's clock.  The penalty is computed by a
 plugin of nbgrader's own late-submission interface (:class:`LatePenalty`), and kept beside the
 raw score: nbgrader's gradebook, ``grades.csv``, the feedback page and ``report.html`` show both.
 
-A mistake in the file is one line each, saying what to write instead
-(:exc:`SettingsProblem`); grading does not start with any.
+The file is read by :mod:`.course_settings`: a mistake is one line each, saying what to write
+instead (:exc:`SettingsProblem`); grading does not start with any.
 """
 
 from __future__ import annotations
 
 import datetime
 import math
-import sys
+import dataclasses
 from dataclasses import dataclass, replace
-from pathlib import Path
-from typing import Any, Mapping, Optional
+from typing import Mapping, Optional
 
 from nbgrader.plugins import LateSubmissionPlugin
 from traitlets import Enum, Float
 
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - Python 3.10
-    import tomli as tomllib
+from . import due_dates
+from .mistakes import Mistakes
 
 #: The penalties a policy may have: none, or a share of the score per day or hour begun.
 PENALTIES = ('none', 'per-day', 'per-hour')
@@ -40,18 +39,14 @@ POLICY_KEYS = {'penalty': 'one of "none", "per-day", "per-hour"',
                'cap_percent': 'a number from 0 to 100 (the most lateness may cost)',
                'grace_minutes': 'a number of minutes, 0 or more',
                'cutoff_hours': 'a number of hours, 0 or more (later than that: 0 points)',
-               'without_time': 'one of "on-time", "zero"',
-               'zip_time_zone': 'a time zone name such as "Europe/Berlin" or "UTC"'}
-#: An example of a due date, for the line of a mistake.
-EXAMPLE_DUE = '2026-10-05T23:59:00+02:00'
+               'without_time': 'one of "on-time", "zero"'}
+#: Keys of a table that are not the policy's: the zone its due dates are in (any table),
+#: and the zone of a zip entry's time that carries none ([late] only).
+ZONE_KEYS = ('time_zone', 'zip_time_zone')
 
 
-class SettingsProblem(Exception):
+class SettingsProblem(Mistakes):
     """The settings file cannot be used: ``lines`` holds one line per mistake."""
-
-    def __init__(self, lines: list[str]) -> None:
-        super().__init__('\n'.join(lines))
-        self.lines = lines
 
 
 @dataclass(frozen=True)
@@ -82,11 +77,14 @@ class CourseSettings:
 
     :ivar zip_time_zone: the zone of a zip entry's time that carries none (a zip stores local
         time unless its maker added the UTC time).
+    :ivar zones: notebook -> the named zone its due dates are in (``time_zone``), where one
+        is set; an extension's local time is read there.
     """
 
     due: Mapping[str, datetime.datetime]
     policies: Mapping[str, Policy]
     zip_time_zone: datetime.tzinfo = datetime.timezone.utc
+    zones: Mapping[str, datetime.tzinfo] = dataclasses.field(default_factory=dict)
 
     def policy(self, notebook: str) -> Policy:
         return self.policies.get(notebook, Policy())
@@ -124,6 +122,8 @@ class Lateness:
     :ivar late_s: seconds after the due date (0 when on time or nothing is due).
     :ivar raw: the score nbgrader gave; :ivar penalty: the points lateness cost.
     :ivar note: the sentence for notes.json and the feedback ('' when on time).
+    :ivar class_due: the class's due date where the learner has an extension (``due`` is
+        theirs), else None.
     """
 
     due: Optional[datetime.datetime]
@@ -133,6 +133,7 @@ class Lateness:
     raw: float
     penalty: float
     note: str = ''
+    class_due: Optional[datetime.datetime] = None
 
     @property
     def final(self) -> float:
@@ -143,11 +144,18 @@ class Lateness:
         ('' when the submission says none), both in the due date's time zone, to the second:
         the two compare at a glance."""
         zone = self.due.tzinfo if self.due else None
-        due = self.due.isoformat(sep=' ', timespec='seconds') if self.due else ''
+        due = due_dates.shown(self.due) if self.due else ''
         if self.handed_in is None:
             return due, ''
         when = self.handed_in.astimezone(zone) if zone else self.handed_in
         return due, f'{when.isoformat(sep=" ", timespec="seconds")} ({self.source})'
+
+    def extension(self) -> str:
+        """The learner's extension in words ('' without one): ``to`` their due date, then
+        the class's in brackets, each as :func:`.due_dates.shown` writes it."""
+        if self.class_due is None or self.due is None:
+            return ''
+        return f'to {due_dates.shown(self.due)} (the class\'s: {due_dates.shown(self.class_due)})'
 
 
 def late_by(seconds: float) -> str:
@@ -161,141 +169,40 @@ def late_by(seconds: float) -> str:
 
 
 def assess(settings: CourseSettings, notebook: str, raw: float,
-           handed_in: Optional[tuple[datetime.datetime, str]]) -> Lateness:
+           handed_in: Optional[tuple[datetime.datetime, str]],
+           extension: Optional[datetime.datetime] = None) -> Lateness:
     """What lateness costs a notebook that scored ``raw`` (its final score is
     :attr:`Lateness.final`).
 
     :param handed_in: the time the submission says it was handed in, and where that came
         from; None when it says nothing.
+    :param extension: the learner's own due date of ``notebook`` (:mod:`.extensions`), which
+        replaces the class's; None for the class's.
     """
-    due = settings.due.get(notebook)
+    class_due = settings.due.get(notebook)
+    due = extension or class_due
     when, source = handed_in if handed_in else (None, '')
     if due is None:
         return Lateness(None, when, source, 0.0, raw, 0.0)
+    late = Lateness(due, when, source, 0.0, raw, 0.0,
+                    class_due=class_due if extension else None)
     policy = settings.policy(notebook)
     if when is None:
         if policy.without_time == 'zero':
-            return Lateness(due, None, '', 0.0, raw, raw, 'no hand-in time in the submission '
-                                                          '(the policy scores that 0)')
-        return Lateness(due, None, '', 0.0, raw, 0.0, 'no hand-in time in the submission: '
-                                                      'graded as on time')
+            return replace(late, penalty=raw, note='no hand-in time in the submission (the '
+                                                   'policy scores that 0)')
+        return replace(late, note='no hand-in time in the submission: graded as on time')
     late_s = max(0.0, (when - due).total_seconds())
     if late_s <= policy.grace_minutes * 60:
-        return Lateness(due, when, source, 0.0, raw, 0.0)
-    said = f'handed in {late_by(late_s)} after the due date ({source})'
+        return late
+    yours = ' (your extension\'s)' if extension else ''
+    said = f'handed in {late_by(late_s)} after the due date{yours} ({source})'
     if policy.cutoff_hours is not None and late_s > policy.cutoff_hours * 3600:
-        return Lateness(due, when, source, late_s, raw, raw,
-                        f'{said}, past the cutoff of {late_by(policy.cutoff_hours * 3600)}: '
-                        f'0 points (it scored {raw:g})')
+        return replace(late, late_s=late_s, penalty=raw,
+                       note=f'{said}, past the cutoff of {late_by(policy.cutoff_hours * 3600)}: '
+                            f'0 points (it scored {raw:g})')
     plugin = LatePenalty(per=policy.penalty, percent=policy.percent,
                          cap_percent=policy.cap_percent, grace_s=policy.grace_minutes * 60)
     penalty = min(raw, plugin.late_submission_penalty('', raw, late_s) or 0.0)
     cost = f': {penalty:g} points off' if penalty else ': no penalty'
-    return Lateness(due, when, source, late_s, raw, penalty, said + cost)
-
-
-def read_settings(path: Path, notebooks: list[str]) -> CourseSettings:
-    """The course's settings file at ``path`` (TOML), checked against the course's
-    ``notebooks``; :data:`NO_DEADLINES` when there is no file.
-
-    :raises SettingsProblem: with one line per mistake, each saying what to write instead.
-    """
-    if not path.is_file():
-        return NO_DEADLINES
-    try:
-        data = tomllib.loads(path.read_text())
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as error:
-        raise SettingsProblem([f'{path}: not TOML ({error}); see docs/instructors.md, '
-                               '"A term, step by step", for an example']) from None
-    lines: list[str] = []
-    default = _policy(data.get('late', {}), Policy(), f'{path} [late]', lines)
-    due, policies = {}, {}
-    notebooks_table = data.get('notebooks', {})
-    for key in sorted(set(data) - {'late', 'notebooks'}):
-        lines.append(f'{path}: unknown section [{key}]: write [late] or [notebooks.NN-title]')
-    for notebook, table in notebooks_table.items() if isinstance(notebooks_table, dict) else ():
-        where = f'{path} [notebooks.{notebook}]'
-        if notebook not in notebooks:
-            near = [n for n in notebooks if n[:2] == notebook[:2]]
-            lines.append(f'{where}: no notebook {notebook!r} in the course: write one of its '
-                         f'names, such as {(near or notebooks)[0]!r}')
-            continue
-        if not isinstance(table, dict):
-            lines.append(f'{where}: write a table with due = {EXAMPLE_DUE}')
-            continue
-        when = _due(table.get('due'), where, lines)
-        if when is not None:
-            due[notebook] = when
-        policies[notebook] = _policy({k: v for k, v in table.items() if k != 'due'}, default,
-                                     where, lines)
-    zone = _zone(data.get('late', {}).get('zip_time_zone', 'UTC'), f'{path} [late]', lines)
-    if lines:
-        raise SettingsProblem(lines)
-    return CourseSettings(due, {n: policies.get(n, default) for n in notebooks}, zone)
-
-
-def _due(value: Any, where: str, lines: list[str]) -> Optional[datetime.datetime]:
-    """A due date: a TOML date-time with its offset (or a string of one)."""
-    if isinstance(value, str):
-        try:
-            value = datetime.datetime.fromisoformat(value)
-        except ValueError:
-            lines.append(f'{where}: due = {value!r} is not a date and time: write due = '
-                         f'{EXAMPLE_DUE} (with its time zone)')
-            return None
-    if not isinstance(value, datetime.datetime):
-        lines.append(f'{where}: due is missing or not a date and time: write due = '
-                     f'{EXAMPLE_DUE} (with its time zone)')
-        return None
-    if value.tzinfo is None or value.utcoffset() is None:
-        lines.append(f'{where}: due = {value.isoformat()} has no time zone: write it with its '
-                     f'offset, such as due = {value.isoformat()}+02:00 (or Z for UTC)')
-        return None
-    return value
-
-
-def _policy(table: Any, base: Policy, where: str, lines: list[str]) -> Policy:
-    """``base`` with the policy keys ``table`` sets; one line per wrong key or value."""
-    if not isinstance(table, dict):
-        lines.append(f'{where}: write a table of the late policy\'s keys')
-        return base
-    changes: dict[str, Any] = {}
-    for key, value in table.items():
-        if key == 'zip_time_zone' and where.endswith('[late]'):
-            continue
-        if key not in POLICY_KEYS or key == 'zip_time_zone':
-            lines.append(f'{where}: unknown key {key!r}: write one of '
-                         f'{", ".join(k for k in POLICY_KEYS if k != "zip_time_zone")}')
-            continue
-        wrong = _wrong(key, value)
-        if wrong:
-            lines.append(f'{where}: {key} = {value!r} {wrong}: write {key} = '
-                         f'{POLICY_KEYS[key]}')
-            continue
-        changes[key] = float(value) if key not in ('penalty', 'without_time') else value
-    return replace(base, **changes)
-
-
-def _wrong(key: str, value: Any) -> str:
-    """Why ``value`` cannot be ``key``'s ('' when it can)."""
-    if key == 'penalty':
-        return '' if value in PENALTIES else 'is not a penalty'
-    if key == 'without_time':
-        return '' if value in WITHOUT_TIME else 'is not a choice'
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        return 'is not a number'
-    if value < 0:
-        return 'is negative'
-    if key in ('percent', 'cap_percent') and value > 100:
-        return 'is more than 100'
-    return ''
-
-
-def _zone(name: Any, where: str, lines: list[str]) -> datetime.tzinfo:
-    import zoneinfo
-    try:
-        return zoneinfo.ZoneInfo(str(name))
-    except (zoneinfo.ZoneInfoNotFoundError, ValueError):
-        lines.append(f'{where}: zip_time_zone = {name!r} is no time zone: write '
-                     f'zip_time_zone = {POLICY_KEYS["zip_time_zone"].split(" such as ")[1]}')
-        return datetime.timezone.utc
+    return replace(late, late_s=late_s, penalty=penalty, note=said + cost)

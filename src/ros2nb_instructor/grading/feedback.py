@@ -84,16 +84,17 @@ def flags_html(flags: Sequence[str]) -> str:
 
 
 def late_html(late: Optional[Lateness]) -> str:
-    """A notebook's lateness as the box of the feedback page that says when it was due and
-    handed in (both in the due date's time zone), its score before lateness, the penalty and
-    its score (empty when it had no due date)."""
+    """A notebook's lateness as the box of the feedback page that says when it was due (the
+    learner's extension, if they have one, beside the class's due date) and handed in (both
+    in the due date's time zone), its score before lateness, the penalty and its score
+    (empty when it had no due date)."""
     if late is None or late.due is None:
         return ''
     due, when = late.shown()
     return render('late.html.j2', late={
         'due': due, 'handed_in': when or 'the submission says no time', 'raw': f'{late.raw:g}',
         'penalty': f'{late.penalty:g}', 'final': f'{late.final:g}', 'note': late.note,
-        'cost': late.penalty > 0})
+        'cost': late.penalty > 0, 'extension': late.extension()})
 
 
 #: The boxes above nbgrader's feedback (:func:`safe_feedback`): bootstrap's panels, which

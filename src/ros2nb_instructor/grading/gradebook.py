@@ -8,7 +8,7 @@ for the scoring run: every notebook was run in a sandbox and judged before).
 from __future__ import annotations
 
 import contextlib
-import csv
+import datetime
 import fcntl
 import hashlib
 import json
@@ -27,7 +27,11 @@ from ros2nb import graded_parts
 from ..paths import ASSIGNMENT, ROOT, SOLUTIONS, gradebook_url
 from . import feedback
 from .deadlines import NO_DEADLINES, CourseSettings, Lateness, assess
-from .submissions import Learner, screen_zip
+from .extensions import NONE as NO_EXTENSIONS
+from .extensions import Extensions
+from .spreadsheets import write_csv
+from .submissions import Learner
+from .zips import screen_zip
 
 #: nbgrader's command, from the course's venv (or conda environment).
 NBGRADER = str(Path(sys.executable).with_name('nbgrader'))
@@ -120,17 +124,20 @@ def _generate_course(kept: Path) -> None:
 
 
 def collect_zip(archive: Path, course: Path, times: Optional[dict] = None,
-                zone: Any = None) -> tuple[Path, list[str]]:
+                zone: Any = None, canvas_learners: Optional[dict[str, str]] = None
+                ) -> tuple[Path, list[str]]:
     """nbgrader's ``zip_collect`` on a screened copy of a platform download.
 
-    :param times: filled with the hand-in times the archive says (:func:`.submissions.screen_zip`),
+    :param times: filled with the hand-in times the archive says (:func:`.zips.screen_zip`),
         a zone-less entry time taken in ``zone`` (default UTC).
+    :param canvas_learners: Canvas user id -> learner (the roster's), for Canvas's zip.
     :return: the folder of learner folders, and one line per member refused.
+    :raises .hand_in_times.TimeProblem: for a time in the archive the grader does not read.
     """
     downloaded = course / 'downloaded' / ASSIGNMENT / 'archive'
     downloaded.mkdir(parents=True)
     refused = screen_zip(archive, downloaded / archive.name, times,
-                         *([zone] if zone is not None else []))
+                         zone if zone is not None else datetime.timezone.utc, canvas_learners)
     regexp = r'.*/extracted/(?:.*/)?(?P<student_id>[^/]+)/(?P<file_id>[^/]+\.ipynb)$'
     code = nbgrader(course, 'zip_collect', ASSIGNMENT, '--force',
                     f'--FileNameCollectorPlugin.named_regexp={regexp}', log=course / 'grading.log')
@@ -177,13 +184,14 @@ CSV_COLUMNS = ['learner', 'notebook', 'score', 'max_score', 'raw_score', 'late_p
 
 
 def write_results(course: Path, out: Path, learners: list[Learner], notebooks: list[str],
-                  deadlines: CourseSettings = NO_DEADLINES) -> list[list[str]]:
+                  deadlines: CourseSettings = NO_DEADLINES,
+                  extensions: Extensions = NO_EXTENSIONS) -> list[list[str]]:
     """grades.csv from nbgrader's gradebook, and the feedback files; return the CSV rows
     (:data:`CSV_COLUMNS`; learner's name as shown, then a TOTAL row per learner).
 
-    A handed-in notebook's lateness (:func:`.deadlines.assess`) goes into the learner's
-    ``late`` and notes, and into nbgrader's gradebook as its late submission penalty (so
-    ``nbgrader export`` and the formgrader show it too)."""
+    A handed-in notebook's lateness (:func:`.deadlines.assess`, with the learner's extension)
+    goes into the learner's ``late`` and notes, and into nbgrader's gradebook as its late
+    submission penalty (so ``nbgrader export`` and the formgrader show it too)."""
     rows = []
     with Gradebook(gradebook_url(course)) as gb:
         maxima = {nb.name: nb.max_score for nb in gb.find_assignment(ASSIGNMENT).notebooks}
@@ -200,7 +208,8 @@ def write_results(course: Path, out: Path, learners: list[Learner], notebooks: l
                 raw = scored.score if scored is not None else 0.0
                 late = None
                 if notebook in learner.files:
-                    late = assess(deadlines, notebook, raw, learner.handed_in.get(notebook))
+                    late = assess(deadlines, notebook, raw, learner.handed_in.get(notebook),
+                                  extensions.of(learner.name, notebook))
                     learner.late[notebook] = late
                     if late.note:
                         learner.note(notebook, late.note)
@@ -215,10 +224,7 @@ def write_results(course: Path, out: Path, learners: list[Learner], notebooks: l
             rows.append([learner.shown, 'TOTAL', f'{total:g}', f'{sum(maxima.values()):g}',
                          f'{raw_total:g}', f'{raw_total - total:g}', '', ''])
         gb.db.commit()
-    with open(out / 'grades.csv', 'w', newline='') as stream:
-        writer = csv.writer(stream)
-        writer.writerow(CSV_COLUMNS)
-        writer.writerows([spreadsheet_safe(row[0]), *row[1:]] for row in rows)
+    write_csv(out / 'grades.csv', CSV_COLUMNS, rows)
     return rows
 
 
@@ -246,17 +252,6 @@ def _feedback_page(course: Path, folder: Path, learner: Learner, notebook: str,
                f'{str(error)[:200]}); the score stands')
         learner.note(notebook, why)
         page.write_text(feedback.page(notebook, feedback.render('paragraph.html.j2', text=why)))
-
-
-#: What makes a spreadsheet read a cell as a formula (OWASP, "CSV Injection").
-FORMULA_STARTS = ('=', '+', '-', '@', '\t', '\r')
-
-
-def spreadsheet_safe(text: str) -> str:
-    """``text`` as a spreadsheet shows it as a value, never runs it: a cell beginning with
-    ``=``, ``+``, ``-``, ``@``, a tab or a carriage return gets a ``'`` in front (the rest
-    stays as the learner's folder is named).  Used for ``grades.csv``'s learner column."""
-    return f"'{text}" if text.startswith(FORMULA_STARTS) else text
 
 
 class Scoring:

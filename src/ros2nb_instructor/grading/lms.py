@@ -1,203 +1,140 @@
 """Grades a learning platform imports: Canvas's and Moodle's gradebook CSV, and a plain CSV.
 
-Runs on the instructor's host, after nbgrader scored the class (``make grade ... EXPORT=canvas``).
-Each format is an nbgrader export plugin (:class:`nbgrader.plugins.ExportPlugin`: ``to``, and
-``export(gradebook)``), given the roster and the learners' names by :mod:`.term`. A score is
-nbgrader's, less the late penalty grading stored beside it (:mod:`.deadlines`). A roster (CSV,
-:func:`read_roster`) maps the course's learner names (their folders) to the platform's ids: a
-learner of the roster with nothing handed in gets 0 on every notebook, with a note; a learner who
-handed in and is not in the roster is written to ``not-in-roster.csv`` beside the export, with their
-scores, and named on the console.
+Runs on the instructor's host (``make export``, or ``make grade ... EXPORT=canvas``).  This
+module only lays out a :class:`Table` of marks (made by :mod:`.exporting` from nbgrader's
+gradebook) in each platform's import format; every cell goes through
+:func:`.spreadsheets.safe_cell`.  A blank cell is "no mark yet" on both platforms, never 0.
 
-The columns follow the platforms' documented imports (docs/instructors.md cites the pages):
-Canvas matches a row by ``ID``, ``SIS User ID`` or ``SIS Login ID`` and reads one column per
-assignment, with the points of each in a ``Points Possible`` row; Moodle maps a column of its
-choice (``ID number``, ``Username`` or ``Email address``) to its users, and one column per
-grade item.
+The layouts follow each importer's own source:
+
+- **Canvas** (canvas-lms, ``lib/gradebook_importer.rb``): a header row that starts
+  ``Student``, ``ID``, then ``SIS User ID``, ``SIS Login ID`` and ends its learner columns
+  with ``Section``; then one column per assignment (a new one is made for an unknown
+  title); a row whose first cell is ``Points Possible`` sets each new assignment's points; a
+  learner is found by ``ID``, else by SIS User ID or SIS Login ID, else by name; a blank or
+  ``-`` cell is no score.
+- **Moodle** (``grade/import/csv/classes/load_data.php``; docs.moodle.org, "Grade import"):
+  any columns, each mapped at import: a user column (``ID number`` to ``useridnumber``,
+  ``Email address`` to ``useremail``, ``Username`` to ``username``), each notebook's column
+  to a grade item and its ``Feedback for ...`` column to that item's feedback; a blank or
+  ``-`` grade is no grade.  A CSV cannot carry a grade item's maximum: a column mapped to
+  "new grade item" gets Moodle's default maximum of 100, so map each notebook's column to a
+  grade item you made with that notebook's points (:func:`moodle_items` says them).
+- **csv**: ``learner``, one column per notebook, ``total``.
 """
 
 from __future__ import annotations
 
-import csv
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Optional
+from typing import Mapping, Optional, Sequence
 
-from nbgrader.api import Gradebook, MissingEntry
-from nbgrader.plugins import ExportPlugin
-from traitlets import Dict, List, Unicode
+from .roster import Roster, RosterRow
+from .spreadsheets import Cell, write_csv
 
-from ..paths import ASSIGNMENT
-
-#: The roster's columns: ``learner`` (the folder's name) and the platform's ids.
-ROSTER_COLUMNS = ('learner', 'name', 'first_name', 'last_name', 'lms_id', 'sis_id', 'login',
-                  'email', 'section')
 #: Canvas's gradebook import: the learner's columns, then one per assignment.
 CANVAS_COLUMNS = ('Student', 'ID', 'SIS User ID', 'SIS Login ID', 'Section')
-#: Moodle's grade import (CSV): the user's columns, then one per grade item.
+#: Moodle's grade import (CSV): the user's columns, then each notebook and its feedback.
 MOODLE_COLUMNS = ('First name', 'Last name', 'ID number', 'Username', 'Email address')
-#: The roster ids each platform can match a row by.
-MATCHED_BY = {'canvas': ('lms_id', 'sis_id', 'login'), 'moodle': ('sis_id', 'login', 'email'),
-              'csv': ()}
+#: Moodle's own name of an item's feedback column in its CSV export.
+MOODLE_FEEDBACK = 'Feedback for {}'
+#: The platforms an export is written for.
+PLATFORMS = ('canvas', 'moodle', 'csv')
+#: What the file of the learners who are not in the roster is called, beside the export.
+NOT_IN_ROSTER = 'not-in-roster.csv'
 
 
-class RosterProblem(Exception):
-    """The roster cannot be used: ``lines`` holds one line per mistake."""
+@dataclass(frozen=True)
+class Mark:
+    """One learner's mark of one notebook, as an export writes it.
 
-    def __init__(self, lines: list[str]) -> None:
-        super().__init__('\n'.join(lines))
-        self.lines = lines
+    :ivar score: the points it counts (after lateness); None: blank, no mark yet (not
+        handed in and not yet due for this learner).
+    :ivar feedback: one line for a platform's feedback column.
+    """
+
+    score: Optional[float]
+    feedback: str = ''
 
 
-@dataclass
+@dataclass(frozen=True)
 class Table:
-    """The class's final scores, as an export writes them.
+    """The marks an export writes, built once.
 
-    :ivar scores: learner's name -> notebook -> score (after lateness).
+    :ivar notebooks: the notebooks exported (each a column), in course order.
     :ivar maxima: notebook -> its points.
-    :ivar notes: learner's name -> what the export says of them.
+    :ivar marks: learner -> notebook -> their mark, for every learner graded or on the roster.
     """
 
-    notebooks: list[str]
-    maxima: dict[str, float]
-    scores: dict[str, dict[str, float]] = field(default_factory=dict)
-    notes: dict[str, str] = field(default_factory=dict)
+    notebooks: tuple[str, ...]
+    maxima: Mapping[str, float]
+    marks: Mapping[str, Mapping[str, Mark]] = field(default_factory=dict)
+
+    def cells(self, learner: str) -> list[Cell]:
+        """The learner's score cells, blank where they have no mark."""
+        marks = self.marks.get(learner, {})
+        return [_cell(marks.get(n, Mark(None))) for n in self.notebooks]
+
+    def total(self, learner: str) -> float:
+        """The learner's points in the exported notebooks."""
+        return sum(m.score or 0.0 for m in self.marks.get(learner, {}).values())
 
 
-def read_roster(path: Path, lms: str) -> dict[str, dict[str, str]]:
-    """The roster at ``path`` (CSV, a header row of :data:`ROSTER_COLUMNS`): learner -> row.
+def _cell(mark: Mark) -> Cell:
+    return '' if mark.score is None else mark.score
 
-    :raises RosterProblem: one line per mistake: no ``learner`` column, a column the roster
-        does not have, a learner twice, a row with none of the ids ``lms`` matches by.
+
+def write(lms: str, table: Table, roster: Optional[Roster], path: Path) -> list[str]:
+    """Write ``table`` for ``lms`` (:data:`PLATFORMS`) to ``path``, a row per roster learner
+    (every learner of ``table`` without a roster); the learners not in ``roster`` go to
+    :data:`NOT_IN_ROSTER` beside it.
+
+    :return: one line per learner who has marks and is not in the roster.
     """
-    try:
-        with open(path, newline='', encoding='utf-8-sig') as stream:
-            rows = list(csv.DictReader(stream))
-            header = list(rows[0]) if rows else []
-    except (OSError, UnicodeDecodeError, csv.Error) as error:
-        raise RosterProblem([f'{path}: cannot be read as CSV ({error}): write a CSV file with '
-                             f'a header row of {", ".join(ROSTER_COLUMNS)}']) from None
-    lines = []
-    if 'learner' not in header:
-        raise RosterProblem([f'{path}: no "learner" column: write a header row such as '
-                             'learner,name,sis_id,login,email (learner: the folder\'s name)'])
-    lines += [f'{path}: unknown column {c!r}: write one of {", ".join(ROSTER_COLUMNS)}'
-              for c in header if c not in ROSTER_COLUMNS]
-    roster: dict[str, dict[str, str]] = {}
-    for number, row in enumerate(rows, start=2):
-        name = (row.get('learner') or '').strip()
-        if not name:
-            lines.append(f'{path} line {number}: no learner: write the learner\'s folder name')
-        elif name in roster:
-            lines.append(f'{path} line {number}: {name} is in the roster twice: keep one row')
-        elif MATCHED_BY[lms] and not any((row.get(k) or '').strip() for k in MATCHED_BY[lms]):
-            lines.append(f'{path} line {number}: {name} has none of the ids {lms} matches by: '
-                         f'write one of {", ".join(MATCHED_BY[lms])}')
-        else:
-            roster[name] = {k: (v or '').strip() for k, v in row.items() if k}
-    if lines:
-        raise RosterProblem(lines)
-    return roster
-
-
-def _name(row: dict[str, str], learner: str) -> tuple[str, str]:
-    """A learner's first and last name from the roster (its ``name`` split at the last space
-    when it has no first_name/last_name)."""
-    first, last = row.get('first_name', ''), row.get('last_name', '')
-    if not (first or last):
-        first, _, last = (row.get('name') or learner).rpartition(' ')
-        first, last = (first, last) if first else (last, '')
-    return first, last
-
-
-def write(lms: str, table: Table, roster: Optional[dict[str, dict[str, str]]],
-          path: Path) -> list[str]:
-    """Write ``table`` for ``lms`` (``canvas``, ``moodle``, ``csv``) to ``path``; the learners
-    not in ``roster`` go to ``not-in-roster.csv`` beside it.  Return one line per learner
-    who was handed in but is not in the roster, and per roster learner with nothing handed in."""
-    roster = roster if roster is not None else {name: {'learner': name} for name in table.scores}
-    lines = [f'{name}: handed in, not in the roster: written to {path.parent}/not-in-roster.csv'
-             for name in table.scores if name not in roster]
-    for name in roster:
-        if name not in table.scores:
-            table.notes[name] = 'in the roster, nothing handed in: 0 points'
-            lines.append(f'{name}: {table.notes[name]}')
-    score = {name: {n: table.scores.get(name, {}).get(n, 0.0) for n in table.notebooks}
-             for name in roster}
-    cells = [[f'{score[name][n]:g}' for n in table.notebooks] for name in roster]
-    with open(path, 'w', newline='', encoding='utf-8') as stream:
-        out = csv.writer(stream)
-        if lms == 'canvas':
-            out.writerow([*CANVAS_COLUMNS, *table.notebooks])
-            out.writerow(['Points Possible', '', '', '', '',
-                          *(f'{table.maxima[n]:g}' for n in table.notebooks)])
-            for (name, row), got in zip(roster.items(), cells):
-                first, last = _name(row, name)
-                student = f'{last}, {first}' if last and first else (last or first)
-                out.writerow([student, row.get('lms_id', ''), row.get('sis_id', ''),
-                              row.get('login', ''), row.get('section', ''), *got])
-        elif lms == 'moodle':
-            out.writerow([*MOODLE_COLUMNS, *table.notebooks])
-            for (name, row), got in zip(roster.items(), cells):
-                out.writerow([*_name(row, name), row.get('sis_id', ''), row.get('login', ''),
-                              row.get('email', ''), *got])
-        else:
-            out.writerow(['learner', *table.notebooks, 'total'])
-            for name, got in zip(roster, cells):
-                out.writerow([name, *got, f'{sum(score[name].values()):g}'])
-    extra = [name for name in table.scores if name not in roster]
+    rows = roster if roster is not None else {name: RosterRow(name) for name in table.marks}
+    header, body = _layout(lms, table, rows)
+    write_csv(path, header, body)
+    extra = [name for name in table.marks if name not in rows]
     if extra:
-        with open(path.parent / 'not-in-roster.csv', 'w', newline='', encoding='utf-8') as stream:
-            out = csv.writer(stream)
-            out.writerow(['learner', *table.notebooks, 'total'])
-            for name in extra:
-                points = [table.scores[name].get(n, 0.0) for n in table.notebooks]
-                out.writerow([name, *(f'{g:g}' for g in points), f'{sum(points):g}'])
-    return lines
+        write_csv(path.parent / NOT_IN_ROSTER, ['learner', *table.notebooks, 'total'],
+                  [[name, *table.cells(name), table.total(name)] for name in extra])
+    return [f'{name}: graded, not in the roster: written to {path.parent / NOT_IN_ROSTER}'
+            for name in extra]
 
 
-class CourseExport(ExportPlugin):
-    """An nbgrader export plugin for one platform: nbgrader's scores less the late penalties,
-    one column per notebook, for the roster's learners.
-
-    :ivar names: nbgrader's student id -> the learner's name (their folder).
-    """
-
-    lms = Unicode('csv').tag(config=True)
-    roster = Dict(allow_none=True, default_value=None).tag(config=True)
-    names = Dict().tag(config=True)
-    notebooks: List[str] = List().tag(config=True)
-    said: List[str] = List()
-
-    def export(self, gradebook: Gradebook) -> None:
-        """Write the export to ``to`` (``said``: the lines about missing and extra learners)."""
-        assignment = gradebook.find_assignment(ASSIGNMENT)
-        maxima = {nb.name: nb.max_score for nb in assignment.notebooks}
-        table = Table(list(self.notebooks) or sorted(maxima), maxima)
-        for student_id, name in self.names.items():
-            table.scores[name] = {n: _final(gradebook, n, student_id) for n in table.notebooks}
-        self.said = write(self.lms, table, self.roster, Path(self.to))
-
-
-def _final(gradebook: Gradebook, notebook: str, student_id: str) -> float:
-    try:
-        scored: Any = gradebook.find_submission_notebook(notebook, ASSIGNMENT, student_id)
-    except MissingEntry:
-        return 0.0
-    return max(0.0, scored.score - (scored.late_submission_penalty or 0.0))
-
-
-class CanvasExport(CourseExport):
-    """Canvas's gradebook import (``EXPORT=canvas``)."""
-
-    lms = Unicode('canvas').tag(config=True)
+def _layout(lms: str, table: Table, rows: Roster
+            ) -> tuple[list[str], list[Sequence[Cell]]]:
+    """The header and rows of ``lms``'s file."""
+    if lms == 'canvas':
+        points: list[Cell] = ['Points Possible', '', '', '', '',
+                              *(table.maxima[n] for n in table.notebooks)]
+        body: list[Sequence[Cell]] = [points]
+        for name, row in rows.items():
+            first, last = row.names()
+            student = f'{last}, {first}' if last and first else (last or first)
+            body.append([student, row.lms_id, row.sis_id, row.login, row.section,
+                         *table.cells(name)])
+        return [*CANVAS_COLUMNS, *table.notebooks], body
+    if lms == 'moodle':
+        header = [*MOODLE_COLUMNS]
+        for notebook in table.notebooks:
+            header += [notebook, MOODLE_FEEDBACK.format(notebook)]
+        body = []
+        for name, row in rows.items():
+            marks = table.marks.get(name, {})
+            cells: list[Cell] = [*row.names(), row.sis_id, row.login, row.email]
+            for notebook in table.notebooks:
+                mark = marks.get(notebook, Mark(None))
+                cells += [_cell(mark), mark.feedback]
+            body.append(cells)
+        return header, body
+    return (['learner', *table.notebooks, 'total'],
+            [[name, *table.cells(name), table.total(name)] for name in rows])
 
 
-class MoodleExport(CourseExport):
-    """Moodle's CSV grade import (``EXPORT=moodle``)."""
-
-    lms = Unicode('moodle').tag(config=True)
-
-
-#: ``EXPORT=``'s choices and their plugins.
-EXPORTS = {'canvas': CanvasExport, 'moodle': MoodleExport, 'csv': CourseExport}
+def moodle_items(table: Table) -> str:
+    """The grade items Moodle needs before the import, in one line: each notebook's column
+    and the maximum grade its item must have (a CSV cannot say it)."""
+    items = ', '.join(f'{n} {table.maxima[n]:g}' for n in table.notebooks)
+    return ('Moodle: map each notebook\'s column to a grade item whose maximum grade is its '
+            f'points ({items}); a new grade item would get Moodle\'s maximum of 100')

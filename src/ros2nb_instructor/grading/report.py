@@ -142,8 +142,9 @@ def _alike(notebooks: list[str], learners: list[Learner], course: Path) -> dict[
 
 
 def _late_rows(notebooks: list[str], learners: list[Learner]) -> list[dict[str, object]]:
-    """Per learner and notebook with a due date: when it was due and handed in, its score
-    before lateness, the penalty, its score, and the note (:mod:`.deadlines`)."""
+    """Per learner and notebook with a due date: when it was due (their extension's due date,
+    marked) and handed in, its score before lateness, the penalty, its score, and the note
+    (:mod:`.deadlines`)."""
     rows = []
     for learner in learners:
         for notebook in notebooks:
@@ -151,6 +152,7 @@ def _late_rows(notebooks: list[str], learners: list[Learner]) -> list[dict[str, 
             if late is not None and late.due is not None:
                 due, handed_in = late.shown()
                 rows.append({'learner': learner.shown, 'notebook': notebook, 'due': due,
+                             'extension': late.extension(),
                              'handed_in': handed_in or '–',
                              'late_by': late_by(late.late_s) if late.late_s else '',
                              'raw': f'{late.raw:g}', 'penalty': f'{late.penalty:g}',

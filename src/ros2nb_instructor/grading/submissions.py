@@ -1,8 +1,9 @@
-"""Who handed in what: learner folders, their notebook files, and a platform's .zip.
+"""Who handed in what, and when: learner folders, their notebook files, their hand-in times.
 
 Part of the grading (:mod:`ros2nb_instructor.grading`), on the instructor's host.  Every
 learner folder with a legal name is graded or listed with the reason; every file is
-graded or named in a note; nothing is skipped without a word.
+graded or named in a note; nothing is skipped without a word.  A platform's .zip becomes
+such folders first (:mod:`.zips`).
 """
 
 from __future__ import annotations
@@ -11,22 +12,22 @@ import datetime
 import os
 import re
 import stat
-import struct
-import zipfile
 from dataclasses import dataclass, field
-from pathlib import Path, PurePosixPath
+from pathlib import Path
 from typing import Any, Optional
 
 import nbformat
 
+from .hand_in_times import HANDED_IN, TIMESTAMP, TimeProblem, read_record, read_timestamp
+from .mistakes import Mistakes
+
 #: Characters nbgrader cannot have in a student id: it builds glob patterns from ids, and
 #: reads a list of ids to leave out as one comma-separated string.
 _GLOB = re.compile(r'[*?\[\]{}\\,]')
-#: What browsers and file managers add to a name they save twice.
-_COPY = re.compile(r'^(?P<stem>.+?)(?: ?\(\d+\)| - Copy(?: \(\d+\))?| copy(?: \d+)?|-Copy\d*)$')
-#: Files a platform's download may hold that are archives themselves.
-ARCHIVE_SUFFIXES = ('.zip', '.tar', '.tgz', '.gz', '.bz2', '.xz', '.7z', '.rar')
-ARCHIVE_MAGIC = (b'PK\x03\x04', b'\x1f\x8b', b'BZh', b'\xfd7zXZ', b'7z\xbc\xaf', b'Rar!')
+#: What browsers and file managers add to a name they save twice (and Canvas to a file
+#: handed in again: ``NN-title-1.ipynb``).
+_COPY = re.compile(r'^(?P<stem>.+?)'
+                   r'(?: ?\(\d+\)| - Copy(?: \(\d+\))?| copy(?: \d+)?|-Copy\d*|-\d+)$')
 
 
 @dataclass
@@ -41,7 +42,7 @@ class Learner:
     :ivar flags: notebook -> the judge's flags (code that reaches into the course,
         :mod:`ros2nb.judge.flags`), shown on the feedback page and in the report's notes.
     :ivar handed_in: notebook -> when the submission says it was handed in (aware), and
-        where that comes from (:data:`TIMESTAMP`, :data:`ZIP_ENTRY`).
+        where that comes from (:mod:`.hand_in_times`).
     :ivar late: notebook -> its raw score, late penalty and why (:mod:`.deadlines`), once
         nbgrader scored it.
     """
@@ -109,41 +110,36 @@ def notebook_for(filename: str, notebooks: list[str]) -> Optional[str]:
     return match.group('stem') if match and match.group('stem') in notebooks else None
 
 
-#: The file nbgrader's exchange writes beside a submission: when it was handed in (UTC).
-TIMESTAMP = 'timestamp.txt'
-#: Where a hand-in time read from a platform zip's entry comes from.
-ZIP_ENTRY = 'zip entry'
+def _times(entry: Path, learner: 'Learner', notebooks: list[str]) -> None:
+    """The hand-in times ``entry`` says: its ``handed-in.json`` per notebook, else its nbgrader
+    ``timestamp.txt`` for every notebook of the folder (:mod:`.hand_in_times`).
+
+    :raises TimeProblem: for a time either file holds that the grader does not read.
+    """
+    stamp = entry / TIMESTAMP
+    if not stamp.is_symlink() and stamp.is_file():
+        when = read_timestamp(stamp)
+        learner.handed_in.update({n: (when, TIMESTAMP) for n in notebooks})
+    record = entry / HANDED_IN
+    if not record.is_symlink() and record.is_file():
+        learner.handed_in.update({n: (t, HANDED_IN)
+                                  for n, t in read_record(record, notebooks).items()})
 
 
-def read_timestamp(text: str) -> Optional[datetime.datetime]:
-    """An nbgrader ``timestamp.txt``'s time, aware (nbgrader's own parser: a time without a
-    zone is UTC, as nbgrader writes it); None when it is no time."""
-    from nbgrader.utils import parse_utc
-    try:
-        return parse_utc(text.strip()).replace(tzinfo=datetime.timezone.utc)
-    except (ValueError, OverflowError, TypeError):
-        return None
-
-
-def _timestamp(entry: Path, learner: 'Learner', notebooks: list[str]) -> None:
-    """The hand-in time of ``entry``'s nbgrader timestamp.txt, for all the learner's notebooks."""
-    path = entry / TIMESTAMP
-    if path.is_symlink() or not path.is_file():
-        return
-    when = read_timestamp(path.read_text(errors='replace')[:200])
-    if when is None:
-        learner.note('_folder', f'{TIMESTAMP} holds no time nbgrader reads: no hand-in time')
-        return
-    learner.handed_in.update({n: (when, TIMESTAMP) for n in notebooks})
+class SubmissionProblem(Mistakes):
+    """Submissions the grader will not guess at: ``lines`` holds one line per mistake (a
+    hand-in time it does not read), each saying what to write; nothing is graded."""
 
 
 def find_learners(folder: Path, notebooks: list[str]) -> tuple[list[Learner], list[str]]:
     """One Learner per learner folder; also the lines about entries that are not graded.
-    A folder's nbgrader ``timestamp.txt`` is when all its notebooks were handed in.
+    A folder's ``handed-in.json`` says when each notebook was handed in, its nbgrader
+    ``timestamp.txt`` when all were (:func:`_times`).
 
     :return: the learners (sorted by name) and one line per entry refused.
+    :raises SubmissionProblem: one line per hand-in time the grader does not read.
     """
-    learners, refused, taken = [], [], set[str]()
+    learners, refused, taken, problems = [], [], set[str](), []
     for number, entry in enumerate(sorted(folder.iterdir(), key=lambda p: p.name), start=1):
         if entry.is_symlink():
             refused.append(f'"{shown(entry.name)}": a link, not a learner folder (links are '
@@ -162,9 +158,12 @@ def find_learners(folder: Path, notebooks: list[str]) -> tuple[list[Learner], li
             learner.note('_folder', f'graded under the id {learner.id} (nbgrader cannot use '
                                     f'the folder name {learner.shown} itself)')
         candidates: dict[str, list[Path]] = {}
-        _timestamp(entry, learner, notebooks)
+        try:
+            _times(entry, learner, notebooks)
+        except TimeProblem as problem:
+            problems.append(str(problem))
         for path in sorted(entry.iterdir()):
-            if path.name == TIMESTAMP:
+            if path.name in (TIMESTAMP, HANDED_IN):
                 continue
             if path.is_symlink():
                 learner.note('_folder', f'{shown(path.name)} is a link (links are not followed: '
@@ -186,88 +185,9 @@ def find_learners(folder: Path, notebooks: list[str]) -> tuple[list[Learner], li
                 learner.note(notebook, f'also handed in {", ".join(others)}: not graded '
                                        f'(graded {shown(chosen.name)})')
         learners.append(learner)
+    if problems:
+        raise SubmissionProblem(problems)
     return learners, refused
-
-
-def _is_archive(name: str, head: bytes) -> bool:
-    return name.lower().endswith(ARCHIVE_SUFFIXES) or head.startswith(ARCHIVE_MAGIC)
-
-
-def _learner_paths(members: list[zipfile.ZipInfo]) -> list[tuple[zipfile.ZipInfo, tuple]]:
-    """Each member with its path's parts below the archive's top level.
-
-    One folder around everything that holds no file itself (a platform's export folder) is
-    not a learner: it is left out.  Then the first part of a path names the learner, and
-    nothing below it ever names another.
-    """
-    paths = [(m, PurePosixPath(m.filename).parts) for m in members]
-    tops = {parts[0] for _m, parts in paths}
-    if len(tops) == 1 and all(len(parts) >= 3 for _m, parts in paths):
-        paths = [(m, parts[1:]) for m, parts in paths]
-    return paths
-
-
-def entry_time(member: zipfile.ZipInfo, zone: datetime.tzinfo) -> datetime.datetime:
-    """When a zip entry was last written: its UTC time where the zip's maker added one (the
-    extended timestamp field, 0x5455), else its local time, taken in ``zone``."""
-    extra, at = member.extra, 0
-    while at + 4 <= len(extra):
-        tag, size = struct.unpack('<HH', extra[at:at + 4])
-        if tag == 0x5455 and size >= 5 and extra[at + 4] & 1:
-            seconds = struct.unpack('<I', extra[at + 5:at + 9])[0]
-            return datetime.datetime.fromtimestamp(seconds, datetime.timezone.utc)
-        at += 4 + size
-    return datetime.datetime(*member.date_time, tzinfo=zone)
-
-
-def screen_zip(archive: Path, cleaned: Path, times: Optional[dict] = None,
-               zone: datetime.tzinfo = datetime.timezone.utc) -> list[str]:
-    """Copy the members of a platform's .zip that may be graded into ``cleaned``.
-
-    A learner is a folder at the archive's top level (below one export folder, if all is
-    in one); their notebooks may be anywhere under it, and go to ``LEARNER/NAME`` in
-    ``cleaned`` for nbgrader's ``zip_collect``: a folder deeper down (``mallory/alice/``,
-    ``mallory/extracted/bob/``) is mallory's, never alice's or bob's.  Refused, one line
-    each: archives inside the archive (never unpacked), files outside any learner's folder,
-    and a second copy of a notebook in one learner's folder (the shallowest is graded).
-
-    :param times: filled with (learner's folder, file name) -> (when it was handed in, where
-        that comes from): a ``timestamp.txt`` in the learner's folder, else the entry's time
-        (:func:`entry_time`, a zone-less time taken in ``zone``).
-    :return: one line per refusal.
-    :raises zipfile.BadZipFile: when ``archive`` is not a zip file.
-    """
-    stamped: dict[str, datetime.datetime] = {}
-    lines = []
-    with zipfile.ZipFile(archive) as source, zipfile.ZipFile(cleaned, 'w') as out:
-        members = [m for m in source.infolist() if not m.is_dir()]
-        chosen: dict[tuple[str, str], zipfile.ZipInfo] = {}
-        for member, parts in sorted(_learner_paths(members),
-                                    key=lambda mp: (len(mp[1]), mp[1])):
-            with source.open(member) as stream:
-                head = stream.read(8)
-            if parts[-1] == TIMESTAMP and len(parts) >= 2:
-                when = read_timestamp(source.read(member)[:200].decode('utf-8', 'replace'))
-                if when is not None:
-                    stamped.setdefault(parts[0], when)
-            elif _is_archive(parts[-1], head):
-                lines.append(f'{member.filename}: an archive inside the archive is not '
-                             'unpacked; hand in the notebooks themselves')
-            elif len(parts) < 2 or legal_name(parts[0]):
-                lines.append(f'{member.filename}: not in a learner\'s folder at the top of '
-                             'the archive')
-            elif (parts[0], parts[-1]) in chosen:
-                lines.append(f'{member.filename}: another copy of {parts[-1]} in '
-                             f'{parts[0]}\'s folder; graded '
-                             f'{chosen[parts[0], parts[-1]].filename}')
-            else:
-                chosen[parts[0], parts[-1]] = member
-                out.writestr(f'{parts[0]}/{parts[-1]}', source.read(member))
-    if times is not None:
-        for (learner, name), member in chosen.items():
-            times[learner, name] = ((stamped[learner], TIMESTAMP) if learner in stamped
-                                    else (entry_time(member, zone), ZIP_ENTRY))
-    return lines
 
 
 #: Largest notebook file read (a notebook with a few plots is a few MB).

@@ -1,7 +1,8 @@
-"""What a term adds to grading a class: due dates, the roster, an export, one learner again.
+"""What a term adds to grading a class: due dates, extensions, the roster, one learner again.
 
 Runs on the instructor's host, for ``ros2nb-grade`` (:mod:`.cli`): ``--settings`` (the course's
-``course.toml``, :mod:`.deadlines`), ``--export canvas|moodle|csv`` with ``--roster`` (:mod:`.lms`),
+``course.toml``, :mod:`.course_settings`), ``--extensions`` (:mod:`.extensions`), ``--export
+canvas|moodle|csv`` with ``--roster`` (:mod:`.roster`; the export itself is :mod:`.exporting`'s),
 and ``--learner NAME``: that learner graded again into an earlier grading, the others kept as
 they were (``learners.json``, what grading made of each learner before nbgrader scored them).
 """
@@ -9,6 +10,7 @@ they were (``learners.json``, what grading made of each learner before nbgrader 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import datetime
 import json
 import shutil
@@ -18,13 +20,14 @@ from typing import Optional
 
 from nbgrader.api import Gradebook, MissingEntry
 
-from ..paths import ASSIGNMENT, ROOT, gradebook_url
-from .deadlines import CourseSettings, SettingsProblem, read_settings
-from .lms import EXPORTS, RosterProblem, read_roster
+from ..paths import ASSIGNMENT, SETTINGS, gradebook_url
+from .course_settings import read_settings
+from .deadlines import NO_DEADLINES, CourseSettings, SettingsProblem
+from .extensions import EXTENSIONS, NONE, Extensions, ExtensionsProblem, read_extensions
+from .lms import PLATFORMS
+from .roster import RosterProblem, RosterRow, read_roster
 from .submissions import Learner
 
-#: The course's settings file, where the instructor keeps due dates and the late policy.
-SETTINGS = ROOT / 'course.toml'
 #: What grading made of each learner before nbgrader scored them, kept for ``--learner``.
 STATE = 'learners.json'
 
@@ -32,7 +35,10 @@ STATE = 'learners.json'
 def add_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument('--settings', type=Path, default=SETTINGS,
                         help='the course settings file: due dates and the late policy')
-    parser.add_argument('--export', choices=sorted(EXPORTS),
+    parser.add_argument('--extensions', type=Path,
+                        help='per learner and notebook, a later due date (default: '
+                             f'{EXTENSIONS} beside --settings)')
+    parser.add_argument('--export', choices=PLATFORMS,
                         help='also write grading/export/<choice>.csv for a learning platform')
     parser.add_argument('--roster', type=Path,
                         help='CSV mapping learner names to the platform\'s ids (for --export)')
@@ -42,11 +48,19 @@ def add_options(parser: argparse.ArgumentParser) -> None:
 
 @dataclass(frozen=True)
 class Term:
-    """The term's settings for one grading: due dates, and the roster of an export."""
+    """The term's settings for one grading: due dates, the roster (of an export, or to take
+    in Canvas's zip), and, once the learners are known, their extensions."""
 
     deadlines: CourseSettings
     export: Optional[str]
-    roster: Optional[dict[str, dict[str, str]]]
+    roster: Optional[dict[str, RosterRow]]
+    extensions: Extensions = NONE
+
+    def canvas_learners(self) -> Optional[dict[str, str]]:
+        """Canvas user id (the roster's ``lms_id``) -> learner, for Canvas's zip."""
+        if self.roster is None:
+            return None
+        return {row.lms_id: name for name, row in self.roster.items() if row.lms_id}
 
 
 def read_term(args: argparse.Namespace, notebooks: list[str]) -> tuple[Optional[Term], list[str]]:
@@ -55,7 +69,7 @@ def read_term(args: argparse.Namespace, notebooks: list[str]) -> tuple[Optional[
     try:
         deadlines = read_settings(args.settings, notebooks)
     except SettingsProblem as problem:
-        deadlines, lines = CourseSettings({}, {}), list(problem.lines)
+        deadlines, lines = NO_DEADLINES, list(problem.lines)
     roster = None
     if args.roster is not None:
         try:
@@ -66,6 +80,23 @@ def read_term(args: argparse.Namespace, notebooks: list[str]) -> tuple[Optional[
         lines.append(f'EXPORT={args.export} needs a roster of the platform\'s ids: '
                      'ROSTER=roster.csv (docs/instructors.md, "A term, step by step")')
     return (None, lines) if lines else (Term(deadlines, args.export, roster), [])
+
+
+def extensions_file(args: argparse.Namespace) -> Path:
+    """The extensions file ``args`` name: ``--extensions``, else beside ``--settings``."""
+    return args.extensions or args.settings.parent / EXTENSIONS
+
+
+def with_extensions(term: Term, args: argparse.Namespace, notebooks: list[str],
+                    learners: list[Learner]) -> tuple[Optional[Term], list[str]]:
+    """``term`` with the extensions file ``args`` names, checked against the class's due
+    dates and ``learners`` (and the roster's), or the lines that say what is wrong."""
+    names = {learner.name for learner in learners} | set(term.roster or ())
+    try:
+        extensions = read_extensions(extensions_file(args), term.deadlines, notebooks, names)
+    except ExtensionsProblem as problem:
+        return None, problem.lines
+    return dataclasses.replace(term, extensions=extensions), []
 
 
 def with_roster(learners: list[Learner], roster: Optional[dict]) -> list[Learner]:
@@ -81,22 +112,6 @@ def with_roster(learners: list[Learner], roster: Optional[dict]) -> list[Learner
         absent.note('_folder', 'in the roster, nothing handed in: 0 points')
         learners.append(absent)
     return sorted(learners, key=lambda learner: learner.name)
-
-
-def export(term: Term, course: Path, out: Path, learners: list[Learner],
-           notebooks: list[str]) -> None:
-    """``out/export/<platform>.csv`` through the platform's nbgrader export plugin."""
-    if term.export is None:
-        return
-    folder = out / 'export'
-    folder.mkdir(exist_ok=True)
-    plugin = EXPORTS[term.export](to=str(folder / f'{term.export}.csv'), roster=term.roster,
-                                  names={lr.id: lr.shown for lr in learners},
-                                  notebooks=notebooks)
-    with Gradebook(gradebook_url(course)) as gradebook:
-        plugin.export(gradebook)
-    for line in plugin.said:
-        print(f'export: {line}')
 
 
 def save_state(out: Path, learners: list[Learner]) -> None:

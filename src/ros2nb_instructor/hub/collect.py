@@ -1,18 +1,20 @@
 """``ros2nb-hub-collect``: collect the learners' notebooks from the course's JupyterHub.
 
-Runs on the classroom server (``make hub-collect CLASS=DIR``), as root or an instructor.
+Runs on the classroom server (``make hub-collect CLASS=DIR``), as root.
 
-On the hub of ``make hub`` a learner, say ``alice``, works in
-``~alice/ros2-course/notebooks/``. For every member of the hub's Unix group
-(``ROS2_COURSE_HUB_GROUP``, default ``ros2-course``) this copies the notebooks found there
-that bear a course notebook's name into ``DIR/alice/``: the layout that
-``make grade SUBMISSIONS=DIR`` reads. Run it as root, or as a user who can read the
-learners' folders.
+By default it collects what each learner handed in (``ros2nb.hand_in("03")``): the hub's
+hand-in store (:mod:`.hand_in_store`, root's alone) holds each learner's notebooks as last
+handed in and the time of each by the hand-in service's clock.  ``DIR/alice/`` gets alice's
+notebooks and ``handed-in.json``, those times: the layout ``make grade SUBMISSIONS=DIR``
+reads, each notebook graded by its own hand-in time.
 
-A learner's home is theirs to change, so a file is copied only if it is a regular file (a
-symbolic link is refused, never followed), owned by that learner and at most
-``MAX_NOTEBOOK_BYTES`` long. That way nobody hands in someone else's notebook or a file
-of the system. Exit code 0 when the collection worked, whatever was missing.
+With ``--from-homes`` (``HOMES=1``) it collects the notebooks as they are in the learners'
+work folders instead (``~alice/ros2-course/notebooks/``; for a class that does not hand in),
+with no times: the late policy's ``without_time`` decides.  For every member of the hub's
+Unix group (``ROS2_COURSE_HUB_GROUP``, default ``ros2-course``) a file is then copied only if
+it is a regular file (a symbolic link is refused, never followed), owned by that learner and
+at most ``MAX_NOTEBOOK_BYTES`` long: nobody hands in someone else's notebook or a file of the
+system.  Exit code 0 when the collection worked, whatever was missing.
 """
 
 from __future__ import annotations
@@ -28,7 +30,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Optional
 
-from ..paths import NOTEBOOKS
+from ..grading.hand_in_times import HANDED_IN, record_text
+from ..paths import NOTEBOOKS, ROOT
+from .hand_in_store import Store
+
+#: Where the hub keeps what learners hand in (the hub's config passes the same to the
+#: service): in the hub's state folder, root's alone.
+DEFAULT_STORE = ROOT / '.cache' / 'hub' / 'handed-in'
 
 #: Each learner's notebooks, relative to their home (see environment/jupyterhub_config.py).
 LEARNER_NOTEBOOKS = Path('ros2-course') / 'notebooks'
@@ -122,14 +130,43 @@ def collect_learner(learner: Learner, names: list[str], destination: Path) -> Co
     return done
 
 
-def collect(learners: list[Learner], destination: Path) -> dict[str, Collected]:
-    """Collect every learner's notebooks into ``destination`` (which must be new or empty).
+def _new_folder(destination: Path) -> None:
+    """Make ``destination`` for a collection.
 
-    :raises CollectError: if ``destination`` holds files already.
+    :raises CollectError: if it holds files already.
     """
     if destination.exists() and any(destination.iterdir()):
         raise CollectError(f'{destination} is not empty: collect into a new folder.')
     destination.mkdir(parents=True, exist_ok=True)
+
+
+def collect_handed_in(store: Store, destination: Path) -> dict[str, Collected]:
+    """Copy every learner's handed-in notebooks from ``store`` into ``destination/<learner>/``
+    with ``handed-in.json``, the time of each hand-in.
+
+    :raises CollectError: if ``destination`` holds files already.
+    """
+    _new_folder(destination)
+    results = {}
+    for learner in store.learners():
+        times = store.handed_in(learner)
+        target = destination / learner
+        target.mkdir()
+        for notebook in times:
+            data = (store.folder(learner) / f'{notebook}.ipynb').read_bytes()
+            (target / f'{notebook}.ipynb').write_bytes(data)
+        (target / HANDED_IN).write_text(record_text(times))
+        results[learner] = Collected(copied=[f'{n}.ipynb' for n in times])
+    return results
+
+
+def collect(learners: list[Learner], destination: Path) -> dict[str, Collected]:
+    """Collect every learner's notebooks from their work folders into ``destination``
+    (which must be new or empty), with no hand-in times.
+
+    :raises CollectError: if ``destination`` holds files already.
+    """
+    _new_folder(destination)
     names = sorted(p.name for p in COURSE_NOTEBOOKS.glob('*.ipynb'))
     results = {}
     for learner in learners:
@@ -152,11 +189,24 @@ def main(argv: Optional[list[str]] = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument('destination', type=Path, help='new folder for DIR/<learner>/NN-*.ipynb')
     parser.add_argument('--group', default=os.environ.get('ROS2_COURSE_HUB_GROUP', DEFAULT_GROUP),
-                        help="the hub's Unix group (default: $ROS2_COURSE_HUB_GROUP or "
-                             f'{DEFAULT_GROUP})')
+                        help="the hub's Unix group, for --from-homes (default: "
+                             f'$ROS2_COURSE_HUB_GROUP or {DEFAULT_GROUP})')
+    parser.add_argument('--store', type=Path,
+                        default=Path(os.environ.get('ROS2_COURSE_HUB_HANDED_IN', DEFAULT_STORE)),
+                        help='the hub\'s hand-in store (default: $ROS2_COURSE_HUB_HANDED_IN or '
+                             f'{DEFAULT_STORE})')
+    parser.add_argument('--from-homes', action='store_true',
+                        help='collect the work folders as they are, not what was handed in')
     options = parser.parse_args(argv)
     try:
-        results = collect(group_learners(options.group), options.destination)
+        if options.from_homes:
+            results = collect(group_learners(options.group), options.destination)
+        elif not options.store.is_dir():
+            raise CollectError(f'{options.store} holds no hand-ins (nobody ran ros2nb.hand_in, '
+                               'or the hub keeps them elsewhere: STORE=folder); to collect the '
+                               'work folders as they are, add HOMES=1.')
+        else:
+            results = collect_handed_in(Store(options.store), options.destination)
     except CollectError as error:
         print(error, file=sys.stderr)
         return 2

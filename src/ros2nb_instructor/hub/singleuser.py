@@ -38,7 +38,7 @@ from ros2nb.terminal.workspace import WORKSPACE_NAME
 
 from .. import lab
 from ..lab import update_work_folder
-from ..paths import NOTEBOOKS, ROOT
+from ..paths import EXTENSIONS, NOTEBOOKS, ROOT
 
 #: The course repository.
 COURSE = ROOT
@@ -98,8 +98,23 @@ def closed_to_others(path: Path, *, need: int) -> Optional[Path]:
     return None if real.stat().st_mode & need == need else real
 
 
+def extensions_open_to_learners(course: Path) -> Optional[str]:
+    """Return why the course would show learners what is not theirs (its ``extensions.toml``,
+    every learner's extensions, readable by others), or ``None``."""
+    private = course / EXTENSIONS
+    if private.exists() and private.stat().st_mode & (stat.S_IROTH | stat.S_IRGRP):
+        return (f'Learners can read {private} (every learner\'s extensions): make it yours '
+                f'alone, chmod 600 {private}, then start the hub again.')
+    return None
+
+
 def check_learners_can_use_course(python: Path) -> Optional[str]:
-    """Return why learners could not start the course's server as themselves, or ``None``."""
+    """Return why learners could not start the course's server as themselves, or why the
+    course would show them what is not theirs (:func:`extensions_open_to_learners`), or
+    ``None``."""
+    private = extensions_open_to_learners(COURSE)
+    if private:
+        return private
     needs = ((python, stat.S_IXOTH), (Path(__file__).resolve(), stat.S_IROTH),
              (NOTEBOOKS, stat.S_IROTH | stat.S_IXOTH))
     for path, need in needs:
