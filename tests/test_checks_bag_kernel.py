@@ -19,6 +19,7 @@ pytestmark = [pytest.mark.ros,
 
 import ros2nb  # noqa: E402
 from ros2nb.errors import CheckFailed, Ros2nbError, UsageError  # noqa: E402
+from ros2nb.terminal.bag import metadata  # noqa: E402
 from ros2nb.terminal.workspace import WORKSPACE_ENV  # noqa: E402
 
 from bag_cases import (ANSWERS, CHECKS, CONTEXT_WITHOUT_START, LEARNER, MISTAKE_IDS,  # noqa: E402
@@ -102,6 +103,25 @@ def test_a_bag_opens_with_readers_the_course_does_not_own(kernel, tmp_path):
         logs = [reader.deserialize(raw, c.msgtype) for c, _t, raw in
                 reader.messages([c for c in reader.connections if c.topic == '/rosout'])]
     assert sum('Status: ' in log.msg for log in logs) == 3600
+
+
+def test_a_recording_of_rosout_may_start_before_the_node_that_logs(kernel, tmp_path):
+    """/rosout's type is ROS's own: the notebook records a replay's statuses before its
+    replay() adds the monitor.  A topic of the course's still needs its publisher first (the
+    nodes added inside the with block: the check and the next cell both refuse it)."""
+    nodes = defined('')
+    ros2nb.stop()  # no node of an earlier test publishes anything
+    with pytest.raises(UsageError, match=r'^/temperature has no publisher in the ROS graph yet'):
+        ros2nb.bag_record(tmp_path / 'early', '/temperature', '/rosout')
+    with ros2nb.bag_record(tmp_path / 'statuses', '/rosout'):
+        ros2nb.add(nodes['pub'].TemperatureSensor())
+        ros2nb.add(nodes['sub'].TemperatureMonitor())
+        ros2nb.spin(5, show_logs=False)
+    ros2nb.stop()
+    recorded = metadata(tmp_path / 'statuses')['topics_with_message_count']
+    topics = {t['topic_metadata']['name']: t['topic_metadata']['type'] for t in recorded}
+    assert topics == {'/rosout': 'rcl_interfaces/msg/Log'}
+    assert ros2nb.bag_info(tmp_path / 'statuses')['/rosout'] >= 5  # a status per reading
 
 
 @pytest.mark.parametrize('call, pattern', [

@@ -50,6 +50,10 @@ from .topic import resolve
 
 #: The storage every bag of the course uses (rosbag2's default since Iron).
 STORAGE_ID = 'mcap'
+#: Topics whose type ROS itself fixes, known before any node publishes them: every node logs
+#: on /rosout, so a recording of it may start before the node that will log (notebook 10
+#: records a replay's statuses before replay() adds the monitor, as ros2 bag record would).
+ROS_TOPIC_TYPES: Final = {'/rosout': 'rcl_interfaces/msg/Log'}
 #: rosbag2's metadata version written (Jazzy's rosbag2 writes and reads 9).
 METADATA_VERSION: Final = 9
 #: What replay and recording keep: every message (a burst never overflows a queue).
@@ -159,7 +163,8 @@ def bag_record(output: Any, *topics: str) -> Recording:
 
     :param output: the bag's folder; it must not exist yet.
     :param topics: topic names, e.g. ``'/temperature'``, ``'/rosout'``; each must have a
-        publisher already (its type is taken from the graph).
+        publisher already (its type is taken from the graph), but ``/rosout``, whose type
+        is ROS's own.
     :return: the running recording.
     :raises UsageError: for no topics, a topic that is not a name, a folder that exists,
         or a topic nobody publishes (yet: a subscription alone does not count).
@@ -182,6 +187,8 @@ def bag_record(output: Any, *topics: str) -> Recording:
         name = resolve(topic)
         # its publishers' type only: a subscription (a check listening) publishes nothing
         published = sorted({info.topic_type for info in graph.get_publishers_info_by_topic(name)})
+        if not published and name in ROS_TOPIC_TYPES:
+            published = [ROS_TOPIC_TYPES[name]]
         if not published:
             raise UsageError(f'{name} has no publisher in the ROS graph yet: add the node that '
                              'publishes it before recording (topic_list() shows the topics).')
