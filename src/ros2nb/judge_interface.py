@@ -235,6 +235,10 @@ class Judge(Protocol):
         """A subject with the context cells and the learner's answer cells run (in
         ``workspace``, by default the learner's)."""
 
+    def answer_home(self, ref: AnswerRef, workspace: Optional[Path] = None) -> Path:
+        """The home folder of the subject that runs ``ref`` (:meth:`answer_subject`): a folder
+        of its own, never the judge's."""
+
     def answers_workspace(self, steps: tuple[str, ...]) -> Path:
         """The learner's workspace, or a copy with the course's reference node files where
         ``steps`` (:data:`ros2nb.course.STEPS`) are missing."""

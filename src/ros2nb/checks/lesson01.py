@@ -26,8 +26,8 @@ def check_expanded_path(judge: Optional[Judge], make_path: Any, *, ends_with: st
     :raises CheckFailed: e.g. for the tutorial's ``/Documents/...`` (no ``~``).
     """
     if isinstance(make_path, AnswerRef) and judge is not None:  # their subject's home
+        home = judge.answer_home(make_path)  # the subject that answers: its own home
         path = decoded(answer_results(judge, make_path, [[]])[0], f'{make_path.name}()')
-        home = Path(judge.subject_env()['HOME'])
         shown = '~'  # the grader's folder for it: its name would differ from run to run
     else:
         path, home = call_learner(make_path), Path.home()
@@ -41,6 +41,8 @@ def check_expanded_path(judge: Optional[Judge], make_path: Any, *, ends_with: st
     if home not in path.parents:
         raise CheckFailed(f'{path} is not inside your home folder {shown}: a path that '
                           'starts with "/" starts at the root of the disk.')
+    if shown == '~':  # as the grader shows it: the subject's folder is named anew each run
+        path = Path('~') / path.relative_to(home)
     if not str(path).endswith(ends_with):
         raise CheckFailed(f'{path} should end with {ends_with}.')
     return f'{path} is inside your home folder.'

@@ -37,8 +37,8 @@ from .observer import Observer
 from .reaching import Reaching
 from .stand_ins import source_of
 from .written import workspace_files
-from .subjects import (HANDED, Output, SubjectHung, SubjectProcess, python_start, subject_env,
-                       subject_prefix, subjects_folder)
+from .subjects import (HANDED, Output, SubjectHung, SubjectProcess, home_and_tmp, python_start,
+                       subject_env, subject_prefix, subjects_folder)
 
 
 #: ``python -I -c SET_ENV_AND_EXEC ENV_JSON PROGRAM ARGS...``: PROGRAM (looked up on the
@@ -243,6 +243,11 @@ class Session:
         if found is not None:
             found.update({relative: text.encode() for relative, text in files.items()})
             self.workspace = self.hand_over('as-written-', found)
+
+    def answer_home(self, ref: AnswerRef, workspace: Optional[Path] = None) -> Path:
+        """The home folder of the subject that runs ``ref`` (started now if need be)."""
+        subject = self.answer_subject(ref, workspace)
+        return home_and_tmp(self._folders[subject.proc.pid])[0]
 
     def answer_subject(self, ref: AnswerRef, workspace: Optional[Path] = None) -> SubjectProcess:
         """A subject with the course's context cells and the learner's answer cells run (in
