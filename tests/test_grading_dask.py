@@ -46,7 +46,7 @@ NOTEBOOKS = sorted(SOLUTION)
 SEED = 4242
 #: A progress line, as a local grading prints it.
 PROGRESS = re.compile(r'^\[\d+/\d+ notebooks, \d+/\d+ learners; .* so far, .*\] (.*) graded$')
-#: Notebook 01's answer with a call the judge flags (it reads stack frames), and no point lost.
+#: Notebook 01's answer with a call the judge flags (it reads stack frames): no point lost.
 REACHING_IN = ("    return Path('~/Documents/ROS2_and_RL_Tutorials').expanduser()",
                "    import sys\n    sys._getframe(0)\n"
                "    return Path('~/Documents/ROS2_and_RL_Tutorials').expanduser()")
@@ -77,9 +77,10 @@ CLASS = {
     'Lovelace, Ada': Case({NB01: 1}, {}, {'_folder': 'graded under the id learner-'}),
     'browser-copy': Case({NB01: 1}, {}, {NB01: f'graded {NB01} (1).ipynb as {NB01}.ipynb'}),
     'kills-its-kernel': EXPECTED['kills-its-kernel'],
-    # Frames read while the grader ran the code: the part earns nothing (ros2nb.judge.reaching)
-    # and the flags box says why, carried back from the cluster like any feedback.
-    'reaches-in': Case({NB01: 0}, {NB01: FLAGS_HEADING},
+    # Frames read while the grader ran the code: the point stays (the judge decides on what
+    # it sees; the hook only notes), and the flags box for the instructor says why, carried
+    # back from the cluster like any feedback.
+    'reaches-in': Case({NB01: 1}, {NB01: FLAGS_HEADING},
                        {NB01: f'{FLAGGED} answer cell {NB01}-challenge-1 line'}),
 }
 
