@@ -416,12 +416,18 @@ def test_entry_point_checks(session, package_files):
     fails(session, checks.check_entry_points, r'is not written NAME = package.module:function: the '
                                      r'module is written with dots')
     entries("'temperature_publisher = sensor_simulator.publisher:main',", SUBSCRIBER_ENTRY + ',')
-    fails(session, checks.check_entry_points, r'did not start main\(\) of '
-                                     r'sensor_simulator.temperature_publisher \(ModuleNotFound'
-                                     r"Error: No module named 'sensor_simulator.publisher'\): "
-                                     r'temperature_publisher = sensor_simulator.publisher:main: '
-                                     r'it should start main\(\) in '
-                                     r'sensor_simulator/temperature_publisher.py')
+    said = fails(session, checks.check_entry_points, r'did not start main\(\) of '
+                 r'sensor_simulator.temperature_publisher \(ModuleNotFound'
+                 r"Error: No module named 'sensor_simulator.publisher'\): "
+                 r'temperature_publisher = sensor_simulator.publisher:main: '
+                 r'it should start main\(\) in sensor_simulator/temperature_publisher.py; left '
+                 r'of the colon, name that file as a module')
+    assert 'sensor_simulator.temperature_publisher:main' not in said  # the line says how, not what
+    entries("'temperature_publisher = sensor_simulator.temperature_publisher:start',",
+            SUBSCRIBER_ENTRY + ',')
+    fails(session, checks.check_entry_points, r'temperature_publisher = sensor_simulator.'
+          r'temperature_publisher:start: right of the colon goes the function that starts the '
+          r'node, main, as temperature_publisher.py defines it\.$')
 
 
 def test_setup_cfg_checks(session, package_files, capsys):

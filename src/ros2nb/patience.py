@@ -159,25 +159,17 @@ class HeldBack:
 
     :param threads: each thread's seconds on the run queue so far, by thread (its id, e.g.
         :func:`run_queue_seconds`, or any key that names it), read at every look.
-    :param wanting_share: a thread counts only when it stood on the run queue for at least
-        this share of the interval (:data:`WANTING_SHARE`): one that wakes for a moment and
-        sleeps again stands there a little whenever it wakes on a busy machine, but what it
-        does is done at once.
     """
 
-    def __init__(self, threads: Callable[[], Mapping[Any, float]],
-                 wanting_share: float = 0.0) -> None:
+    def __init__(self, threads: Callable[[], Mapping[Any, float]]) -> None:
         self._threads = threads
         self._last = threads()
         self._owed = 0.0
-        self._wanting_share = wanting_share
 
-    def look(self, interval_s: float = 0.0) -> None:
-        """Read the threads again, ``interval_s`` seconds after the last look; what they
-        stood on the run queue since is owed."""
+    def look(self) -> None:
+        """Read the threads again; what they stood on the run queue since is owed."""
         now = self._threads()
-        grown = max((delay - self._last.get(tid, 0.0) for tid, delay in now.items()
-                     if delay - self._last.get(tid, 0.0) >= self._wanting_share * interval_s),
+        grown = max((delay - self._last.get(tid, 0.0) for tid, delay in now.items()),
                     default=0.0)
         self._last = now
         self._owed += max(0.0, grown)
@@ -238,14 +230,13 @@ class Patience:
 
     What the trees wait for may be the watcher's own process (a subject waits for its
     judge's clock, its answers, its discovery messages): time the machine kept the watcher
-    from working is not the trees' idle time either.  So an idle interval counts only the
-    part of it that no other thread of the watcher's process stood on the run queue for
-    most of (:class:`HeldBack`; its CPU time never counts: a judge busy with other subjects
-    would make every program it waits on look busy), and at most two looks of it: a
-    watcher kept from looking longer (by its own work, or by a thread of its process that
+    from running is not the trees' idle time either.  So an idle interval counts only the
+    part of it that the watcher's most delayed thread did not stand on the run queue
+    (:class:`HeldBack`, every thread, the one that looks included: it may be the one that
+    serves what the trees wait for; its CPU time never counts: a judge busy with other
+    subjects would make every program it waits on look busy), and at most two looks of it:
+    a watcher kept from looking longer (by its own work, or by a thread of its process that
     holds the GIL while the machine starves it) was late, which says nothing of the trees.
-    The thread that looks is not among those others: it only looks, and what kept it from
-    looking the two looks' bound has counted already.
 
     Introduced in ``03-write-the-publisher.ipynb`` (how long the judge waits for a subject).
 
@@ -276,17 +267,16 @@ class Patience:
         self._looked = now
         self._verdict = False
         #: What kept the watcher's own process from running (:meth:`_watcher_threads`).
-        self._held = HeldBack(self._watcher_threads, WANTING_SHARE)
+        self._held = HeldBack(self._watcher_threads)
 
     def _watcher_threads(self) -> dict[int, float]:
-        """Each thread of the watcher's process but the one that looks: its seconds on the
-        run queue so far.  Nothing when the watcher is one of the trees (then its threads
+        """Each thread of the watcher's process, the one that looks included: its seconds on
+        the run queue so far.  Nothing when the watcher is one of the trees (then its threads
         are the trees' own)."""
         pid = os.getpid()
         if pid in self.pids:
             return {}
-        return {task: thread.queued_s for task, thread in _threads(pid).items()
-                if (pid, task) != self._looker}
+        return {task: thread.queued_s for task, thread in _threads(pid).items()}
 
     @staticmethod
     def _idle_between(before: TreeLook, after: TreeLook, interval: float) -> bool:
@@ -308,7 +298,7 @@ class Patience:
         if self._verdict or now - self._looked < LOOK_S:
             return self._verdict
         before, self._last = self._last, look_at_trees(self.pids, skip=self._looker)
-        self._held.look(now - self._looked)
+        self._held.look()
         if self._idle_between(before, self._last, now - self._looked):
             # Looks come a LOOK_S apart; of a longer interval, what is beyond two looks was the
             # watcher's lateness (its own work, or a thread of its process the machine starves

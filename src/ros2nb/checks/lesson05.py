@@ -119,9 +119,15 @@ def _entries_cause(setup_py: Path) -> Optional[str]:
             have = ', '.join(f'{k} = {v}' for k, v in sorted(scripts.items())) or 'none'
             return (f'console_scripts has no entry named {executable} (it has: {have}); the name '
                     'left of = is what you pass to ros2 run.')
-        if scripts[executable].replace(' ', '') != want:
-            return (f'{executable} = {scripts[executable]}: it should start main() in '
-                    f'{course.PACKAGE}/{executable}.py, written {want}.')
+        target = scripts[executable].replace(' ', '')
+        if target != want:
+            module, _, function = target.partition(':')
+            if module != want.partition(':')[0]:
+                return (f'{executable} = {scripts[executable]}: it should start main() in '
+                        f'{course.PACKAGE}/{executable}.py; left of the colon, name that file '
+                        'as a module (package.module: dots, no .py).')
+            return (f'{executable} = {scripts[executable]}: right of the colon goes the function '
+                    f'that starts the node, main, as {executable}.py defines it.')
     return None
 
 
