@@ -144,48 +144,6 @@ def test_a_program_the_scheduler_starves_is_working_not_waiting():
             process.wait()
 
 
-#: An idle program whose dozen threads each wake twenty times a second, as Fast DDS's do.
-MANY_THREADS_IDLE = """
-import os, sys, threading, time
-os.sched_setaffinity(0, {int(sys.argv[1])})
-os.sched_setscheduler(0, os.SCHED_IDLE, os.sched_param(0))
-def tick():
-    while True:
-        time.sleep(0.05)
-for _ in range(12):
-    threading.Thread(target=tick, daemon=True).start()
-print('idle', flush=True)
-time.sleep(3600)
-"""
-
-
-def test_an_idle_program_whose_many_threads_stand_ready_a_moment_is_given_up():
-    """On a busy machine each thread of an idle program stands on the run queue a moment
-    whenever it wakes: a judge's subject (a dozen Fast DDS threads) beside a class's grading
-    stood there a large share of the wall clock in all, and one of its threads stood ready
-    at most looks (docs/decisions.md).  Counted as work, a main() that never starts ROS was
-    waited on until pytest's time limit.  Here the program, of the lowest scheduling class,
-    shares one CPU with a burner: each thread waits for it a while whenever it wakes
-    (`benchmarks/idle_threads.py`)."""
-    cpu = min(os.sched_getaffinity(0))
-    burners = [subprocess.Popen([sys.executable, '-c', 'import os\nos.sched_setaffinity(0, {%d})'
-                                 '\nwhile True: pass' % cpu])]
-    idle = subprocess.Popen([sys.executable, '-c', MANY_THREADS_IDLE, str(cpu)], text=True,
-                            stdout=subprocess.PIPE)
-    try:
-        assert idle.stdout.readline() == 'idle\n'
-        began = time.monotonic()
-        patience = Patience(idle.pid, LIMIT_S, started=began)
-        while not (gave_up := patience.exhausted()) and time.monotonic() - began < CUT * LIMIT_S:
-            time.sleep(0.1)
-        # the failure prevented: never given up (how soon it is depends on the machine's load)
-        assert gave_up and patience.ran_out_idle, time.monotonic() - began
-    finally:
-        for process in (*burners, idle):
-            process.kill()
-            process.wait()
-
-
 #: A program under a CPU quota: it works WORK_S seconds of CPU (far longer on the wall
 #: clock), says so, waits a moment, says so, and then waits for ever.
 WORKS_WAITS_AND_HANGS = """

@@ -12,21 +12,16 @@ from __future__ import annotations
 import os
 import threading
 import time
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Callable, Mapping, NamedTuple, Optional, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Optional, Sequence
 
 if TYPE_CHECKING:
     import psutil
 
 #: Seconds between two looks at a condition (:func:`poll`).
 POLL_S = 0.02
-#: A process tree using less than this share of one CPU between two looks may be waiting, not
-#: working (unless a thread of it was kept from running: :data:`WANTING_SHARE`).
+#: A process tree using less than this share of one CPU between two looks, counting the
+#: time its threads stood ready on the run queue, is waiting, not working.
 BUSY_SHARE = 0.05
-#: A thread that stood ready on the run queue for this share of the time between two looks
-#: wanted a CPU for most of it: it works, however little the machine let it run.  An idle
-#: thread that wakes for a moment stands there too on a busy machine, but sleeps between.
-WANTING_SHARE = 0.5
 #: Seconds between two looks at a process tree's work (each look reads every process's
 #: parent from /proc: milliseconds on a busy machine).
 LOOK_S = 0.25
@@ -42,8 +37,7 @@ def psutil_module() -> Any:
 def process_tree(pids: Sequence[int]) -> list['psutil.Process']:
     """Each of ``pids`` that is still there and every process under them, once, as
     :class:`psutil.Process` (psutil walks the tree from every process's parent)."""
-    psutil = psutil_module()
-    found: dict[int, Any] = {}  # pid -> its psutil.Process, in the order found
+    psutil, found = psutil_module(), {}  # pid -> its Process, in the order found
     for pid in dict.fromkeys(pids):
         if pid in found:
             continue
@@ -100,36 +94,45 @@ def _this_thread() -> tuple[int, int]:
     return os.getpid(), threading.get_native_id()
 
 
-class Thread(NamedTuple):
-    """One thread as the kernel counts it (``/proc/PID/task/TID/stat`` and ``schedstat``)."""
-    #: ``R`` (running or ready to run), ``S`` (sleeping), ... as ``ps`` shows it.
-    state: str
-    #: Seconds it ran on a CPU so far (nanosecond precision, unlike psutil's ticks).
-    run_s: float
-    #: Seconds it stood ready on the run queue, waiting for a CPU, so far (brought up to date
-    #: only when it gets a CPU).
-    queued_s: float
+def queued_seconds(pids: Sequence[int], *, skip: Optional[tuple[int, int]] = None
+                   ) -> tuple[float, bool]:
+    """How much the threads of ``pids`` stood ready to run, waiting on the run queue for a
+    CPU: the seconds the kernel counted (the second field of ``/proc/PID/task/TID/schedstat``,
+    brought up to date only when a thread gets a CPU), and whether one of them stands ready
+    now (state R).  Gone processes and threads, and a kernel without schedstats, count
+    nothing.
+
+    Read from /proc here, not through psutil: psutil gives a thread's CPU times but neither
+    its time on the run queue nor its state, and these two are what tell a program the
+    scheduler starves from one that waits (:class:`Patience`).
+
+    :param skip: ``(pid, thread id)`` of a thread left out: the one that looks, which runs
+        while it reads (a process that waits for itself, :func:`wait_for_work`).
+    """
+    total, ready = 0.0, False
+    for pid in pids:
+        for task, state, delay in _threads(pid):
+            if (pid, task) == skip:
+                continue
+            ready = ready or state == 'R'
+            total += delay
+    return total, ready
 
 
-def _threads(pid: int) -> dict[int, Thread]:
-    """Each thread of ``pid`` by thread id (none once it is gone, or on a kernel without
-    schedstats).
-
-    Read from /proc here, not through psutil: psutil gives a thread's CPU times in clock
-    ticks but neither its time on the run queue nor its state, and these are what tell a
-    program the scheduler starves from one that waits (:class:`Patience`)."""
+def _threads(pid: int) -> list[tuple[int, str, float]]:
+    """``(thread id, state, seconds on the run queue so far)`` of each thread of ``pid``
+    (none once it is gone)."""
     try:
         tasks = os.listdir(f'/proc/{pid}/task')
     except OSError:
-        return {}
-    found = {}
+        return []
+    found = []
     for task in tasks:
         try:
             with open(f'/proc/{pid}/task/{task}/stat') as stat:
                 state = stat.read().rsplit(')', 1)[1].split()[0]
             with open(f'/proc/{pid}/task/{task}/schedstat') as schedstat:
-                run, queued = schedstat.read().split()[:2]
-            found[int(task)] = Thread(state, int(run) / 1e9, int(queued) / 1e9)
+                found.append((int(task), state, int(schedstat.read().split()[1]) / 1e9))
         except (OSError, IndexError, ValueError):
             continue
     return found
@@ -157,11 +160,11 @@ class HeldBack:
     what one look misses a later one finds: it is owed, and taken from later intervals,
     never more than an interval at a time.
 
-    :param threads: each thread's seconds on the run queue so far, by thread (its id, e.g.
-        :func:`run_queue_seconds`, or any key that names it), read at every look.
+    :param threads: each thread's seconds on the run queue so far, by thread id (e.g.
+        :func:`run_queue_seconds`), read at every look.
     """
 
-    def __init__(self, threads: Callable[[], Mapping[Any, float]]) -> None:
+    def __init__(self, threads: Callable[[], dict[int, float]]) -> None:
         self._threads = threads
         self._last = threads()
         self._owed = 0.0
@@ -182,18 +185,11 @@ class HeldBack:
         return held
 
 
-@dataclass(frozen=True)
-class TreeLook:
-    """What process trees had done when looked at (:func:`look_at_trees`)."""
-    #: CPU seconds (user + system) of every process of the trees, with the children they
-    #: reaped and the threads that ended (psutil's clock ticks).
-    cpu_s: float
-    #: Each thread of the trees, by ``(pid, thread id)``.
-    threads: dict[tuple[int, int], Thread]
-
-
-def look_at_trees(pids: Sequence[int], *, skip: Optional[tuple[int, int]] = None) -> TreeLook:
-    """What the process trees of ``pids`` have done so far, as the kernel counts it.
+def tree_work(pids: int | Sequence[int], *, skip: Optional[tuple[int, int]] = None
+              ) -> tuple[float, float, bool]:
+    """What process trees have done, as the kernel counts it: the CPU seconds of ``pids``
+    and every process under them; the seconds their threads stood ready on the run queue
+    for a CPU (:func:`queued_seconds`); and whether one of them stands ready now.
 
     Only the trees count, not the process that watches them: a judge at work beside its
     watch (its executor and Fast DDS threads, busy with other subjects) would make every
@@ -201,13 +197,11 @@ def look_at_trees(pids: Sequence[int], *, skip: Optional[tuple[int, int]] = None
 
     Introduced in ``03-write-the-publisher.ipynb`` (how long the judge waits for a subject).
 
-    :param skip: ``(pid, thread id)`` of a thread left out: the one that looks, which runs
-        while it reads (a process that waits for itself, :func:`wait_for_work`).
+    :param skip: a thread left out (:func:`queued_seconds`).
     """
-    trees = process_tree(pids)
-    threads = {(process.pid, tid): thread for process in trees
-               for tid, thread in _threads(process.pid).items() if (process.pid, tid) != skip}
-    return TreeLook(sum(_cpu_seconds(process) for process in trees), threads)
+    trees = process_tree([pids] if isinstance(pids, int) else pids)
+    queued, ready = queued_seconds([process.pid for process in trees], skip=skip)
+    return sum(_cpu_seconds(process) for process in trees), queued, ready
 
 
 class Patience:
@@ -218,25 +212,20 @@ class Patience:
     trees do: they have had long enough once they used ``limit_s`` CPU seconds (an endless
     loop), or once they sat idle, waiting for an event, for ``limit_s`` seconds on the wall
     clock.  Between two looks they sat idle when they used less than :data:`BUSY_SHARE` of
-    a CPU and none of their threads was kept from running: none stood ready on the run
-    queue for :data:`WANTING_SHARE` of the interval, and none stands ready at the look
-    without having run since the last (the kernel brings the time on the run queue up to
+    a CPU, counting the time their threads stood ready on the run queue, and none of their
+    threads stands ready at the look (the kernel brings the time on the run queue up to
     date only when a thread runs).  A program the scheduler starves is working, not
     waiting, however long that takes: what bounds a machine that never runs it is outside
-    (a test's time limit, a sandbox's wall time, the learner's stop button).  Their time on
-    the run queue is not work: on a busy machine an idle program's many threads (Fast DDS
-    has a dozen) each stand there a moment whenever they wake, and in all for a large share
-    of the wall clock.
+    (a test's time limit, a sandbox's wall time, the learner's stop button).
 
     What the trees wait for may be the watcher's own process (a subject waits for its
     judge's clock, its answers, its discovery messages): time the machine kept the watcher
     from running is not the trees' idle time either.  So an idle interval counts only the
-    part of it that the watcher's most delayed thread did not stand on the run queue
-    (:class:`HeldBack`, every thread, the one that looks included: it may be the one that
-    serves what the trees wait for; its CPU time never counts: a judge busy with other
-    subjects would make every program it waits on look busy), and at most two looks of it:
-    a watcher kept from looking longer (by its own work, or by a thread of its process that
-    holds the GIL while the machine starves it) was late, which says nothing of the trees.
+    part of it that the watcher's most delayed thread did not stand on the run queue (its
+    CPU time never counts: a judge busy with other subjects would make every program it
+    waits on look busy), and at most two looks of it: a watcher kept from looking longer
+    (by its own work, or by a thread of its process that holds the GIL while the machine
+    starves it) was late, which says nothing of the trees.
 
     Introduced in ``03-write-the-publisher.ipynb`` (how long the judge waits for a subject).
 
@@ -256,58 +245,43 @@ class Patience:
         self.limit_s = limit_s
         now = time.monotonic()
         self.started = now if started is None else started
-        #: The thread that looks (the one that made this: it is left out of what it watches).
-        self._looker = _this_thread()
-        self._last = look_at_trees(self.pids, skip=self._looker)
-        self.cpu_at_start = self._last.cpu_s
+        self.cpu_at_start, queued, _ready = tree_work(self.pids, skip=_this_thread())
         #: Seconds on the wall clock the trees sat idle so far.  Of the time before this
         #: first look, a look's length counts: what the watcher took beyond it was its own
         #: lateness (the machine, or its own work, kept it from looking), not their waiting.
         self.idle_s = min(now - self.started, LOOK_S)
-        self._looked = now
+        self._look = (now, self.cpu_at_start + queued)
         self._verdict = False
         #: What kept the watcher's own process from running (:meth:`_watcher_threads`).
         self._held = HeldBack(self._watcher_threads)
 
     def _watcher_threads(self) -> dict[int, float]:
-        """Each thread of the watcher's process, the one that looks included: its seconds on
-        the run queue so far.  Nothing when the watcher is one of the trees (then its threads
-        are the trees' own)."""
+        """Each thread of the watcher's process, the one that looks included (kept from
+        running, it looks late, and the interval grows by time nobody waited): its seconds
+        on the run queue so far.  Nothing when the watcher is one of the trees (then its time
+        on the run queue is the trees' work already)."""
         pid = os.getpid()
         if pid in self.pids:
             return {}
-        return {task: thread.queued_s for task, thread in _threads(pid).items()}
-
-    @staticmethod
-    def _idle_between(before: TreeLook, after: TreeLook, interval: float) -> bool:
-        """Whether the trees sat idle between two looks ``interval`` seconds apart: they
-        used little CPU, and none of their threads wanted more (it stood on the run queue
-        for most of the interval, or stands there now and has not run since the last look)."""
-        ran, wanting = 0.0, False
-        for key, thread in after.threads.items():
-            earlier = before.threads.get(key, Thread('R', 0.0, 0.0))  # new: ready since made
-            ran += thread.run_s - earlier.run_s
-            wanting = wanting or thread.queued_s - earlier.queued_s >= WANTING_SHARE * interval \
-                or thread.state == earlier.state == 'R' and thread.run_s == earlier.run_s
-        return not wanting and max(ran, after.cpu_s - before.cpu_s) < BUSY_SHARE * interval
+        return {task: delay for task, _state, delay in _threads(pid)}
 
     def exhausted(self) -> bool:
         """True once the trees have had their limit (call it every fraction of a second: it
         reads /proc once every :data:`LOOK_S`)."""
         now = time.monotonic()
-        if self._verdict or now - self._looked < LOOK_S:
+        then, busy_then = self._look
+        if self._verdict or now - then < LOOK_S:
             return self._verdict
-        before, self._last = self._last, look_at_trees(self.pids, skip=self._looker)
+        cpu, queued, ready = tree_work(self.pids, skip=_this_thread())
         self._held.look()
-        if self._idle_between(before, self._last, now - self._looked):
+        if not ready and cpu + queued - busy_then < BUSY_SHARE * (now - then):
             # Looks come a LOOK_S apart; of a longer interval, what is beyond two looks was the
             # watcher's lateness (its own work, or a thread of its process the machine starves
             # holding the GIL it needs), not the trees' waiting, as before the first look.
-            interval = min(now - self._looked, 2 * LOOK_S)
+            interval = min(now - then, 2 * LOOK_S)
             self.idle_s += interval - self._held.take(interval)
-        self._looked = now
-        self._verdict = self._last.cpu_s - self.cpu_at_start >= self.limit_s \
-            or self.idle_s >= self.limit_s
+        self._look = (now, cpu + queued)
+        self._verdict = cpu - self.cpu_at_start >= self.limit_s or self.idle_s >= self.limit_s
         return self._verdict
 
     @property
