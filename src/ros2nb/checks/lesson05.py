@@ -121,8 +121,7 @@ def _entries_cause(setup_py: Path) -> Optional[str]:
                     'left of = is what you pass to ros2 run.')
         target = scripts[executable].replace(' ', '')
         if target != want:
-            module, _, function = target.partition(':')
-            if module != want.partition(':')[0]:
+            if target.partition(':')[0] != f'{course.PACKAGE}.{executable}':
                 return (f'{executable} = {scripts[executable]}: it should start main() in '
                         f'{course.PACKAGE}/{executable}.py; left of the colon, name that file '
                         'as a module (package.module: dots, no .py).')
