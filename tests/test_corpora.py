@@ -6,10 +6,11 @@ corpus: each twin loses exactly its parts.  Each attack (``corpus_attacks.py``) 
 part its twin loses, except those the wire cannot tell from honest code, which the judge
 flags for the instructor instead (``tests/test_flags.py``).  The attacks that reach into the
 process they run in (``corpus_reaching.py``, the sixth hostile class's among them) are graded
-twice, with two seeds of the drawn inputs, as the grader grades them (the judge and each
-subject sandboxed): each loses its twin's parts in both (the sixth class's exactly its twin's
+once, with a seed of the drawn inputs new in every run, as the grader grades them (the judge
+and each subject sandboxed): each loses its twin's parts (the sixth class's exactly its twin's
 score), its lost parts say why in one line, and those the subject's audit hook sees
-(``seen``) are noted at run time, never a verdict.
+(``seen``) are noted at run time, never a verdict.  (A second seed in the same run doubled
+their cost: docs/decisions.md.)
 
 ``python tests/corpora.py`` prints every learner's score; run with an older checkout's judge it
 gives the "before" column of the closing notes.
@@ -32,9 +33,9 @@ from ros2nb_instructor.grading.settings import JUDGE_TIMEOUT_S as SANDBOXED_JUDG
 #: Each test grades one learner.
 pytestmark = [pytest.mark.judge, pytest.mark.timeout(time_limit_s(1))]
 TWINS = {learner.name: learner for learner in [*ATTACKS, *HONEST]}
-#: The two seeds of this run's gradings of the reaching attacks (each pytest-xdist worker
-#: draws its own: a new pair every run).
-SEEDS = (new_seed(), new_seed())
+#: The seed of this run's gradings of the reaching attacks (each pytest-xdist worker draws
+#: its own: a new one every run).
+SEED = new_seed()
 
 
 @pytest.mark.parametrize('knows_nothing', [False, True],
@@ -66,13 +67,12 @@ def test_an_attack_scores_what_its_twin_scores(attack, tmp_path):
 @pytest.mark.sandbox
 @pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))
 @pytest.mark.timeout(SANDBOXED_JUDGE_S + BESIDE_JUDGES_S)  # one grading, the grader's way
-@pytest.mark.parametrize('run', [0, 1], ids=['seed 1', 'seed 2'])
 @pytest.mark.parametrize('attack', REACHING, ids=[a.name for a in REACHING])
-def test_reaching_in_scores_at_most_its_twin_and_says_so(attack, run, tmp_path):
+def test_reaching_in_scores_at_most_its_twin_and_says_so(attack, tmp_path):
     """Graded as the grader grades: in its sandboxes the course's answers are not on a
     subject's disk and no subject reads what another wrote, and no verdict comes from what
     the audit hooks saw (they only note it)."""
-    seed, twin = SEEDS[run], TWINS[attack.twin]
+    seed, twin = SEED, TWINS[attack.twin]
     attacked, flags = judged_in_sandbox(attack, tmp_path, seed=seed)
     lost = failed(attacked)
     context = (seed, lost, flags)
