@@ -104,12 +104,11 @@ graph-tool:
 image-tool:
 	$(call from_debian,podman runc debootstrap,podman runc debootstrap,the image test skips.,the image test builds the course's image with them.)
 
-# The fast lane (docs/developing.md): ruff over the course's Python, mypy over the seams
-# between the places code runs (pyproject.toml: [tool.mypy]; its cache in .cache/mypy), then
-# the tests that need only Python (no ROS process, kernel, sandbox, browser, image or hub:
-# tests/conftest.py's lanes), notebook structure and layer rules among them, on both cores
-# (pytest-xdist): one process took a minute for its 478 tests, two take half.  Run it while
-# you work.
+# The fast lane (docs/developing.md): ruff over the course's Python, mypy over all of src
+# (pyproject.toml: [tool.mypy]; its cache in .cache/mypy), then the tests that need only
+# Python (no ROS process, kernel, sandbox, browser, image or hub: tests/conftest.py's lanes),
+# notebook structure and layer rules among them, on both cores (pytest-xdist): one process
+# took a minute for its 478 tests, two take half.  Run it while you work.
 check: $(STAMP) bytecode
 	@$(VENV)/bin/ruff check --quiet .
 	@$(PY) -m mypy

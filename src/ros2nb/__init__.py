@@ -43,7 +43,7 @@ _ON_FIRST_USE = {'checks': 'checks', 'progress': 'checks', 'rules': 'rules',
 __getattr__, __dir__ = loader(globals(), _ON_FIRST_USE)
 
 
-def load_ipython_extension(ipython) -> None:
+def load_ipython_extension(ipython: object) -> None:
     """``%load_ext ros2nb``: the ``%%part FILE N`` cell magic and one-line errors (notebook 03)."""
     install(ipython)
 

@@ -289,7 +289,7 @@ def _take_course_file(name: str) -> str:
     """
     relative = {Path(r).name: r for r in WRITTEN_IN}.get(Path(name).name)
     text = reference_source(Path(name).name) if relative else None
-    if text is None:
+    if relative is None or text is None:
         raise ValueError(f'take= names the course\'s node files, '
                          f'{" or ".join(repr(Path(r).name) for r in WRITTEN_IN)} (got {name!r}); '
                          'the course gives none while grading.')

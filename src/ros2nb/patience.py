@@ -37,7 +37,8 @@ def psutil_module() -> Any:
 def process_tree(pids: Sequence[int]) -> list['psutil.Process']:
     """Each of ``pids`` that is still there and every process under them, once, as
     :class:`psutil.Process` (psutil walks the tree from every process's parent)."""
-    psutil, found = psutil_module(), {}  # pid -> its Process, in the order found
+    psutil = psutil_module()
+    found: dict[int, Any] = {}  # pid -> its Process, in the order found
     for pid in dict.fromkeys(pids):
         if pid in found:
             continue

@@ -117,10 +117,12 @@ class _Trial:
             if self.out.incompatible is None:
                 self.out.incompatible, self.out.event_s = info, time.monotonic() - started
 
+        def on_message(msg: Int32) -> None:
+            self.out.received.append(msg.data)
+
         events = SubscriptionEventCallbacks(incompatible_qos=on_incompatible)
-        return self.nodes[1].create_subscription(
-            Int32, self.topic, lambda msg: self.out.received.append(msg.data), profile,
-            event_callbacks=events)
+        return self.nodes[1].create_subscription(Int32, self.topic, on_message, profile,
+                                                 event_callbacks=events)
 
     def wait_matched(self, publisher: Any) -> bool:
         """Spin (events only arrive so) until matched or the incompatible event fired."""

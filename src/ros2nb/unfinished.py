@@ -23,7 +23,8 @@ _PLACEHOLDER = 'NotImplementedError'
 
 def _self_uses(cls: ast.ClassDef) -> tuple[set[str], set[str]]:
     """The ``self.NAME`` a class reads, and those it assigns, anywhere in its methods."""
-    read, assigned = set(), set()
+    read: set[str] = set()
+    assigned: set[str] = set()
     for node in ast.walk(cls):
         if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) \
                 and node.value.id == 'self':

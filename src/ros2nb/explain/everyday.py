@@ -178,7 +178,7 @@ def _unset_local(exc: UnboundLocalError, frame: FrameType) -> str:
     function = frame.f_code.co_name
     line = stored(frame.f_code, name, 'STORE_FAST')
     text = linecache.getline(frame.f_code.co_filename, line).strip() if line else ''
-    if text.startswith(('import ', 'from ')):
+    if line is not None and text.startswith(('import ', 'from ')):
         return (f'{name} is used before {function} imports it ({place(frame.f_code, line)}): '
                 'import it at the top of the file instead.')
     if line is not None and line < frame.f_lineno and _in_branch(frame, line):
@@ -196,8 +196,9 @@ def _in_branch(frame: FrameType, line: int) -> bool:
         tree = ast.parse(textwrap.dedent(''.join(lines)))
     except (OSError, TypeError, SyntaxError):
         return False
-    return any(isinstance(node, ast.If) and node.lineno + first - 1 < line
-               <= node.end_lineno + first - 1 for node in ast.walk(tree))
+    return any(isinstance(node, ast.If) and node.end_lineno is not None
+               and node.lineno + first - 1 < line <= node.end_lineno + first - 1
+               for node in ast.walk(tree))
 
 
 _MISSING = re.compile(r"^(?P<called>[\w.]+)\(\) missing \d+ required positional "
@@ -249,6 +250,8 @@ def _unexpected_keyword(exc: TypeError, frame: FrameType) -> Optional[str]:
     target = {**frame.f_globals, **frame.f_locals}.get(path.split('.')[0])
     for part in path.split('.')[1:]:
         target = getattr(target, part, None)
+    if not callable(target):  # what inspect.signature refuses first, with a TypeError
+        return None
     try:
         takes = [p for p in inspect.signature(target).parameters if p not in ('self', 'args',
                                                                                'kwargs')]

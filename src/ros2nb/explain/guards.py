@@ -12,6 +12,7 @@ from typing import Any, Callable, Optional
 
 from rclpy.exceptions import InvalidHandle
 from rclpy.node import Node
+from rclpy.subscription import Subscription
 
 from ..endpoints import type_name
 from ..errors import Ros2nbError
@@ -63,7 +64,7 @@ def check_node(node: Any, rt: Any) -> None:
                 raise Ros2nbError(f'{name} made a {kind} on {entity.topic_name} with a message '
                                   f'{cls}() instead of the message type: pass {cls} without '
                                   'the parentheses.')
-            if kind == 'subscription' and not callable(entity.callback):
+            if isinstance(entity, Subscription) and not callable(entity.callback):
                 raise Ros2nbError(f'{name} has a subscription on {entity.topic_name} whose '
                                   f'callback is {entity.callback!r}: pass the method itself, '
                                   'without the parentheses.')

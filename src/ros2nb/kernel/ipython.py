@@ -140,7 +140,7 @@ def install(ip: Any = None) -> bool:
     ip.events.register('post_run_cell', _after_cell)
     ip.set_custom_exc((Exception,), _explain)
     rclpy.spin = _spin_in_a_cell
-    Executor.spin = _executor_spin_in_a_cell
-    Executor.spin_until_future_complete = _until_complete_in_a_cell
+    setattr(Executor, 'spin', _executor_spin_in_a_cell)
+    setattr(Executor, 'spin_until_future_complete', _until_complete_in_a_cell)
     setattr(ip, _INSTALLED, True)
     return True

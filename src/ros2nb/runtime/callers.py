@@ -18,7 +18,9 @@ import functools
 import importlib.machinery
 import inspect
 import os
+import sys
 from types import FrameType
+from typing import Optional
 
 from rclpy.impl import rcutils_logger
 
@@ -52,13 +54,15 @@ def find_caller(frame: FrameType) -> FrameType:
         _rclpy_find_caller(frame)  # rclpy fills in its own files' names on first use
     internal = rcutils_logger._internal_callers
     while any(name in _real_path(_file_of(frame)) for name in internal):
+        if frame.f_back is None:  # the stack's first frame: no caller outside rclpy's logging
+            return frame
         frame = frame.f_back
     return frame
 
 
-def _caller_id_new(cls: type, frame: FrameType = None) -> rcutils_logger.CallerId:
+def _caller_id_new(cls: type, frame: Optional[FrameType] = None) -> rcutils_logger.CallerId:
     if not frame:  # from rclpy's log(): its frames are skipped, as from rclpy's own __new__
-        frame = find_caller(inspect.currentframe().f_back)
+        frame = find_caller(sys._getframe(1))  # the frame that called this one
     return tuple.__new__(cls, (frame.f_code.co_name, os.path.abspath(_file_of(frame)),
                                frame.f_lineno, frame.f_lasti))
 
@@ -66,10 +70,10 @@ def _caller_id_new(cls: type, frame: FrameType = None) -> rcutils_logger.CallerI
 def use_cheaper_caller_lookup() -> None:
     """Make rclpy's loggers in this process find their caller this way (idempotent)."""
     rcutils_logger._find_caller = find_caller
-    rcutils_logger.CallerId.__new__ = _caller_id_new
+    setattr(rcutils_logger.CallerId, '__new__', _caller_id_new)
 
 
 def use_rclpy_caller_lookup() -> None:
     """Put rclpy's own caller lookup back (the tests compare the two)."""
     rcutils_logger._find_caller = _rclpy_find_caller
-    rcutils_logger.CallerId.__new__ = _rclpy_caller_id_new
+    setattr(rcutils_logger.CallerId, '__new__', _rclpy_caller_id_new)

@@ -68,7 +68,7 @@ def enable_field_checks() -> None:
     os.environ['ROS_PYTHON_CHECK_FIELDS'] = '1'
     for module in list(sys.modules.values()):
         if getattr(module, 'ros_python_check_fields', None) == '':
-            module.ros_python_check_fields = '1'
+            setattr(module, 'ros_python_check_fields', '1')
 
 
 class Runtime(LogLines, Spinning, NodeKeeping, SimulatedClock):

@@ -12,6 +12,10 @@ import sys
 import threading
 import time
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # only the type: this module imports no ROS
+    from rcl_interfaces.msg import Log
 
 #: Log lines kept while no cell is reading them; older ones are counted, not kept.
 MAX_PENDING_LOG_LINES = 2000
@@ -101,7 +105,7 @@ class LogLines:
         """A new cell starts: lines made before it are no longer news (IPython pre_run_cell)."""
         self._epoch += 1
 
-    def _on_log(self, msg) -> None:
+    def _on_log(self, msg: Log) -> None:
         """Take one /rosout message (the subscription's callback)."""
         with self._lock:
             self.log_counts[msg.name] += 1

@@ -17,10 +17,11 @@ import contextlib
 import functools
 import os
 import weakref
-from typing import Any, Iterable, Iterator, Optional, Union
+from typing import TYPE_CHECKING, Any, ContextManager, Iterable, Iterator, Optional, Union
 
 import rclpy
 from rclpy.exceptions import InvalidHandle
+from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 
 from ..errors import Ros2nbError, UsageError
@@ -45,7 +46,7 @@ def drop_qos_warnings(node: Node, entities: Optional[Iterable[Any]] = None) -> N
     time.
     """
     for entity in (node.publishers if entities is None else entities):
-        for handler in entity.event_handlers:
+        for handler in entity.event_handlers:  # type: ignore[union-attr]  # rclpy mistypes its list
             node.remove_waitable(handler)
             handler.destroy()
         entity.event_handlers = []
@@ -163,9 +164,23 @@ def _destroy(nodes: Iterable[Node]) -> None:
 class NodeKeeping:
     """The running nodes by full name, and the emptied shells of replaced ones.
 
-    Needs, from the runtime it is part of: ``executor``, ``exclusive``, ``drain``,
-    ``alive``, ``ensure_alive``, ``own_logger``, ``sim_time``, ``_on_sim`` and ``_set_clock``.
+    Needs, from the runtime it is part of (declared below for the type checker):
+    ``executor``, ``exclusive``, ``drain``, ``alive``, ``ensure_alive``, ``own_logger``,
+    ``sim_time``, ``_on_sim`` and ``_set_clock``.
     """
+
+    executor: SingleThreadedExecutor
+    sim_time: bool
+    _on_sim: set[str]
+
+    if TYPE_CHECKING:  # the runtime's other sides define these: only their types here
+        @property
+        def alive(self) -> bool: ...
+        def exclusive(self) -> ContextManager[object]: ...
+        def drain(self) -> int: ...
+        def ensure_alive(self) -> None: ...
+        def own_logger(self, name: str) -> None: ...
+        def _set_clock(self, nodes: Iterable[Node], sim: bool) -> None: ...
 
     def __init__(self) -> None:
         self._nodes: dict[str, Node] = {}

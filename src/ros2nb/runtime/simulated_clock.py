@@ -16,11 +16,12 @@ its steps from there and publishes no ``/clock`` of its own.
 from __future__ import annotations
 
 import contextlib
-from typing import Callable, Iterable, Iterator, Optional, Protocol
+from typing import TYPE_CHECKING, Callable, ContextManager, Iterable, Iterator, Optional, Protocol
 
 from rclpy.clock import ROSClock
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.publisher import Publisher
 from rclpy.time import Time
 from rosgraph_msgs.msg import Clock
 
@@ -83,9 +84,19 @@ def _rclpy_callbacks_only(node: Node) -> Iterator[None]:
 class SimulatedClock:
     """Simulated time: its current value, the nodes on it, and stepping it.
 
-    Needs, from the runtime it is part of: ``_nodes``, ``exclusive``, ``drain``, ``alive``
-    and ``_clock_publisher`` (a ``/clock`` publisher).
+    Needs, from the runtime it is part of (declared below for the type checker):
+    ``_nodes``, ``exclusive``, ``drain``, ``alive`` and ``_clock_publisher`` (a ``/clock``
+    publisher).
     """
+
+    _nodes: dict[str, Node]
+    _clock_publisher: Publisher
+
+    if TYPE_CHECKING:  # the runtime's other sides define these: only their types here
+        @property
+        def alive(self) -> bool: ...
+        def exclusive(self) -> ContextManager[object]: ...
+        def drain(self) -> int: ...
 
     def __init__(self, sim_time: bool) -> None:
         #: The kernel's clock: True for simulated time, False for the wall clock.

@@ -11,11 +11,13 @@ from __future__ import annotations
 import collections
 import contextlib
 import threading
-from typing import Callable, Iterator, Optional
+from typing import TYPE_CHECKING, Callable, Iterator, Optional, Protocol
 
+from rclpy.callback_groups import CallbackGroup
+from rclpy.context import Context
 from rclpy.exceptions import InvalidHandle
 from rclpy.executors import (ConditionReachedException, ExternalShutdownException,
-                             ShutdownException, TimeoutException)
+                             ShutdownException, SingleThreadedExecutor, TimeoutException)
 from rclpy.node import Node
 
 from ..errors import Ros2nbError
@@ -41,6 +43,14 @@ def _label(entity: object) -> str:
     return getattr(callback, '__qualname__', repr(callback))
 
 
+class _Entity(Protocol):
+    """What rclpy's executor marks on each entity it hands out (a timer, subscription,
+    service, client, guard condition or waitable of a node)."""
+
+    _executor_event: bool
+    callback_group: CallbackGroup
+
+
 def _never() -> bool:
     """rclpy's default wait condition: never reached."""
     return False
@@ -49,9 +59,19 @@ def _never() -> bool:
 class Spinning:
     """The executor, its background thread and the pause that lets another thread spin.
 
-    Needs, from the runtime it is part of: ``executor``, ``context``, ``node`` (ros2nb's
-    own), ``_nodes``, ``_report_failure`` and ``_discard``.
+    Needs, from the runtime it is part of (declared below for the type checker):
+    ``executor``, ``context``, ``node`` (ros2nb's own), ``_nodes``, ``_report_failure`` and
+    ``_discard``.
     """
+
+    executor: SingleThreadedExecutor
+    context: Context
+    node: Node
+    _nodes: dict[str, Node]
+
+    if TYPE_CHECKING:  # the runtime's other sides define these: only their types here
+        def _report_failure(self, failure: CallbackFailure) -> None: ...
+        def _discard(self, node: Node) -> None: ...
 
     def __init__(self, background: bool) -> None:
         self._pause_requested = threading.Event()
@@ -93,6 +113,7 @@ class Spinning:
                  until: Callable[[], bool] = _never) -> Optional[str]:
         """Run one ready callback; return its name, or None when none became ready in time
         (or ``until()`` became true while waiting: the executor's ``wake()`` checks it)."""
+        entity: object  # any of a node's entities (rclpy's return type leaves it unbound)
         try:
             handler, entity, node = self.executor.wait_for_ready_callbacks(
                 timeout_sec=timeout_sec, condition=until)
@@ -165,12 +186,14 @@ class Spinning:
             self.executor._tasks = []
             self.executor._cb_iter = None
         for node in [self.node, *self._nodes.values()]:
-            for entity in (*node.timers, *node.subscriptions, *node.services, *node.clients,
-                           *node.guards, *node.waitables):
+            entities: tuple[_Entity, ...] = (
+                *node.timers, *node.subscriptions, *node.services, *node.clients,
+                *node.guards, *node.waitables)
+            for entity in entities:
                 entity._executor_event = False
                 group = entity.callback_group
-                if getattr(group, '_active_entity', None) is not None:
-                    group._active_entity = None
+                if getattr(group, '_active_entity', None) is not None:  # mutually exclusive
+                    setattr(group, '_active_entity', None)
 
     def _spin_in_background(self) -> None:
         """The background thread: run callbacks until stopped, pausing when asked."""

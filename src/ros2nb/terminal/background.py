@@ -14,7 +14,7 @@ from __future__ import annotations
 import atexit
 import subprocess
 import threading
-from typing import Optional
+from typing import Any, Callable, Optional
 
 from ..errors import UsageError
 from ..explain.ros_settings import output_mistake
@@ -89,7 +89,7 @@ class NodeProcess:
         def said() -> bool:
             return self._ended or sum(text in line for line in self.lines) >= count
 
-        def look(condition, seconds: float) -> bool:
+        def look(condition: Callable[[], Any], seconds: float) -> bool:
             with self._changed:
                 return self._changed.wait_for(condition, seconds)
 

@@ -99,9 +99,9 @@ class Recording:
         self._process: Optional[subprocess.Popen] = None
         self._subscriptions: list[Any] = []
         self._writer: Any = None
-        if _real_ros2():
+        if ros2 := _real_ros2():
             self._process = subprocess.Popen(
-                [_real_ros2(), 'bag', 'record', '-o', str(path), '-s', STORAGE_ID,
+                [ros2, 'bag', 'record', '-o', str(path), '-s', STORAGE_ID,
                  '--use-sim-time', *topics], env=node_process_env(os.environ))
             return
         store = typestore()
@@ -237,13 +237,13 @@ def bag_info(name: Any) -> dict[str, int]:
     :raises Ros2nbError: when the folder is no bag.
     """
     path = _bag_path(name)
-    if _real_ros2():
-        subprocess.run([_real_ros2(), 'bag', 'info', str(path)], check=False,
+    if ros2 := _real_ros2():
+        subprocess.run([ros2, 'bag', 'info', str(path)], check=False,
                        env=node_process_env(os.environ))
     with _reader(path) as reader:
         counts = {c.topic: c.msgcount for c in reader.connections}
         files = sorted(f.name for f in path.iterdir() if f.suffix == f'.{STORAGE_ID}')
-        if _real_ros2():
+        if ros2:
             return counts
         print(f'Files:             {files[0] if files else ""}')
         for more in files[1:]:
@@ -296,9 +296,9 @@ def bag_play(name: Any, *, rate: float = 1.0, topics: Optional[Sequence[str]] = 
     if not rt.sim_time:
         raise Ros2nbError('bag_play replays on simulated time: start ROS with '
                           'ros2nb.start(sim_time=True).')
-    if _real_ros2():
+    if ros2 := _real_ros2():
         args = ['--topics', *topics] if topics else []
-        subprocess.run([_real_ros2(), 'bag', 'play', str(path), '--clock', '--rate', str(rate),
+        subprocess.run([ros2, 'bag', 'play', str(path), '--clock', '--rate', str(rate),
                         *args], check=False, env=node_process_env(os.environ))
         return {}
     with _reader(path) as reader, working.shown(f'playing {path.name}'):

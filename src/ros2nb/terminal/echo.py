@@ -11,7 +11,7 @@ import importlib
 import math
 import statistics
 import time
-from typing import Any, Optional
+from typing import Any, Callable, Optional, Protocol
 
 from rclpy.qos import DurabilityPolicy, QoSPresetProfiles, QoSProfile, ReliabilityPolicy
 
@@ -24,7 +24,15 @@ from .topic import did_you_mean, graph_topics, resolve
 DEFAULT_WAIT_S = 10.0
 
 
-def message_type(type_name: str) -> type:
+class MessageClass(Protocol):
+    """A message class rosidl generated (``std_msgs.msg.Float32``), as the terminal verbs use it."""
+
+    __name__: str
+
+    def get_fields_and_field_types(self) -> dict[str, str]: ...
+
+
+def message_type(type_name: str) -> MessageClass:
     """Import a message class from its ROS name, e.g. ``'std_msgs/msg/Float32'``.
 
     :raises Ros2nbError: if the name is malformed or the package is not installed.
@@ -76,7 +84,7 @@ def _echo_qos(topic: str) -> QoSProfile:
     return qos
 
 
-def _topic_type(name: str, msg_type: Optional[str]) -> type:
+def _topic_type(name: str, msg_type: Optional[str]) -> MessageClass:
     """The message class to subscribe with: ``msg_type``, else the type the graph shows."""
     if msg_type is None:
         types = graph_topics().get(name)
@@ -89,8 +97,9 @@ def _topic_type(name: str, msg_type: Optional[str]) -> type:
     return message_type(msg_type)
 
 
-def _collect(name: str, cls: type, count: int, timeout: float,
-             sim_time: Optional[bool], on_message, *, show_logs: bool = True) -> int:
+def _collect(name: str, cls: MessageClass, count: int, timeout: float,
+             sim_time: Optional[bool], on_message: Callable[[Any], None], *,
+             show_logs: bool = True) -> int:
     """Subscribe to topic ``name`` on the kernel's node; run until ``count`` messages or
     ``timeout``."""
     rt = current_runtime()

@@ -57,7 +57,7 @@ def graph_edges(*, expect: Iterable[str] = (),
     :raises Ros2nbError: if ROS is not up, or an expected node did not appear in time.
     """
     want = set(expect)
-    found: list[tuple[str, str, str]] = []
+    found: set[tuple[str, str, str]] = set()
 
     def shown() -> bool:  # or every process started for it ended, some by themselves
         nonlocal found

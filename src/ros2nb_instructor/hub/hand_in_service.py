@@ -45,7 +45,11 @@ log = logging.getLogger(LOG)
 
 
 class Learners(HubOAuthenticated, web.RequestHandler):
-    """A request of one learner, who the hub says it is from."""
+    """A request of one learner, who the hub says it is from.
+
+    Its handlers end with ``finish`` and never await the Future it returns: that only says
+    when tornado has written the response out, which it does without them.
+    """
 
     def initialize(self, store: Store, schedule: Schedule) -> None:
         self.store, self.schedule = store, schedule
@@ -66,13 +70,13 @@ class Learners(HubOAuthenticated, web.RequestHandler):
 
     def reply(self, value: Any) -> None:
         self.set_header('Content-Type', 'application/json')
-        self.finish(json.dumps(dataclasses.asdict(value)))
+        _ = self.finish(json.dumps(dataclasses.asdict(value)))
 
     def write_error(self, status_code: int, **kwargs: Any) -> None:
         """One line of text, no page and no traceback."""
         self.set_header('Content-Type', 'text/plain; charset=utf-8')
         error = kwargs.get('exc_info', (None, None))[1]
-        self.finish(getattr(error, 'log_message', None) or self._reason)
+        _ = self.finish(getattr(error, 'log_message', None) or self._reason)
 
 
 class HandIns(Learners):
@@ -114,14 +118,15 @@ class Feedback(Learners):
         if notebook is None:
             items = ''.join(f'<li><a href="{n}.html">{n}</a></li>'
                             for n in self.store.feedback(learner))
-            self.finish(f'<!doctype html><html><head><meta charset="utf-8"><title>Your feedback'
-                        f'</title></head><body><h1>Your feedback, {html.escape(learner)}</h1><ul>'
-                        f'{items or "<li>none released yet</li>"}</ul></body></html>')
+            _ = self.finish(
+                f'<!doctype html><html><head><meta charset="utf-8"><title>Your feedback'
+                f'</title></head><body><h1>Your feedback, {html.escape(learner)}</h1><ul>'
+                f'{items or "<li>none released yet</li>"}</ul></body></html>')
             return
         page = self.store.page(learner, notebook)
         if page is None:
             raise web.HTTPError(404, f'no feedback on {notebook} released to you yet')
-        self.finish(page)
+        _ = self.finish(page)
 
 
 def application(store: Store, schedule: Schedule, prefix: str) -> web.Application:
