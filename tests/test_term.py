@@ -307,6 +307,8 @@ def test_a_class_under_two_policies_exported_and_one_learner_again(tmp_path):
         done = grade(tmp_path / 'class', '--out', out, '--settings', tmp_path / f'{policy}.toml',
                      '--export', lms_name, '--roster', tmp_path / 'roster.csv', '--seed', 7)
         assert done.returncode == 0, done.stdout + done.stderr
+        # The lines name the files where the grading ends up, not the folder it is made in.
+        assert f'export: wrote {out / "export" / f"{lms_name}.csv"}\n' in done.stdout, done.stdout
         rows = csv_rows(out)
         for learner, (raw, penalty, score) in EXPECTED[policy].items():
             row = rows[learner]
