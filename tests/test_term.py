@@ -193,6 +193,19 @@ def test_canvas_columns(tmp_path):
         ['learner', *NOTEBOOKS, 'total'], ['\'=HYPERLINK("http://x")', '0', '1', '1']]
 
 
+def test_not_in_roster_csv_goes_once_the_roster_has_everyone(tmp_path):
+    """Before, an export with a fuller roster left the earlier not-in-roster.csv, naming
+    learners the new export had matched."""
+    (tmp_path / 'roster.csv').write_text(ROSTER)
+    rows_of = roster.read_roster(tmp_path / 'roster.csv', 'canvas')
+    lms.write('canvas', a_table(), rows_of, tmp_path / 'canvas.csv')
+    assert (tmp_path / 'not-in-roster.csv').exists()
+    everyone = {**rows_of, '=HYPERLINK("http://x")': roster.RosterRow('=HYPERLINK("http://x")',
+                                                                       lms_id='104')}
+    assert lms.write('canvas', a_table(), everyone, tmp_path / 'canvas.csv') == []
+    assert sorted(p.name for p in tmp_path.iterdir()) == ['canvas.csv', 'roster.csv']
+
+
 def test_moodle_and_plain_columns(tmp_path):
     """Moodle: the user's columns, then each notebook and its "Feedback for" column (as
     Moodle's own export names it); a CSV cannot carry an item's maximum, so one line says
@@ -294,6 +307,8 @@ def test_a_class_under_two_policies_exported_and_one_learner_again(tmp_path):
         done = grade(tmp_path / 'class', '--out', out, '--settings', tmp_path / f'{policy}.toml',
                      '--export', lms_name, '--roster', tmp_path / 'roster.csv', '--seed', 7)
         assert done.returncode == 0, done.stdout + done.stderr
+        # The lines name the files where the grading ends up, not the folder it is made in.
+        assert f'export: wrote {out / "export" / f"{lms_name}.csv"}\n' in done.stdout, done.stdout
         rows = csv_rows(out)
         for learner, (raw, penalty, score) in EXPECTED[policy].items():
             row = rows[learner]

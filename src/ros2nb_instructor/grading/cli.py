@@ -360,8 +360,8 @@ def _grade_with(cluster: Optional['Cluster'], args: argparse.Namespace, submissi
     rows = write_results(course, out, learners, notebooks, term.deadlines, term.extensions)
     if term.export:
         for line in export(out, term.export, term.roster, term.deadlines, term.extensions,
-                           learners=learners):
-            print(f'export: {line}')
+                           learners=learners):  # out moves to args.out once complete (main)
+            print(f'export: {line.replace(str(out), str(args.out.resolve()))}')
     _report(out, learners, rows, refused, settings.seed)
     try:
         write_report(out, learners, notebooks, rows, refused)

@@ -87,7 +87,7 @@ def _cell(mark: Mark) -> Cell:
 def write(lms: str, table: Table, roster: Optional[Roster], path: Path) -> list[str]:
     """Write ``table`` for ``lms`` (:data:`PLATFORMS`) to ``path``, a row per roster learner
     (every learner of ``table`` without a roster); the learners not in ``roster`` go to
-    :data:`NOT_IN_ROSTER` beside it.
+    :data:`NOT_IN_ROSTER` beside it, and with none that file is removed.
 
     :return: one line per learner who has marks and is not in the roster.
     """
@@ -95,11 +95,13 @@ def write(lms: str, table: Table, roster: Optional[Roster], path: Path) -> list[
     header, body = _layout(lms, table, rows)
     write_csv(path, header, body)
     extra = [name for name in table.marks if name not in rows]
+    apart = path.parent / NOT_IN_ROSTER
     if extra:
-        write_csv(path.parent / NOT_IN_ROSTER, ['learner', *table.notebooks, 'total'],
+        write_csv(apart, ['learner', *table.notebooks, 'total'],
                   [[name, *table.cells(name), table.total(name)] for name in extra])
-    return [f'{name}: graded, not in the roster: written to {path.parent / NOT_IN_ROSTER}'
-            for name in extra]
+    else:  # an earlier export's would still name learners the roster now has
+        apart.unlink(missing_ok=True)
+    return [f'{name}: graded, not in the roster: written to {apart}' for name in extra]
 
 
 def _layout(lms: str, table: Table, rows: Roster
