@@ -22,7 +22,7 @@ import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Mapping, Optional
+from typing import Any, Mapping, Optional
 
 from . import nbmeta
 
@@ -100,7 +100,7 @@ def record_path() -> Path:
     return Path(os.environ.get(WORK_ENV) or Path.cwd()).expanduser() / RECORD
 
 
-def outcomes(path: Optional[Path] = None) -> dict[str, dict]:
+def outcomes(path: Optional[Path] = None) -> dict[str, dict[str, Any]]:
     """The recorded outcome of each check, by its name: ``{'passed': bool, 'line': str,
     'at': ISO time}``; empty when nothing was recorded (or the file makes no sense)."""
     try:
@@ -130,7 +130,7 @@ def remember(check: str, passed: bool, line: str, path: Optional[Path] = None, *
         pass
 
 
-def state(part: Part, recorded: Mapping[str, dict]) -> str:
+def state(part: Part, recorded: Mapping[str, Mapping[str, Any]]) -> str:
     """The part's state from the recorded outcomes (:data:`PASSED`, :data:`FAILED`,
     :data:`NOT_YET`, or :data:`HIDDEN` for a hidden test)."""
     if part.check is None:
@@ -156,7 +156,7 @@ def _points(points: float) -> str:
 
 
 def rows(all_parts: list[Part], states: Mapping[str, str],
-         notes: Optional[Mapping[str, str]] = None) -> list[dict]:
+         notes: Optional[Mapping[str, str]] = None) -> list[dict[str, Any]]:
     """One row per notebook, for the tables: its parts with their states, the points passed,
     and its ``notes`` line (when it is due and was handed in; '' for none)."""
     by_notebook: dict[str, list[Part]] = {}
@@ -170,7 +170,7 @@ def rows(all_parts: list[Part], states: Mapping[str, str],
             for notebook, mine in by_notebook.items()]
 
 
-def table_text(table: list[dict]) -> str:
+def table_text(table: list[dict[str, Any]]) -> str:
     """The table as plain text: one line per notebook, one per part."""
     passed, total = sum(r['passed'] for r in table), sum(r['points'] for r in table)
     lines = [f'Passed {passed:g} of {total:g} points.']
@@ -197,7 +197,8 @@ _TABLE = '''\
 </table>'''
 
 
-def table_html(table: list[dict], caption: str, link: Optional[tuple[str, str]] = None) -> str:
+def table_html(table: list[dict[str, Any]], caption: str,
+               link: Optional[tuple[str, str]] = None) -> str:
     """The table as HTML (escaped by jinja2): a row per part, grouped by notebook; ``link``
     (text, address), when given, is a line above it (the learner's feedback on the hub)."""
     from jinja2 import Environment  # only where a table is shown, never in a check's import
@@ -210,7 +211,8 @@ def table_html(table: list[dict], caption: str, link: Optional[tuple[str, str]] 
         total=sum(r['points'] for r in table))
 
 
-def show_table(table: list[dict], caption: str, link: Optional[tuple[str, str]] = None) -> None:
+def show_table(table: list[dict[str, Any]], caption: str,
+               link: Optional[tuple[str, str]] = None) -> None:
     """Show the table (and ``link``, :func:`table_html`): as HTML (with the text beside it)
     in a Jupyter kernel, else as text."""
     text = f'{caption}. {table_text(table)}' + (f'\n{link[0]}: {link[1]}' if link else '')

@@ -328,7 +328,7 @@ UNFINISHED = ('The grader could not finish this check ({error}); the other check
               'otherwise tell your instructor.')
 
 
-def captured(call: Callable[[], Any]) -> dict:
+def captured(call: Callable[[], Any]) -> dict[str, Any]:
     """Run one check (in the judge); return its outcome as JSON-safe data for the kernel.
 
     An error the check did not expect (a subject's reply of the wrong shape, say) fails
@@ -359,7 +359,7 @@ def captured(call: Callable[[], Any]) -> dict:
     return {'passed': True, 'lines': out.getvalue().splitlines()}
 
 
-def show_result(result: dict) -> None:
+def show_result(result: dict[str, Any]) -> None:
     """Print a passed result's lines (:func:`captured`), or raise the failure it describes.
 
     :raises CheckFailed: (or :class:`LearnerCodeError`) with the judge's verdict.

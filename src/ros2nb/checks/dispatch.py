@@ -62,7 +62,7 @@ def ask_judge(check: str) -> None:
     show_result(result)
 
 
-def _read_until_done(proc: subprocess.Popen, work: working.Working) -> tuple[str, str]:
+def _read_until_done(proc: subprocess.Popen[bytes], work: working.Working) -> tuple[str, str]:
     """The judge's stdout and its own stderr lines, read as they come until it ends; each
     line of what it does shown on the way.
 

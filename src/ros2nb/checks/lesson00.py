@@ -53,7 +53,7 @@ def check_endpoint(judge: Optional[Judge], node_class: Any, kind: str, topic: st
     return f'{name} has a {kind} on {topic} [{type_name}].'
 
 
-def _kernel_node_endpoints(node_class: Any) -> tuple[str, list]:
+def _kernel_node_endpoints(node_class: Any) -> tuple[str, list[tuple[str, str, str]]]:
     require_ros()
     node = call_learner(node_class)
     if not isinstance(node, Node):
@@ -65,7 +65,8 @@ def _kernel_node_endpoints(node_class: Any) -> tuple[str, list]:
         node.destroy_node()
 
 
-def _answer_node_endpoints(judge: Judge, ref: AnswerRef) -> tuple[str, list, list]:
+def _answer_node_endpoints(judge: Judge, ref: AnswerRef
+                          ) -> tuple[str, list[tuple[str, str, str]], list[tuple[str, str, str]]]:
     subject = judge.answer_subject(ref)
     reply = subject.request(NewNode(cls=ref.name))
     if reply.no_class:

@@ -13,13 +13,13 @@ from typing import Optional
 
 from std_msgs.msg import String
 
-from ..judge_interface import Judge
+from ..judge_interface import Heard, Judge
 
 #: The topic the course's code in a subject tells the judge on.
 WITNESS_TOPIC = '/ros2nb/witness'
 
 
-def told_to(judge: Judge) -> list:
+def told_to(judge: Judge) -> list[Heard]:
     """The judge's list of what arrives on :data:`WITNESS_TOPIC` (watched from now on)."""
     return judge.observer.watch(WITNESS_TOPIC, String, lambda msg: msg.data)
 
@@ -35,7 +35,7 @@ def _numbers(text: str) -> list[Optional[float]]:
     return found
 
 
-def drawings(heard: list, start: int) -> list[dict[str, list[Optional[float]]]]:
+def drawings(heard: list[Heard], start: int) -> list[dict[str, list[Optional[float]]]]:
     """The drawings told from position ``start`` on, in order of arrival:
     ``{'times_s': [...], 'temps_c': [...]}`` each; what is no drawing is left out."""
     found = []

@@ -61,7 +61,7 @@ def learner_traceback(exc: BaseException) -> list[str]:
     return lines
 
 
-def describe_error(error: BaseException) -> dict:
+def describe_error(error: BaseException) -> dict[str, Any]:
     """The learner-facing facts of an exception: ``type``, ``message`` (at most 500
     characters), ``explanation`` (the one line of a known mistake, else of Python's error
     with what to do, :mod:`.everyday`; None when no frame is the learner's), ``traceback``

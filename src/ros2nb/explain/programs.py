@@ -11,7 +11,7 @@ Introduced in ``03-write-the-publisher.ipynb``.
 from __future__ import annotations
 
 import json
-from typing import Optional
+from typing import Any, Optional
 
 from rclpy.exceptions import NotInitializedException
 
@@ -37,7 +37,7 @@ def explained_line(error: BaseException, *, in_program: bool = True) -> str:
                                                               'where')})
 
 
-def read_explained(text: str) -> Optional[dict]:
+def read_explained(text: str) -> Optional[dict[str, Any]]:
     """The facts of the last :func:`explained_line` in a program's output, or None."""
     for line in reversed(text.splitlines()):
         if line.startswith(EXPLAINED_MARK):

@@ -166,7 +166,8 @@ class JudgeClock:
             else:
                 looked = time.monotonic()
 
-    def _settle(self, ack: dict, base: tuple[dict[str, int], dict[str, int]], pid: int) -> None:
+    def _settle(self, ack: dict[str, Any], base: tuple[dict[str, int], dict[str, int]],
+                pid: int) -> None:
         """Wait until what the subject ``pid`` announced in ``ack`` (all it published and
         logged since it started) has arrived: what the judge heard since then (``base``: what
         it had heard when the subject started), on the topics it watched then and on /rosout.

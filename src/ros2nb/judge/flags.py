@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import ast
 from pathlib import Path
-from typing import Iterable, Optional
+from typing import Any, Iterable, Optional
 
 from IPython.core.inputtransformer2 import TransformerManager
 
@@ -258,8 +258,8 @@ def _python_of_cell(text: str, parts: bool) -> Optional[str]:
         return None
 
 
-def notebook_flags(submission: dict, workspace: Path, source: Optional[dict] = None
-                   ) -> list[str]:
+def notebook_flags(submission: dict[str, Any], workspace: Path,
+                   source: Optional[dict[str, Any]] = None) -> list[str]:
     """Every flag of a submitted notebook: its answer cells, every code cell the learner
     added or changed (one the course's ``source`` notebook does not have; a graded cell may
     lack its hidden tests), and the package files its ``%%part`` cells write in

@@ -65,9 +65,10 @@ def _defined_names(source: str) -> set[str]:
     return names
 
 
-def grade(source: dict, submission: dict, judge: Judge,
-          checked: Callable[[str, dict], None] = lambda grade_id, result: None,
-          starting: Callable[[str], None] = lambda grade_id: None) -> dict[str, dict]:
+def grade(source: dict[str, Any], submission: dict[str, Any], judge: Judge,
+          checked: Callable[[str, dict[str, Any]], None] = lambda grade_id, result: None,
+          starting: Callable[[str], None] = lambda grade_id: None
+          ) -> dict[str, dict[str, Any]]:
     """Run every graded cell of ``source`` (the course's notebook, hidden tests included).
 
     Names in a graded call (``LoudListener``) are the learner's: the judge passes an

@@ -13,7 +13,7 @@ import contextlib
 import math
 import threading
 import time
-from typing import Any, Callable, Optional
+from typing import AbstractSet, Any, Callable, Optional
 
 import rclpy
 from rcl_interfaces.msg import Log
@@ -219,8 +219,8 @@ class Observer:
         :raises NotDecided: when ``seconds`` pass first (the line says what was seen).
         """
         want = {tuple(e) for e in expected}
-        owners: dict[bytes, set] = {}
-        found: set = set()
+        owners: dict[bytes, set[tuple[str, str, str]]] = {}
+        found: set[tuple[str, str, str]] = set()
 
         def covered() -> bool:
             nonlocal owners, found
@@ -256,17 +256,18 @@ class Observer:
             return found
         return []
 
-    def _endpoints_by_process(self, name: str, namespace: str) -> dict[bytes, set]:
+    def _endpoints_by_process(self, name: str, namespace: str
+                              ) -> dict[bytes, set[tuple[str, str, str]]]:
         """Endpoints of the nodes ``namespace/name``, by the participant that owns them."""
-        owners: dict[bytes, set] = {}
+        owners: dict[bytes, set[tuple[str, str, str]]] = {}
         for kind, topic, info in self._endpoint_infos():
             if info.node_name == name and info.node_namespace == namespace:
                 owner = bytes(info.endpoint_gid[:PARTICIPANT_PREFIX_BYTES])
                 owners.setdefault(owner, set()).add((kind, topic, info.topic_type))
         return owners
 
-    def _unseen(self, name: str, processes: int, want: set, found: set,
-                seconds: float) -> str:
+    def _unseen(self, name: str, processes: int, want: AbstractSet[tuple[str, ...]],
+                found: AbstractSet[tuple[str, ...]], seconds: float) -> str:
         """Why the graph never showed what a subject said its node made, in one line."""
         if processes > 1:
             return (f'{processes} programs have a node named {name} on the grader\'s ROS domain '

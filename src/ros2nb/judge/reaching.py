@@ -121,7 +121,7 @@ class Reaching:
     :param subjects: the session's running subjects, by key (read as they go).
     """
 
-    def __init__(self, subjects: dict[tuple, Any]) -> None:
+    def __init__(self, subjects: dict[tuple[Any, ...], Any]) -> None:
         self._subjects = subjects
         #: Every event seen, with the subject that saw it, in order of reading.
         self.found: list[tuple[Any, Reached]] = []

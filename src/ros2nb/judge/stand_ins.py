@@ -28,6 +28,7 @@ from typing import Any, Callable, Optional
 
 from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor, SetParametersResult
 from rclpy.node import Node
+from rclpy.parameter import Parameter
 from std_msgs.msg import Bool, Float32
 
 from .. import course
@@ -139,7 +140,7 @@ def thresholds_init(self: LearnersNode) -> None:
     self.get_logger().info('Temperature Monitor Node Started')
 
 
-def thresholds_on_set(self: LearnersNode, parameters: list) -> SetParametersResult:
+def thresholds_on_set(self: LearnersNode, parameters: list[Parameter]) -> SetParametersResult:
     """Part 4 of notebook 08's monitor: a change that leaves ``low_below_c`` at or above
     ``high_above_c`` is refused, with a reason."""
     new = {parameter.name: parameter.value for parameter in parameters}

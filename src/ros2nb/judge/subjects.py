@@ -130,7 +130,7 @@ class Output:
         return '\n'.join(self.lines)
 
 
-def _well_formed_ack(line: bytes) -> Optional[dict]:
+def _well_formed_ack(line: bytes) -> Optional[dict[str, Any]]:
     """An acknowledgement as :class:`~ros2nb.subject.judge_time.JudgeTime` writes it, or None."""
     try:
         ack = json.loads(line)
@@ -202,7 +202,7 @@ class SubjectProcess:
         self._buffer = b''
         self._ack_buffer = b''
         #: The newest well-formed acknowledgement of a step (None before the first).
-        self.last_ack: Optional[dict] = None
+        self.last_ack: Optional[dict[str, Any]] = None
         #: What the subject last said it waits for on the judge's side (the judge's clock,
         #: :data:`~ros2nb.subject.judge_time.WAITING_FOR_CLOCK`), or None: idle there, it is
         #: not the learner's code that hangs.
@@ -258,7 +258,7 @@ class SubjectProcess:
         line, self._buffer = self._buffer.split(b'\n', 1)
         return json.loads(line)
 
-    def take_ack(self) -> Optional[dict]:
+    def take_ack(self) -> Optional[dict[str, Any]]:
         """The newest acknowledgement that came since the last call (None if none came).
 
         Lines that are not well formed are skipped: the process runs learner code, which may

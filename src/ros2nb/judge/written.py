@@ -26,7 +26,7 @@ import re
 import shlex
 import stat
 from pathlib import Path
-from typing import Optional
+from typing import Any, Optional
 
 from .. import course, nbmeta
 from ..terminal.files import AUTHOR_MARKERS, PARTS_RECORD, PLACEHOLDER
@@ -51,7 +51,7 @@ EARLIER = {'package': (course.SETUP_PY_FILE, course.SETUP_CFG_FILE),
 UNKNOWN = None
 
 
-def _earlier_files(submission: dict) -> set[str]:
+def _earlier_files(submission: dict[str, Any]) -> set[str]:
     """The package files notebooks before this one wrote (its number read off a grade id)."""
     ids = [nbmeta.nbgrader_metadata(cell).get('grade_id') for cell in nbmeta.cells(submission)]
     numbers = [int(i[:2]) for i in ids if isinstance(i, str) and i[:2].isdigit()]
@@ -59,7 +59,7 @@ def _earlier_files(submission: dict) -> set[str]:
     return {file for step in steps for file in EARLIER.get(step, ())}
 
 
-def cell_parts(submission: dict) -> dict[str, dict[int, Optional[str]]]:
+def cell_parts(submission: dict[str, Any]) -> dict[str, dict[int, Optional[str]]]:
     """What the notebook's ``%%part`` cells write, run in order as ``write_part`` saves each
     part: file (relative to the workspace) -> part number -> its text, or :data:`UNKNOWN`
     where a placeholder kept what an earlier notebook wrote."""
@@ -108,7 +108,7 @@ def _joined(parts: dict[str, str]) -> str:
                         sorted(parts, key=lambda n: int(n) if n.isdigit() else 0)) + '\n'
 
 
-def as_written(submission: dict, workspace: Path) -> dict[str, str]:
+def as_written(submission: dict[str, Any], workspace: Path) -> dict[str, str]:
     """The package files of ``workspace`` that are not what ``submission``'s ``%%part`` cells
     write: relative path -> the text those cells write (the record's parts where a
     placeholder kept an earlier notebook's)."""

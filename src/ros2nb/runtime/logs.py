@@ -12,7 +12,7 @@ import sys
 import threading
 import time
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # only the type: this module imports no ROS
     from rcl_interfaces.msg import Log
@@ -63,8 +63,9 @@ class LogLines:
         self._our_loggers: set[str] = set()
         #: /rosout lines received so far, per logger name, from every process on the domain.
         self.log_counts: collections.Counter[str] = collections.Counter()
-        # (cell epoch, logger name | None for our own lines | CallbackFailure, level, text)
-        self._log_lines: collections.deque[tuple] = collections.deque()
+        # (cell epoch, logger name | None for our own lines | CallbackFailure, level,
+        # text | the CallbackFailure, stamp ns): the second and fourth vary with the kind
+        self._log_lines: collections.deque[tuple[int, Any, int, Any, int]] = collections.deque()
         self._overflow = 0
         self._epoch = 0
         # (epoch, wall-clock ns): lines of that cell stamped before then are not shown

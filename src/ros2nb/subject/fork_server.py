@@ -106,7 +106,7 @@ def _reap(status: dict[int, int]) -> None:
             os.close(fd)
 
 
-def _become(request: dict, kept: list[int], out: int) -> NoReturn:
+def _become(request: dict[str, Any], kept: list[int], out: int) -> NoReturn:
     """In the forked child: become ``python -P -m MODULE ARGS`` (the request's) started in
     its folder with its environment, then run it to its end (this never returns).
 

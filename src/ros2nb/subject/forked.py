@@ -35,7 +35,7 @@ import subprocess
 import sys
 import threading
 import time
-from typing import IO, Optional
+from typing import IO, Any, Optional
 
 from ..processes import die_with_parent
 from . import fork_server
@@ -104,7 +104,8 @@ class ForkServer:
     :param process: the server when it was started afresh (None when forked from here).
     """
 
-    def __init__(self, sock: socket.socket, process: Optional[subprocess.Popen] = None) -> None:
+    def __init__(self, sock: socket.socket, process: Optional[subprocess.Popen[bytes]] = None
+                 ) -> None:
         self._sock, self._process = sock, process
         self._lock = threading.Lock()
         self._failed = False
@@ -113,7 +114,7 @@ class ForkServer:
         """Whether the server still answers (as far as this side knows)."""
         return not self._failed and (self._process is None or self._process.poll() is None)
 
-    def fork(self, fds: tuple[int, ...], request: dict) -> tuple[int, int]:
+    def fork(self, fds: tuple[int, ...], request: dict[str, Any]) -> tuple[int, int]:
         """Ask for a child; return its pid and the read end of its exit-code pipe.
 
         :param fds: the child's own pipes (a subject's command, reply and acknowledgement),
@@ -219,7 +220,7 @@ def fork_program(args: list[str], cwd: str, env: dict[str, str]) -> ForkedProces
     return _fork({'module': fork_server.PROGRAM, 'cwd': cwd, 'env': env, 'args': args}, ())
 
 
-def _fork(request: dict, fds: tuple[int, ...]) -> ForkedProcess:
+def _fork(request: dict[str, Any], fds: tuple[int, ...]) -> ForkedProcess:
     """Ask the fork server (this process's, started if need be) for a child.
 
     :raises FileNotFoundError: when its folder does not exist (as ``subprocess.Popen``).

@@ -59,12 +59,12 @@ class JudgeTime:
     its next step, so that it stamps each with the step that made it.
     """
 
-    _counts: Counter = Counter()
-    _logged: Counter = Counter()
+    _counts: Counter[str] = Counter()
+    _logged: Counter[str] = Counter()
     _counting = False
     _claimed: Optional[int] = None
     #: The topics the judge hears (:data:`JUDGE_TOPICS_ENV`).
-    topics: frozenset = frozenset()
+    topics: frozenset[str] = frozenset()
 
     def __init__(self, fd: int) -> None:
         self._fd = fd
@@ -242,7 +242,7 @@ class JudgeTime:
                           look=taken)
 
 
-def _reach_judge(runtime: Any, topics: frozenset) -> None:
+def _reach_judge(runtime: Any, topics: frozenset[str]) -> None:
     """Wait (at most :data:`JUDGE_MATCH_WAIT_S`) until each publisher of ``runtime``'s on a
     topic the judge hears has matched a subscription: a message published before the judge's
     subscription was discovered would never reach it (a volatile topic keeps nothing for late

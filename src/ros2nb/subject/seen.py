@@ -111,7 +111,7 @@ def _attribution() -> tuple[Callable[[Any], bool], Callable[..., Any], Callable[
         name = frame.f_code.co_filename
         return not (name.startswith(trusted) or name.startswith(frozen) or name == stand_in)
 
-    def innermost(frame: Any, forwarding: frozenset) -> Any:
+    def innermost(frame: Any, forwarding: frozenset[str]) -> Any:
         while frame is not None and frame.f_code.co_filename in forwarding and not (
                 frame.f_code.co_filename == logging_file and frame.f_code.co_name not in passing):
             frame = frame.f_back
@@ -132,7 +132,7 @@ def _teller(write: Callable[[str], Any]) -> tuple[Callable[[str, str, Any], None
     """``tell(kind, what, frame)``: count the event; write one line on the judge's pipe once
     per kind, event and place, for the first :data:`PER_KIND` places of each kind, then the
     kind's count at each power of two.  ``end()``: the last line, every kind's count."""
-    written: set = set()
+    written: set[tuple[str, str, str]] = set()
     places: dict[str, int] = {}
     counts: dict[str, int] = {}
     mark, limit, cut, count_mark, end_mark = MARK, PER_KIND, 300, COUNT, END
@@ -158,7 +158,8 @@ def _teller(write: Callable[[str], Any]) -> tuple[Callable[[str, str, Any], None
     return tell, end
 
 
-def _examiner(tell: Callable[[str, str, Any], None]) -> Callable[[str, tuple, Any], None]:
+def _examiner(tell: Callable[[str, str, Any], None]
+              ) -> Callable[[str, tuple[Any, ...], Any], None]:
     """``examine(event, args, caller)``: whether the learner's code caused a watched event,
     and if so, tell it."""
     learners, innermost, anyone = _attribution()
@@ -173,7 +174,7 @@ def _examiner(tell: Callable[[str, str, Any], None]) -> Callable[[str, tuple, An
         os.fsdecode, len, isinstance, any
     path_types = (str, bytes, os.PathLike)
 
-    def examine(event: str, args: tuple, caller: Any) -> None:
+    def examine(event: str, args: tuple[Any, ...], caller: Any) -> None:
         if event in frame_events:
             frame = innermost(caller, frames)
             if frame is not None and learners(frame):
@@ -208,7 +209,7 @@ def _examiner(tell: Callable[[str, str, Any], None]) -> Callable[[str, tuple, An
     return examine
 
 
-def make_hook(write: Callable[[str], Any]) -> tuple[Callable[[str, tuple], None],
+def make_hook(write: Callable[[str], Any]) -> tuple[Callable[[str, tuple[Any, ...]], None],
                                                     Callable[[], None]]:
     """The audit hook, writing each event the learner's code caused with ``write``, and the
     function that writes the last line (every kind's count)."""
@@ -216,7 +217,7 @@ def make_hook(write: Callable[[str], Any]) -> tuple[Callable[[str, tuple], None]
     examine, getframe, attribute = _examiner(tell), sys._getframe, getattr
     watched, busy = WATCHED, threading.local()
 
-    def hook(event: str, args: tuple) -> None:
+    def hook(event: str, args: tuple[Any, ...]) -> None:
         if event not in watched and not event.startswith('ctypes.'):
             return
         if attribute(busy, 'on', False):

@@ -96,7 +96,7 @@ class Recording:
         self.path = path
         self.counts = dict.fromkeys(topics, 0)
         self._rt = current_runtime()
-        self._process: Optional[subprocess.Popen] = None
+        self._process: Optional[subprocess.Popen[bytes]] = None
         self._subscriptions: list[Any] = []
         self._writer: Any = None
         if ros2 := _real_ros2():

@@ -134,7 +134,7 @@ def _check_request(package_name: str, build_type: str, license: str,
             'remove the directory or choose a different destination directory or package name')
 
 
-def pkg_create(package_name: str, *, destination: str | os.PathLike = '.',
+def pkg_create(package_name: str, *, destination: str | os.PathLike[str] = '.',
                build_type: str = 'ament_python', dependencies: Sequence[str] = (),
                description: str = 'TODO: Package description',
                license: str = 'TODO: License declaration',

@@ -35,7 +35,8 @@ START_UP_S = 60.0
 CONSOLE_FORMAT = '[{severity}] [{name}]: {message}'
 
 
-def stream_lines(proc: subprocess.Popen, index: int, prefix: str, lines: queue.Queue) -> None:
+def stream_lines(proc: subprocess.Popen[str], index: int, prefix: str,
+                 lines: queue.Queue[tuple[int, Optional[str]]]) -> None:
     """Put ``(index, prefix + line)`` in ``lines`` for each line ``proc`` prints; ``(index, None)``
     when it closes its output."""
     assert proc.stdout is not None
@@ -182,7 +183,7 @@ def run_and_interrupt(*argvs: Sequence[str], labels: Optional[Sequence[str]] = N
     if env is None:
         env = node_process_env(os.environ)
     labels = list(labels) if labels is not None else [Path(a[0]).name for a in argvs]
-    lines: queue.Queue = queue.Queue()
+    lines: queue.Queue[tuple[int, Optional[str]]] = queue.Queue()
     procs = []
     said: list[list[str]] = [[] for _ in argvs]  # each process's lines, for its last error
     try:
@@ -208,8 +209,8 @@ def run_and_interrupt(*argvs: Sequence[str], labels: Optional[Sequence[str]] = N
     return codes
 
 
-def _relay(procs: list[subprocess.Popen], lines: queue.Queue, seconds: float,
-           said: list[list[str]]) -> None:
+def _relay(procs: list[subprocess.Popen[str]], lines: queue.Queue[tuple[int, Optional[str]]],
+           seconds: float, said: list[list[str]]) -> None:
     """Print the processes' lines as they come (and keep each one's in ``said``); press
     Ctrl+C for them after ``seconds``.
 

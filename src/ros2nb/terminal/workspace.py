@@ -11,7 +11,7 @@ from typing import Iterable, Optional, Sequence, Union
 
 from ..errors import Ros2nbError
 
-PathLike = Union[str, os.PathLike]
+PathLike = Union[str, os.PathLike[str]]
 
 #: Environment variable that moves the course workspace (tests point it at a temp dir).
 WORKSPACE_ENV = 'ROS2NB_WORKSPACE'

@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import argparse
 import concurrent.futures
+import datetime
 import json
 import os
 import shutil
@@ -382,7 +383,7 @@ def _find(submissions: Path, course: Path, notebooks: list[str], term: Term
     :raises SubmissionProblem, TimeProblem: for a hand-in time the grader does not read.
     """
     refused: list[str] = []
-    times: dict = {}
+    times: dict[tuple[str, str], tuple[datetime.datetime, str]] = {}
     if submissions.suffix == '.zip':
         submissions, refused = collect_zip(submissions, course, times,
                                            term.deadlines.zip_time_zone, term.canvas_learners())

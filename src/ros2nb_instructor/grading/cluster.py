@@ -18,13 +18,16 @@ import os
 import time
 import uuid
 from pathlib import Path
-from typing import Any, Iterator, Optional
+from typing import TYPE_CHECKING, Any, Hashable, Iterator, Optional
 
 from ..paths import ASSIGNMENT
 from .cluster_task import FromWorker, Job, accept, course_version, grade_job, resource_name
 from .learners import file_graded
 from .settings import Settings
 from .submissions import MAX_SUBMISSION_BYTES, Learner
+
+if TYPE_CHECKING:  # only the type: a class on a cluster imports distributed when it connects
+    from distributed import Future
 
 #: Seconds to wait for a scheduler to answer, and for its first worker to join.
 CONNECT_S = 30
@@ -112,7 +115,7 @@ class Cluster:
         and has their notes and the judge's results, as a local grading leaves them.
         """
         release = course / 'release' / ASSIGNMENT
-        futures = {}
+        futures: dict[Future[FromWorker], tuple[Learner, Job]] = {}
         # Most notebooks first (a higher priority), so the longest learner does not start last.
         for learner in sorted(learners, key=lambda lr: -len(lr.files)):
             job = Job(learner.id, {n: _handed_in(p) for n, p in learner.files.items()},
@@ -132,7 +135,8 @@ class Cluster:
             grade_job, job, key=f'ros2nb-learner-{uuid.uuid4().hex[:12]}-{job.id}', pure=False,
             resources={resource_name(self.version): 1}, priority=len(job.files))
 
-    def _resubmit_unrunnable(self, futures: dict, pending: set) -> None:
+    def _resubmit_unrunnable(self, futures: dict[Future[FromWorker], tuple[Learner, Job]],
+                             pending: set[Future[FromWorker]]) -> None:
         """Submit again the tasks no worker could take when they were placed (every checked
         worker had gone); a worker checked since does not make the scheduler look at them.
         They never ran, so nobody is graded twice."""
@@ -145,7 +149,8 @@ class Cluster:
             futures[again] = (learner, job)
             pending.add(again)
 
-    def _gathered(self, course: Path, futures: dict) -> Iterator[list]:
+    def _gathered(self, course: Path, futures: dict[Future[FromWorker], tuple[Learner, Job]]
+                  ) -> Iterator[list[tuple[Learner, Optional[BaseException]]]]:
         """The learners of ``futures`` in batches as their tasks end, each taken once."""
         from distributed import wait
         pending, taken, looked = set(futures), set(), time.monotonic()
@@ -159,7 +164,7 @@ class Cluster:
                     wait(list(pending), timeout=LOOK_S, return_when='FIRST_COMPLETED')
             except TimeoutError:
                 continue
-            batch = []
+            batch: list[tuple[Learner, Optional[BaseException]]] = []
             for future in [f for f in pending if f.done()]:
                 pending.discard(future)
                 learner = futures[future][0]
@@ -182,7 +187,7 @@ class Cluster:
         self.client.close()
 
 
-def _unrunnable_keys(dask_scheduler: Any) -> list:
+def _unrunnable_keys(dask_scheduler: Any) -> list[Hashable]:
     """Run on the scheduler: the keys of the tasks no worker can run now."""
     return [task.key for task in dask_scheduler.unrunnable]
 

@@ -123,7 +123,8 @@ def _generate_course(kept: Path) -> None:
         shutil.rmtree(fresh, ignore_errors=True)
 
 
-def collect_zip(archive: Path, course: Path, times: Optional[dict] = None,
+def collect_zip(archive: Path, course: Path,
+                times: Optional[dict[tuple[str, str], tuple[datetime.datetime, str]]] = None,
                 zone: Any = None, canvas_learners: Optional[dict[str, str]] = None
                 ) -> tuple[Path, list[str]]:
     """nbgrader's ``zip_collect`` on a screened copy of a platform download.
@@ -263,7 +264,7 @@ class Scoring:
 
     def __init__(self, course: Path) -> None:
         self._course = course
-        self._process: Optional[subprocess.Popen] = None
+        self._process: Optional[subprocess.Popen[str]] = None
 
     def __enter__(self) -> 'Scoring':
         return self
@@ -293,7 +294,7 @@ class Scoring:
             self._end()
         return False
 
-    def _started(self) -> subprocess.Popen:
+    def _started(self) -> subprocess.Popen[str]:
         if self._process is None:
             with open(self._course / 'grading.log', 'a') as log:
                 self._process = subprocess.Popen(

@@ -49,7 +49,7 @@ class Verdict(NamedTuple):
     :ivar flags: code that reaches into the course, for the instructor (:mod:`ros2nb.judge.flags`).
     """
 
-    results: dict
+    results: dict[str, dict[str, Any]]
     problem: Optional[str]
     flags: tuple[str, ...] = ()
 
@@ -177,7 +177,7 @@ class Judges:
         self._pool = concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs),
                                                            thread_name_prefix='judge')
 
-    def submit(self, *arguments: Any) -> concurrent.futures.Future:
+    def submit(self, *arguments: Any) -> concurrent.futures.Future[Verdict]:
         return self._pool.submit(judge_notebook, *arguments)
 
     def close(self) -> None:

@@ -78,7 +78,7 @@ class Judging:
 
     said: tuple[str, ...]
     executed: nbformat.NotebookNode
-    verdict: concurrent.futures.Future
+    verdict: concurrent.futures.Future[Verdict]
 
 
 #: What became of one notebook once its run was over: never a ``str`` or a bare tuple.

@@ -111,7 +111,8 @@ def for_the_run(release: nbformat.NotebookNode,
     return nb
 
 
-def result_outputs(result: Optional[dict], problem: Optional[str]) -> list:
+def result_outputs(result: Optional[dict[str, Any]], problem: Optional[str]
+                   ) -> list[nbformat.NotebookNode]:
     """The outputs of a graded cell: the judge's lines, and its verdict when it failed."""
     if result is None:
         reason = problem or 'the grader could not check this cell'
@@ -134,7 +135,7 @@ def _escape_markdown(source: str) -> str:
     return source.replace('&', '&amp;').replace('<', '&lt;')
 
 
-def _safe_outputs(outputs: list) -> list:
+def _safe_outputs(outputs: list[nbformat.NotebookNode]) -> list[nbformat.NotebookNode]:
     """Outputs of the safe types only, without their metadata (nbconvert writes an image's
     width and height into the page unquoted: metadata could add an attribute)."""
     kept = []
@@ -217,7 +218,8 @@ def bound_markdown(release: nbformat.NotebookNode, nb: nbformat.NotebookNode) ->
 
 
 def for_scoring(release: nbformat.NotebookNode, executed: nbformat.NotebookNode,
-                results: dict[str, dict], problem: Optional[str] = None) -> nbformat.NotebookNode:
+                results: dict[str, dict[str, Any]], problem: Optional[str] = None
+                ) -> nbformat.NotebookNode:
     """The notebook nbgrader scores and turns into feedback.
 
     Every graded cell of the course is there exactly once (a deleted one is put back

@@ -93,8 +93,8 @@ def _check_rows(notebooks: list[str], learners: list[Learner]) -> list[dict[str,
     than half)."""
     rows = []
     for notebook in notebooks:
-        passed: collections.Counter = collections.Counter()
-        judged: collections.Counter = collections.Counter()
+        passed: collections.Counter[str] = collections.Counter()
+        judged: collections.Counter[str] = collections.Counter()
         for learner in learners:
             for check, result in learner.results.get(notebook, {}).items():
                 judged[check] += 1
@@ -107,7 +107,7 @@ def _check_rows(notebooks: list[str], learners: list[Learner]) -> list[dict[str,
 
 def _failure_rows(learners: list[Learner]) -> list[dict[str, object]]:
     """The failure lines learners saw most often: how many learners, the check, the line."""
-    counts: collections.Counter = collections.Counter()
+    counts: collections.Counter[tuple[str, str]] = collections.Counter()
     for learner in learners:
         for notebook, results in learner.results.items():
             for check, result in results.items():

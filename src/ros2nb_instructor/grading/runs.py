@@ -12,7 +12,7 @@ import json
 import subprocess
 import sys
 from pathlib import Path
-from typing import Optional
+from typing import Any, Optional
 
 import nbformat
 
@@ -29,7 +29,7 @@ MAX_NOTEBOOK_BYTES = 20_000_000
 
 
 def run_notebook(scratch: Scratch, notebook: str, prepared: nbformat.NotebookNode,
-                 settings: Settings) -> tuple[nbformat.NotebookNode, dict, Optional[str]]:
+                 settings: Settings) -> tuple[nbformat.NotebookNode, dict[str, Any], Optional[str]]:
     """Execute the prepared notebook in the learner's sandbox.
 
     The notebook goes in through a folder of the grader's (read-only inside); the runner
@@ -73,7 +73,7 @@ def run_notebook(scratch: Scratch, notebook: str, prepared: nbformat.NotebookNod
     return executed, status, stopped
 
 
-def stopped_note(status: dict, limit: str) -> str:
+def stopped_note(status: dict[str, Any], limit: str) -> str:
     """The note of a run stopped at ``limit``: which cells did not run, and that the points
     come from the grader's checks (a heavy honest run, or a loop, alike: no blame)."""
     ran, cells = status.get('ran', 0), status.get('cells', 0)
@@ -86,7 +86,7 @@ def stopped_note(status: dict, limit: str) -> str:
 
 
 def _read_back(out: Path, notebook: str, prepared: nbformat.NotebookNode
-               ) -> tuple[nbformat.NotebookNode, dict]:
+               ) -> tuple[nbformat.NotebookNode, dict[str, Any]]:
     """The executed notebook and the runner's status, or the prepared one and why not."""
     try:
         executed = nbformat.reads(read_regular(out, f'{notebook}.run.ipynb', MAX_NOTEBOOK_BYTES)
@@ -113,7 +113,7 @@ NO_STATUS = {'ran': 0, 'cells': 0, 'timed_out': [], 'output_cut': [], 'kernel_di
              'finished': False}
 
 
-def checked_status(status: object) -> Optional[dict]:
+def checked_status(status: object) -> Optional[dict[str, Any]]:
     """The runner's status when every field has its type (ints, lists of ints), else None."""
     def whole(value: object) -> bool:
         return isinstance(value, int) and not isinstance(value, bool) and 0 <= value < 1_000_000
@@ -132,7 +132,7 @@ def checked_status(status: object) -> Optional[dict]:
     return {key: status.get(key) for key in (*NO_STATUS, 'runner_error')}
 
 
-def run_note(status: dict, stopped: Optional[str]) -> Optional[str]:
+def run_note(status: dict[str, Any], stopped: Optional[str]) -> Optional[str]:
     """What happened while the notebook ran, in words (None when nothing worth saying)."""
     notes = [stopped] if stopped else []
     if status.get('kernel_died_at') is not None:

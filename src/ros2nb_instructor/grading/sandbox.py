@@ -289,7 +289,7 @@ def _read_steps(running: Running, steps: Callable[[str], str | None]) -> tuple[s
     return ''.join(lines), ''.join(e for e in errors if e)
 
 
-def _launched(argv: list[str], limits: Limits, popen: dict, *, stage: Path | None = None,
+def _launched(argv: list[str], limits: Limits, popen: dict[str, Any], *, stage: Path | None = None,
               sources: Sequence[str] = (), uid: int | None = None) -> Running:
     """``argv`` started through the launcher in fresh cgroups (its limits, or rlimits where no
     cgroup could be made), watched by a :class:`Running`."""

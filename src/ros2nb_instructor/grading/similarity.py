@@ -91,7 +91,7 @@ def _part_of(text: str) -> Optional[tuple[str, str]]:
     return (words[0], words[1]) if len(words) >= 2 else None
 
 
-def _read(path: Optional[Path]) -> list[dict]:
+def _read(path: Optional[Path]) -> list[dict[str, Any]]:
     try:
         return [c for c in nbmeta.cells(json.loads(path.read_text()))
                 if c.get('cell_type') == 'code'] if path else []
@@ -126,7 +126,7 @@ def course_of(solution: Optional[Path], handed_out: Optional[Path]) -> Course:
     return Course(texts, parts, np.array(sorted(hashes), dtype=np.int64))
 
 
-def graded(cells: list[dict], course: Course) -> dict[str, str]:
+def graded(cells: list[dict[str, Any]], course: Course) -> dict[str, str]:
     """Name -> the learner's text of each part the judge grades in a notebook's code cells:
     answer cells by grade id, ``%%part`` cells the learner added by the answer whose part
     they write (``... (an added cell)``) or by file and part; cells as the course gave them
@@ -181,7 +181,7 @@ def _ratio(a: Any, b: Any) -> float:
     return float(max(shares)) if min(shares) >= FLOOR and overlap >= MIN_CHARS else 0.0
 
 
-def fingerprints(cells: list[dict], course: Course, small: set[str]) -> dict[str, Any]:
+def fingerprints(cells: list[dict[str, Any]], course: Course, small: set[str]) -> dict[str, Any]:
     """name -> fingerprint of each part of :func:`graded`, the ``small`` ones (and those too
     small themselves) in one group, :data:`SMALL`."""
     parts = graded(cells, course)
@@ -231,7 +231,7 @@ def _added(name: str) -> bool:
     return name.endswith(' (an added cell)') or ' part ' in name
 
 
-def _pairs(notebook: str, read: dict) -> list[Pair]:
+def _pairs(notebook: str, read: dict[str, dict[str, Any]]) -> list[Pair]:
     """Every pair at or above :data:`THRESHOLD` (the course's answer first): parts of the
     same name, and each part in an added cell beside every part of the other."""
     found = []

@@ -51,7 +51,7 @@ class Learner:
     id: str
     files: dict[str, Path] = field(default_factory=dict)
     notes: dict[str, str] = field(default_factory=dict)
-    results: dict[str, dict] = field(default_factory=dict)
+    results: dict[str, dict[str, dict[str, Any]]] = field(default_factory=dict)
     flags: dict[str, list[str]] = field(default_factory=dict)
     handed_in: dict[str, tuple[datetime.datetime, str]] = field(default_factory=dict)
     late: dict[str, Any] = field(default_factory=dict)

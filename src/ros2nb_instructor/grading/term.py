@@ -99,7 +99,8 @@ def with_extensions(term: Term, args: argparse.Namespace, notebooks: list[str],
     return dataclasses.replace(term, extensions=extensions), []
 
 
-def with_roster(learners: list[Learner], roster: Optional[dict]) -> list[Learner]:
+def with_roster(learners: list[Learner], roster: Optional[dict[str, RosterRow]]
+                ) -> list[Learner]:
     """``learners`` and, for each roster learner with no folder, a learner with nothing handed
     in (0 on every notebook, and a note saying so)."""
     if not roster:

@@ -113,7 +113,8 @@ def entry_time(member: zipfile.ZipInfo, zone: datetime.tzinfo) -> datetime.datet
     return datetime.datetime(*member.date_time, tzinfo=zone)
 
 
-def screen_zip(archive: Path, cleaned: Path, times: Optional[dict] = None,
+def screen_zip(archive: Path, cleaned: Path,
+               times: Optional[dict[tuple[str, str], tuple[datetime.datetime, str]]] = None,
                zone: datetime.tzinfo = datetime.timezone.utc,
                canvas_learners: Optional[Mapping[str, str]] = None) -> list[str]:
     """Copy the members of a platform's .zip that may be graded into ``cleaned``, as

@@ -47,13 +47,15 @@ def _image_size(output: Any) -> int:
 class LimitedClient(NotebookClient):
     """nbclient with a size limit per cell and a save after every cell."""
 
-    def __init__(self, nb: nbformat.NotebookNode, out: Path, status: dict, **kwargs: Any) -> None:
+    def __init__(self, nb: nbformat.NotebookNode, out: Path, status: dict[str, Any],
+                 **kwargs: Any) -> None:
         super().__init__(nb, **kwargs)
         self.out_path, self.status = out, status
         self._notes: dict[int, Any] = {}
         self.on_cell_executed = self._saved
 
-    def output(self, outs: list, msg: dict, display_id: Optional[str], cell_index: int) -> Any:
+    def output(self, outs: list[nbformat.NotebookNode], msg: dict[str, Any],
+               display_id: Optional[str], cell_index: int) -> Any:
         out = super().output(outs, msg, display_id, cell_index)
         if out is None:
             return None
@@ -77,7 +79,7 @@ class LimitedClient(NotebookClient):
                 outs.append(note)
         return out
 
-    def _saved(self, cell: Any, cell_index: int, execute_reply: dict) -> None:
+    def _saved(self, cell: Any, cell_index: int, execute_reply: dict[str, Any]) -> None:
         error = execute_reply.get('content', {})
         if error.get('ename') == 'CellTimeoutError':
             self.status['timed_out'].append(cell_index)
@@ -85,7 +87,7 @@ class LimitedClient(NotebookClient):
         save(self.nb, self.out_path, self.status)
 
 
-def save(nb: nbformat.NotebookNode, out: Path, status: dict) -> None:
+def save(nb: nbformat.NotebookNode, out: Path, status: dict[str, Any]) -> None:
     """Write the notebook and its status atomically (a kill never leaves half a file)."""
     for path, text in ((out, nbformat.writes(nb)),
                        (Path(str(out) + '.status.json'), json.dumps(status))):
@@ -116,7 +118,7 @@ def main(argv: list[str]) -> int:
     args = parser.parse_args(argv)
     folder = _working_folder(args.folder or args.notebook.parent)
     nb = nbformat.read(args.notebook, as_version=4)
-    status: dict = {'ran': 0, 'cells': len(nb.cells), 'timed_out': [], 'output_cut': [],
+    status: dict[str, Any] = {'ran': 0, 'cells': len(nb.cells), 'timed_out': [], 'output_cut': [],
                     'kernel_died_at': None, 'finished': False}
     timeout_error = {'ename': 'CellTimeoutError',
                      'evalue': f'the grader stopped this cell after {args.cell_timeout} s',
