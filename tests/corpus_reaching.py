@@ -366,7 +366,7 @@ REACHING = [
 
 # ================================================================== the sixth class
 # Each cause the sixth hostile class found, as an attacker beside its honest twin, written from
-# the class's description (graded in the grader's sandbox, with a seed new in every run:
+# the class's description (graded in the grader's sandbox, with two seeds new in every run:
 # test_corpora.py).  In the design they met, the judge's instruments lived in the learner's
 # process; now a point is what the judge observes from outside it, and each scores its twin's.
 

@@ -5,12 +5,12 @@ The honest and wrong corpora are graded in ``test_corpus_honest.py`` and
 corpus: each twin loses exactly its parts.  Each attack (``corpus_attacks.py``) loses every
 part its twin loses, except those the wire cannot tell from honest code, which the judge
 flags for the instructor instead (``tests/test_flags.py``).  The attacks that reach into the
-process they run in (``corpus_reaching.py``, the sixth hostile class's among them) are graded
-once, with a seed of the drawn inputs new in every run, as the grader grades them (the judge
-and each subject sandboxed): each loses its twin's parts (the sixth class's exactly its twin's
-score), its lost parts say why in one line, and those the subject's audit hook sees
-(``seen``) are noted at run time, never a verdict.  (A second seed in the same run doubled
-their cost: docs/decisions.md.)
+process they run in (``corpus_reaching.py``) are graded as the grader grades them (the judge and
+each subject sandboxed), with seeds of the drawn inputs new in every run: the sixth hostile
+class's with two (each must score exactly its twin's score with both), the earlier ones with
+one (a second doubled their cost: docs/decisions.md).  Each loses its twin's parts, its lost
+parts say why in one line, and those the subject's audit hook sees (``seen``) are noted at
+run time, never a verdict.
 
 ``python tests/corpora.py`` prints every learner's score; run with an older checkout's judge it
 gives the "before" column of the closing notes.
@@ -33,9 +33,12 @@ from ros2nb_instructor.grading.settings import JUDGE_TIMEOUT_S as SANDBOXED_JUDG
 #: Each test grades one learner.
 pytestmark = [pytest.mark.judge, pytest.mark.timeout(time_limit_s(1))]
 TWINS = {learner.name: learner for learner in [*ATTACKS, *HONEST]}
-#: The seed of this run's gradings of the reaching attacks (each pytest-xdist worker draws
-#: its own: a new one every run).
-SEED = new_seed()
+#: The seeds of this run's gradings of the reaching attacks (each pytest-xdist worker draws
+#: its own: a new pair every run); the sixth class's attacks are graded with both.
+SEEDS = (new_seed(), new_seed())
+#: (attack, which seed): the sixth class's twice, the earlier attacks once.
+REACHING_RUNS = [(attack, run) for attack in REACHING
+                 for run in ((0, 1) if attack.extra.get('sixth') else (0,))]
 
 
 @pytest.mark.parametrize('knows_nothing', [False, True],
@@ -67,12 +70,13 @@ def test_an_attack_scores_what_its_twin_scores(attack, tmp_path):
 @pytest.mark.sandbox
 @pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))
 @pytest.mark.timeout(SANDBOXED_JUDGE_S + BESIDE_JUDGES_S)  # one grading, the grader's way
-@pytest.mark.parametrize('attack', REACHING, ids=[a.name for a in REACHING])
-def test_reaching_in_scores_at_most_its_twin_and_says_so(attack, tmp_path):
+@pytest.mark.parametrize('attack, run', REACHING_RUNS,
+                         ids=[f'{a.name}-seed {run + 1}' for a, run in REACHING_RUNS])
+def test_reaching_in_scores_at_most_its_twin_and_says_so(attack, run, tmp_path):
     """Graded as the grader grades: in its sandboxes the course's answers are not on a
     subject's disk and no subject reads what another wrote, and no verdict comes from what
     the audit hooks saw (they only note it)."""
-    seed, twin = SEED, TWINS[attack.twin]
+    seed, twin = SEEDS[run], TWINS[attack.twin]
     attacked, flags = judged_in_sandbox(attack, tmp_path, seed=seed)
     lost = failed(attacked)
     context = (seed, lost, flags)
