@@ -48,7 +48,7 @@ def main() -> int:
                 outcome = captured(lambda: checks.run_check('check_sensor_hour', session))
                 print(f'| {hour} | {time.monotonic() - wall:.2f} | {own_cpu_s() - judge:.2f} '
                       f'| {busy_cpu_s() - busy:.2f} | '
-                      f'{"passed" if outcome["passed"] else outcome.get("message", "")[:60]} |')
+                      f'{"passed" if outcome.passed else (outcome.message or "")[:60]} |')
         finally:
             session.close()
     return 0

@@ -91,7 +91,7 @@ def main(periods: list[str]) -> int:
                 seen.clear()
                 wall, used = time.monotonic(), cpu.total()
                 outcome = captured(lambda: checks.run_check(name, session))
-                verdict = 'passed' if outcome['passed'] else outcome.get('message', '')[:70]
+                verdict = 'passed' if outcome.passed else (outcome.message or '')[:70]
                 first = ', '.join(f'{t:g}' for t in (seen[0][:4] if seen else []))
                 print(f'| {period} | {name[6:]} | {first} | {verdict} | '
                       f'{time.monotonic() - wall:.1f} | {cpu.total() - used:.1f} |')

@@ -31,7 +31,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Iterator, Optional, Union
 
+from ros2nb.outcomes import CellChecked, CheckOutcome, NotebookChecked
 from ros2nb.temporary import temporary_folder
+from ros2nb.typed_json import decoded
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / 'tests'))  # judging.py, the corpora
@@ -211,7 +213,7 @@ def learner_workspace(learner: Learner, root: Path) -> Iterator[tuple[Path, dict
 
 def grade_learner(learner: Learner, root: Path, *, knows_nothing: bool = False,
                   seed: Optional[int] = None, cpu_share: Optional[float] = None
-                  ) -> dict[str, dict]:
+                  ) -> dict[str, CheckOutcome]:
     """Grade one learner's notebook in a fresh workspace under ``root``, with the judge's
     own command in a process and session of its own (``judge_apart.py``), as the grader
     runs it (with the grading's ``seed`` of the drawn inputs, when given).
@@ -219,7 +221,7 @@ def grade_learner(learner: Learner, root: Path, *, knows_nothing: bool = False,
     :param knows_nothing: the judge's reader of the learner's text finds nothing.
     :param cpu_share: CPUs the judge and its subjects may use together (a CPU quota; None:
         what the machine gives), as the grader's ``--cpu-share``.
-    :return: ``{grade id without NN-: result}`` (``passed``, and ``message`` when failed).
+    :return: ``{grade id without NN-: outcome}``.
     :raises AssertionError: when the judge printed no result (its output in the message).
     """
     return judged(learner, root, knows_nothing=knows_nothing, seed=seed, cpu_share=cpu_share)[0]
@@ -227,9 +229,10 @@ def grade_learner(learner: Learner, root: Path, *, knows_nothing: bool = False,
 
 def judged(learner: Learner, root: Path, *, knows_nothing: bool = False,
            seed: Optional[int] = None, cpu_share: Optional[float] = None
-           ) -> tuple[dict[str, dict], list[str]]:
-    """:func:`grade_learner`'s results, and the judge's flags (its text scan's and what the
-    subjects' audit hooks saw, ``at run time``)."""
+           ) -> tuple[dict[str, CheckOutcome], list[str], dict[str, float]]:
+    """:func:`grade_learner`'s results, the judge's flags (its text scan's and what the
+    subjects' audit hooks saw, ``at run time``), and what each check cost (CPU seconds, judge
+    and subjects, by grade id without NN-; none for a judge stopped at a limit)."""
     from ros2nb import domains
     from ros2nb.course import GRADING_ENV
     from ros2nb.processes import kill_process_group
@@ -271,19 +274,16 @@ def judged(learner: Learner, root: Path, *, knows_nothing: bool = False,
     if ended.out_of_cpu or ended.timed_out:  # what it had not checked scores nothing, as
         verdict = stopped_verdict(out, given / 'source.ipynb',  # in the grader
                                   ended.out_of_cpu and cpu_s, ended.step)
-        unchecked = {'passed': False, 'type': 'GradingError', 'message': verdict.problem}
+        unchecked = CheckOutcome(False, (), 'GradingError', verdict.problem)
         return ({gid: verdict.results.get(f'{learner.notebook}-{gid}', unchecked)
-                 for gid in points(learner.notebook)}, [])
+                 for gid in points(learner.notebook)}, [], {})
     lines = out.strip().splitlines()
     assert lines and lines[-1].startswith('{'), f'the judge printed no result: {out}{err}'
-    verdict = json.loads(lines[-1])
-    cpu_s = {}  # what each check cost, judge and subjects: the judge's line as it was decided
-    for line in lines[:-1]:
-        if line.startswith('{"cell"'):
-            decided = json.loads(line)
-            cpu_s[decided['cell']] = decided.get('cpu_s')
-    return ({gid[3:]: {**result, 'cpu_s': cpu_s.get(gid)}
-             for gid, result in verdict['results'].items()}, verdict.get('flags', []))
+    verdict = decoded(NotebookChecked, json.loads(lines[-1]))
+    decided = [decoded(CellChecked, json.loads(line)) for line in lines[:-1]
+               if line.startswith('{"cell"')]  # each as it was decided, with its cost
+    return ({gid[3:]: result for gid, result in verdict.results.items()}, verdict.flags,
+            {checked.cell[3:]: checked.cpu_s for checked in decided})
 
 
 def _hour_judged(learner: Learner) -> bool:
@@ -294,7 +294,7 @@ def _hour_judged(learner: Learner) -> bool:
 
 
 def judged_in_sandbox(learner: Learner, root: Path, *, seed: Optional[int] = None
-                      ) -> tuple[dict[str, dict], list[str]]:
+                      ) -> tuple[dict[str, CheckOutcome], list[str]]:
     """:func:`judged`, the way the grader judges: its judge and each subject in sandboxes of
     their own (``grading.judging.judge_notebook``), where the course's answers are not on a
     subject's disk and no subject reads what another wrote.  Needs the grader's sandbox."""
@@ -329,7 +329,7 @@ def judged_in_sandbox(learner: Learner, root: Path, *, seed: Optional[int] = Non
             os.environ[WORKSPACE_ENV] = saved
         ws_module._current = None
         scratch.remove()
-    unchecked = {'passed': False, 'type': 'GradingError', 'message': problem}
+    unchecked = CheckOutcome(False, (), 'GradingError', problem)
     return ({gid: results.get(f'{learner.notebook}-{gid}', unchecked)
              for gid in points(learner.notebook)}, list(flags))
 
@@ -342,10 +342,10 @@ def flags_of(learner: Learner, root: Path) -> list[str]:
         return notebook_flags(nb, ws, json.loads(NOTEBOOKS[learner.notebook].read_text()))
 
 
-def score(learner: Learner, results: dict[str, dict]) -> float:
+def score(learner: Learner, results: dict[str, CheckOutcome]) -> float:
     """The points ``results`` earn in the learner's notebook."""
     worth = points(learner.notebook)
-    return sum(worth[gid] for gid, result in results.items() if result['passed'])
+    return sum(worth[gid] for gid, result in results.items() if result.passed)
 
 
 def every_learner() -> dict[str, Learner]:
@@ -381,17 +381,18 @@ def main(argv: list[str]) -> int:
         learner = learners[name]
         with temporary_folder('corpus') as root:
             try:
-                results = grade_learner(learner, Path(root), seed=seed, cpu_share=share)
-                failed = sorted(gid for gid, r in results.items() if not r['passed'])
+                results, _flags, cpu_s = judged(learner, Path(root), seed=seed,
+                                                cpu_share=share)
+                failed = sorted(gid for gid, r in results.items() if not r.passed)
                 shown = f'{score(learner, results):g}'
             except Exception as error:  # an older judge may not grade it at all
-                results = {}
+                results, cpu_s = {}, {}
                 failed, shown = [f'{type(error).__name__}: {error}'[:120]], 'error'
         if as_json:
             print(json.dumps({'name': name, 'results': {
-                gid: {k: r.get(k) for k in ('passed', 'type', 'message')}
+                gid: {'passed': r.passed, 'type': r.type, 'message': r.message}
                 for gid, r in results.items()}, 'cpu_s': {
-                gid: r.get('cpu_s') for gid, r in results.items()},
+                gid: cpu_s.get(gid) for gid in results},
                 'error': None if results else failed[0]}), flush=True)
         else:
             print(f'{name}\t{shown}\t{expected_score(learner):g}\t{",".join(failed)}',

@@ -18,15 +18,16 @@ from __future__ import annotations
 from pathlib import Path
 
 from corpora import Learner, expected_score, grade_learner, judged, score
+from ros2nb.outcomes import CheckOutcome
 
 
-def failed(results: dict) -> dict[str, str]:
+def failed(results: dict[str, CheckOutcome]) -> dict[str, str]:
     """grade id -> message, of the parts that failed."""
-    return {gid: r.get('message', '') for gid, r in results.items() if not r['passed']}
+    return {gid: r.message or '' for gid, r in results.items() if not r.passed}
 
 
 def full_marks_without_the_text_reader(learner: Learner, root: Path) -> None:
-    results, flags = judged(learner, root, knows_nothing=True)
+    results, flags, _cpu_s = judged(learner, root, knows_nothing=True)
     assert failed(results) == {}, (learner.name, failed(results))
     assert flags == [], (learner.name, flags)
 

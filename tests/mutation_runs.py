@@ -36,6 +36,7 @@ from ros2nb.judge.subjects import SubjectProcess
 from ros2nb.subject_replies import Called, Encoded
 from ros2nb.temporary import temporary_folder
 from ros2nb.judge_interface import captured
+from ros2nb.outcomes import CheckOutcome
 
 from judging import judging_env
 from kernels import Cell, CellHung, Kernel
@@ -91,12 +92,12 @@ class Shown:
                    ename=ename)
 
     @classmethod
-    def of_outcome(cls, outcome: dict) -> 'Shown':
+    def of_outcome(cls, outcome: CheckOutcome) -> 'Shown':
         """A judge's outcome as the kernel (``show_result``) and the feedback show it."""
-        if outcome['passed']:
-            return cls(lines=list(outcome['lines']))
-        error = [*outcome.get('traceback', []), f"{outcome['type']}: {outcome['message']}"]
-        return cls(lines=list(outcome['lines']), ename=outcome['type'],
+        if outcome.passed:
+            return cls(lines=list(outcome.lines))
+        error = [*outcome.traceback, f'{outcome.type}: {outcome.message}']
+        return cls(lines=list(outcome.lines), ename=outcome.type or '',
                    error=[part for line in error for part in line.split('\n')])
 
 
@@ -283,8 +284,7 @@ class NotebookRun:
             write_parts(nb)
             produced = Produced(self.session)
             result = grade(graded, nb, self.session)[answer.check_id]
-        shown = Shown(lines=list(result['lines'])) if result['passed'] \
-            else Shown.of_outcome(result)
+        shown = Shown.of_outcome(result)
         shown.seconds = round(time.monotonic() - began, 1)
         return shown, produced.numbers()
 

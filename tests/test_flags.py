@@ -20,6 +20,7 @@ import pytest
 from corpora import NOTEBOOKS, Learner, every_learner, flags_of
 from corpus_attacks import ATTACKS
 from ros2nb.judge.flags import reaching_in
+from ros2nb.outcomes import CheckOutcome
 from ros2nb_instructor.grading import feedback
 from ros2nb_instructor.grading import learners as learners_module
 from ros2nb_instructor.grading.judging import Verdict
@@ -107,7 +108,7 @@ def test_a_flag_reaches_the_instructors_note_and_no_point(tmp_path):
     are the judge's, untouched."""
     number = '02'
     release = nbformat.read(NOTEBOOKS[number], as_version=4)
-    graded = {c.metadata['nbgrader']['grade_id']: {'passed': True, 'lines': ['Check passed: x']}
+    graded = {c.metadata['nbgrader']['grade_id']: CheckOutcome(True, ('Check passed: x',))
               for c in release.cells if c.metadata.get('nbgrader', {}).get('grade')}
     verdict: concurrent.futures.Future = concurrent.futures.Future()
     verdict.set_result(Verdict(graded, None, ('answer cell 02-x line 3: uses sys._getframe',)))

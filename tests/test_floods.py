@@ -142,8 +142,8 @@ def test_a_slow_flood_is_found_by_what_one_check_hears(tmp_path, monkeypatch):
     finally:
         scratch.remove()
     assert problem is None, problem
-    assert [gid for gid, result in results.items() if result['passed']] == [
+    assert [gid for gid, result in results.items() if result.passed] == [
         '03-sensor-constructor', '03-sensor-main'], results
     line = CHECK_LINE.format(limit=CHECK_FLOOD_LIMIT)
-    assert results['03-sensor-callback']['message'] == line, results
-    assert results['03-sensor-hour']['message'] == line, results
+    assert results['03-sensor-callback'].message == line, results
+    assert results['03-sensor-hour'].message == line, results

@@ -221,7 +221,7 @@ def test_a_subject_writes_nowhere_its_judge_reads(scratch, monkeypatch):
         PLANTING_READER
     results, problem, _flags = judge_notebook(scratch, NB02, submitted, Settings(120, 600, True),
                                              scratch.snapshot(NB02))
-    assert problem is None and results and all(r.get('passed') for r in results.values()), \
+    assert problem is None and results and all(r.passed for r in results.values()), \
         results
     folder = scratch.top / f'judge-{NB02}'
     planted = {p.relative_to(folder).parts[0] for p in folder.rglob('*') if p.name in PLANTED}
@@ -286,7 +286,7 @@ def test_a_learners_build_scripts_never_run_in_the_judge(scratch, monkeypatch):
     results, problem, _flags = judge_notebook(scratch, NB05, submitted,
                                              Settings(120, 600, True, seed=8675309),
                                              scratch.snapshot(NB05))
-    assert problem is None and results and all(r.get('passed') for r in results.values()), \
+    assert problem is None and results and all(r.passed for r in results.values()), \
         results
     folder = scratch.top / f'judge-{NB05}'
     ran = [p.relative_to(folder).parts[0] for p in folder.rglob('hook-ran')]
@@ -386,7 +386,7 @@ def test_a_copy_of_the_stand_ins_scores_its_twins_score_in_the_sandbox(who, scra
     results, problem, flags = judge_notebook(scratch, notebook, nbformat.from_dict(nb),
                                              Settings(120, 600, True), scratch.snapshot(notebook))
     assert problem is None, problem
-    lost = {gid for gid, r in results.items() if not r['passed']}
+    lost = {gid for gid, r in results.items() if not r.passed}
     assert lost == {f'{notebook[:2]}-{part}' for part in (
         'sensor-constructor', 'sensor-callback', 'sensor-hour')}, results
     assert bool(flags) == (who == 'attack'), flags

@@ -23,7 +23,7 @@ LAYERS: list[tuple[str, ...]] = [
     ('ros2nb.errors', 'ros2nb.patience', 'ros2nb.processes', 'ros2nb.temporary',
      'ros2nb.endpoints', 'ros2nb.nbmeta',
      'ros2nb.on_first_use', 'ros2nb.typed_json', 'ros2nb.working', 'ros2nb.unfinished',
-     'ros2nb.graded_parts', 'ros2nb.hand_ins'),
+     'ros2nb.graded_parts', 'ros2nb.hand_ins', 'ros2nb.outcomes'),
     ('ros2nb.domains',),
     ('ros2nb.terminal.workspace',),
     ('ros2nb.terminal.files', 'ros2nb.terminal.colcon', 'ros2nb.terminal.pkg_templates'),

@@ -20,6 +20,7 @@ from kernels import Kernel, solution_cells
 from ros2nb import course, graded_parts
 from ros2nb.checks import base
 from ros2nb.errors import CheckFailed
+from ros2nb.outcomes import CHECK_FAILED, CheckOutcome
 from ros2nb_instructor.grading import feedback
 from ros2nb_instructor.grading.gradebook import standing_table
 from ros2nb_instructor.grading.submissions import Learner
@@ -106,9 +107,9 @@ def test_the_feedback_page_is_headed_by_the_graders_own_table():
     counts for nothing here, and a notebook not handed in says so."""
     learner = Learner('ada', 'ada', files={'03-write-the-publisher': Path('03.ipynb')},
                       results={'03-write-the-publisher': {
-                          '03-sensor-constructor': {'passed': True},
-                          '03-sensor-callback': {'passed': False},
-                          '03-sensor-hour': {'passed': True}}})
+                          '03-sensor-constructor': CheckOutcome(True),
+                          '03-sensor-callback': CheckOutcome(False, (), CHECK_FAILED, 'wrong'),
+                          '03-sensor-hour': CheckOutcome(True)}})
     made = ('<html><head><style>p {}</style></head><body class="jp-Notebook">'
             '<p>nbgrader\'s page</p></body></html>')
     page = feedback.safe_feedback(made, '03-write-the-publisher', (),

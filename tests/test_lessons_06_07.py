@@ -420,8 +420,8 @@ def test_a_reply_of_no_known_shape_fails_that_check_alone(session, monkeypatch):
     with pytest.raises(Unreadable, match=r'^NodeMade.name is int, not str$'):
         run_check(session, checks.check_plot_callback)
     outcome = captured(lambda: run_check(session, checks.check_plot_callback))
-    assert outcome['passed'] is False and '\n' not in outcome['message']
-    assert outcome['message'].startswith('The grader could not finish this check (Unreadable: '
+    assert outcome.passed is False and outcome.message and '\n' not in outcome.message
+    assert outcome.message.startswith('The grader could not finish this check (Unreadable: '
                                          'NodeMade.name is int, not str)'), outcome
 
 

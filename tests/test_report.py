@@ -10,6 +10,7 @@ import html
 import re
 from pathlib import Path
 
+from ros2nb.outcomes import CHECK_FAILED, CheckOutcome
 from ros2nb_instructor.grading.report import write_report
 from ros2nb_instructor.grading.submissions import Learner
 
@@ -24,13 +25,13 @@ def class_of_three() -> tuple[list[Learner], list[list[str]]]:
     mallory = Learner('<script>alert(1)</script>', 'mallory')
     for learner in (ada, bo, mallory):
         learner.files['03-write-the-publisher'] = Path('03.ipynb')
-        learner.results['03-write-the-publisher'] = {'constructor': {'passed': True}}
+        learner.results['03-write-the-publisher'] = {'constructor': CheckOutcome(True)}
     for learner in (ada, bo):
         learner.files['04-write-the-subscriber'] = Path('04.ipynb')
-    ada.results['04-write-the-subscriber'] = {'callback': {'passed': True}}
-    bo.results['04-write-the-subscriber'] = {'callback': {'passed': False, 'message': FAILURE}}
-    mallory.results['03-write-the-publisher']['callback'] = {
-        'passed': False, 'message': FAILURE}
+    failed = CheckOutcome(False, (), CHECK_FAILED, FAILURE)
+    ada.results['04-write-the-subscriber'] = {'callback': CheckOutcome(True)}
+    bo.results['04-write-the-subscriber'] = {'callback': failed}
+    mallory.results['03-write-the-publisher']['callback'] = failed
     mallory.note('_folder', '<b>bold</b> claims')
     rows = [['ada', NOTEBOOKS[0], '6', '6'], ['ada', NOTEBOOKS[1], '4', '4'],
             ['ada', 'TOTAL', '10', '10'],

@@ -18,6 +18,7 @@ from typing import (TYPE_CHECKING, Any, Callable, ContextManager, Optional, Prot
                     TypeVar)
 
 from .errors import CheckFailed, LearnerCodeError, NotDecided, Ros2nbError
+from .outcomes import CHECK_FAILED, LEARNER_CODE_ERROR, NOT_DECIDED, CheckOutcome
 from .processes import Process
 from .subject_interface import Command
 from .subject_replies import LearnerError, Reply
@@ -328,48 +329,45 @@ UNFINISHED = ('The grader could not finish this check ({error}); the other check
               'otherwise tell your instructor.')
 
 
-def captured(call: Callable[[], Any]) -> dict[str, Any]:
-    """Run one check (in the judge); return its outcome as JSON-safe data for the kernel.
+def captured(call: Callable[[], Any]) -> CheckOutcome:
+    """Run one check (in the judge); return its outcome.
 
     An error the check did not expect (a subject's reply of the wrong shape, say) fails
     that check with one line (:data:`UNFINISHED`), so a notebook's other checks still count.
-
-    :return: ``passed`` and the printed ``lines``; when failed also ``type``
-        (``'CheckFailed'``, ``'LearnerCodeError'`` or ``'NotDecided'``: the check could
-        not decide, :class:`~ros2nb.errors.NotDecided`), ``message`` and, for the second,
-        ``traceback`` (the learner's frames, one string each).
     """
     out = io.StringIO()
+
+    def failed(kind: str, message: str, traceback: Sequence[str] = ()) -> CheckOutcome:
+        return CheckOutcome(False, tuple(out.getvalue().splitlines()), kind, message,
+                            tuple(traceback))
+
     try:
         with contextlib.redirect_stdout(out):
             call()
     except LearnerCodeError as error:
-        return {'passed': False, 'type': 'LearnerCodeError', 'message': str(error),
-                'traceback': error.traceback_lines, 'lines': out.getvalue().splitlines()}
+        return failed(LEARNER_CODE_ERROR, str(error), error.traceback_lines)
     except NotDecided as error:
-        return {'passed': False, 'type': 'NotDecided', 'message': str(error),
-                'lines': out.getvalue().splitlines()}
+        return failed(NOT_DECIDED, str(error))
     except (CheckFailed, Ros2nbError) as error:
-        return {'passed': False, 'type': 'CheckFailed', 'message': str(error),
-                'lines': out.getvalue().splitlines()}
+        return failed(CHECK_FAILED, str(error))
     except Exception as error:  # what a process that ran learner code said made no sense
-        return {'passed': False, 'type': 'CheckFailed', 'lines': out.getvalue().splitlines(),
-                'message': UNFINISHED.format(error=f'{type(error).__name__}: '
-                                                   f'{(str(error).splitlines() or [""])[0][:160]}')}
-    return {'passed': True, 'lines': out.getvalue().splitlines()}
+        return failed(CHECK_FAILED, UNFINISHED.format(
+            error=f'{type(error).__name__}: {(str(error).splitlines() or [""])[0][:160]}'))
+    return CheckOutcome(True, tuple(out.getvalue().splitlines()))
 
 
-def show_result(result: dict[str, Any]) -> None:
-    """Print a passed result's lines (:func:`captured`), or raise the failure it describes.
+def show_result(result: CheckOutcome) -> None:
+    """Print a passed outcome's lines (:func:`captured`), or raise the failure it describes.
 
     :raises CheckFailed: (or :class:`LearnerCodeError`) with the judge's verdict.
     :raises NotDecided: when the judge could not decide.
     """
-    if result['passed']:
-        print('\n'.join(result['lines']))
+    if result.passed:
+        print('\n'.join(result.lines))
         return
-    if result['type'] == 'LearnerCodeError':
-        raise LearnerCodeError(result['message'], result['traceback'])
-    if result['type'] == 'NotDecided':
-        raise NotDecided(result['message'])
-    raise CheckFailed(result['message'])
+    message = result.message or 'the check failed without a message'
+    if result.type == LEARNER_CODE_ERROR:
+        raise LearnerCodeError(message, list(result.traceback))
+    if result.type == NOT_DECIDED:
+        raise NotDecided(message)
+    raise CheckFailed(message)

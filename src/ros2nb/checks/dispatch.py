@@ -19,9 +19,11 @@ import sys
 from .. import domains, working
 from ..errors import CheckFailed, Ros2nbError
 from ..judge_interface import show_result
+from ..outcomes import CheckOutcome
 from ..patience import LOOK_S, Patience
 from ..processes import kill_process_group
 from ..terminal.workspace import WORKSPACE_ENV, current_workspace
+from ..typed_json import decoded
 
 #: Seconds one check may take in all when the kernel runs it: of its judge's work while it
 #: works, of the wall clock while it waits (:class:`~ros2nb.patience.Patience`).
@@ -55,8 +57,8 @@ def ask_judge(check: str) -> None:
         raise CheckFailed(f'{INTERRUPTED}: run the cell again to check.') from None
     lines = out.strip().splitlines()
     try:
-        result = json.loads(lines[-1])
-    except (IndexError, json.JSONDecodeError):
+        result = decoded(CheckOutcome, json.loads(lines[-1]))
+    except (IndexError, ValueError):  # no line, not JSON, or not an outcome (Unreadable)
         raise Ros2nbError(f'The check could not run (exit code {proc.returncode}): '
                           f'{(err.strip().splitlines() or ["no output"])[-1]}') from None
     show_result(result)

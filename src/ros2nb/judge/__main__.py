@@ -64,6 +64,7 @@ def main(argv: list[str]) -> int:
     from .. import checks
     from ..errors import Ros2nbError
     from ..judge_interface import captured
+    from ..outcomes import CellChecked, CheckOutcome, NotebookChecked
     from ..terminal.workspace import default_workspace
     from .graded_cells import grade
     from .session import Session
@@ -75,7 +76,7 @@ def main(argv: list[str]) -> int:
     session, hurried = Session(default_workspace(), seed), False
     try:
         if argv[0] == 'check':
-            result: Any = captured(lambda: checks.run_check(argv[1], session))
+            result: Any = captured(lambda: checks.run_check(argv[1], session)).as_json()
         else:
             # Only grading flags code (the flags parse cells with IPython, whose imports
             # every check of a learner's kernel would pay).
@@ -93,14 +94,14 @@ def main(argv: list[str]) -> int:
                 began[0] = tree_cpu_seconds(os.getpid())
                 print(json.dumps({'begin': grade_id}), flush=True)
 
-            def checked(grade_id: str, outcome: dict[str, Any]) -> None:
+            def checked(grade_id: str, outcome: CheckOutcome) -> None:
                 cpu_s = round(tree_cpu_seconds(os.getpid()) - began[0], 2)
-                print(json.dumps({'cell': grade_id, 'result': outcome, 'cpu_s': cpu_s}),
-                      flush=True)
+                print(json.dumps(CellChecked(grade_id, outcome, cpu_s).as_json()), flush=True)
 
-            result = {'results': grade(source, submission, session, checked, starting),
-                      'flags': flags + [REWRITTEN.format(name=Path(r).name) for r in rewritten]
-                      + session.reaching.flags()}
+            result = NotebookChecked(
+                grade(source, submission, session, checked, starting),
+                flags + [REWRITTEN.format(name=Path(r).name) for r in rewritten]
+                + session.reaching.flags()).as_json()
     except SystemExit:  # ended from outside (_ended): the learner's processes go at once
         hurried = True
         raise

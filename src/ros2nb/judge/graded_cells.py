@@ -8,10 +8,12 @@ cells are read, as text: the names they define become :class:`AnswerRef` for the
 from __future__ import annotations
 
 import ast
+import dataclasses
 from typing import Any, Callable, Optional
 
 from .. import checks, nbmeta
 from ..judge_interface import AnswerRef, Judge, captured
+from ..outcomes import CheckOutcome
 
 
 def _is_check_call(node: ast.AST) -> Optional[str]:
@@ -66,9 +68,9 @@ def _defined_names(source: str) -> set[str]:
 
 
 def grade(source: dict[str, Any], submission: dict[str, Any], judge: Judge,
-          checked: Callable[[str, dict[str, Any]], None] = lambda grade_id, result: None,
+          checked: Callable[[str, CheckOutcome], None] = lambda grade_id, result: None,
           starting: Callable[[str], None] = lambda grade_id: None
-          ) -> dict[str, dict[str, Any]]:
+          ) -> dict[str, CheckOutcome]:
     """Run every graded cell of ``source`` (the course's notebook, hidden tests included).
 
     Names in a graded call (``LoudListener``) are the learner's: the judge passes an
@@ -79,9 +81,10 @@ def grade(source: dict[str, Any], submission: dict[str, Any], judge: Judge,
     :param submission: the learner's notebook (nbformat JSON); only its answer cells
         (nbgrader ``solution: true``) are used.
     :param judge: the session every check's body runs with (:func:`ros2nb.checks.run_check`).
-    :param checked: called with each graded cell's id and result as soon as it is decided.
+    :param checked: called with each graded cell's id and outcome as soon as it is decided.
     :param starting: called with each graded cell's id before its checks run.
-    :return: ``{grade_id: result}`` with ``passed``, ``lines``, ``type``, ``message``.
+    :return: ``{grade_id: outcome}``: a cell's checks run in turn up to the first that fails;
+        its outcome holds the lines of all that ran, and the failure.
     """
     context = [nbmeta.text(c) for c in nbmeta.cells(source) if nbmeta.CONTEXT_TAG in
                nbmeta.tags(c)]
@@ -92,14 +95,16 @@ def grade(source: dict[str, Any], submission: dict[str, Any], judge: Judge,
     results = {}
     for grade_id, cell in nbmeta.graded_cells(source):
         starting(grade_id)
-        results[grade_id] = result = {'passed': True, 'lines': []}
+        lines: list[str] = []
+        result = CheckOutcome(True)
         for name, args, keywords in graded_calls(nbmeta.text(cell)):
             values = [_value(a, names) for a in args]
             options = {k.arg: _value(k.value, names) for k in keywords if k.arg is not None}
             outcome = captured(lambda: checks.run_check(name, judge, *values, **options))
-            result['lines'] += outcome.pop('lines')
-            if not outcome['passed']:
-                result.update(outcome)
+            lines += outcome.lines
+            if not outcome.passed:
+                result = outcome
                 break
+        results[grade_id] = result = dataclasses.replace(result, lines=tuple(lines))
         checked(grade_id, result)
     return results

@@ -170,9 +170,9 @@ def standing_table(learner: Learner) -> str:
     parts = graded_parts.parts(SOLUTIONS)
     states = {}
     for part in parts:
-        result = learner.results.get(part.notebook, {}).get(part.grade_id, {})
+        result = learner.results.get(part.notebook, {}).get(part.grade_id)
         states[part.grade_id] = (graded_parts.NOT_HANDED_IN if part.notebook not in learner.files
-                                 else graded_parts.PASSED if result.get('passed') is True
+                                 else graded_parts.PASSED if result and result.passed
                                  else graded_parts.FAILED)
     return graded_parts.table_html(graded_parts.rows(parts, states),
                                    'Every notebook, as the grader found it')

@@ -21,7 +21,9 @@ import nbformat
 
 from ros2nb import nbmeta
 from ros2nb.checks.drawn import SEED_OPTION
+from ros2nb.outcomes import CellChecked, CheckOutcome, NotebookChecked
 from ros2nb.judge.subjects import HANDED, SUBJECTS_FOLDER_ENV
+from ros2nb.typed_json import Unreadable, decoded
 
 from ..paths import ROOT, SOLUTIONS
 from . import sandbox
@@ -44,12 +46,12 @@ MAX_FLAGS = 20
 class Verdict(NamedTuple):
     """What the judge decided about one notebook.
 
-    :ivar results: ``{grade_id: result}`` (empty when nothing could be checked).
+    :ivar results: ``{grade_id: outcome}`` (empty when nothing could be checked).
     :ivar problem: why nothing could be checked, or None.
     :ivar flags: code that reaches into the course, for the instructor (:mod:`ros2nb.judge.flags`).
     """
 
-    results: dict[str, dict[str, Any]]
+    results: dict[str, CheckOutcome]
     problem: Optional[str]
     flags: tuple[str, ...] = ()
 
@@ -127,10 +129,10 @@ def stopped_verdict(out: str, source: Path, cpu_s: Optional[float] = None,
     nothing."""
     results = {}
     for line in out.splitlines():
-        with contextlib.suppress(ValueError, TypeError, KeyError):
-            printed = json.loads(line)
-            if isinstance(printed, dict) and isinstance(printed.get('result'), dict):
-                results[str(printed['cell'])] = printed['result']
+        if line.startswith('{"cell"'):
+            with contextlib.suppress(ValueError):  # not JSON, or not the line (Unreadable)
+                checked: CellChecked = decoded(CellChecked, json.loads(line))
+                results[checked.cell] = checked.result
     unchecked = [grade_id for grade_id, _cell in nbmeta.graded_cells(
         json.loads(source.read_text())) if grade_id not in results]
     limit = (f'the grader\'s limit of {cpu_s:g} CPU-seconds for one check (the check and the '
@@ -153,17 +155,19 @@ def judge_argv(source: Path, submission: Path, settings: Settings) -> list[str]:
 
 
 def _read_verdict(out: str, err: Optional[str], code: int) -> Verdict:
-    """The judge's verdict from the last line it printed (``{"results", "flags"}``)."""
+    """The judge's verdict from the last line it printed (:class:`NotebookChecked`)."""
     try:
-        printed = json.loads(out.strip().splitlines()[-1])
-        results, flags = printed['results'], printed['flags']
-        if not (isinstance(results, dict) and isinstance(flags, list)):
-            raise ValueError('not the judge\'s answer')
-    except (IndexError, ValueError, TypeError, KeyError):
+        printed: NotebookChecked = decoded(NotebookChecked, json.loads(
+            out.strip().splitlines()[-1]))
+    except Unreadable as error:  # JSON, but not the answer: the field that does not fit
+        return Verdict({}, f'the grader could not check it (judge exit code {code}: its '
+                           f'answer did not fit: {str(error)[:200]})')
+    except (IndexError, ValueError):  # no line, or not JSON: what the judge said last
         last = (err or '').strip().splitlines()[-1:] or ['no message']
         return Verdict({}, f'the grader could not check it (judge exit code {code}: '
                            f'{last[0][:200]})')
-    return Verdict(results, None, tuple(str(flag)[:300] for flag in flags[:MAX_FLAGS]))
+    return Verdict(printed.results, None,
+                   tuple(flag[:300] for flag in printed.flags[:MAX_FLAGS]))
 
 
 class Judges:

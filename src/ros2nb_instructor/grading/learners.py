@@ -11,9 +11,10 @@ import concurrent.futures
 import errno
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Iterable, Mapping, Union
+from typing import Iterable, Mapping, Union
 
 import nbformat
+from ros2nb.outcomes import CheckOutcome
 
 from ..paths import ASSIGNMENT
 from . import notebooks as notebooks_of
@@ -35,14 +36,15 @@ class Graded:
 
     :ivar filed: notebook -> the notebook filed for nbgrader to score (nbformat 4 JSON text).
     :ivar notes: notebook -> what happened to it, in sentences joined by ``; ``.
-    :ivar results: notebook -> the judge's results (grade id -> ``passed``, ``message``, ...).
+    :ivar results: notebook -> the judge's outcomes (grade id ->
+        :class:`~ros2nb.judge_interface.CheckOutcome`).
     :ivar flags: notebook -> the judge's flags (:mod:`ros2nb.judge.flags`): its note says
         them, and the learner's feedback page heads with them.
     """
 
     filed: Mapping[str, str]
     notes: Mapping[str, str]
-    results: Mapping[str, Mapping[str, Any]]
+    results: Mapping[str, Mapping[str, CheckOutcome]]
     flags: Mapping[str, tuple[str, ...]]
 
     @classmethod
@@ -144,8 +146,6 @@ def _run_and_judge(scratch: Scratch, learner: Learner, notebook: str,
     return Judging(tuple(said), executed, verdict)
 
 
-#: A graded cell's result type when its check could not decide (:class:`ros2nb.errors.NotDecided`).
-NOT_DECIDED = 'NotDecided'
 #: The note of a notebook with cells its judge could not decide.
 UNDECIDED = ('the grader could not decide {cells} (what it waited for from its own side never '
              'came: the machine was too busy), which score nothing for now: grade this learner '
@@ -175,8 +175,7 @@ def judged(notebook: str, release: nbformat.NotebookNode, outcome: Outcome) -> G
             verdict: Verdict = outcome.verdict.result()
             if verdict.problem:
                 said.append(verdict.problem)
-            undecided = sorted(gid for gid, r in verdict.results.items()
-                               if not r.get('passed') and r.get('type') == NOT_DECIDED)
+            undecided = sorted(gid for gid, r in verdict.results.items() if r.undecided)
             if undecided:  # not the learner's failure: grade them again once the host is calm
                 said.append(UNDECIDED.format(cells=', '.join(undecided)))
             if verdict.flags:  # the instructor's to look at; the points are the verdict alone

@@ -13,10 +13,11 @@ import copy
 import html
 import json
 import re
-from typing import Any, Optional
+from typing import Any, Mapping, Optional
 
 import nbformat
 from nbconvert.preprocessors import CoalesceStreamsPreprocessor
+from ros2nb.outcomes import CHECK_FAILED, CheckOutcome
 from ros2nb.nbmeta import nbgrader_metadata as nbgrader
 
 #: What the learner's kernel runs in place of a graded cell.
@@ -111,7 +112,7 @@ def for_the_run(release: nbformat.NotebookNode,
     return nb
 
 
-def result_outputs(result: Optional[dict[str, Any]], problem: Optional[str]
+def result_outputs(result: Optional[CheckOutcome], problem: Optional[str]
                    ) -> list[nbformat.NotebookNode]:
     """The outputs of a graded cell: the judge's lines, and its verdict when it failed."""
     if result is None:
@@ -119,14 +120,14 @@ def result_outputs(result: Optional[dict[str, Any]], problem: Optional[str]
         return [nbformat.v4.new_output('error', ename='GradingError', evalue=reason,
                                        traceback=[f'GradingError: {reason}'])]
     outputs = []
-    if result.get('lines'):
+    if result.lines:
         outputs.append(nbformat.v4.new_output('stream', name='stdout',
-                                              text='\n'.join(result['lines']) + '\n'))
-    if not result['passed']:
-        name, message = result['type'], result['message']
+                                              text='\n'.join(result.lines) + '\n'))
+    if not result.passed:
+        name, message = result.type or CHECK_FAILED, result.message or ''
         outputs.append(nbformat.v4.new_output(
             'error', ename=name, evalue=message,
-            traceback=[*result.get('traceback', []), f'{name}: {message}']))
+            traceback=[*result.traceback, f'{name}: {message}']))
     return outputs
 
 
@@ -218,7 +219,7 @@ def bound_markdown(release: nbformat.NotebookNode, nb: nbformat.NotebookNode) ->
 
 
 def for_scoring(release: nbformat.NotebookNode, executed: nbformat.NotebookNode,
-                results: dict[str, dict[str, Any]], problem: Optional[str] = None
+                results: Mapping[str, CheckOutcome], problem: Optional[str] = None
                 ) -> nbformat.NotebookNode:
     """The notebook nbgrader scores and turns into feedback.
 
@@ -228,7 +229,7 @@ def for_scoring(release: nbformat.NotebookNode, executed: nbformat.NotebookNode,
 
     :param release: the course's released notebook (its graded cells, their metadata).
     :param executed: the learner's notebook as the sandbox ran it.
-    :param results: ``{grade_id: result}`` from ros2nb.judge.
+    :param results: ``{grade_id: outcome}`` from ros2nb.judge.
     :param problem: why nothing could be checked, if so (every graded cell shows it).
     """
     # A kernel sends what a cell prints in as many pieces as its flushes happened to make

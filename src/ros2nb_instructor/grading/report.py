@@ -98,7 +98,7 @@ def _check_rows(notebooks: list[str], learners: list[Learner]) -> list[dict[str,
         for learner in learners:
             for check, result in learner.results.get(notebook, {}).items():
                 judged[check] += 1
-                passed[check] += bool(result.get('passed'))
+                passed[check] += result.passed
         rows += [{'notebook': notebook, 'check': check, 'passed': passed[check],
                   'judged': judged[check], 'low': passed[check] < judged[check] / 2}
                  for check in sorted(judged)]
@@ -111,8 +111,8 @@ def _failure_rows(learners: list[Learner]) -> list[dict[str, object]]:
     for learner in learners:
         for notebook, results in learner.results.items():
             for check, result in results.items():
-                if not result.get('passed'):
-                    line = str(result.get('message') or 'failed without a message')
+                if not result.passed:
+                    line = result.message or 'failed without a message'
                     counts[check, line[:MAX_LINE]] += 1
     return [{'count': count, 'check': check, 'line': line}
             for (check, line), count in counts.most_common(TOP_FAILURES)]

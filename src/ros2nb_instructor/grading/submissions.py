@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any, Optional
 
 import nbformat
+from ros2nb.outcomes import CheckOutcome
 
 from .hand_in_times import HANDED_IN, TIMESTAMP, TimeProblem, read_record, read_timestamp
 from .mistakes import Mistakes
@@ -38,7 +39,8 @@ class Learner:
     :ivar id: the id nbgrader knows the learner by (the name, unless nbgrader cannot take it).
     :ivar files: notebook (e.g. ``03-write-the-publisher``) -> the file graded for it.
     :ivar notes: notebook (or ``_folder``) -> what happened, in a sentence.
-    :ivar results: notebook -> the judge's results (grade id -> ``passed``, ``message``).
+    :ivar results: notebook -> the judge's outcomes (grade id ->
+        :class:`~ros2nb.judge_interface.CheckOutcome`).
     :ivar flags: notebook -> the judge's flags (code that reaches into the course,
         :mod:`ros2nb.judge.flags`), shown on the feedback page and in the report's notes.
     :ivar handed_in: notebook -> when the submission says it was handed in (aware), and
@@ -51,7 +53,7 @@ class Learner:
     id: str
     files: dict[str, Path] = field(default_factory=dict)
     notes: dict[str, str] = field(default_factory=dict)
-    results: dict[str, dict[str, dict[str, Any]]] = field(default_factory=dict)
+    results: dict[str, dict[str, CheckOutcome]] = field(default_factory=dict)
     flags: dict[str, list[str]] = field(default_factory=dict)
     handed_in: dict[str, tuple[datetime.datetime, str]] = field(default_factory=dict)
     late: dict[str, Any] = field(default_factory=dict)

@@ -19,6 +19,8 @@ from pathlib import Path
 from typing import Optional
 
 from nbgrader.api import Gradebook, MissingEntry
+from ros2nb.outcomes import CheckOutcome
+from ros2nb.typed_json import decoded
 
 from ..paths import ASSIGNMENT, SETTINGS, gradebook_url
 from .course_settings import read_settings
@@ -121,7 +123,9 @@ def save_state(out: Path, learners: list[Learner]) -> None:
     ASCII escapes keep a folder name that is not UTF-8 (a Windows zip's) exactly as it is."""
     (out / STATE).write_text(json.dumps({learner.name: {
         'id': learner.id, 'files': {n: str(p) for n, p in learner.files.items()},
-        'notes': learner.notes, 'results': learner.results, 'flags': learner.flags,
+        'notes': learner.notes, 'flags': learner.flags,
+        'results': {n: {gid: outcome.as_json() for gid, outcome in results.items()}
+                    for n, results in learner.results.items()},
         'handed_in': {n: [t.isoformat(), s] for n, (t, s) in learner.handed_in.items()}}
         for learner in learners}, indent=1) + '\n')
 
@@ -132,7 +136,10 @@ def load_state(out: Path) -> list[Learner]:
     learners = []
     for name, state in kept.items():
         learner = Learner(name, state['id'], {n: Path(p) for n, p in state['files'].items()},
-                          dict(state['notes']), dict(state['results']), dict(state['flags']))
+                          dict(state['notes']), {n: {gid: decoded(CheckOutcome, outcome)
+                                                     for gid, outcome in results.items()}
+                                                 for n, results in state['results'].items()},
+                          dict(state['flags']))
         learner.handed_in = {n: (datetime.datetime.fromisoformat(t), s)
                              for n, (t, s) in state['handed_in'].items()}
         learners.append(learner)
