@@ -59,6 +59,32 @@ class Counting(Subject):
 def served(subject: Counting) -> Serves:
     return subject
 '''
+#: A check's body of the wrong kind for its decorator, and its honest twin.
+WRONG_CHECK_BODY = '''
+from ros2nb.checks.base import judged
+from ros2nb.judge_interface import Judge
+
+
+@judged
+def check_planted(judge: Judge) -> {returns}:
+    return {value}
+'''
+#: A direct check's notebook function called without an argument its body takes, and its
+#: honest twin: the body's signature, less the judge, is the function's.
+WRONG_CHECK_CALL = '''
+from typing import Any, Optional
+
+from ros2nb.checks.base import direct
+from ros2nb.judge_interface import Judge
+
+
+@direct
+def check_planted(judge: Optional[Judge], make_path: Any, *, ends_with: str) -> str:
+    return 'Check passed: planted'
+
+
+check_planted(print{ends_with})
+'''
 
 PLANTED = {
     'a reply field that does not exist': (
@@ -74,6 +100,16 @@ PLANTED = {
         r'Return type "Reply" of "counts" incompatible with return type "Counts" in supertype'),
     'its honest twin (the reply the command declares)': (
         WRONG_SERVED_REPLY.format(reply='Counts'), None),
+    "a judged check's body that returns no sentence": (
+        WRONG_CHECK_BODY.format(returns='bool', value='True'),
+        r'Argument 1 to "judged" has incompatible type "Callable\[\[Judge\], bool\]"'),
+    'its honest twin (the passed sentence)': (
+        WRONG_CHECK_BODY.format(returns='str', value="'Check passed: planted'"), None),
+    "a direct check called without an argument of its body's": (
+        WRONG_CHECK_CALL.format(ends_with=''),
+        r'Missing named argument "ends_with" for "check_planted"'),
+    'its honest twin (every argument)': (
+        WRONG_CHECK_CALL.format(ends_with=", ends_with='x'"), None),
 }
 
 

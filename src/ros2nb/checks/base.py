@@ -25,7 +25,8 @@ import os
 import sys
 import traceback
 from pathlib import Path
-from typing import Any, Callable, Iterator, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Concatenate, Iterator, Mapping, Optional, \
+    ParamSpec, Sequence, cast
 
 from .. import course, graded_parts, working
 from ..errors import CheckFailed, NotDecided, Ros2nbError
@@ -36,8 +37,15 @@ from ..terminal.workspace import current_workspace
 from . import evidence
 from .dispatch import INTERRUPTED, ask_judge
 
-#: A check's body: ``body(judge, *learner_things) -> the passed sentence``.
+if TYPE_CHECKING:
+    from ..judge_interface import Judge
+
+#: A check's body, as the judge looks it up by name: ``body(judge, *learner_things) -> the
+#: passed sentence`` (each decorator below types its own kind exactly).
 Body = Callable[..., str]
+#: The learner's things a direct check's body takes after the judge: the notebook's
+#: function takes the same.
+P = ParamSpec('P')
 
 
 #: The body of every check of the lessons loaded so far, by the check's name.
@@ -126,7 +134,7 @@ def _register(body: Body, call: Callable[..., None]) -> Callable[..., None]:
     return call
 
 
-def judged(body: Body) -> Callable[[], None]:
+def judged(body: Callable[['Judge'], str]) -> Callable[[], None]:
     """Register ``body(judge)`` as a check that runs only in a judge; return the notebook's
     function, which asks a judge process to run it by name."""
     notebook = int(body.__module__.rpartition('lesson')[2][:2] or 0)
@@ -140,12 +148,12 @@ def judged(body: Body) -> Callable[[], None]:
     return _register(body, call)
 
 
-def direct(body: Body) -> Callable[..., None]:
+def direct(body: Callable[Concatenate[Optional['Judge'], P], str]) -> Callable[P, None]:
     """Register ``body(judge, *args)`` as a check that runs where it is called; return the
     notebook's function, which runs it in the kernel (no judge) and prints its line."""
     notebook = int(body.__module__.rpartition('lesson')[2][:2] or 0)
 
-    def call(*args: Any, **kwargs: Any) -> None:
+    def call(*args: P.args, **kwargs: P.kwargs) -> None:
         _running.append(notebook)
         try:
             with _progress_kept(body.__name__, notebook, args):
@@ -155,7 +163,7 @@ def direct(body: Body) -> Callable[..., None]:
         finally:
             _running.pop()
 
-    return _register(body, call)
+    return cast(Callable[P, None], _register(body, call))
 
 
 #: Times a check runs before it says it could not decide (:class:`~ros2nb.errors.NotDecided`):
