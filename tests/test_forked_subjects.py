@@ -18,6 +18,8 @@ from pathlib import Path
 import pytest
 
 from ros2nb.judge.subjects import SUBJECT_PREFIX_ENV, SubjectProcess, subject_env
+from ros2nb.subject import forked
+from ros2nb.subject.fork_server import PROGRAM, ForkRequest
 from ros2nb.subject_interface import ExecCells
 from ros2nb.processes import kill_process_group
 from waiting import run_to_end, wait_until
@@ -229,3 +231,21 @@ def test_a_subject_in_a_missing_folder_fails_as_a_started_one(tmp_path, monkeypa
         monkeypatch.setenv(SUBJECT_PREFIX_ENV, prefix)
         with pytest.raises(FileNotFoundError):
             SubjectProcess(tmp_path / 'gone')
+
+
+def test_a_fork_request_of_the_wrong_shape_is_refused_in_its_child(tmp_path):
+    """The fork server's child reads its request as its type (ForkRequest), every field
+    checked: a program's arguments sent as one string, not a list, are refused in the child's
+    own output, naming the field, and it exits with 1.  Taken as it came, the string would
+    have become ten arguments of one letter each (``list('program.py')``)."""
+    planted = ForkRequest(module=PROGRAM, cwd=str(tmp_path), env=subject_env(),
+                          site_path=forked._site_path(), args='program.py')
+    read_output, write_output = os.pipe()
+    try:
+        pid, status = forked._started_server().fork((write_output,), planted)
+    finally:
+        os.close(write_output)
+    child = forked.ForkedProcess(pid, os.fdopen(read_output), status, ['python'])
+    assert child.wait(30) == 1
+    said = child.stdout.read().splitlines()
+    assert said[-1] == 'ros2nb.typed_json.Unreadable: ForkRequest.args is str, not list', said

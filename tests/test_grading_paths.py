@@ -4,6 +4,7 @@ Fast checks of the pieces ``tests/test_grading.py`` shows working on a whole cla
 plants the learner's move and shows what the grader makes of it (root, as when grading).
 """
 
+import dataclasses
 import json
 import os
 import subprocess
@@ -20,7 +21,8 @@ from ros2nb.terminal.workspace import WORKSPACE_NAME
 from ros2nb_instructor.grading import notebooks, sandbox
 from ros2nb_instructor.grading.judging import judge_notebook
 from ros2nb_instructor.grading.paths_of_learners import NotARegularFile, read_regular
-from ros2nb_instructor.grading.runs import checked_status
+from ros2nb_instructor.grading.runs import NotebookRun, _read_back, checked_status, run_note
+from ros2nb_instructor.grading.sandboxed.runner import RunStatus
 from ros2nb_instructor.grading.scratch import HOME_BYTES, Scratch, sweep_left_behind
 from ros2nb_instructor.grading.settings import Settings
 from ros2nb_instructor.grading.submissions import Learner
@@ -121,12 +123,34 @@ def test_what_a_killed_grader_left_is_swept_by_the_next(tmp_path):
 def test_a_rewritten_status_is_not_trusted():
     good = {'ran': 3, 'cells': 9, 'timed_out': [1], 'output_cut': [], 'kernel_died_at': None,
             'finished': False}
-    assert checked_status(good) == {**good, 'runner_error': None}
+    assert checked_status(good) == RunStatus(ran=3, cells=9, timed_out=(1,), output_cut=(),
+                                             kernel_died_at=None, finished=False)
     forged = {'ran': 'all', 'cells': None, 'timed_out': 7, 'output_cut': {'a': 1},
               'kernel_died_at': [1], 'finished': 'yes'}
     assert checked_status(forged) is None
     assert checked_status({**good, 'timed_out': [True]}) is None
     assert checked_status([good]) is None
+
+
+def test_a_status_with_one_field_of_the_wrong_type_is_the_learners_note(tmp_path):
+    """The runner's status file, which the learner's code can rewrite, is read as its type
+    (RunStatus), every field checked: the number of cells run, written as text, makes the
+    whole status unread, and the learner gets the note they got before this was typed, not
+    what the rest of it says (test_grading.py grades 'rewrites-its-status' so).  Taken as it
+    came, the note 'its run ended at cell ...' would have failed on '3' + 1."""
+    executed = nbformat.read(SOLUTION[NB01], as_version=4)
+    (tmp_path / f'{NB01}.run.ipynb').write_text(nbformat.writes(executed))
+    status = tmp_path / f'{NB01}.run.ipynb.status.json'
+    written = dataclasses.asdict(RunStatus(ran=3, cells=9, timed_out=(), output_cut=(),
+                                           finished=False))
+    status.write_text(json.dumps(written))
+    assert run_note(NotebookRun(*_read_back(tmp_path, NB01, executed))) == (
+        'its run ended at cell 4 of 9: the notebook stopped or killed the processes running it')
+    status.write_text(json.dumps({**written, 'ran': '3'}))
+    assert run_note(NotebookRun(*_read_back(tmp_path, NB01, executed))) == (
+        "running it stopped early: the runner's status was unreadable or rewritten (its kernel "
+        'or the runner was killed, or the notebook changed it); what ran of the notebook is '
+        'graded')
 
 
 def test_malformed_nbgrader_metadata_is_removed_not_fatal():

@@ -12,6 +12,7 @@ import pytest
 
 from ros2nb_instructor.grading import sandbox
 from ros2nb_instructor.grading.runs import run_note, run_notebook
+from ros2nb_instructor.grading.sandboxed.runner import RunStatus
 from ros2nb_instructor.grading.scratch import Scratch
 from ros2nb_instructor.grading.settings import Settings
 from ros2nb_instructor.grading.submissions import Learner
@@ -25,7 +26,8 @@ pytestmark = [pytest.mark.sandbox, pytest.mark.kernel, pytest.mark.ros,
 NOTEBOOK = '03-write-the-publisher'
 
 
-def flooder_run(tmp_path, settings: Settings, monkeypatch) -> tuple[dict, str, sandbox.Result]:
+def flooder_run(tmp_path, settings: Settings, monkeypatch
+                ) -> tuple[RunStatus, str, sandbox.Result]:
     """The flooder's 03 run in its sandbox, as the grader runs it: the runner's status, the
     note the learner gets, and how the sandbox ended (its CPU seconds)."""
     import nbformat
@@ -37,21 +39,21 @@ def flooder_run(tmp_path, settings: Settings, monkeypatch) -> tuple[dict, str, s
     tmp_path.mkdir()
     scratch = Scratch(tmp_path, Learner('flooder', 'flooder'))
     try:
-        _executed, status, stopped = run_notebook(scratch, NOTEBOOK, notebook, settings)
+        done = run_notebook(scratch, NOTEBOOK, notebook, settings)
     finally:
         scratch.remove()
-    return status, run_note(status, stopped) or '', ended[-1]
+    return done.status, run_note(done) or '', ended[-1]
 
 
 def test_a_kernel_that_floods_is_stopped_at_its_cpu_limit(tmp_path, monkeypatch):
     status, note, ended = flooder_run(
         tmp_path / 'limited', Settings(120, 600, True, notebook_cpu=10), monkeypatch)
-    assert ended.out_of_cpu and ended.cpu_s >= 10 and not status['finished'], (ended, status)
+    assert ended.out_of_cpu and ended.cpu_s >= 10 and not status.finished, (ended, status)
     assert note.startswith('its run reached the limit of 10 CPU-seconds for running a '
                            'notebook'), note
     # It names the cells that did not run and where the points come from, and blames no one:
     # an honest notebook that explores at length is stopped with the same words.
-    ran, cells = status['ran'], status['cells']
+    ran, cells = status.ran, status.cells
     assert f'cells {ran + 1}-{cells} did not run' in note, (note, status)
     assert "its points come from the grader's checks" in note, note
     assert not any(word in note for word in ('loop', 'runaway', 'as fast as')), note

@@ -17,8 +17,10 @@ import pytest
 from ros2nb.judge import observer
 from ros2nb.judge.subjects import SubjectHung, SubjectProcess
 from ros2nb.errors import NotDecided
+from ros2nb.subject.judge_time import Acknowledgement
 from ros2nb.subject_interface import Call, ExecCells, NewNode
 from ros2nb.subject_replies import Called, Encoded, Output
+from ros2nb.typed_json import Unreadable, decoded
 from ros2nb.patience import BUSY_SHARE, LOOK_S, Patience, tree_cpu_seconds, wait_for_work
 from waiting import PATIENCE_S, run_to_end, starved, wait_until
 
@@ -114,6 +116,34 @@ def test_a_subject_that_waits_idle_for_the_judges_clock_is_not_decided(tmp_path)
         with pytest.raises(NotDecided, match="^the grader's clock never reached the process "
                                              'that runs your code$'):
             process.request(NewNode(cls='Quiet', stand_ins=[], args=[]), timeout=LIMIT_S)
+    finally:
+        process.close()
+
+
+#: Learner code that writes two acknowledgements on its subject's pipe to the judge: one as the
+#: subject writes them, then one whose count of /temperature is no number.
+PLANTS_ACKNOWLEDGEMENTS = """
+import os
+from ros2nb.subject.judge_time import JudgeTime
+os.write(JudgeTime.pipe(), b'{"t": 5, "wants": null, "published": {}, "logged": {}}\\n')
+os.write(JudgeTime.pipe(), b'{"t": 7, "wants": 9, "published": {"/temperature": "all"}, '
+                           b'"logged": {}}\\n')
+"""
+
+
+def test_an_acknowledgement_of_the_wrong_shape_is_skipped(tmp_path):
+    """What a subject says on the judge's pipe is read as its type (Acknowledgement), every
+    field checked: a line the learner's code wrote there with a count that is no number is
+    refused, naming the field, and the judge keeps the last one it could read.  Taken as
+    it came, that count would meet the judge's own counts and raise a TypeError there."""
+    planted = {'t': 7, 'wants': 9, 'published': {'/temperature': 'all'}, 'logged': {}}
+    with pytest.raises(Unreadable, match=r"^Acknowledgement\.published\['/temperature'\] is "
+                                         r"str, not int$"):
+        decoded(Acknowledgement, planted)
+    process = SubjectProcess(tmp_path)
+    try:
+        assert process.request(ExecCells(sources=[PLANTS_ACKNOWLEDGEMENTS])).cell_errors == []
+        assert process.last_ack == Acknowledgement(t=5, wants=None, published={}, logged={})
     finally:
         process.close()
 

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import pytest
 
+from ros2nb.typed_json import Unreadable
 from ros2nb_instructor.grading import (course_settings, deadlines, due_dates, exporting, feedback,
                                       lms, roster, sandbox, term)
 from ros2nb_instructor.grading.extensions import Extensions
@@ -151,6 +152,22 @@ def test_learners_json_keeps_a_folder_name_that_is_not_utf8(tmp_path):
     term.save_state(tmp_path, [learner])
     (back,) = term.load_state(tmp_path)
     assert (back.name, back.files, back.handed_in) == (name, learner.files, learner.handed_in)
+
+
+def test_learners_json_of_the_wrong_shape_names_the_learner_and_the_field(tmp_path):
+    """learners.json is read as its type (LearnerState), every field checked: a hand-in time
+    written as a number, not ISO 8601 text, is refused with the learner and the field named.
+    Read by key, it stopped LEARNER= with fromisoformat's TypeError, naming neither."""
+    learner = Learner('ada', 'ada', {NB01: tmp_path / 'ada' / f'{NB01}.ipynb'})
+    learner.handed_in[NB01] = (DUE, TIMESTAMP)
+    term.save_state(tmp_path, [learner])
+    kept = json.loads((tmp_path / term.STATE).read_text())
+    kept['ada']['handed_in'][NB01][0] = int(DUE.timestamp())
+    (tmp_path / term.STATE).write_text(json.dumps(kept))
+    with pytest.raises(Unreadable) as refused:
+        term.load_state(tmp_path)
+    assert str(refused.value) == (f"{tmp_path / term.STATE}, learner ada: "
+                                  f"LearnerState.handed_in['{NB01}'][] is int, not str")
 
 
 ROSTER = ('learner,name,lms_id,sis_id,login,email,section\n'

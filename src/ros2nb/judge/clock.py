@@ -24,10 +24,10 @@ from ..errors import CheckFailed, NotDecided
 from ..qos_profiles import why_unmatched
 from ..patience import Patience
 from ..processes import kill_process_group
-from ..subject.judge_time import JUDGE_CLOCK_QOS
+from ..subject.judge_time import JUDGE_CLOCK_QOS, Acknowledgement
 from ..runtime.core import QUIET_PUBLISHER
 from ..subject_interface import Command
-from ..subject_replies import LearnerError, Reply
+from ..subject_replies import Reply
 from ..judge_interface import Subject
 from .observer import Observer
 from .subjects import REPLY_TIMEOUT_S, SubjectProcess
@@ -135,13 +135,13 @@ class JudgeClock:
             if ack is not None:
                 patience, quiet_since = None, time.monotonic()
                 self._settle(ack, subject.heard_base, subject.proc.pid)
-                if ack.get('wants') is None:  # its spin ended, and all it told of arrived:
+                if ack.wants is None:  # its spin ended, and all it told of arrived:
                     self._publish()  # the same time again lets it go on (destroy its nodes)
             if reply is not None:
                 return reply
             latest = subject.last_ack
-            wants = latest.get('wants') if latest else None
-            if latest is not None and latest['t'] >= self.now_ns and wants is not None \
+            wants = latest.wants if latest else None
+            if latest is not None and latest.t >= self.now_ns and wants is not None \
                     and wants > self.now_ns:
                 if whole_ns > limit_ns:
                     kill_process_group(subject.proc)
@@ -166,7 +166,7 @@ class JudgeClock:
             else:
                 looked = time.monotonic()
 
-    def _settle(self, ack: dict[str, Any], base: tuple[dict[str, int], dict[str, int]],
+    def _settle(self, ack: Acknowledgement, base: tuple[dict[str, int], dict[str, int]],
                 pid: int) -> None:
         """Wait until what the subject ``pid`` announced in ``ack`` (all it published and
         logged since it started) has arrived: what the judge heard since then (``base``: what
@@ -175,18 +175,12 @@ class JudgeClock:
         the judge's clock is a flood, raised before any wait."""
         topics0, logs0 = base
         observer = self._observer
-        failure = ack.get('failure')
-        if failure:
-            explained = bool(failure.get('explained'))
-            message = failure['error'].split(': ', 1)[-1] if not explained else failure['error']
-            raise learner_error(failure['callback'], LearnerError(
-                type=failure['kind'], message=message, where=failure['where'],
-                explanation=failure['error'] if explained else None,
-                traceback=failure['traceback']))
+        if ack.failure is not None:
+            raise learner_error(ack.failure.callback, ack.failure)
 
-        for logger, total in ack.get('logged', {}).items():
+        for logger, total in ack.logged.items():
             observer.floods.announced(pid, '/rosout', logger, total)
-        for topic, total in ack.get('published', {}).items():
+        for topic, total in ack.published.items():
             if topic in topics0:
                 observer.floods.announced(pid, topic, topic, total)
         observer.floods.raise_any()
@@ -194,10 +188,10 @@ class JudgeClock:
         def missing() -> list[str]:
             topics, logs = observer.counts()
             short = []
-            for topic, total in ack.get('published', {}).items():
+            for topic, total in ack.published.items():
                 if topic in topics0 and topics[topic] - topics0[topic] < total:
                     short.append(topic)
-            for logger, total in ack.get('logged', {}).items():
+            for logger, total in ack.logged.items():
                 if logs.get(logger, 0) - logs0.get(logger, 0) < total:
                     short.append(f'/rosout ({logger})')
             return short

@@ -24,7 +24,7 @@ from .. import domains
 from ..errors import CheckFailed, NotDecided
 from ..patience import Patience
 from ..processes import kill_process_group, stop_process_group
-from ..subject.judge_time import JUDGE_CLOCK_ENV
+from ..subject.judge_time import JUDGE_CLOCK_ENV, Acknowledgement, Waiting
 from ..subject.forked import SUBJECT_PREFIX_ENV, fork_subject, has_server
 from ..subject_interface import Command, reply_type, wire
 from ..subject_replies import Reply
@@ -130,38 +130,24 @@ class Output:
         return '\n'.join(self.lines)
 
 
-def _well_formed_ack(line: bytes) -> Optional[dict[str, Any]]:
-    """An acknowledgement as :class:`~ros2nb.subject.judge_time.JudgeTime` writes it, or None."""
-    try:
-        ack = json.loads(line)
-    except ValueError:
-        return None
-    if not (isinstance(ack, dict) and isinstance(ack.get('t'), int)
-            and (ack.get('wants') is None or isinstance(ack.get('wants'), int))):
-        return None
-    for key in ('published', 'logged'):
-        counts = ack.get(key)
-        if not (isinstance(counts, dict) and all(
-                isinstance(k, str) and isinstance(v, int) for k, v in counts.items())):
-            return None
-    failure = ack.get('failure')
-    if failure is not None and not (
-            isinstance(failure, dict)
-            and all(isinstance(failure.get(k), str) for k in ('callback', 'error', 'where', 'kind'))
-            and isinstance(failure.get('traceback'), list)
-            and all(isinstance(line, str) for line in failure['traceback'])):
-        return None
+def _acknowledgement(line: bytes) -> Acknowledgement:
+    """An acknowledgement as :class:`~ros2nb.subject.judge_time.JudgeTime` writes it.
+
+    :raises ros2nb.typed_json.Unreadable: for JSON of another shape, naming the field.
+    :raises ValueError: for a line that is no JSON.
+    """
+    ack: Acknowledgement = decoded(Acknowledgement, json.loads(line))
     return ack
 
 
 def _waiting(line: bytes) -> Optional[str]:
-    """What a subject says it waits for (``{"waiting": TEXT or null}``), or None."""
+    """What a subject says it waits for (:class:`~ros2nb.subject.judge_time.Waiting`), or
+    None (also for a line of another shape)."""
     try:
-        said = json.loads(line)
-    except ValueError:
+        said: Waiting = decoded(Waiting, json.loads(line))
+    except ValueError:  # no JSON, or Unreadable (a ValueError)
         return None
-    waiting = said.get('waiting') if isinstance(said, dict) else None
-    return waiting[:80] if isinstance(waiting, str) else None
+    return said.waiting[:80] if said.waiting is not None else None
 
 
 class SubjectHung(CheckFailed):
@@ -202,7 +188,7 @@ class SubjectProcess:
         self._buffer = b''
         self._ack_buffer = b''
         #: The newest well-formed acknowledgement of a step (None before the first).
-        self.last_ack: Optional[dict[str, Any]] = None
+        self.last_ack: Optional[Acknowledgement] = None
         #: What the subject last said it waits for on the judge's side (the judge's clock,
         #: :data:`~ros2nb.subject.judge_time.WAITING_FOR_CLOCK`), or None: idle there, it is
         #: not the learner's code that hangs.
@@ -258,20 +244,21 @@ class SubjectProcess:
         line, self._buffer = self._buffer.split(b'\n', 1)
         return json.loads(line)
 
-    def take_ack(self) -> Optional[dict[str, Any]]:
+    def take_ack(self) -> Optional[Acknowledgement]:
         """The newest acknowledgement that came since the last call (None if none came).
 
-        Lines that are not well formed are skipped: the process runs learner code, which may
-        write anything there; what it says only tells the judge when to step and what to
-        wait for.  What the subject's audit hook wrote there goes to :attr:`seen`.
+        Lines that are not well formed (:class:`~ros2nb.typed_json.Unreadable`) are skipped:
+        the process runs learner code, which may write anything there; what it says only
+        tells the judge when to step and what to wait for.  What the subject's audit hook
+        wrote there goes to :attr:`seen`.
         """
         newest = None
         for line in self._pipe_lines():
-            ack = _well_formed_ack(line)
-            if ack is not None:
-                newest = ack
-            elif line.startswith(b'{"waiting"'):
-                self.waiting_for = _waiting(line)
+            try:
+                newest = _acknowledgement(line)
+            except ValueError:  # Unreadable (a ValueError), or no JSON
+                if line.startswith(b'{"waiting"'):
+                    self.waiting_for = _waiting(line)
         if newest is not None:
             self.last_ack = newest
         return newest

@@ -22,9 +22,11 @@ import socket
 import sys
 import threading
 import traceback
-from typing import Any, Callable, NoReturn, Union
+from dataclasses import dataclass, field
+from typing import Any, Callable, NoReturn, Optional, Union
 
 from ..processes import die_with_parent
+from ..typed_json import Unreadable, decoded
 
 #: What the server imports before it forks the first child: the subject's own modules and
 #: what rclpy imports when the first node starts (the parameter services' types, numpy for
@@ -42,6 +44,31 @@ MAX_REQUEST_BYTES = 1 << 20
 SUBJECT, PROGRAM = 'ros2nb.subject', 'ros2nb.subject.program'
 #: Most file descriptors one request brings: a subject's three pipes, its output, its status.
 MAX_FDS = 5
+
+
+@dataclass(frozen=True, kw_only=True)
+class ForkRequest:
+    """What a child of the fork server is to become: ``python -P -m MODULE ARGS``.
+
+    Sent by the process that asks for children (:class:`ros2nb.subject.forked.ForkServer`,
+    the judge's side) on the server's socket, as JSON (``dataclasses.asdict``), and read in
+    the forked child with :func:`ros2nb.typed_json.decoded`, every field checked.
+
+    :ivar module: :data:`SUBJECT` or :data:`PROGRAM`.
+    :ivar cwd: its working folder.
+    :ivar env: its whole environment.
+    :ivar site_path: the ``sys.path`` a new process of this Python has after its first entry,
+        without ``PYTHONPATH`` (which ``env`` puts in front).
+    :ivar clock_env: (a subject) the variable that names its acknowledgement pipe.
+    :ivar args: (a program) its arguments: the learner's file, and its class.
+    """
+
+    module: str
+    cwd: str
+    env: dict[str, str]
+    site_path: list[str]
+    clock_env: Optional[str] = None
+    args: list[str] = field(default_factory=list)
 
 
 def serve(sock: socket.socket) -> None:
@@ -106,12 +133,15 @@ def _reap(status: dict[int, int]) -> None:
             os.close(fd)
 
 
-def _become(request: dict[str, Any], kept: list[int], out: int) -> NoReturn:
+def _become(data: Any, kept: list[int], out: int) -> NoReturn:
     """In the forked child: become ``python -P -m MODULE ARGS`` (the request's) started in
     its folder with its environment, then run it to its end (this never returns).
 
+    :param data: the request as JSON, read as a :class:`ForkRequest` once the child's output
+        is its own, so that one of another shape is said there.
     :param kept: the child's own pipes (a subject's command, reply and acknowledgement).
     :param out: where its standard output and error go.
+    :raises ros2nb.typed_json.Unreadable: for a request that does not fit its type.
     """
     os.setsid()
     devnull = os.open(os.devnull, os.O_RDONLY)
@@ -120,13 +150,16 @@ def _become(request: dict[str, Any], kept: list[int], out: int) -> NoReturn:
     os.dup2(out, 2)
     os.close(devnull)
     os.close(out)
-    cwd, env = request['cwd'], dict(request['env'])
-    os.chdir(cwd)
-    if request['module'] == SUBJECT:
+    request: ForkRequest = decoded(ForkRequest, data)
+    env = dict(request.env)
+    os.chdir(request.cwd)
+    if request.module == SUBJECT:
+        if request.clock_env is None:
+            raise Unreadable('ForkRequest.clock_env is missing: a subject needs one')
         args = [str(kept[0]), str(kept[1])]
-        env[request['clock_env']] = str(kept[2])
+        env[request.clock_env] = str(kept[2])
     else:
-        args = list(request['args'])
+        args = list(request.args)
     os.environ.clear()
     os.environ.update(env)
     _standard_streams(unbuffered=bool(env.get('PYTHONUNBUFFERED')))
@@ -138,9 +171,9 @@ def _become(request: dict[str, Any], kept: list[int], out: int) -> NoReturn:
     # As ``python -P`` starts: the working folder is not on the path (no module of the
     # learner's there stands in for the standard library's)
     sys.path[:] = [*filter(None, env.get('PYTHONPATH', '').split(os.pathsep)),
-                   *request['site_path']]
+                   *request.site_path]
     from ..processes import end_this_process
-    if request['module'] == SUBJECT:
+    if request.module == SUBJECT:
         from .__main__ import main
         sys.argv = [sys.modules['ros2nb.subject.__main__'].__file__ or '', *args]
         end_this_process(main(args))

@@ -24,6 +24,7 @@ While grading, each subject and program runs in a sandbox of its own (the judge'
 
 from __future__ import annotations
 
+import dataclasses
 import errno
 import functools
 import json
@@ -35,10 +36,13 @@ import subprocess
 import sys
 import threading
 import time
-from typing import IO, Any, Optional
+from dataclasses import dataclass
+from typing import IO, Optional, Sequence
 
 from ..processes import die_with_parent
+from ..typed_json import decoded
 from . import fork_server
+from .fork_server import ForkRequest
 from .out_of_reach import answers_loaded
 
 #: JSON list put in front of every subject's command while grading (the grader's sandbox):
@@ -46,6 +50,18 @@ from .out_of_reach import answers_loaded
 SUBJECT_PREFIX_ENV = 'ROS2NB_SUBJECT_PREFIX'
 #: Seconds a forked child gets to become the leader of its own session.
 SESSION_WAIT_S = 5.0
+#: What :func:`_site_path` runs: a new Python prints its ``sys.path`` after the first entry,
+#: as a :class:`SitePath` (its one field written by hand: the program imports nothing of ours).
+SITE_PATH_PROGRAM = 'import json, sys\nprint(json.dumps({"entries": sys.path[1:]}))'
+
+
+@dataclass(frozen=True)
+class SitePath:
+    """What :data:`SITE_PATH_PROGRAM` prints, read back with :func:`ros2nb.typed_json.decoded`
+    in the process that asks for children: ``entries``, a new process's ``sys.path`` after
+    its first entry (:attr:`~ros2nb.subject.fork_server.ForkRequest.site_path`)."""
+
+    entries: list[str]
 
 
 class ForkedProcess:
@@ -114,7 +130,7 @@ class ForkServer:
         """Whether the server still answers (as far as this side knows)."""
         return not self._failed and (self._process is None or self._process.poll() is None)
 
-    def fork(self, fds: tuple[int, ...], request: dict[str, Any]) -> tuple[int, int]:
+    def fork(self, fds: tuple[int, ...], request: ForkRequest) -> tuple[int, int]:
         """Ask for a child; return its pid and the read end of its exit-code pipe.
 
         :param fds: the child's own pipes (a subject's command, reply and acknowledgement),
@@ -124,7 +140,7 @@ class ForkServer:
         status_read, status_write = os.pipe()
         try:
             with self._lock:
-                socket.send_fds(self._sock, [json.dumps(request).encode()],
+                socket.send_fds(self._sock, [json.dumps(dataclasses.asdict(request)).encode()],
                                 [*fds, status_write])
                 answer = self._sock.recv(64)
             if not answer:
@@ -205,8 +221,7 @@ def fork_subject(fds: tuple[int, int, int], cwd: str, env: dict[str, str],
         error) is ``stdout``.
     :raises OSError: when the fork server cannot be started.
     """
-    return _fork({'module': fork_server.SUBJECT, 'cwd': cwd, 'env': env,
-                  'clock_env': clock_env}, fds)
+    return _fork(fork_server.SUBJECT, cwd, env, fds, clock_env=clock_env)
 
 
 def fork_program(args: list[str], cwd: str, env: dict[str, str]) -> ForkedProcess:
@@ -217,18 +232,21 @@ def fork_program(args: list[str], cwd: str, env: dict[str, str]) -> ForkedProces
 
     :raises OSError: when the fork server cannot be started.
     """
-    return _fork({'module': fork_server.PROGRAM, 'cwd': cwd, 'env': env, 'args': args}, ())
+    return _fork(fork_server.PROGRAM, cwd, env, (), args=args)
 
 
-def _fork(request: dict[str, Any], fds: tuple[int, ...]) -> ForkedProcess:
-    """Ask the fork server (this process's, started if need be) for a child.
+def _fork(module: str, cwd: str, env: dict[str, str], fds: tuple[int, ...], *,
+          clock_env: Optional[str] = None, args: Sequence[str] = ()) -> ForkedProcess:
+    """Ask the fork server (this process's, started if need be) for a child that becomes
+    ``python -P -m module args`` (a :class:`~ros2nb.subject.fork_server.ForkRequest`).
 
     :raises FileNotFoundError: when its folder does not exist (as ``subprocess.Popen``).
     """
-    if not os.path.isdir(request['cwd']):
-        raise FileNotFoundError(errno.ENOENT, os.strerror(errno.ENOENT), request['cwd'])
+    if not os.path.isdir(cwd):
+        raise FileNotFoundError(errno.ENOENT, os.strerror(errno.ENOENT), cwd)
     read_output, write_output = os.pipe()
-    request['site_path'] = _site_path()
+    request = ForkRequest(module=module, cwd=cwd, env=env, site_path=_site_path(),
+                          clock_env=clock_env, args=list(args))
     try:
         try:
             pid, status = _started_server().fork((*fds, write_output), request)
@@ -240,7 +258,7 @@ def _fork(request: dict[str, Any], fds: tuple[int, ...]) -> ForkedProcess:
     finally:
         os.close(write_output)
     process = ForkedProcess(pid, os.fdopen(read_output, 'r'), status,
-                            ['python', '-m', request['module'], *request.get('args', [])])
+                            ['python', '-m', module, *args])
     _await_session(process)
     return process
 
@@ -264,7 +282,7 @@ def _site_path() -> list[str]:
     ``PYTHONPATH`` (the standard library, site-packages and their ``.pth`` files): the fork
     server's own is the judge's, with whatever the judge added to it."""
     env = {k: v for k, v in os.environ.items() if k != 'PYTHONPATH'}
-    program = 'import json, sys\nprint(json.dumps(sys.path[1:]))'
-    done = subprocess.run([sys.executable, '-c', program], env=env, capture_output=True,
-                          text=True, check=True)
-    return json.loads(done.stdout)
+    done = subprocess.run([sys.executable, '-c', SITE_PATH_PROGRAM], env=env,
+                          capture_output=True, text=True, check=True)
+    site: SitePath = decoded(SitePath, json.loads(done.stdout))
+    return site.entries

@@ -16,7 +16,8 @@ import json
 import os
 import time
 from collections import Counter
-from typing import Any, Callable, Optional
+from dataclasses import dataclass
+from typing import Any, Callable, Optional, Union
 
 from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
@@ -25,7 +26,9 @@ from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock
 
 from ..patience import wait_for_work
+from ..runtime import logs
 from ..runtime.simulated_clock import follow_judge_time
+from ..subject_replies import CallbackFailure
 
 #: Set by a judge for its subjects: the file descriptor its runtime writes one line to for
 #: each step of the judge's clock it finished (:class:`JudgeTime`).
@@ -46,6 +49,55 @@ JUDGE_STEP_WAIT_S = 0.5
 #: What a subject says on the judge's pipe while its new runtime waits for the judge's first
 #: ``/clock`` (``{"waiting": "the judge's clock"}``; ``{"waiting": null}`` once it came).
 WAITING_FOR_CLOCK = "the grader's clock"
+
+
+@dataclass(frozen=True, kw_only=True)
+class Acknowledgement:
+    """A subject's line on the judge's pipe after each step of the judge's clock it finished
+    (:meth:`JudgeTime.ack`), read by the judge
+    (:meth:`ros2nb.judge.subjects.SubjectProcess.take_ack`) with
+    :func:`ros2nb.typed_json.decoded`.  It crosses from the subject, a process that runs the
+    learner's code, to the judge: it only says when to step and what to wait for, never what
+    passes.
+
+    :ivar t: the step of the judge's clock the subject finished (ns).
+    :ivar wants: how far its running spin wants the clock to go (ns); None: no further.
+    :ivar published: messages the process has published so far, per topic.
+    :ivar logged: lines the runtime's nodes have logged so far, per logger.
+    :ivar failure: the first exception a callback of the learner's raised, or None.
+    """
+
+    t: int
+    wants: Optional[int] = None
+    published: dict[str, int]
+    logged: dict[str, int]
+    failure: Optional[CallbackFailure] = None
+
+
+@dataclass(frozen=True)
+class Waiting:
+    """A subject's line on the judge's pipe while its new runtime waits for the judge's first
+    ``/clock`` (:meth:`JudgeTime.follow`), read by the judge
+    (:attr:`ros2nb.judge.subjects.SubjectProcess.waiting_for`): idle then, it waits for the
+    judge, not for the learner's code.
+
+    :ivar waiting: what it waits for (:data:`WAITING_FOR_CLOCK`), or None once it came.
+    """
+
+    waiting: Optional[str]
+
+
+def told(failure: logs.CallbackFailure) -> CallbackFailure:
+    """A callback's failure as the runtime keeps it, in the fields the judge reads every
+    callback's failure in: the exception's class as ``type``, ros2nb's explanation when it
+    had one (then also the ``message``), else Python's own message."""
+    if failure.explained:
+        message, explanation = failure.error, failure.error
+    else:  # ``Type: message``, as the runtime words it
+        message, explanation = failure.error.split(': ', 1)[-1], None
+    return CallbackFailure(callback=failure.callback, node=failure.node, type=failure.kind,
+                           message=message, explanation=explanation, where=failure.where,
+                           traceback=list(failure.traceback))
 
 
 class JudgeTime:
@@ -144,25 +196,20 @@ class JudgeTime:
         if self.latest_ns is None or now > self.latest_ns:
             self.latest_ns = now
 
-    def ack(self, now_ns: int, wants_ns: Optional[int], failures: list[Any],
+    def ack(self, now_ns: int, wants_ns: Optional[int], failures: list[logs.CallbackFailure],
             ours: Callable[[str], bool]) -> None:
-        """Tell the judge that every callback due at ``now_ns`` has run.
+        """Tell the judge that every callback due at ``now_ns`` has run (an
+        :class:`Acknowledgement`).
 
         :param wants_ns: how far the running spin wants the clock to go (None: no further).
         :param ours: which loggers' lines to count: those of the nodes the runtime runs (a
             logger of no node's, or of a node without /rosout, logs nothing the judge hears).
-        :param failures: the callbacks that raised so far
-            (:class:`~ros2nb.runtime.logs.CallbackFailure`); the first is told.
+        :param failures: the callbacks that raised so far; the first is told (:func:`told`).
         """
-        first = dataclasses.asdict(failures[0]) if failures else None
-        if first is not None:
-            first['traceback'] = list(first['traceback'])
-        line = json.dumps({'t': now_ns, 'wants': wants_ns, 'published': dict(self._counts),
-                           'logged': {name: count for name, count in self._logged.items()
-                                      if ours(name)},
-                           'failure': first}) + '\n'
-        with contextlib.suppress(OSError):  # the judge went away: nothing left to tell
-            os.write(self._fd, line.encode())
+        self._say(Acknowledgement(
+            t=now_ns, wants=wants_ns, published=dict(self._counts),
+            logged={name: count for name, count in self._logged.items() if ours(name)},
+            failure=told(failures[0]) if failures else None))
 
     # ------------------------------------------------------------ what the runtime asks
     def follow(self, runtime: Any) -> None:
@@ -172,16 +219,17 @@ class JudgeTime:
         the judge, not for the learner's code."""
         runtime.node.create_subscription(Clock, '/clock', self.on_clock, JUDGE_CLOCK_QOS)
         if self.latest_ns is None:
-            self._say({'waiting': WAITING_FOR_CLOCK})
+            self._say(Waiting(WAITING_FOR_CLOCK))
             while self.latest_ns is None:
                 runtime._run_one(JUDGE_STEP_WAIT_S)
-            self._say({'waiting': None})
+            self._say(Waiting(None))
         runtime.sim_now_ns = self.latest_ns
 
-    def _say(self, what: dict[str, Any]) -> None:
+    def _say(self, what: Union[Acknowledgement, Waiting]) -> None:
         """One line of JSON on the judge's pipe."""
+        line = json.dumps(dataclasses.asdict(what)) + '\n'
         with contextlib.suppress(OSError):  # the judge went away: nothing left to tell
-            os.write(self._fd, (json.dumps(what) + '\n').encode())
+            os.write(self._fd, line.encode())
 
     def take_latest(self, runtime: Any) -> None:
         """Move ``runtime`` to the judge's latest step, if the judge's clock moved on."""

@@ -134,8 +134,8 @@ def _run_and_judge(scratch: Scratch, learner: Learner, notebook: str,
     said += [*notebooks_of.drop_large_attachments(submitted),
              *notebooks_of.bound_markdown(release, submitted)]
     prepared = notebooks_of.for_the_run(release, submitted)
-    executed, status, stopped = run_notebook(scratch, notebook, prepared, settings)
-    happened = run_note(status, stopped)
+    run = run_notebook(scratch, notebook, prepared, settings)
+    happened = run_note(run)
     if scratch.home_full():
         happened = '; '.join(filter(None, [OUT_OF_SPACE.format(HOME_BYTES >> 20), happened]))
     if happened:
@@ -143,7 +143,7 @@ def _run_and_judge(scratch: Scratch, learner: Learner, notebook: str,
     snapshot = scratch.snapshot(notebook)
     verdict = judges.submit(scratch, notebook, submitted, settings, snapshot)
     verdict.add_done_callback(lambda _done: scratch.release(snapshot))
-    return Judging(tuple(said), executed, verdict)
+    return Judging(tuple(said), run.executed, verdict)
 
 
 #: The note of a notebook with cells its judge could not decide.

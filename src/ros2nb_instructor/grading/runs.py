@@ -2,23 +2,29 @@
 
 Runs on the instructor's host; the notebook runs in a sandbox (:mod:`.sandbox`) through
 :mod:`.sandboxed.runner`.  What comes back is read only after the sandbox ended, and only
-the two files the runner was asked to write.
+the two files the runner was asked to write: the executed notebook and its
+:class:`~.sandboxed.runner.RunStatus`.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import errno
 import json
 import subprocess
 import sys
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Optional
+from typing import Optional
 
 import nbformat
+
+from ros2nb.typed_json import Unreadable, decoded
 
 from ..paths import ROOT
 from . import sandbox
 from .paths_of_learners import NotARegularFile, read_regular
+from .sandboxed.runner import RunStatus
 from .scratch import Scratch, sandbox_env
 from .settings import Settings
 
@@ -26,10 +32,35 @@ from .settings import Settings
 RUNNER = 'ros2nb_instructor.grading.sandboxed.runner'
 #: Largest executed notebook read back (the runner cuts each cell's output at 100 kB).
 MAX_NOTEBOOK_BYTES = 20_000_000
+#: A status's cell numbers are below this (a larger one was not written by the runner).
+MAX_CELLS = 1_000_000
+#: The status of a run that said nothing readable.
+NO_STATUS = RunStatus(ran=0, cells=0, timed_out=(), output_cut=(), finished=False)
+#: The status's fields: what else a status holds is not read (the runner writes nothing else).
+_STATUS_FIELDS = frozenset(field.name for field in dataclasses.fields(RunStatus))
+
+
+@dataclass(frozen=True)
+class NotebookRun:
+    """One notebook's run in the learner's sandbox, as the grader read it back on its host
+    after the sandbox ended (:func:`run_notebook`).
+
+    :ivar executed: the executed notebook (what ran of it), or the prepared one when none
+        could be read.
+    :ivar status: the runner's status, every field checked (:func:`checked_status`);
+        :data:`NO_STATUS` when it could not be read.
+    :ivar unread: the grader's own words when the runner's files could not be read, or None.
+    :ivar stopped: the note of a sandbox stopped at a limit (:func:`stopped_note`), or None.
+    """
+
+    executed: nbformat.NotebookNode
+    status: RunStatus
+    unread: Optional[str] = None
+    stopped: Optional[str] = None
 
 
 def run_notebook(scratch: Scratch, notebook: str, prepared: nbformat.NotebookNode,
-                 settings: Settings) -> tuple[nbformat.NotebookNode, dict[str, Any], Optional[str]]:
+                 settings: Settings) -> NotebookRun:
     """Execute the prepared notebook in the learner's sandbox.
 
     The notebook goes in through a folder of the grader's (read-only inside); the runner
@@ -38,7 +69,8 @@ def run_notebook(scratch: Scratch, notebook: str, prepared: nbformat.NotebookNod
     learner's home, whatever the learner's code put there.
 
     :return: the executed notebook (what ran of it), the runner's status (checked: every
-        field of the right type), and a note when the sandbox had to be stopped.
+        field of the right type), why they could not be read, and a note when the sandbox
+        had to be stopped.
     """
     given, out = scratch.run_folders(notebook)
     (given / f'{notebook}.ipynb').write_text(nbformat.writes(prepared))
@@ -63,20 +95,20 @@ def run_notebook(scratch: Scratch, notebook: str, prepared: nbformat.NotebookNod
             timed_out = False
         except subprocess.TimeoutExpired:
             timed_out = True
-    executed, status = _read_back(out, notebook, prepared)
+    executed, status, unread = _read_back(out, notebook, prepared)
     if timed_out or out_of_cpu:
         stopped = stopped_note(status, f'the limit of {settings.notebook_cpu:g} CPU-seconds for '
                                'running a notebook (its kernel and every process it started, '
                                'together)' if out_of_cpu else
                                f'the limit of {settings.notebook_timeout} s for running a '
                                'notebook')
-    return executed, status, stopped
+    return NotebookRun(executed, status, unread, stopped)
 
 
-def stopped_note(status: dict[str, Any], limit: str) -> str:
+def stopped_note(status: RunStatus, limit: str) -> str:
     """The note of a run stopped at ``limit``: which cells did not run, and that the points
     come from the grader's checks (a heavy honest run, or a loop, alike: no blame)."""
-    ran, cells = status.get('ran', 0), status.get('cells', 0)
+    ran, cells = status.ran, status.cells
     which = (f'it was stopped while cell {ran + 1} of {cells} ran, so cells {ran + 1}-{cells} '
              'did not run' if 0 < ran + 1 < cells else
              f'it was stopped while cell {ran + 1} of {cells} ran' if cells else
@@ -86,8 +118,9 @@ def stopped_note(status: dict[str, Any], limit: str) -> str:
 
 
 def _read_back(out: Path, notebook: str, prepared: nbformat.NotebookNode
-               ) -> tuple[nbformat.NotebookNode, dict[str, Any]]:
-    """The executed notebook and the runner's status, or the prepared one and why not."""
+               ) -> tuple[nbformat.NotebookNode, RunStatus, Optional[str]]:
+    """The executed notebook and the runner's status, or the prepared one (or
+    :data:`NO_STATUS`) and why not."""
     try:
         executed = nbformat.reads(read_regular(out, f'{notebook}.run.ipynb', MAX_NOTEBOOK_BYTES)
                                   .decode('utf-8'), as_version=4)
@@ -95,65 +128,58 @@ def _read_back(out: Path, notebook: str, prepared: nbformat.NotebookNode
         why = ('it left a link where its executed notebook belongs'
                if isinstance(error, NotARegularFile) and error.errno == errno.ELOOP
                else 'its run left no readable notebook')
-        return prepared, {**NO_STATUS, 'unread': why}
+        return prepared, NO_STATUS, why
     try:
-        status = json.loads(read_regular(out, f'{notebook}.run.ipynb.status.json', 1_000_000))
+        data = json.loads(read_regular(out, f'{notebook}.run.ipynb.status.json', 1_000_000))
     except (OSError, ValueError):
-        status = None
-    status = checked_status(status)
+        data = None
+    status = checked_status(data)
     if status is None:
-        return executed, {**NO_STATUS, 'unread': (
+        return executed, NO_STATUS, (
             "the runner's status was unreadable or rewritten (its kernel or the runner was "
-            "killed, or the notebook changed it); what ran of the notebook is graded")}
-    return executed, status
+            "killed, or the notebook changed it); what ran of the notebook is graded")
+    return executed, status, None
 
 
-#: A status of a run that said nothing readable.
-NO_STATUS = {'ran': 0, 'cells': 0, 'timed_out': [], 'output_cut': [], 'kernel_died_at': None,
-             'finished': False}
-
-
-def checked_status(status: object) -> Optional[dict[str, Any]]:
-    """The runner's status when every field has its type (ints, lists of ints), else None."""
-    def whole(value: object) -> bool:
-        return isinstance(value, int) and not isinstance(value, bool) and 0 <= value < 1_000_000
-
-    if not isinstance(status, dict):
+def checked_status(data: object) -> Optional[RunStatus]:
+    """The runner's status (parsed JSON) as a :class:`~.sandboxed.runner.RunStatus` when
+    every field it has has its type (whole numbers below :data:`MAX_CELLS`, lists of them),
+    else None.  Keys it does not have are not read."""
+    if not isinstance(data, dict):
         return None
-    died = status.get('kernel_died_at')
-    lists = (status.get('timed_out'), status.get('output_cut'))
-    error = status.get('runner_error')
-    ok = (whole(status.get('ran')) and whole(status.get('cells'))
-          and isinstance(status.get('finished'), bool) and (died is None or whole(died))
-          and all(isinstance(v, list) and all(whole(i) for i in v) for v in lists)
-          and (error is None or isinstance(error, str)))
-    if not ok:
+    try:
+        status: RunStatus = decoded(RunStatus, {key: value for key, value in data.items()
+                                                if key in _STATUS_FIELDS})
+    except Unreadable:
         return None
-    return {key: status.get(key) for key in (*NO_STATUS, 'runner_error')}
+    died = () if status.kernel_died_at is None else (status.kernel_died_at,)
+    numbers = (status.ran, status.cells, *status.timed_out, *status.output_cut, *died)
+    return status if all(0 <= number < MAX_CELLS for number in numbers) else None
 
 
-def run_note(status: dict[str, Any], stopped: Optional[str]) -> Optional[str]:
+def run_note(run: NotebookRun) -> Optional[str]:
     """What happened while the notebook ran, in words (None when nothing worth saying)."""
-    notes = [stopped] if stopped else []
-    if status.get('kernel_died_at') is not None:
-        notes.append(f'its kernel died while cell {status["kernel_died_at"] + 1} ran (the '
+    status = run.status
+    notes = [run.stopped] if run.stopped else []
+    if status.kernel_died_at is not None:
+        notes.append(f'its kernel died while cell {status.kernel_died_at + 1} ran (the '
                      'process was killed or exited); the cells after it did not run')
-    if status.get('timed_out'):
-        cells = ', '.join(str(i + 1) for i in status['timed_out'])
+    if status.timed_out:
+        cells = ', '.join(str(i + 1) for i in status.timed_out)
         notes.append(f'cell(s) {cells} ran longer than the limit and were interrupted; the '
                      'cells after them still ran')
-    if status.get('output_cut'):
-        cells = ', '.join(str(i + 1) for i in status['output_cut'])
+    if status.output_cut:
+        cells = ', '.join(str(i + 1) for i in status.output_cut)
         notes.append(f'the output of cell(s) {cells} was cut (too large to keep)')
-    if status.get('unread'):  # the grader's own words
-        notes.append(f'running it stopped early: {status["unread"]}')
-    if status.get('runner_error'):
+    if run.unread:  # the grader's own words
+        notes.append(f'running it stopped early: {run.unread}')
+    if status.runner_error:
         # The status is written inside the sandbox, where the learner's code runs: its words
         # are quoted as the run's, never said as the grader's.
-        said = json.dumps(status['runner_error'][:300], ensure_ascii=False)
+        said = json.dumps(status.runner_error[:300], ensure_ascii=False)
         notes.append(f'running it stopped early; the run inside the sandbox reported (its own '
                      f'words, unchecked): {said}')
-    if not notes and not status.get('finished'):
-        notes.append(f'its run ended at cell {status["ran"] + 1} of {status["cells"]}: the '
+    if not notes and not status.finished:
+        notes.append(f'its run ended at cell {status.ran + 1} of {status.cells}: the '
                      'notebook stopped or killed the processes running it')
     return '; '.join(notes) or None

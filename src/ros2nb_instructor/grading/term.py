@@ -20,7 +20,7 @@ from typing import Optional
 
 from nbgrader.api import Gradebook, MissingEntry
 from ros2nb.outcomes import CheckOutcome
-from ros2nb.typed_json import decoded
+from ros2nb.typed_json import Unreadable, decoded
 
 from ..paths import ASSIGNMENT, SETTINGS, gradebook_url
 from .course_settings import read_settings
@@ -28,10 +28,34 @@ from .deadlines import NO_DEADLINES, CourseSettings, SettingsProblem
 from .extensions import EXTENSIONS, NONE, Extensions, ExtensionsProblem, read_extensions
 from .lms import PLATFORMS
 from .roster import RosterProblem, RosterRow, read_roster
-from .submissions import Learner
+from .submissions import Learner, shown
 
 #: What grading made of each learner before nbgrader scored them, kept for ``--learner``.
 STATE = 'learners.json'
+
+
+@dataclass(frozen=True, kw_only=True)
+class LearnerState:
+    """One learner in ``learners.json``, under their folder's name, as grading left them
+    before nbgrader scored them: written by one ``ros2nb-grade`` (:func:`save_state`) and read
+    by a later one (``--learner``, ``--export``: :func:`load_state`, with
+    :func:`ros2nb.typed_json.decoded`), both on the instructor's host.
+
+    :ivar id: the id nbgrader knows the learner by.
+    :ivar files: notebook -> the file graded for it (a path, as text).
+    :ivar notes: notebook (or ``_folder``) -> what happened, in a sentence.
+    :ivar results: notebook -> the judge's outcomes (grade id -> its outcome).
+    :ivar flags: notebook -> the judge's flags.
+    :ivar handed_in: notebook -> (when it was handed in, ISO 8601 with its zone; where that
+        comes from).
+    """
+
+    id: str
+    files: dict[str, str]
+    notes: dict[str, str]
+    results: dict[str, dict[str, CheckOutcome]]
+    flags: dict[str, list[str]]
+    handed_in: dict[str, tuple[str, str]]
 
 
 def add_options(parser: argparse.ArgumentParser) -> None:
@@ -121,27 +145,32 @@ def save_state(out: Path, learners: list[Learner]) -> None:
     """``learners.json``: each learner's files, notes, results, flags and hand-in times, as
     grading left them before nbgrader scored them (``--learner`` starts from it).  JSON's
     ASCII escapes keep a folder name that is not UTF-8 (a Windows zip's) exactly as it is."""
-    (out / STATE).write_text(json.dumps({learner.name: {
-        'id': learner.id, 'files': {n: str(p) for n, p in learner.files.items()},
-        'notes': learner.notes, 'flags': learner.flags,
-        'results': {n: {gid: outcome.as_json() for gid, outcome in results.items()}
-                    for n, results in learner.results.items()},
-        'handed_in': {n: [t.isoformat(), s] for n, (t, s) in learner.handed_in.items()}}
+    (out / STATE).write_text(json.dumps({learner.name: dataclasses.asdict(LearnerState(
+        id=learner.id, files={n: str(p) for n, p in learner.files.items()},
+        notes=learner.notes, results=learner.results, flags=learner.flags,
+        handed_in={n: (t.isoformat(), s) for n, (t, s) in learner.handed_in.items()}))
         for learner in learners}, indent=1) + '\n')
 
 
 def load_state(out: Path) -> list[Learner]:
-    """The learners ``learners.json`` kept (:func:`save_state`)."""
+    """The learners ``learners.json`` kept (:func:`save_state`).
+
+    :raises ros2nb.typed_json.Unreadable: for a learner whose entry does not fit
+        :class:`LearnerState` (the line names the learner and the field).
+    """
     kept = json.loads((out / STATE).read_text())
+    if not isinstance(kept, dict):
+        raise Unreadable(f'{out / STATE} is not a JSON object')
     learners = []
-    for name, state in kept.items():
-        learner = Learner(name, state['id'], {n: Path(p) for n, p in state['files'].items()},
-                          dict(state['notes']), {n: {gid: decoded(CheckOutcome, outcome)
-                                                     for gid, outcome in results.items()}
-                                                 for n, results in state['results'].items()},
-                          dict(state['flags']))
+    for name, entry in kept.items():
+        try:
+            state: LearnerState = decoded(LearnerState, entry)
+        except Unreadable as error:
+            raise Unreadable(f'{out / STATE}, learner {shown(name)}: {error}') from None
+        learner = Learner(name, state.id, {n: Path(p) for n, p in state.files.items()},
+                          dict(state.notes), dict(state.results), dict(state.flags))
         learner.handed_in = {n: (datetime.datetime.fromisoformat(t), s)
-                             for n, (t, s) in state['handed_in'].items()}
+                             for n, (t, s) in state.handed_in.items()}
         learners.append(learner)
     return learners
 

@@ -8,16 +8,19 @@ files the grader reads back.  nbclient does the executing.  What
 it adds: every cell has a time limit after which its kernel is interrupted and the next
 cell runs; a cell's output is cut at a size limit, with a note; the notebook is saved
 after every cell, so whatever ran is kept even if the sandbox is stopped from outside;
-and ``OUT.status.json`` says what happened: cells that ran too long, a kernel that died, output
-that was cut.  Nothing here decides a grade (ros2nb.judge does, nbgrader scores).
+and ``OUT.status.json`` says what happened (a :class:`RunStatus`): cells that ran too long, a
+kernel that died, output that was cut.  Nothing here decides a grade (ros2nb.judge does,
+nbgrader scores).
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import os
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Optional
 
@@ -30,6 +33,34 @@ MAX_CELL_OUTPUT_BYTES = 100_000
 #: Bytes of images (base64) one cell may keep besides: a plot or two.
 MAX_CELL_IMAGE_BYTES = 2_000_000
 IMAGE_TYPES = ('image/png', 'image/jpeg', 'image/svg+xml')
+
+
+@dataclass(frozen=True, kw_only=True)
+class RunStatus:
+    """What happened while the notebook ran, as far as it ran.
+
+    The runner writes it beside the executed notebook (``OUT.status.json``, :func:`save`)
+    inside the learner's sandbox; the grader reads it back on its host after the sandbox
+    ended (:func:`ros2nb_instructor.grading.runs.checked_status`, with
+    :func:`ros2nb.typed_json.decoded`).  The learner's code runs beside the runner, as the
+    same user, and may rewrite the file: a status that does not fit is that learner's note.
+
+    :ivar ran: cells run so far (the number of the cell running, counted from 0).
+    :ivar cells: cells in the notebook.
+    :ivar timed_out: the cells (from 0) interrupted at the cell limit.
+    :ivar output_cut: the cells (from 0) whose output was cut (:data:`MAX_CELL_OUTPUT_BYTES`).
+    :ivar kernel_died_at: the cell (from 0) its kernel died in, or None.
+    :ivar finished: True once every cell ran.
+    :ivar runner_error: why nbclient could not go on (``Type: text``), or None.
+    """
+
+    ran: int
+    cells: int
+    timed_out: tuple[int, ...]
+    output_cut: tuple[int, ...]
+    kernel_died_at: Optional[int] = None
+    finished: bool
+    runner_error: Optional[str] = None
 
 
 def _size(output: Any) -> int:
@@ -47,7 +78,7 @@ def _image_size(output: Any) -> int:
 class LimitedClient(NotebookClient):
     """nbclient with a size limit per cell and a save after every cell."""
 
-    def __init__(self, nb: nbformat.NotebookNode, out: Path, status: dict[str, Any],
+    def __init__(self, nb: nbformat.NotebookNode, out: Path, status: RunStatus,
                  **kwargs: Any) -> None:
         super().__init__(nb, **kwargs)
         self.out_path, self.status = out, status
@@ -70,7 +101,8 @@ class LimitedClient(NotebookClient):
                     out['text'] = out['text'][:room]
                     outs.insert(len(outs) - (note is not None), out)
             if note is None:
-                self.status['output_cut'].append(cell_index)
+                self.status = dataclasses.replace(
+                    self.status, output_cut=(*self.status.output_cut, cell_index))
                 note = self._notes[cell_index] = nbformat.v4.new_output(
                     'stream', name='stderr', text=(
                         f'\n[The grader cut this cell\'s output at {MAX_CELL_OUTPUT_BYTES // 1000} '
@@ -82,15 +114,17 @@ class LimitedClient(NotebookClient):
     def _saved(self, cell: Any, cell_index: int, execute_reply: dict[str, Any]) -> None:
         error = execute_reply.get('content', {})
         if error.get('ename') == 'CellTimeoutError':
-            self.status['timed_out'].append(cell_index)
-        self.status['ran'] = cell_index + 1
+            self.status = dataclasses.replace(
+                self.status, timed_out=(*self.status.timed_out, cell_index))
+        self.status = dataclasses.replace(self.status, ran=cell_index + 1)
         save(self.nb, self.out_path, self.status)
 
 
-def save(nb: nbformat.NotebookNode, out: Path, status: dict[str, Any]) -> None:
+def save(nb: nbformat.NotebookNode, out: Path, status: RunStatus) -> None:
     """Write the notebook and its status atomically (a kill never leaves half a file)."""
     for path, text in ((out, nbformat.writes(nb)),
-                       (Path(str(out) + '.status.json'), json.dumps(status))):
+                       (Path(str(out) + '.status.json'),
+                        json.dumps(dataclasses.asdict(status)))):
         partial = path.with_name(path.name + '.partial')
         partial.write_text(text)
         os.replace(partial, path)
@@ -118,8 +152,7 @@ def main(argv: list[str]) -> int:
     args = parser.parse_args(argv)
     folder = _working_folder(args.folder or args.notebook.parent)
     nb = nbformat.read(args.notebook, as_version=4)
-    status: dict[str, Any] = {'ran': 0, 'cells': len(nb.cells), 'timed_out': [], 'output_cut': [],
-                    'kernel_died_at': None, 'finished': False}
+    status = RunStatus(ran=0, cells=len(nb.cells), timed_out=(), output_cut=(), finished=False)
     timeout_error = {'ename': 'CellTimeoutError',
                      'evalue': f'the grader stopped this cell after {args.cell_timeout} s',
                      'traceback': [f'CellTimeoutError: the grader stopped this cell after '
@@ -131,17 +164,18 @@ def main(argv: list[str]) -> int:
     save(nb, args.out, status)
     try:
         client.execute()
-        status['finished'] = True
+        client.status = dataclasses.replace(client.status, finished=True)
     except DeadKernelError:
-        status['kernel_died_at'] = status['ran']
+        client.status = dataclasses.replace(client.status, kernel_died_at=client.status.ran)
         # Whether the kernel said the number of the cell it died in before it died is a race
         # of the machine's: no number is shown for that cell on any machine.
-        for cell in nb.cells[status['ran']:]:
+        for cell in nb.cells[client.status.ran:]:
             if cell.cell_type == 'code':
                 cell.execution_count = None
     except Exception as error:  # nbclient could not go on: say why, keep what ran
-        status['runner_error'] = f'{type(error).__name__}: {str(error)[:300]}'
-    save(nb, args.out, status)
+        client.status = dataclasses.replace(
+            client.status, runner_error=f'{type(error).__name__}: {str(error)[:300]}')
+    save(nb, args.out, client.status)
     return 0
 
 
