@@ -8,6 +8,7 @@ one line naming the field, never read by key into a learner's score or feedback.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import pytest
@@ -46,7 +47,7 @@ def test_an_outcome_crosses_to_the_kernel_as_it_was_decided(error, passed, kind)
     assert outcome.lines == ('Looked at your node.',)
     if isinstance(error, KeyError):
         assert outcome.message == UNFINISHED.format(error="KeyError: 'reply'")
-    read = decoded(CheckOutcome, json.loads(json.dumps(outcome.as_json())))
+    read = decoded(CheckOutcome, json.loads(json.dumps(dataclasses.asdict(outcome))))
     assert read == outcome
     if passed:
         show_result(read)
@@ -89,7 +90,7 @@ def test_a_judge_stopped_at_a_limit_scores_the_cells_it_had_decided(tmp_path):
         for gid in ('03-a', '03-b', '03-c')], 'metadata': {}, 'nbformat': 4,
         'nbformat_minor': 5}))
     lines = [json.dumps({'begin': '03-a'}),
-             json.dumps(CellChecked('03-a', CheckOutcome(True), 1.5).as_json()),
+             json.dumps(dataclasses.asdict(CellChecked('03-a', CheckOutcome(True), 1.5))),
              json.dumps({'cell': '03-b', 'result': {'passed': 1}, 'cpu_s': 2.0}),
              'a line that is no JSON']
     verdict = stopped_verdict('\n'.join(lines), source, 60.0, '03-c')

@@ -1,7 +1,7 @@
 """A check's outcome as a value: what the judge decided, one type from the judge to the
 learner's kernel and to the grader's notebooks, gradebook, feedback pages and report.
 
-Crossing a process it travels as JSON (``as_json``) and is read back with
+Crossing a process it travels as JSON (:func:`dataclasses.asdict`) and is read back with
 :func:`ros2nb.typed_json.decoded`, every field checked; its field names are its JSON keys.
 The judge makes it (:func:`ros2nb.judge_interface.captured`); nothing else writes one.  No
 ROS import.
@@ -11,9 +11,8 @@ Introduced in ``03-write-the-publisher.ipynb`` (every check of a node runs in a 
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
-from typing import Any, Optional
+from typing import Optional
 
 #: :attr:`CheckOutcome.type` of a check that failed on what the learner wrote.
 CHECK_FAILED = 'CheckFailed'
@@ -50,10 +49,6 @@ class CheckOutcome:
         """Whether the check could not decide (not the learner's failure)."""
         return not self.passed and self.type == NOT_DECIDED
 
-    def as_json(self) -> dict[str, Any]:
-        """JSON-safe data of this outcome (what :func:`ros2nb.typed_json.decoded` reads back)."""
-        return dataclasses.asdict(self)
-
 
 @dataclass(frozen=True)
 class CellChecked:
@@ -64,10 +59,6 @@ class CellChecked:
     result: CheckOutcome
     cpu_s: float  #: CPU seconds the judge's process tree spent on it
 
-    def as_json(self) -> dict[str, Any]:
-        """JSON-safe data of this line."""
-        return dataclasses.asdict(self)
-
 
 @dataclass(frozen=True)
 class NotebookChecked:
@@ -76,7 +67,3 @@ class NotebookChecked:
 
     results: dict[str, CheckOutcome]  #: graded cell id -> its outcome
     flags: list[str]
-
-    def as_json(self) -> dict[str, Any]:
-        """JSON-safe data of this line."""
-        return dataclasses.asdict(self)

@@ -12,6 +12,7 @@ check draws its inputs from a seed the judge draws itself; only the grader gives
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import signal
@@ -76,7 +77,8 @@ def main(argv: list[str]) -> int:
     session, hurried = Session(default_workspace(), seed), False
     try:
         if argv[0] == 'check':
-            result: Any = captured(lambda: checks.run_check(argv[1], session)).as_json()
+            result: Any = dataclasses.asdict(
+                captured(lambda: checks.run_check(argv[1], session)))
         else:
             # Only grading flags code (the flags parse cells with IPython, whose imports
             # every check of a learner's kernel would pay).
@@ -96,12 +98,13 @@ def main(argv: list[str]) -> int:
 
             def checked(grade_id: str, outcome: CheckOutcome) -> None:
                 cpu_s = round(tree_cpu_seconds(os.getpid()) - began[0], 2)
-                print(json.dumps(CellChecked(grade_id, outcome, cpu_s).as_json()), flush=True)
+                print(json.dumps(dataclasses.asdict(CellChecked(grade_id, outcome, cpu_s))),
+                      flush=True)
 
-            result = NotebookChecked(
+            result = dataclasses.asdict(NotebookChecked(
                 grade(source, submission, session, checked, starting),
                 flags + [REWRITTEN.format(name=Path(r).name) for r in rewritten]
-                + session.reaching.flags()).as_json()
+                + session.reaching.flags()))
     except SystemExit:  # ended from outside (_ended): the learner's processes go at once
         hurried = True
         raise

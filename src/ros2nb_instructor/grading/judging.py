@@ -21,8 +21,8 @@ import nbformat
 
 from ros2nb import nbmeta
 from ros2nb.checks.drawn import SEED_OPTION
-from ros2nb.outcomes import CellChecked, CheckOutcome, NotebookChecked
 from ros2nb.judge.subjects import HANDED, SUBJECTS_FOLDER_ENV
+from ros2nb.outcomes import CellChecked, CheckOutcome, NotebookChecked
 from ros2nb.typed_json import Unreadable, decoded
 
 from ..paths import ROOT, SOLUTIONS
@@ -129,10 +129,9 @@ def stopped_verdict(out: str, source: Path, cpu_s: Optional[float] = None,
     nothing."""
     results = {}
     for line in out.splitlines():
-        if line.startswith('{"cell"'):
-            with contextlib.suppress(ValueError):  # not JSON, or not the line (Unreadable)
-                checked: CellChecked = decoded(CellChecked, json.loads(line))
-                results[checked.cell] = checked.result
+        with contextlib.suppress(ValueError):  # not JSON, or another line (Unreadable)
+            checked: CellChecked = decoded(CellChecked, json.loads(line))
+            results[checked.cell] = checked.result
     unchecked = [grade_id for grade_id, _cell in nbmeta.graded_cells(
         json.loads(source.read_text())) if grade_id not in results]
     limit = (f'the grader\'s limit of {cpu_s:g} CPU-seconds for one check (the check and the '

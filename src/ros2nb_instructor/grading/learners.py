@@ -37,7 +37,7 @@ class Graded:
     :ivar filed: notebook -> the notebook filed for nbgrader to score (nbformat 4 JSON text).
     :ivar notes: notebook -> what happened to it, in sentences joined by ``; ``.
     :ivar results: notebook -> the judge's outcomes (grade id ->
-        :class:`~ros2nb.judge_interface.CheckOutcome`).
+        :class:`~ros2nb.outcomes.CheckOutcome`).
     :ivar flags: notebook -> the judge's flags (:mod:`ros2nb.judge.flags`): its note says
         them, and the learner's feedback page heads with them.
     """

@@ -40,7 +40,7 @@ class Learner:
     :ivar files: notebook (e.g. ``03-write-the-publisher``) -> the file graded for it.
     :ivar notes: notebook (or ``_folder``) -> what happened, in a sentence.
     :ivar results: notebook -> the judge's outcomes (grade id ->
-        :class:`~ros2nb.judge_interface.CheckOutcome`).
+        :class:`~ros2nb.outcomes.CheckOutcome`).
     :ivar flags: notebook -> the judge's flags (code that reaches into the course,
         :mod:`ros2nb.judge.flags`), shown on the feedback page and in the report's notes.
     :ivar handed_in: notebook -> when the submission says it was handed in (aware), and
