@@ -249,6 +249,13 @@ MONITOR_MISTAKES = [
                                        r'callback belongs and self\.temperature_callback '
                                        r'where the queue depth belongs; it takes the message '
                                        r'type, the topic, the callback and the queue depth'),
+    ('a branch that sets no status', "status = 'High'", 'pass',
+     checks.check_monitor_callback, r'^TemperatureMonitor.temperature_callback raised for '
+                                    r'\d+\.\d\d °C: status has no value here: '
+                                    r'temperature_callback sets it in the other branches of its '
+                                    r'if/elif/else, but not in the branch where temperature_c > '
+                                    r'HIGH_ABOVE_C, which this call took: set status there too\. '
+                                    r'\(temperature_subscriber\.py line \d+: pass\)$'),
     ('the message for its value', 'temperature_c = msg.data', 'temperature_c = msg',
      checks.check_monitor_callback, r'temperature_callback raised for 19.99 °C: a Float32 message '
                                     r'is not its value: use its field \(data\), e.g. msg.data'),
