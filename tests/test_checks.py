@@ -112,9 +112,10 @@ SENSOR_MISTAKES = [
      checks.check_sensor_constructor, r'uses std_msgs/msg/Float64, but the topic carries '
                                       r'std_msgs/msg/Float32'),
     ('period', 'PUBLISH_PERIOD_S = 1.0 ', 'PUBLISH_PERIOD_S = 2.0 ',
-     checks.check_sensor_constructor, r'3 readings in 6 s of the grader.s clock; the sensor '
-                                      r'publishes one every 1.0 s \(6 in 6 s\): give the timer '
-                                      r'PUBLISH_PERIOD_S'),
+     checks.check_sensor_constructor, r'^The timer fires every 2.0 s \(temperature_publisher.py '
+                                      r'line \d+: PUBLISH_PERIOD_S = 2.0 .*\): 3 readings in 6 s '
+                                      r'of the grader.s clock, where the sensor publishes one '
+                                      r'every 1.0 s \(6 in 6 s\): write PUBLISH_PERIOD_S = 1.0'),
     ('period a little short', 'PUBLISH_PERIOD_S = 1.0 ', 'PUBLISH_PERIOD_S = 0.99 ',
      checks.check_sensor_constructor, r'The readings came between the grader.s whole seconds: '
                                       r'the timer.s period is not 1.0 s: give the timer '
@@ -176,8 +177,11 @@ SENSOR_MISTAKES = [
                                r'of rclpy.shutdown\(\)'),
     ('a timer of 0.5 s', 'self.create_timer(PUBLISH_PERIOD_S, self.publish_temperature)',
      'self.create_timer(0.5, self.publish_temperature)',
-     checks.check_sensor_constructor, r'^\d+ readings in 6 s of the grader.s clock; the sensor '
-                                      r'publishes one every 1.0 s \(6 in 6 s\)'),
+     checks.check_sensor_constructor, r'^The timer fires every 0.5 s \(temperature_publisher.py '
+                                      r'line \d+: self.timer = self.create_timer\(0.5, '
+                                      r'self.publish_temperature\)\): 1[123] readings in 6 s of '
+                                      r'the grader.s clock, where the sensor publishes one every '
+                                      r'1.0 s \(6 in 6 s\): give the timer PUBLISH_PERIOD_S\.$'),
     ('the walk kept in a local', 'self.temperature = max(MIN_TEMPERATURE_C,',
      'temperature = max(MIN_TEMPERATURE_C,',
      checks.check_sensor_callback, r'publish_temperature never changes self.temperature: it sets '
@@ -245,6 +249,13 @@ MONITOR_MISTAKES = [
                                        r'callback belongs and self\.temperature_callback '
                                        r'where the queue depth belongs; it takes the message '
                                        r'type, the topic, the callback and the queue depth'),
+    ('a branch that sets no status', "status = 'High'", 'pass',
+     checks.check_monitor_callback, r'^TemperatureMonitor.temperature_callback raised for '
+                                    r'\d+\.\d\d °C: status has no value here: '
+                                    r'temperature_callback sets it in the other branches of its '
+                                    r'if/elif/else, but not in the branch where temperature_c > '
+                                    r'HIGH_ABOVE_C, which this call took: set status there too\. '
+                                    r'\(temperature_subscriber\.py line \d+: pass\)$'),
     ('the message for its value', 'temperature_c = msg.data', 'temperature_c = msg',
      checks.check_monitor_callback, r'temperature_callback raised for 19.99 °C: a Float32 message '
                                     r'is not its value: use its field \(data\), e.g. msg.data'),

@@ -45,7 +45,7 @@ def _constructor_problem(judge: Judge, run: SensorRun, seconds: float) -> Option
         return run.problem or CheckFailed(_no_readings(judge))
     period = period_problem(run.readings, seconds)
     if period is not None:
-        return period
+        return _timer_period(judge, len(run.readings), seconds) or period
     first = run.readings[0][1]
     if abs(first - course.START_TEMPERATURE_C) > course.MAX_STEP_C + FLOAT32_TOLERANCE_C:
         return CheckFailed(f'The first reading is {first:.2f} °C: the walk starts at '
@@ -56,6 +56,31 @@ def _constructor_problem(judge: Judge, run: SensorRun, seconds: float) -> Option
         return CheckFailed(f'{course.SENSOR_CLASS} logged nothing when it started: log a line '
                            "such as 'Temperature Sensor Node Started' with the node's logger.")
     return None
+
+
+def _timer_period(judge: Judge, count: int, seconds: float) -> Optional[CheckFailed]:
+    """The line for ``count`` readings in ``seconds``, too many or too few for
+    PUBLISH_PERIOD_S, when the learner's one timer was given another period (read after the
+    fact, and only when the count the judge heard agrees with it): that period, and the
+    learner's line that set it; None otherwise (the count alone says it)."""
+    source = ClassSource.read(judge.workspace, course.PUBLISHER_FILE, course.SENSOR_CLASS)
+    timers = source.timers() if source is not None else []
+    period = timers[0].period if len(timers) == 1 else None
+    if source is None or not isinstance(period, (int, float)) or isinstance(period, bool) \
+            or period <= 0 or abs(count - seconds / course.PUBLISH_PERIOD_S) <= 1 \
+            or abs(count - seconds / period) > 1:
+        return None
+    line = source.defined_at(timers[0].named) if timers[0].named else timers[0].line
+    lines = (TEXT.read(judge.workspace / course.PUBLISHER_FILE) or '').splitlines()
+    if line is None or not 0 < line <= len(lines):
+        return None
+    where = f'({Path(course.PUBLISHER_FILE).name} line {line}: {lines[line - 1].strip()})'
+    fix = (f'write {timers[0].named} = {course.PUBLISH_PERIOD_S}, as the course gives it'
+           if timers[0].named else 'give the timer PUBLISH_PERIOD_S')
+    expected = round(seconds / course.PUBLISH_PERIOD_S)
+    return CheckFailed(f'The timer fires every {period} s {where}: {count} readings in '
+                       f'{seconds:g} s of the grader\'s clock, where the sensor publishes one '
+                       f'every {course.PUBLISH_PERIOD_S} s ({expected} in {seconds:g} s): {fix}.')
 
 
 def _no_readings(judge: Judge) -> str:

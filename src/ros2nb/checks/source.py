@@ -47,10 +47,15 @@ class Timer:
 
     :ivar period: the period in seconds, or :data:`UNKNOWN` when it is not a constant.
     :ivar callback: the method's name for ``self.NAME``, else the argument's source text.
+    :ivar line: the line of the call in the file.
+    :ivar named: the name given as the period (``PUBLISH_PERIOD_S``), or '' for another
+        expression (a number written out).
     """
 
     period: Any
     callback: str
+    line: int = 0
+    named: str = ''
 
 
 def _assigned(function: Optional[ast.AST], target: str) -> list[ast.expr]:
@@ -189,6 +194,13 @@ class ClassSource:
             return self.attribute(node.attr, depth + 1)
         return UNKNOWN
 
+    def defined_at(self, name: str) -> Optional[int]:
+        """The line where the file's top level last assigns ``name``, or None."""
+        scope: list[ast.stmt] = [s for s in self.module.body
+                                 if isinstance(s, (ast.Assign, ast.AnnAssign))]
+        found = _assigned(ast.Module(body=scope, type_ignores=[]), name)
+        return found[-1].lineno if found else None
+
     def assignments(self, attribute: str) -> list[ast.expr]:
         """Values ``__init__`` assigns to ``self.<attribute>``, in order."""
         return _assigned(self.method('__init__'), f'self.{attribute}')
@@ -211,7 +223,8 @@ class ClassSource:
                     period = node.args[0] if node.args else given.get('timer_period_sec')
                     callback = node.args[1] if len(node.args) > 1 else given.get('callback')
                     timers.append(Timer(self.value(period, function) if period else UNKNOWN,
-                                        _method_name(callback)))
+                                        _method_name(callback), node.lineno,
+                                        period.id if isinstance(period, ast.Name) else ''))
         return timers
 
     def callbacks(self, factory: str, position: int) -> list[str]:

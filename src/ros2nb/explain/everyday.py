@@ -20,6 +20,7 @@ from types import FrameType
 from typing import Any, Optional
 
 from ..errors import Ros2nbError, UsageError
+from .branches import unset_on_path
 from .frames import frames_of, learner_frame
 from .names import (declared, import_of, learners_functions, place, raising_text,
                     similar, stored, stored_near)
@@ -181,6 +182,9 @@ def _unset_local(exc: UnboundLocalError, frame: FrameType) -> str:
     if line is not None and text.startswith(('import ', 'from ')):
         return (f'{name} is used before {function} imports it ({place(frame.f_code, line)}): '
                 'import it at the top of the file instead.')
+    branch = unset_on_path(frame, name)
+    if branch is not None:  # placed at that branch by cause_place, not at the line reading it
+        return branch.words
     if line is not None and line < frame.f_lineno and _in_branch(frame, line):
         return (f'{name} has no value here: {function} sets it only in some branches of an '
                 'if/elif/else, not in the one this call took: set it in every branch.')
@@ -267,8 +271,13 @@ def cause_place(exc: BaseException) -> Optional[str]:
     """``FILE line N: source`` of the learner's line that caused ``exc`` where that is not
     the line that raised it, or None.  A parameter's value of the wrong kind (None: declared
     without a default) fails where it is used, perhaps in a line the course gave: the cause
-    is the learner's ``declare_parameter`` of it."""
+    is the learner's ``declare_parameter`` of it.  A name read after an ``if`` whose branch
+    taken set no value for it fails at the read, which is right: the cause is that branch."""
     frame = learner_frame(exc)
+    if frame is not None and isinstance(exc, UnboundLocalError):  # the branch that set nothing
+        quoted = re.search(r"'(\w+)'", _first_line(exc))
+        branch = unset_on_path(frame, quoted.group(1)) if quoted else None
+        return place(frame.f_code, branch.line) if branch is not None else None
     if frame is None or not isinstance(exc, (TypeError, ValueError)):
         return None
     filled = filled_wrongly(exc, frame) if isinstance(exc, TypeError) else None
