@@ -20,7 +20,7 @@ import pytest
 from grading_samples import LEARNER, NB01, SOLUTION
 from waiting import PATIENCE_S, wait_for
 
-from ros2nb_instructor.grading import sandbox
+from ros2nb_instructor.grading.sandbox import bubblewrap
 from ros2nb_instructor.paths import ASSIGNMENT, gradebook_url
 
 #: The instructor's grading command, as the course's venv installs it.
@@ -28,7 +28,7 @@ GRADE = str(Path(sys.executable).with_name('ros2nb-grade'))
 
 pytestmark = pytest.mark.timeout(1200)
 #: ros2nb-grade refuses to start without a sandbox (unless told: NO_SANDBOX=1).
-NEEDS_A_SANDBOX = pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))
+NEEDS_A_SANDBOX = pytest.mark.skipif(bubblewrap.problem() is not None, reason=str(bubblewrap.problem()))
 
 
 @pytest.mark.sandbox
@@ -152,7 +152,7 @@ def test_a_scoring_process_that_ended_is_started_again(tmp_path):
     # Here, not at the top: nbgrader's package imports its server extensions (costly), and
     # every pytest-xdist worker imports each test file while it collects.
     from nbgrader.api import Gradebook
-    from ros2nb_instructor.grading.gradebook import Scoring, set_up_course
+    from ros2nb_instructor.grading.scores.gradebook import Scoring, set_up_course
     course = tmp_path / 'nbgrader'
     course.mkdir()
     set_up_course(course)
@@ -163,7 +163,7 @@ def test_a_scoring_process_that_ended_is_started_again(tmp_path):
     with Scoring(course) as scoring:
         assert scoring.score(exclude=['bo'])
         scorers = [pid for pid in os.listdir('/proc') if pid.isdigit() and _runs(
-            pid, b'ros2nb_instructor.grading.scoring', str(course).encode())]
+            pid, b'ros2nb_instructor.grading.scores.scoring', str(course).encode())]
         assert len(scorers) == 1, scorers
         os.kill(int(scorers[0]), signal.SIGKILL)
         assert scoring.score(exclude=['ada'])
@@ -187,7 +187,7 @@ def test_a_grading_waits_for_the_course_another_is_making(locked, tmp_path, monk
     grading that asks while another is making it waits for that one.  Without the lock the
     second made it again (nbgrader's generate_assignment, seconds of CPU).  generate_assignment
     is played by a stand-in that holds until the test lets it finish."""
-    from ros2nb_instructor.grading import gradebook
+    from ros2nb_instructor.grading.scores import gradebook
     monkeypatch.setattr(gradebook, 'SET_UP_CACHE', tmp_path)
     made, at_lock, finish = [], [], threading.Event()
     real_flock = fcntl.flock

@@ -24,14 +24,14 @@ from typing import Any, Iterable, Optional
 from nbgrader.api import Gradebook, MissingEntry
 from ros2nb import graded_parts
 
-from ..paths import ASSIGNMENT, ROOT, SOLUTIONS, gradebook_url
-from . import feedback
-from .deadlines import NO_DEADLINES, CourseSettings, Lateness, assess
-from .extensions import NONE as NO_EXTENSIONS
-from .extensions import Extensions
-from .spreadsheets import write_csv
-from .submissions import Learner
-from .zips import screen_zip
+from ...paths import ASSIGNMENT, ROOT, SOLUTIONS, gradebook_url
+from ..export.spreadsheets import write_csv
+from ..intake.deadlines import NO_DEADLINES, CourseSettings, Lateness, assess
+from ..intake.extensions import Extensions
+from ..intake.extensions import NONE as NO_EXTENSIONS
+from ..intake.submissions import Learner
+from ..intake.zips import screen_zip
+from ..reports import feedback
 
 #: nbgrader's command, from the course's venv (or conda environment).
 NBGRADER = str(Path(sys.executable).with_name('nbgrader'))
@@ -298,7 +298,7 @@ class Scoring:
         if self._process is None:
             with open(self._course / 'grading.log', 'a') as log:
                 self._process = subprocess.Popen(
-                    [sys.executable, '-m', 'ros2nb_instructor.grading.scoring',
+                    [sys.executable, '-m', 'ros2nb_instructor.grading.scores.scoring',
                      str(self._course)], cwd=self._course, env=_course_env(self._course),
                     stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=log, text=True)
         return self._process
