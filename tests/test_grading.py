@@ -36,7 +36,8 @@ from ros2nb_instructor.grading.sandbox.scratch import HOME_BYTES
 CLASS_LIMIT_S = 1800
 pytestmark = [pytest.mark.sandbox, pytest.mark.judge, pytest.mark.kernel,
               pytest.mark.timeout(CLASS_LIMIT_S),
-              pytest.mark.skipif(bubblewrap.problem() is not None, reason=str(bubblewrap.problem()))]
+              pytest.mark.skipif(bubblewrap.problem() is not None,
+                                 reason=str(bubblewrap.problem()))]
 #: The class is graded by ros2nb-grade's own main (GRADE_WITH_FAULTS: five learners meet a
 #: planted fault) with its default limits per cell and per notebook: an honest notebook must
 #: never meet them, however busy the machine (a 30 s limit cut a complete learner's simulated

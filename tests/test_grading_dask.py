@@ -33,13 +33,14 @@ from test_grading import CLASS_LIMIT_S, as_text, in_the_csv
 from ros2nb_instructor.grading.sandbox import bubblewrap
 from ros2nb_instructor.grading.cluster.client import Cluster
 from ros2nb_instructor.grading.reports.feedback import FLAGS_HEADING
-from ros2nb_instructor.grading.scores.gradebook import set_up_course
+from ros2nb_instructor.grading.scores.nbgrader_course import set_up_course
 from ros2nb_instructor.grading.judging.learners import FLAGGED
 from ros2nb_instructor.grading.judging.settings import CELL_TIMEOUT_S, NOTEBOOK_TIMEOUT_S, Settings
 from ros2nb_instructor.grading.intake.submissions import find_learners
 
 pytestmark = [pytest.mark.sandbox, pytest.mark.timeout(CLASS_LIMIT_S),
-              pytest.mark.skipif(bubblewrap.problem() is not None, reason=str(bubblewrap.problem()))]
+              pytest.mark.skipif(bubblewrap.problem() is not None,
+                                 reason=str(bubblewrap.problem()))]
 GRADE = str(Path(sys.executable).with_name('ros2nb-grade'))
 NOTEBOOKS = sorted(SOLUTION)
 #: The seed of both gradings' drawn inputs: the judges check both alike.

@@ -22,7 +22,7 @@ from ros2nb.checks import base
 from ros2nb.errors import CheckFailed
 from ros2nb.outcomes import CHECK_FAILED, CheckOutcome
 from ros2nb_instructor.grading.reports import feedback
-from ros2nb_instructor.grading.scores.gradebook import standing_table
+from ros2nb_instructor.grading.reports.pages import standing_table
 from ros2nb_instructor.grading.intake.submissions import Learner
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -20,7 +20,8 @@ from ros2nb_instructor.grading.intake.submissions import Learner
 from test_floods import flooder_notebook
 
 pytestmark = [pytest.mark.sandbox, pytest.mark.kernel, pytest.mark.ros,
-              pytest.mark.skipif(bubblewrap.problem() is not None, reason=str(bubblewrap.problem())),
+              pytest.mark.skipif(bubblewrap.problem() is not None,
+                                 reason=str(bubblewrap.problem())),
               pytest.mark.timeout(400)]
 
 NOTEBOOK = '03-write-the-publisher'

@@ -61,7 +61,8 @@ from .judging.settings import CELL_TIMEOUT_S, JOBS, NOTEBOOK_CPU_S, NOTEBOOK_TIM
 from .reports.report import write_report
 from .sandbox import bubblewrap
 from .sandbox.scratch import grading_folder
-from .scores.gradebook import Scoring, collect_zip, set_up_course, write_results
+from .scores.gradebook import Scoring, write_results
+from .scores.nbgrader_course import collect_zip, set_up_course
 
 if TYPE_CHECKING:
     from .cluster.client import Cluster

@@ -2,9 +2,10 @@
 
 Runs on the classroom server, in the hand-in service (:mod:`.hand_in_service`), as root.
 Due dates are read from ``course.toml`` and ``extensions.toml`` at each request
-(:mod:`ros2nb_instructor.grading.intake.course_settings`, :mod:`ros2nb_instructor.grading.intake.extensions`),
-so a new extension shows at once; a file with a mistake shows no due dates (the service's
-log says the mistake) and hand-ins go on.  The answer is :class:`ros2nb.hand_ins.NotebookStatus`.
+(:mod:`ros2nb_instructor.grading.intake.course_settings`,
+:mod:`ros2nb_instructor.grading.intake.extensions`), so a new extension shows at once; a
+file with a mistake shows no due dates (the service's log says the mistake) and hand-ins go
+on.  The answer is :class:`ros2nb.hand_ins.NotebookStatus`.
 """
 
 from __future__ import annotations

@@ -12,7 +12,8 @@ platform's file is :mod:`.lms`'s.
 
 The same export is an nbgrader export plugin (:class:`CanvasExport`, :class:`MoodleExport`,
 :class:`CourseExport`: nbgrader's ``ExportPlugin``, ``export(gradebook)``), so
-``cd grading/nbgrader && nbgrader export --exporter=ros2nb_instructor.grading.export.exporting.CanvasExport
+``cd grading/nbgrader && nbgrader export
+--exporter=ros2nb_instructor.grading.export.exporting.CanvasExport
 --CanvasExport.roster=../../roster.csv`` writes the same file.
 """
 

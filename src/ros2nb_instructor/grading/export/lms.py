@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Mapping, Optional, Sequence
 
-from ..intake.roster import PLATFORMS, Roster, RosterRow
+from ..intake.roster import Roster, RosterRow
 from .spreadsheets import Cell, write_csv
 
 #: Canvas's gradebook import: the learner's columns, then one per assignment.
@@ -83,7 +83,7 @@ def _cell(mark: Mark) -> Cell:
 
 
 def write(lms: str, table: Table, roster: Optional[Roster], path: Path) -> list[str]:
-    """Write ``table`` for ``lms`` (:data:`PLATFORMS`) to ``path``, a row per roster learner
+    """Write ``table`` for ``lms`` (:data:`.roster.PLATFORMS`) to ``path``, a row per roster learner
     (every learner of ``table`` without a roster); the learners not in ``roster`` go to
     :data:`NOT_IN_ROSTER` beside it, and with none that file is removed.
 
