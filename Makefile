@@ -131,7 +131,7 @@ test: check $(STAMP) bytecode sandbox-tool browser-tool axe-tool graph-tool imag
 # that grades makes it, at make test's busiest moment and as the first step of the sample
 # class, tests/'s longest chain, which then waits for it (docs/decisions.md).
 grading-course: $(STAMP) bytecode
-	@$(PY) -c 'from ros2nb_instructor.grading.gradebook import kept_course; kept_course()'
+	@$(PY) -c 'from ros2nb_instructor.grading.scores.nbgrader_course import kept_course; kept_course()'
 
 # The course's website (docs/site/build.py): the lessons as the learner sees them (from the
 # stored outputs of solutions/, each answer an exercise with its hint, never its solution),

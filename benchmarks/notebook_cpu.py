@@ -101,7 +101,7 @@ def main() -> int:
     parser.add_argument('--burners', type=int, default=0)
     parser.add_argument('--share', type=int, default=0, help='grade on 1/K of a core')
     options = parser.parse_args()
-    from ros2nb_instructor.grading.settings import JUDGE_CPU_S, NOTEBOOK_CPU_S
+    from ros2nb_instructor.grading.judging.settings import JUDGE_CPU_S, NOTEBOOK_CPU_S
     group = cpu_share(options.share) if options.share else None
     burners = [subprocess.Popen([sys.executable, '-c', 'while True: pass'])
                for _ in range(options.burners)]

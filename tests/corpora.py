@@ -258,16 +258,16 @@ def judged(learner: Learner, root: Path, *, knows_nothing: bool = False,
                str(given / 'source.ipynb'), str(given / 'submission.ipynb'),
                *(['--seed', str(seed)] if seed is not None else [])]
     # Bounded as the grader bounds a judge: each check's CPU time and its subjects' together.
-    from ros2nb_instructor.grading import sandbox
-    from ros2nb_instructor.grading.judging import check_begins, stopped_verdict
-    from ros2nb_instructor.grading.settings import JUDGE_CPU_S
+    from ros2nb_instructor.grading.sandbox import bubblewrap
+    from ros2nb_instructor.grading.judging.judges import check_begins, stopped_verdict
+    from ros2nb_instructor.grading.judging.settings import JUDGE_CPU_S
     cpu_s = JUDGE_CPU_S[learner.notebook]
-    judge = sandbox.watched(command, sandbox.Limits(wall_s=JUDGE_TIMEOUT_S, cpu_step_s=cpu_s,
+    judge = bubblewrap.watched(command, bubblewrap.Limits(wall_s=JUDGE_TIMEOUT_S, cpu_step_s=cpu_s,
                                                     cpu_share=cpu_share),
                             env=env, cwd=root, text=True, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, start_new_session=True)
     try:
-        ended = sandbox.run_to_end(judge, steps=check_begins)
+        ended = bubblewrap.run_to_end(judge, steps=check_begins)
     finally:
         kill_process_group(judge.process)  # what it left (nothing, once it answered)
     out, err = ended.stdout, ended.stderr
@@ -302,10 +302,10 @@ def judged_in_sandbox(learner: Learner, root: Path, *, seed: Optional[int] = Non
     from ros2nb import course
     from ros2nb.terminal import workspace as ws_module
     from ros2nb.terminal.workspace import WORKSPACE_ENV, create_workspace
-    from ros2nb_instructor.grading.judging import judge_notebook
-    from ros2nb_instructor.grading.scratch import Scratch
-    from ros2nb_instructor.grading.settings import Settings
-    from ros2nb_instructor.grading.submissions import Learner as Handed
+    from ros2nb_instructor.grading.judging.judges import judge_notebook
+    from ros2nb_instructor.grading.sandbox.scratch import Scratch
+    from ros2nb_instructor.grading.judging.settings import Settings
+    from ros2nb_instructor.grading.intake.submissions import Learner as Handed
     scratch, nb, notebook = Scratch(root, Handed('learner', 'learner')), \
         submission(learner), NOTEBOOKS[learner.notebook].stem
     saved, reference = os.environ.get(WORKSPACE_ENV), course.reference_source

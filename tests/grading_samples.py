@@ -126,7 +126,9 @@ STAGES = ('read', 'run', 'judge', 'file', 'feedback')
 #: exactly as ros2nb-grade grades them.  python -c GRADE_WITH_FAULTS SUBMISSIONS --out ...
 GRADE_WITH_FAULTS = '''
 import functools, json, sys
-from ros2nb_instructor.grading import cli, feedback, judging, learners, notebooks
+from ros2nb_instructor.grading import cli
+from ros2nb_instructor.grading.judging import judges, learners, notebooks
+from ros2nb_instructor.grading.reports import feedback
 
 def plant(module, name, stage, text_of):
     real = getattr(module, name)
@@ -139,7 +141,7 @@ def plant(module, name, stage, text_of):
 
 plant(learners, 'readable', 'read', lambda path: str(path))
 plant(learners, 'run_notebook', 'run', lambda scratch, nb, prepared, settings: json.dumps(prepared))
-plant(judging, 'judge_notebook', 'judge', lambda s, n, submitted, *rest: json.dumps(submitted))
+plant(judges, 'judge_notebook', 'judge', lambda s, n, submitted, *rest: json.dumps(submitted))
 plant(notebooks, 'for_scoring', 'file', lambda release, executed, *rest: json.dumps(executed))
 plant(feedback, 'safe_feedback', 'feedback', lambda made, title, *rest: made)
 sys.exit(cli.main(sys.argv[1:]))

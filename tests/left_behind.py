@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 from ros2nb.temporary import sweep_all
-from ros2nb_instructor.grading import cgroups
+from ros2nb_instructor.grading.sandbox import cgroups
 
 
 def main() -> int:

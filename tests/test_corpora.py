@@ -27,8 +27,8 @@ from corpus_checks import failed, scores_what_its_twin_scores
 from corpus_honest import HONEST
 from corpus_reaching import REACHING
 from ros2nb.checks.drawn import new_seed
-from ros2nb_instructor.grading import sandbox
-from ros2nb_instructor.grading.settings import JUDGE_TIMEOUT_S as SANDBOXED_JUDGE_S
+from ros2nb_instructor.grading.sandbox import bubblewrap
+from ros2nb_instructor.grading.judging.settings import JUDGE_TIMEOUT_S as SANDBOXED_JUDGE_S
 
 #: Each test grades one learner.
 pytestmark = [pytest.mark.judge, pytest.mark.timeout(time_limit_s(1))]
@@ -68,7 +68,7 @@ def test_an_attack_scores_what_its_twin_scores(attack, tmp_path):
 
 
 @pytest.mark.sandbox
-@pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))
+@pytest.mark.skipif(bubblewrap.problem() is not None, reason=str(bubblewrap.problem()))
 @pytest.mark.timeout(SANDBOXED_JUDGE_S + BESIDE_JUDGES_S)  # one grading, the grader's way
 @pytest.mark.parametrize('attack, run', REACHING_RUNS,
                          ids=[f'{a.name}-seed {run + 1}' for a, run in REACHING_RUNS])

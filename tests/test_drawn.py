@@ -19,8 +19,8 @@ from ros2nb.errors import Ros2nbError
 from ros2nb.judge.__main__ import arguments
 from ros2nb.judge.session import Session
 from ros2nb_instructor.grading import cli
-from ros2nb_instructor.grading.judging import judge_argv
-from ros2nb_instructor.grading.settings import Settings
+from ros2nb_instructor.grading.judging.judges import judge_argv
+from ros2nb_instructor.grading.judging.settings import Settings
 
 
 def inputs_of(judge) -> dict:

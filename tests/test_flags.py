@@ -21,11 +21,11 @@ from corpora import NOTEBOOKS, Learner, every_learner, flags_of
 from corpus_attacks import ATTACKS
 from ros2nb.judge.flags import reaching_in
 from ros2nb.outcomes import CheckOutcome
-from ros2nb_instructor.grading import feedback
-from ros2nb_instructor.grading import learners as learners_module
-from ros2nb_instructor.grading.judging import Verdict
-from ros2nb_instructor.grading.report import write_report
-from ros2nb_instructor.grading.submissions import Learner as ClassLearner
+from ros2nb_instructor.grading.reports import feedback
+from ros2nb_instructor.grading.judging import learners as learners_module
+from ros2nb_instructor.grading.judging.judges import Verdict
+from ros2nb_instructor.grading.reports.report import write_report
+from ros2nb_instructor.grading.intake.submissions import Learner as ClassLearner
 
 LEARNERS = every_learner()
 SOLUTIONS = [Learner(f'solution {number}', number, {}) for number in sorted(NOTEBOOKS)

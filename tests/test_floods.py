@@ -15,7 +15,7 @@ import pytest
 
 from ros2nb import checks, course
 from ros2nb.judge.floods import CHECK_FLOOD_LIMIT
-from ros2nb_instructor.grading import sandbox
+from ros2nb_instructor.grading.sandbox import bubblewrap
 
 from judging import run_check
 from test_checks import PUB, fails, mutated, restore
@@ -108,7 +108,7 @@ def test_what_one_run_of_main_logs_counts_in_that_run_alone(session):
 
 
 @pytest.mark.sandbox
-@pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))
+@pytest.mark.skipif(bubblewrap.problem() is not None, reason=str(bubblewrap.problem()))
 @pytest.mark.timeout(900)
 def test_a_slow_flood_is_found_by_what_one_check_hears(tmp_path, monkeypatch):
     """A callback that logs 450 lines a reading never floods a window of the judge's clock,
@@ -122,10 +122,10 @@ def test_a_slow_flood_is_found_by_what_one_check_hears(tmp_path, monkeypatch):
     import nbformat
     from corpora import Learner as CorpusLearner, submission, write_parts
     from corpus_floods import READING_LINE, SLOW_FLOOD
-    from ros2nb_instructor.grading.judging import judge_notebook
-    from ros2nb_instructor.grading.scratch import Scratch
-    from ros2nb_instructor.grading.settings import Settings
-    from ros2nb_instructor.grading.submissions import Learner
+    from ros2nb_instructor.grading.judging.judges import judge_notebook
+    from ros2nb_instructor.grading.sandbox.scratch import Scratch
+    from ros2nb_instructor.grading.judging.settings import Settings
+    from ros2nb_instructor.grading.intake.submissions import Learner
     from ros2nb.terminal import workspace as ws_module
     nb = submission(CorpusLearner('flooder', '03', {'sensor-callback': [
         (READING_LINE, SLOW_FLOOD)]}))

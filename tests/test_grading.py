@@ -28,15 +28,16 @@ from grading_samples import (EXPECTED, FULL, GRADE_WITH_FAULTS, MARK, NB01, NOT_
                              SOLUTION, STAGES, build)
 
 from ros2nb.temporary import owned_folder
-from ros2nb_instructor.grading import sandbox
-from ros2nb_instructor.grading.scratch import HOME_BYTES
+from ros2nb_instructor.grading.sandbox import bubblewrap
+from ros2nb_instructor.grading.sandbox.scratch import HOME_BYTES
 
 #: The longest the class may take to grade (s): a hang detector, not a speed target (make bench
 #: is that), with room for a slow day on 2 cores beside CPU burners (docs/decisions.md).
 CLASS_LIMIT_S = 1800
 pytestmark = [pytest.mark.sandbox, pytest.mark.judge, pytest.mark.kernel,
               pytest.mark.timeout(CLASS_LIMIT_S),
-              pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))]
+              pytest.mark.skipif(bubblewrap.problem() is not None,
+                                 reason=str(bubblewrap.problem()))]
 #: The class is graded by ros2nb-grade's own main (GRADE_WITH_FAULTS: five learners meet a
 #: planted fault) with its default limits per cell and per notebook: an honest notebook must
 #: never meet them, however busy the machine (a 30 s limit cut a complete learner's simulated

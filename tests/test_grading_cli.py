@@ -20,7 +20,7 @@ import pytest
 from grading_samples import LEARNER, NB01, SOLUTION
 from waiting import PATIENCE_S, wait_for
 
-from ros2nb_instructor.grading import sandbox
+from ros2nb_instructor.grading.sandbox import bubblewrap
 from ros2nb_instructor.paths import ASSIGNMENT, gradebook_url
 
 #: The instructor's grading command, as the course's venv installs it.
@@ -28,7 +28,8 @@ GRADE = str(Path(sys.executable).with_name('ros2nb-grade'))
 
 pytestmark = pytest.mark.timeout(1200)
 #: ros2nb-grade refuses to start without a sandbox (unless told: NO_SANDBOX=1).
-NEEDS_A_SANDBOX = pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))
+NEEDS_A_SANDBOX = pytest.mark.skipif(bubblewrap.problem() is not None,
+                                     reason=str(bubblewrap.problem()))
 
 
 @pytest.mark.sandbox
@@ -152,7 +153,8 @@ def test_a_scoring_process_that_ended_is_started_again(tmp_path):
     # Here, not at the top: nbgrader's package imports its server extensions (costly), and
     # every pytest-xdist worker imports each test file while it collects.
     from nbgrader.api import Gradebook
-    from ros2nb_instructor.grading.gradebook import Scoring, set_up_course
+    from ros2nb_instructor.grading.scores.gradebook import Scoring
+    from ros2nb_instructor.grading.scores.nbgrader_course import set_up_course
     course = tmp_path / 'nbgrader'
     course.mkdir()
     set_up_course(course)
@@ -163,7 +165,7 @@ def test_a_scoring_process_that_ended_is_started_again(tmp_path):
     with Scoring(course) as scoring:
         assert scoring.score(exclude=['bo'])
         scorers = [pid for pid in os.listdir('/proc') if pid.isdigit() and _runs(
-            pid, b'ros2nb_instructor.grading.scoring', str(course).encode())]
+            pid, b'ros2nb_instructor.grading.scores.scoring', str(course).encode())]
         assert len(scorers) == 1, scorers
         os.kill(int(scorers[0]), signal.SIGKILL)
         assert scoring.score(exclude=['ada'])
@@ -187,8 +189,8 @@ def test_a_grading_waits_for_the_course_another_is_making(locked, tmp_path, monk
     grading that asks while another is making it waits for that one.  Without the lock the
     second made it again (nbgrader's generate_assignment, seconds of CPU).  generate_assignment
     is played by a stand-in that holds until the test lets it finish."""
-    from ros2nb_instructor.grading import gradebook
-    monkeypatch.setattr(gradebook, 'SET_UP_CACHE', tmp_path)
+    from ros2nb_instructor.grading.scores import nbgrader_course
+    monkeypatch.setattr(nbgrader_course, 'SET_UP_CACHE', tmp_path)
     made, at_lock, finish = [], [], threading.Event()
     real_flock = fcntl.flock
 
@@ -204,9 +206,9 @@ def test_a_grading_waits_for_the_course_another_is_making(locked, tmp_path, monk
         (kept / 'gradebook.db').write_bytes(b'')
 
     monkeypatch.setattr(fcntl, 'flock', flock)
-    monkeypatch.setattr(gradebook, '_generate_course', generate)
+    monkeypatch.setattr(nbgrader_course, '_generate_course', generate)
     found = []
-    graders = [threading.Thread(target=lambda: found.append(gradebook.kept_course()))
+    graders = [threading.Thread(target=lambda: found.append(nbgrader_course.kept_course()))
                for _ in range(2)]
     graders[0].start()
     wait_for(lambda: made, 'the first grading making the course')
@@ -218,4 +220,4 @@ def test_a_grading_waits_for_the_course_another_is_making(locked, tmp_path, monk
     for grader in graders:
         grader.join(PATIENCE_S)
     assert len(made) == (1 if locked else 2)
-    assert found == [tmp_path / gradebook._solutions_digest()] * 2
+    assert found == [tmp_path / nbgrader_course._solutions_digest()] * 2

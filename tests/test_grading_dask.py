@@ -30,16 +30,17 @@ from grading_samples import EXPECTED, LEARNER, NB00, NB01, NB02, ROOT, SOLUTION,
 from notebook_outputs import sanitize
 from test_grading import CLASS_LIMIT_S, as_text, in_the_csv
 
-from ros2nb_instructor.grading import sandbox
-from ros2nb_instructor.grading.cluster import Cluster
-from ros2nb_instructor.grading.feedback import FLAGS_HEADING
-from ros2nb_instructor.grading.gradebook import set_up_course
-from ros2nb_instructor.grading.learners import FLAGGED
-from ros2nb_instructor.grading.settings import CELL_TIMEOUT_S, NOTEBOOK_TIMEOUT_S, Settings
-from ros2nb_instructor.grading.submissions import find_learners
+from ros2nb_instructor.grading.sandbox import bubblewrap
+from ros2nb_instructor.grading.cluster.client import Cluster
+from ros2nb_instructor.grading.reports.feedback import FLAGS_HEADING
+from ros2nb_instructor.grading.scores.nbgrader_course import set_up_course
+from ros2nb_instructor.grading.judging.learners import FLAGGED
+from ros2nb_instructor.grading.judging.settings import CELL_TIMEOUT_S, NOTEBOOK_TIMEOUT_S, Settings
+from ros2nb_instructor.grading.intake.submissions import find_learners
 
 pytestmark = [pytest.mark.sandbox, pytest.mark.timeout(CLASS_LIMIT_S),
-              pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))]
+              pytest.mark.skipif(bubblewrap.problem() is not None,
+                                 reason=str(bubblewrap.problem()))]
 GRADE = str(Path(sys.executable).with_name('ros2nb-grade'))
 NOTEBOOKS = sorted(SOLUTION)
 #: The seed of both gradings' drawn inputs: the judges check both alike.

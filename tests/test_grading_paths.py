@@ -18,14 +18,15 @@ from grading_samples import NB01, NB02, NB05, SOLUTION
 from ros2nb import course
 from ros2nb.terminal import workspace as ws_module
 from ros2nb.terminal.workspace import WORKSPACE_NAME
-from ros2nb_instructor.grading import notebooks, sandbox
-from ros2nb_instructor.grading.judging import judge_notebook
-from ros2nb_instructor.grading.paths_of_learners import NotARegularFile, read_regular
-from ros2nb_instructor.grading.runs import NotebookRun, _read_back, checked_status, run_note
+from ros2nb_instructor.grading.judging import notebooks
+from ros2nb_instructor.grading.sandbox import bubblewrap
+from ros2nb_instructor.grading.judging.judges import judge_notebook
+from ros2nb_instructor.grading.sandbox.paths_of_learners import NotARegularFile, read_regular
+from ros2nb_instructor.grading.judging.runs import NotebookRun, _read_back, checked_status, run_note
 from ros2nb_instructor.grading.sandboxed.runner import RunStatus
-from ros2nb_instructor.grading.scratch import HOME_BYTES, Scratch, sweep_left_behind
-from ros2nb_instructor.grading.settings import Settings
-from ros2nb_instructor.grading.submissions import Learner
+from ros2nb_instructor.grading.sandbox.scratch import HOME_BYTES, Scratch, sweep_left_behind
+from ros2nb_instructor.grading.judging.settings import Settings
+from ros2nb_instructor.grading.intake.submissions import Learner
 
 
 @pytest.fixture
@@ -229,7 +230,7 @@ PLANTED = ('sitecustomize.py', 'DEFAULT_FASTRTPS_PROFILES.xml')
 
 @pytest.mark.sandbox
 @pytest.mark.judge
-@pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))
+@pytest.mark.skipif(bubblewrap.problem() is not None, reason=str(bubblewrap.problem()))
 @pytest.mark.timeout(300)
 def test_a_subject_writes_nowhere_its_judge_reads(scratch, monkeypatch):
     """The learner's code in a subject may write its own folder, never the judge's cwd
@@ -279,7 +280,7 @@ export PATH="$HOME/bin:$PATH"
 
 @pytest.mark.sandbox
 @pytest.mark.judge
-@pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))
+@pytest.mark.skipif(bubblewrap.problem() is not None, reason=str(bubblewrap.problem()))
 @pytest.mark.timeout(300)
 def test_a_learners_build_scripts_never_run_in_the_judge(scratch, monkeypatch):
     """install/setup.bash and the hooks it sources were written by a build that ran the
@@ -390,7 +391,7 @@ def test_the_judge_reads_a_learners_bag_from_its_own_copy_links_refused(tmp_path
 
 @pytest.mark.sandbox
 @pytest.mark.judge
-@pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))
+@pytest.mark.skipif(bubblewrap.problem() is not None, reason=str(bubblewrap.problem()))
 @pytest.mark.timeout(300)
 @pytest.mark.parametrize('who', ['twin', 'attack'])
 def test_a_copy_of_the_stand_ins_scores_its_twins_score_in_the_sandbox(who, scratch, monkeypatch):

@@ -36,13 +36,13 @@ import hubs
 from hubs import LEARNERS, ROOT, SERVER_START_S, Hub, server_ready, server_state, start_hub
 from waiting import PATIENCE_S, wait_for
 
-from ros2nb_instructor.grading import sandbox
+from ros2nb_instructor.grading.sandbox import bubblewrap
 from ros2nb.temporary import owned_folder
 
 pytestmark = [pytest.mark.hub, pytest.mark.browser, pytest.mark.kernel, pytest.mark.sandbox,
               pytest.mark.judge, pytest.mark.timeout(12 * PATIENCE_S)]
 
-for _why in (hubs.problem(), browser.problem(), sandbox.problem()):
+for _why in (hubs.problem(), browser.problem(), bubblewrap.problem()):
     if _why:
         pytest.skip(_why, allow_module_level=True)
 

@@ -143,7 +143,7 @@ def test_the_store_keeps_each_hand_in_with_its_own_time_and_refuses_the_rest(tmp
 def test_collect_carries_each_notebooks_time_to_the_grader(tmp_path):
     """make hub-collect copies what was handed in and handed-in.json beside it; the grader
     reads each notebook's own time from there (as the server recorded it)."""
-    from ros2nb_instructor.grading.submissions import find_learners
+    from ros2nb_instructor.grading.intake.submissions import find_learners
     store = hand_in_store.Store(tmp_path / 'store')
     stored = store.hand_in('grace', SHIPPED[3][:-6], NOTEBOOK_BYTES)
     results = collector.collect_handed_in(store, tmp_path / 'class')

@@ -42,6 +42,14 @@ LAYERS: list[tuple[str, ...]] = [
     # ros2nb_instructor: the instructor's host (and, for the runner, the learner's sandbox).
     ('ros2nb_instructor.paths',),
     ('ros2nb_instructor.grading.sandboxed',),
+    # grading, one room per role, in the order a notebook goes through them: what was taken
+    # in, the sandboxes, a learner run and judged, the pages and files for people, nbgrader.
+    ('ros2nb_instructor.grading.intake',),
+    ('ros2nb_instructor.grading.sandbox',),
+    ('ros2nb_instructor.grading.judging',),
+    ('ros2nb_instructor.grading.reports', 'ros2nb_instructor.grading.export'),
+    ('ros2nb_instructor.grading.scores',),
+    ('ros2nb_instructor.grading.cluster',),
     ('ros2nb_instructor.grading', 'ros2nb_instructor.authoring', 'ros2nb_instructor.hub',
      'ros2nb_instructor.lab'),
     ('ros2nb_instructor',),
@@ -166,6 +174,21 @@ def test_a_planted_circle_and_an_upward_import_are_named():
     assert problems(planted, layers) == [
         'pkg.low imports pkg.high, a layer above it',
         'import circle: pkg.high -> pkg.low, pkg.low -> pkg.high']
+
+
+def test_a_grading_room_that_imports_a_later_one_is_named():
+    """The grading's rooms are layers too: taken in, sandboxed, judged, scored.  A module of
+    the intake that reached for the sandbox, or the sandbox for the judging, is named."""
+    sources = tree_sources()
+    sources['ros2nb_instructor.grading.intake.planted'] = (
+        'from ..sandbox import bubblewrap\n', False)
+    sources['ros2nb_instructor.grading.sandbox.planted_too'] = (
+        'def later():\n    from ..judging.learners import Graded\n', False)
+    assert problems(sources, LAYERS) == [
+        'ros2nb_instructor.grading.intake.planted imports '
+        'ros2nb_instructor.grading.sandbox.bubblewrap, a layer above it',
+        'ros2nb_instructor.grading.sandbox.planted_too imports '
+        'ros2nb_instructor.grading.judging.learners, a layer above it']
 
 
 def test_no_module_or_function_is_too_long():

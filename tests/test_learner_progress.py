@@ -21,9 +21,9 @@ from ros2nb import course, graded_parts
 from ros2nb.checks import base
 from ros2nb.errors import CheckFailed
 from ros2nb.outcomes import CHECK_FAILED, CheckOutcome
-from ros2nb_instructor.grading import feedback
-from ros2nb_instructor.grading.gradebook import standing_table
-from ros2nb_instructor.grading.submissions import Learner
+from ros2nb_instructor.grading.reports import feedback
+from ros2nb_instructor.grading.reports.pages import standing_table
+from ros2nb_instructor.grading.intake.submissions import Learner
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -10,31 +10,32 @@ cells running into the 120-s cell limit; the judge's side of such a flood is
 
 import pytest
 
-from ros2nb_instructor.grading import sandbox
-from ros2nb_instructor.grading.runs import run_note, run_notebook
+from ros2nb_instructor.grading.sandbox import bubblewrap
+from ros2nb_instructor.grading.judging.runs import run_note, run_notebook
 from ros2nb_instructor.grading.sandboxed.runner import RunStatus
-from ros2nb_instructor.grading.scratch import Scratch
-from ros2nb_instructor.grading.settings import Settings
-from ros2nb_instructor.grading.submissions import Learner
+from ros2nb_instructor.grading.sandbox.scratch import Scratch
+from ros2nb_instructor.grading.judging.settings import Settings
+from ros2nb_instructor.grading.intake.submissions import Learner
 
 from test_floods import flooder_notebook
 
 pytestmark = [pytest.mark.sandbox, pytest.mark.kernel, pytest.mark.ros,
-              pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem())),
+              pytest.mark.skipif(bubblewrap.problem() is not None,
+                                 reason=str(bubblewrap.problem())),
               pytest.mark.timeout(400)]
 
 NOTEBOOK = '03-write-the-publisher'
 
 
 def flooder_run(tmp_path, settings: Settings, monkeypatch
-                ) -> tuple[RunStatus, str, sandbox.Result]:
+                ) -> tuple[RunStatus, str, bubblewrap.Result]:
     """The flooder's 03 run in its sandbox, as the grader runs it: the runner's status, the
     note the learner gets, and how the sandbox ended (its CPU seconds)."""
     import nbformat
     notebook = nbformat.from_dict(flooder_notebook('rosout'))
     ended = []
-    run = sandbox.Sandbox.run
-    monkeypatch.setattr(sandbox.Sandbox, 'run', lambda *a, **kw: ended.append(run(*a, **kw))
+    run = bubblewrap.Sandbox.run
+    monkeypatch.setattr(bubblewrap.Sandbox, 'run', lambda *a, **kw: ended.append(run(*a, **kw))
                         or ended[-1])
     tmp_path.mkdir()
     scratch = Scratch(tmp_path, Learner('flooder', 'flooder'))

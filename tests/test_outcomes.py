@@ -2,7 +2,7 @@
 field by field where it crosses a process (``ros2nb.outcomes``).
 
 The judge prints it as JSON; the learner's kernel (``checks.dispatch``) and the grader
-(``grading.judging``) decode it with ``ros2nb.typed_json``: what does not fit is refused with
+(``grading.judging.judges``) decode it with ``ros2nb.typed_json``: what does not fit is refused with
 one line naming the field, never read by key into a learner's score or feedback.  No ROS here.
 """
 
@@ -18,7 +18,7 @@ from ros2nb.judge_interface import UNFINISHED, captured, show_result
 from ros2nb.outcomes import (CHECK_FAILED, LEARNER_CODE_ERROR, NOT_DECIDED, CellChecked,
                              CheckOutcome, NotebookChecked)
 from ros2nb.typed_json import Unreadable, decoded
-from ros2nb_instructor.grading.judging import _read_verdict, stopped_verdict
+from ros2nb_instructor.grading.judging.judges import _read_verdict, stopped_verdict
 
 
 def check_that(error: Exception | None):

@@ -11,8 +11,8 @@ import re
 from pathlib import Path
 
 from ros2nb.outcomes import CHECK_FAILED, CheckOutcome
-from ros2nb_instructor.grading.report import write_report
-from ros2nb_instructor.grading.submissions import Learner
+from ros2nb_instructor.grading.reports.report import write_report
+from ros2nb_instructor.grading.intake.submissions import Learner
 
 NOTEBOOKS = ['03-write-the-publisher', '04-write-the-subscriber']
 FAILURE = 'TemperatureSensor() never calls super().__init__'
@@ -172,7 +172,7 @@ def test_every_pair_at_the_threshold_is_listed_by_copydetects_own_measure(tmp_pa
     import nbformat
     from corpora import every_learner
     from grading_samples import NB03, written_by
-    from ros2nb_instructor.grading.similarity import alike
+    from ros2nb_instructor.grading.reports.similarity import alike
     from ros2nb_instructor.paths import NOTEBOOKS as HANDED_OUT
     corpus, handed = every_learner(), {}
     for who, name in (('one', '03 a timer of 1 (an int)'),
@@ -195,7 +195,7 @@ def test_the_honest_corpus_as_a_class_lists_no_two_classmates(tmp_path):
     import nbformat
     from corpus_honest import HONEST
     from grading_samples import NOTEBOOKS_BY_NUMBER, SOLUTION, written_by
-    from ros2nb_instructor.grading.similarity import COURSE, alike
+    from ros2nb_instructor.grading.reports.similarity import COURSE, alike
     from ros2nb_instructor.paths import NOTEBOOKS as HANDED_OUT
     by_notebook: dict[str, dict[str, Path]] = {}
     for index, learner in enumerate(HONEST):

@@ -1,4 +1,4 @@
-"""ros2nb_instructor.grading.sandbox with real processes: every protection next to the
+"""ros2nb_instructor.grading.sandbox.bubblewrap with real processes: every protection next to the
 failure it prevents.
 
 Each probe also runs without the sandbox (or with the protection off) and must succeed
@@ -20,12 +20,12 @@ from pathlib import Path
 
 import pytest
 
-from ros2nb_instructor.grading import sandbox
-from ros2nb_instructor.grading.sandbox import Limits, Sandbox
+from ros2nb_instructor.grading.sandbox import bubblewrap
+from ros2nb_instructor.grading.sandbox.bubblewrap import Limits, Sandbox
 from waiting import PATIENCE_S
 
 ROOT = Path(__file__).resolve().parent.parent
-PROBLEM = sandbox.problem()
+PROBLEM = bubblewrap.problem()
 pytestmark = [pytest.mark.sandbox, pytest.mark.skipif(PROBLEM is not None, reason=str(PROBLEM))]
 PY = sys.executable
 ENV = {'PATH': '/usr/bin:/bin', 'HOME': '/tmp', 'LANG': 'C.UTF-8'}
@@ -89,7 +89,7 @@ def plain(argv: list[str], env: dict[str, str] = ENV, **kw) -> subprocess.Comple
 
 
 def boxed(box: Sandbox, argv: list[str],
-          limits: Limits = Limits(wall_s=PATIENCE_S)) -> sandbox.Result:
+          limits: Limits = Limits(wall_s=PATIENCE_S)) -> bubblewrap.Result:
     return box.run(argv, limits, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
@@ -98,7 +98,7 @@ def python_code(code: str, *args: str) -> list[str]:
 
 
 def test_a_trivial_sandbox_works_here():
-    assert sandbox.problem() is None
+    assert bubblewrap.problem() is None
     result = boxed(Sandbox(env=ENV), ['true'])
     assert (result.returncode, result.timed_out) == (0, False)
     assert {'wall', 'file-size'} <= set(result.limits_enforced)
@@ -207,7 +207,7 @@ def test_files_hidden_read_only_and_scratch(tmp_path):
               'course append': ('append', course / 'notebooks' / 'a.ipynb'),
               'course create': ('create', course / 'new.txt'),
               'hidden read': ('read', course / 'solutions' / 'a.ipynb'),
-              'repository read': ('read', Path(sandbox.__file__)),
+              'repository read': ('read', Path(bubblewrap.__file__)),
               'shadow read': ('read', '/etc/shadow'),
               'home list': ('list', Path.home()),
               'sysctl write': ('open-for-write', '/proc/sys/vm/swappiness'),
@@ -217,7 +217,7 @@ def test_files_hidden_read_only_and_scratch(tmp_path):
     box = Sandbox(readable=[course], hidden=[course / 'solutions'], writable=[scratch], env=ENV)
     inside = json.loads(boxed(box, probe).stdout)
     # Only the folders leading to the bound Python installation show in the home folder.
-    python_in_home = {p.relative_to(Path.home()).parts[0] for p in sandbox._python_paths()
+    python_in_home = {p.relative_to(Path.home()).parts[0] for p in bubblewrap._python_paths()
                       if Path.home() in p.parents}
     assert inside == {
         'course read': 'ok', 'course append': 'OSError', 'course create': 'OSError',  # EROFS
@@ -226,7 +226,7 @@ def test_files_hidden_read_only_and_scratch(tmp_path):
         'sysctl write': 'PermissionError' if os.geteuid() == 0 else inside['sysctl write'],
         'scratch append': 'ok', 'scratch create': 'ok'}
     made = (scratch / 'made-inside.txt').stat().st_uid
-    assert made == (sandbox.HOST_UID if os.geteuid() == 0 else os.getuid())
+    assert made == (bubblewrap.HOST_UID if os.geteuid() == 0 else os.getuid())
     # Control: outside, the same probe reads and writes all of it (run after the sandbox
     # so that its writes cannot hide a failure inside).
     outside = json.loads(plain(probe).stdout)
@@ -345,7 +345,7 @@ def test_cpu_time_of_all_processes_together_kills_the_sandbox():
 
 
 def test_cpu_time_falls_back_to_a_limit_per_process(monkeypatch):
-    monkeypatch.setattr(sandbox.cgroups_of, 'make_cgroups', lambda *limits: ([], []))
+    monkeypatch.setattr(bubblewrap.cgroups_of, 'make_cgroups', lambda *limits: ([], []))
     started = time.monotonic()
     result = boxed(Sandbox(env=ENV), python_code('while True: pass'),
                    Limits(wall_s=PATIENCE_S, cpu_s=1))
@@ -454,12 +454,12 @@ def test_nested_subject_shares_network_but_not_pids(tmp_path):
         (tmp_path / f'{name}.py').write_text(text)
     marker = f'judge-{uuid.uuid4().hex}'
     # Inside its own network namespace the judge needs no LOCALHOST range; UDPv4 because the
-    # 'private' subject has its own /dev/shm (see sandbox.inner_prefix).
+    # 'private' subject has its own /dev/shm (see bubblewrap.inner_prefix).
     env = {**ENV, 'ROS_DOMAIN_ID': '7', 'FASTDDS_BUILTIN_TRANSPORTS': 'UDPv4'}
     judge = Sandbox(readable=[tmp_path], env=env, nested=True)
     # What the judge receives, as JSON.
-    prefixes = json.dumps({'private': sandbox.inner_prefix(),
-                           'shared': sandbox.inner_prefix(share_shm=True)})
+    prefixes = json.dumps({'private': bubblewrap.inner_prefix(),
+                           'shared': bubblewrap.inner_prefix(share_shm=True)})
     result = boxed(judge, [PY, str(tmp_path / 'judge.py'), prefixes, marker, str(tmp_path)])
     report = json.loads(result.stdout)
     assert [code for code, _ in report['talkers']] == [0, 0], report['talkers']

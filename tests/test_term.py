@@ -20,12 +20,14 @@ from pathlib import Path
 import pytest
 
 from ros2nb.typed_json import Unreadable
-from ros2nb_instructor.grading import (course_settings, deadlines, due_dates, exporting, feedback,
-                                      lms, roster, sandbox, term)
-from ros2nb_instructor.grading.extensions import Extensions
-from ros2nb_instructor.grading.hand_in_times import TIMESTAMP, ZIP_ENTRY, parse_time
-from ros2nb_instructor.grading.submissions import Learner, find_learners
-from ros2nb_instructor.grading.zips import screen_zip
+from ros2nb_instructor.grading.export import exporting, lms
+from ros2nb_instructor.grading.intake import course_settings, deadlines, due_dates, roster, term
+from ros2nb_instructor.grading.reports import feedback
+from ros2nb_instructor.grading.sandbox import bubblewrap
+from ros2nb_instructor.grading.intake.extensions import Extensions
+from ros2nb_instructor.grading.intake.hand_in_times import TIMESTAMP, ZIP_ENTRY, parse_time
+from ros2nb_instructor.grading.intake.submissions import Learner, find_learners
+from ros2nb_instructor.grading.intake.zips import screen_zip
 
 NB01 = '01-create-a-workspace'
 NOTEBOOKS = ['00-setup-and-the-pubsub-idea', NB01]
@@ -306,7 +308,7 @@ def csv_rows(out: Path) -> dict[str, dict[str, str]]:
 @pytest.mark.judge
 @pytest.mark.kernel
 @pytest.mark.timeout(1800)
-@pytest.mark.skipif(sandbox.problem() is not None, reason=str(sandbox.problem()))
+@pytest.mark.skipif(bubblewrap.problem() is not None, reason=str(bubblewrap.problem()))
 def test_a_class_under_two_policies_exported_and_one_learner_again(tmp_path):
     """On time, a day late, past the cutoff, no time: grades.csv, the feedback pages and
     report.html show raw score, penalty and score as each policy says; Canvas's and Moodle's
@@ -427,7 +429,7 @@ def the_other_exports(tmp_path: Path, out: Path, canvas: list[list[str]]) -> Non
     course = out / 'nbgrader'
     nbgrader = subprocess.run(
         [str(Path(sys.executable).with_name('nbgrader')), 'export',
-         '--exporter=ros2nb_instructor.grading.exporting.CanvasExport',
+         '--exporter=ros2nb_instructor.grading.export.exporting.CanvasExport',
          f'--CanvasExport.roster={tmp_path / "roster.csv"}',
          f'--CanvasExport.settings={tmp_path / "daily.toml"}',
          f'--CanvasExport.extensions={tmp_path / "extensions.toml"}',

@@ -15,12 +15,13 @@ from pathlib import Path
 
 import pytest
 
-from ros2nb_instructor.grading import course_settings, deadlines, extensions, feedback
-from ros2nb_instructor.grading.hand_in_times import (HANDED_IN, TIMESTAMP, TimeProblem,
-                                                     parse_time, record_text)
-from ros2nb_instructor.grading.roster import RosterProblem, read_roster
-from ros2nb_instructor.grading.submissions import SubmissionProblem, find_learners
-from ros2nb_instructor.grading.zips import screen_zip
+from ros2nb_instructor.grading.intake import course_settings, deadlines, extensions
+from ros2nb_instructor.grading.intake.hand_in_times import (HANDED_IN, TIMESTAMP, TimeProblem,
+                                                            parse_time, record_text)
+from ros2nb_instructor.grading.reports import feedback
+from ros2nb_instructor.grading.intake.roster import RosterProblem, read_roster
+from ros2nb_instructor.grading.intake.submissions import SubmissionProblem, find_learners
+from ros2nb_instructor.grading.intake.zips import screen_zip
 
 NB03, NB05 = '03-write-the-publisher', '05-entry-points-and-run'
 NOTEBOOKS = ['00-setup-and-the-pubsub-idea', '01-create-a-workspace', NB03, NB05]
@@ -240,8 +241,8 @@ def test_canvas_submissions_zip_is_taken_in_through_the_roster(tmp_path):
 def test_an_export_leaves_blank_what_is_not_yet_due_or_not_scored(tmp_path):
     """A DUE_BY still to come made every notebook due by it due now (0 for who had not
     handed in yet), and a notebook handed in without a score in the gradebook was 0."""
-    from ros2nb_instructor.grading.exporting import deciding_time, mark
-    from ros2nb_instructor.grading.submissions import Learner
+    from ros2nb_instructor.grading.export.exporting import deciding_time, mark
+    from ros2nb_instructor.grading.intake.submissions import Learner
     course = settings(tmp_path, GUIDE)
     soon = datetime.datetime.now(UTC) + datetime.timedelta(days=400)
     assert deciding_time(soon) < soon

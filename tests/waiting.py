@@ -98,13 +98,13 @@ def _poll(condition: Callable[[], Any], seconds: float, interval: float) -> bool
 @contextlib.contextmanager
 def starved(share: float) -> Iterator[Callable[[int], None]]:
     """A CPU quota of ``share`` CPUs while the block runs (the grader's own cgroups,
-    :func:`ros2nb_instructor.grading.cgroups.make_cgroups`): ``admit(tid)`` puts a process
+    :func:`ros2nb_instructor.grading.sandbox.cgroups.make_cgroups`): ``admit(tid)`` puts a process
     (by its pid, with the children it starts later) or one thread of this process (by its
     thread id: cgroup v1 moves a thread alone) under it.  A program there gets at most that
     share however idle the machine is: slow for certain, not by luck.  Skips the test where
     no quota can be set (not root, no cpu controller)."""
     import pytest
-    from ros2nb_instructor.grading import cgroups
+    from ros2nb_instructor.grading.sandbox import cgroups
     made, enforced = cgroups.make_cgroups(64, 1 << 30, share)
     quota = [c for c in made if (c / 'cpu.cfs_quota_us').exists() or (c / 'cpu.max').exists()]
     if 'cpu(cgroup)' not in enforced or not quota:

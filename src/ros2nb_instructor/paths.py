@@ -16,9 +16,11 @@ SOLUTIONS = ROOT / 'solutions'
 NOTEBOOKS = ROOT / 'notebooks'
 #: nbgrader's name for the set of notebooks a learner submits.
 ASSIGNMENT = 'ros2-pubsub'
-#: The course's settings for a term: due dates and the late policy (grading.course_settings).
+#: The course's settings for a term: due dates and the late policy
+#: (grading.intake.course_settings).
 SETTINGS = ROOT / 'course.toml'
-#: Each learner's extensions, beside the settings (grading.extensions): the instructor's alone.
+#: Each learner's extensions, beside the settings (grading.intake.extensions): the
+#: instructor's alone.
 EXTENSIONS = 'extensions.toml'
 
 

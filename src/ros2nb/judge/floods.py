@@ -35,7 +35,7 @@ FLOOD_WINDOW_NS = 1_000_000_000
 #: Lines one logger may send, and messages a watched topic may carry, within one check: the
 #: longest checks hear an hour of the sensor (3,600 readings, a line each) and notebook 10's
 #: recording its monitor's 3,600 statuses beside; a fifth of what a judge can hear within the
-#: CPU limit of one check (``ros2nb_instructor.grading.settings.JUDGE_CPU_S``).
+#: CPU limit of one check (``ros2nb_instructor.grading.judging.settings.JUDGE_CPU_S``).
 CHECK_FLOOD_LIMIT = 20_000
 
 

@@ -18,7 +18,7 @@ import sys
 from pathlib import Path
 from typing import Optional
 
-from ..grading.gradebook import kept_course
+from ..grading.scores.nbgrader_course import kept_course
 from ..paths import ASSIGNMENT, NOTEBOOKS, ROOT
 
 
@@ -26,8 +26,9 @@ def generate(out: Path) -> list[Path]:
     """Write learner versions of every solutions/*.ipynb into ``out``; return their paths.
 
     They are the release of the nbgrader course of the current solutions, made once per
-    version of the solutions (:func:`~ros2nb_instructor.grading.gradebook.kept_course`): the
-    notebooks a grading hands out are these very files.
+    version of the solutions
+    (:func:`~ros2nb_instructor.grading.scores.nbgrader_course.kept_course`): the notebooks a
+    grading hands out are these very files.
 
     :raises SystemExit: when nbgrader's ``generate_assignment`` failed.
     """

@@ -5,7 +5,7 @@ DIR/<learner>/ holds a learner's copies of notebooks/NN-*.ipynb (any subset).  n
 keeps the gradebook, scores the notebooks and writes the feedback; this script decides
 nothing by itself.  Per notebook, three steps, none of which the notebook can reach:
 
-1. The learner's notebook runs in a sandbox of its own (:mod:`.sandbox`: its own PID and
+1. The learner's notebook runs in a sandbox of its own (:mod:`.bubblewrap`: its own PID and
    network namespaces, only its own scratch folder writable, the course, the gradebook,
    other learners, solutions and hidden tests invisible; time, memory, task, file-size
    and output limits), on a workspace shared only with that learner's other notebooks.
@@ -50,21 +50,22 @@ from ros2nb.checks.drawn import SEED_OPTION, new_seed, parse_seed
 from ros2nb.errors import Ros2nbError
 
 from ..paths import ASSIGNMENT, ROOT
-from . import sandbox
-from .gradebook import Scoring, collect_zip, set_up_course, write_results
-from .judging import Judges
-from .learners import file_graded, grade_learner
-from .report import write_report
-from .scratch import grading_folder
-from .settings import CELL_TIMEOUT_S, JOBS, NOTEBOOK_CPU_S, NOTEBOOK_TIMEOUT_S, Settings
-from .exporting import export
-from .hand_in_times import TimeProblem
-from .submissions import Learner, SubmissionProblem, find_learners
-from .term import (Term, add_options, forget, load_state, read_term, save_state, with_extensions,
-                   with_roster)
+from .export.exporting import export
+from .intake.hand_in_times import TimeProblem
+from .intake.submissions import Learner, SubmissionProblem, find_learners
+from .intake.term import (Term, add_options, forget, load_state, read_term, save_state,
+                          with_extensions, with_roster)
+from .judging.judges import Judges
+from .judging.learners import file_graded, grade_learner
+from .judging.settings import CELL_TIMEOUT_S, JOBS, NOTEBOOK_CPU_S, NOTEBOOK_TIMEOUT_S, Settings
+from .reports.report import write_report
+from .sandbox import bubblewrap
+from .sandbox.scratch import grading_folder
+from .scores.gradebook import Scoring, write_results
+from .scores.nbgrader_course import collect_zip, set_up_course
 
 if TYPE_CHECKING:
-    from .cluster import Cluster
+    from .cluster.client import Cluster
 
 
 def _options(argv: Optional[list[str]]) -> argparse.Namespace:
@@ -119,7 +120,7 @@ def _refusal(submissions: Path, out: Path, args: argparse.Namespace) -> Optional
     if not submissions.exists():
         return f'{submissions} does not exist: pass SUBMISSIONS=folder-of-learner-folders or a .zip'
     # On a cluster, learners' code runs on the workers, each checked for a sandbox there.
-    why = None if args.no_sandbox or args.scheduler else sandbox.problem()
+    why = None if args.no_sandbox or args.scheduler else bubblewrap.problem()
     if why:
         return (f'No sandbox can be made here ({why}); grading runs learners\' code, so it stops. '
                 'For work you trust, run again with NO_SANDBOX=1 (--no-sandbox).')
@@ -300,7 +301,7 @@ def _grade(args: argparse.Namespace, submissions: Path, out: Path, started: floa
                         args.notebook_cpu, args.judge_cpu, args.cpu_share)
     if not args.scheduler:
         return _grade_with(None, args, submissions, out, started, settings)
-    from .cluster import Cluster, ClusterProblem  # Dask is imported for a cluster only
+    from .cluster.client import Cluster, ClusterProblem  # Dask is imported for a cluster only
     try:
         cluster = Cluster(args.scheduler, settings)
     except ClusterProblem as problem:

@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Optional
 
-from ..grading.hand_in_times import HANDED_IN, record_text
+from ..grading.intake.hand_in_times import HANDED_IN, record_text
 from ..paths import NOTEBOOKS, ROOT
 from .hand_in_store import Store
 

@@ -35,8 +35,8 @@ from jupyterhub.services.auth import HubOAuthCallbackHandler, HubOAuthenticated
 from ros2nb.hand_ins import SAVED_HEADER, Standing
 from tornado import ioloop, web
 
-from ..grading.feedback import CSP
-from ..grading.hand_in_times import TimeProblem, parse_time
+from ..grading.reports.feedback import CSP
+from ..grading.intake.hand_in_times import TimeProblem, parse_time
 from ..paths import EXTENSIONS, SETTINGS
 from .hand_in_store import MAX_NOTEBOOK_BYTES, Refused, Store
 from .schedule import LOG, Schedule, status

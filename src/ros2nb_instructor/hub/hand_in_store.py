@@ -12,7 +12,7 @@ never from the request.  Layout::
     <store>/hand-ins.log                        one line per hand-in, for the instructor
 
 The time of a hand-in is the service's clock when the notebook was stored, in UTC; the
-record is the grader's ``handed-in.json`` (:mod:`ros2nb_instructor.grading.hand_in_times`).
+record is the grader's ``handed-in.json`` (:mod:`ros2nb_instructor.grading.intake.hand_in_times`).
 Every file is written whole, then renamed into place: a reader never sees half of one.
 """
 
@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Optional
 
-from ..grading.hand_in_times import HANDED_IN, read_record, record_text
+from ..grading.intake.hand_in_times import HANDED_IN, read_record, record_text
 from ..paths import NOTEBOOKS
 
 #: A hub user name the store keeps a folder for (the names ``make grade`` takes as folders).

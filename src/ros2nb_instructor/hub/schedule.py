@@ -2,9 +2,10 @@
 
 Runs on the classroom server, in the hand-in service (:mod:`.hand_in_service`), as root.
 Due dates are read from ``course.toml`` and ``extensions.toml`` at each request
-(:mod:`ros2nb_instructor.grading.course_settings`, :mod:`ros2nb_instructor.grading.extensions`),
-so a new extension shows at once; a file with a mistake shows no due dates (the service's
-log says the mistake) and hand-ins go on.  The answer is :class:`ros2nb.hand_ins.NotebookStatus`.
+(:mod:`ros2nb_instructor.grading.intake.course_settings`,
+:mod:`ros2nb_instructor.grading.intake.extensions`), so a new extension shows at once; a
+file with a mistake shows no due dates (the service's log says the mistake) and hand-ins go
+on.  The answer is :class:`ros2nb.hand_ins.NotebookStatus`.
 """
 
 from __future__ import annotations
@@ -17,9 +18,9 @@ from typing import Optional
 
 from ros2nb.hand_ins import NotebookStatus
 
-from ..grading.course_settings import read_settings
-from ..grading.deadlines import NO_DEADLINES, CourseSettings, SettingsProblem, late_by
-from ..grading.extensions import NONE, Extensions, ExtensionsProblem, read_extensions
+from ..grading.intake.course_settings import read_settings
+from ..grading.intake.deadlines import NO_DEADLINES, CourseSettings, SettingsProblem, late_by
+from ..grading.intake.extensions import NONE, Extensions, ExtensionsProblem, read_extensions
 from .hand_in_store import Store, course_notebooks
 
 #: The service's log.

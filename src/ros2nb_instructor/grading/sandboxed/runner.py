@@ -2,7 +2,7 @@
 """Execute one learner notebook for grading, with limits: \
 ``python -m ros2nb_instructor.grading.sandboxed.runner IN OUT``.
 
-Runs inside the learner's sandbox (:mod:`ros2nb_instructor.grading.sandbox`), as the
+Runs inside the learner's sandbox (:mod:`ros2nb_instructor.grading.sandbox.bubblewrap`), as the
 sandbox's user, beside the learner's kernel: nothing it writes is trusted beyond the two
 files the grader reads back.  nbclient does the executing.  What
 it adds: every cell has a time limit after which its kernel is interrupted and the next
@@ -41,7 +41,7 @@ class RunStatus:
 
     The runner writes it beside the executed notebook (``OUT.status.json``, :func:`save`)
     inside the learner's sandbox; the grader reads it back on its host after the sandbox
-    ended (:func:`ros2nb_instructor.grading.runs.checked_status`, with
+    ended (:func:`ros2nb_instructor.grading.judging.runs.checked_status`, with
     :func:`ros2nb.typed_json.decoded`).  The learner's code runs beside the runner, as the
     same user, and may rewrite the file: a status that does not fit is that learner's note.
 

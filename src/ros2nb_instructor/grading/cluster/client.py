@@ -1,12 +1,12 @@
 """Grading a class on a Dask cluster (``make grade SCHEDULER=tcp://host:8786``): a task a learner.
 
 Runs on the instructor's host.  Each learner is one task of a Dask scheduler, graded on a
-worker where the course is installed by :func:`.cluster_task.grade_job` (the local grading's
+worker where the course is installed by :func:`.worker.grade_job` (the local grading's
 :func:`.learners.grade_learner`, in the same sandboxes); what comes back is filed in the
 instructor's nbgrader course, which scores it as on one machine (:mod:`.cli`).
 
-A worker is checked before any learner runs there (:func:`.cluster_task.accept`): the same
-course version (:func:`.cluster_task.course_version`) and a sandbox; a worker refused gets one
+A worker is checked before any learner runs there (:func:`.worker.accept`): the same
+course version (:func:`.worker.course_version`) and a sandbox; a worker refused gets one
 line and never the resource the learners' tasks need.  Workers that join later are checked as
 they come.  A worker that dies while it holds learners costs nobody: the scheduler runs their
 tasks again elsewhere, and each learner's result is taken once, from the one task that finished.
@@ -20,11 +20,11 @@ import uuid
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Hashable, Iterator, Optional
 
-from ..paths import ASSIGNMENT
-from .cluster_task import FromWorker, Job, accept, course_version, grade_job, resource_name
-from .learners import file_graded
-from .settings import Settings
-from .submissions import MAX_SUBMISSION_BYTES, Learner
+from ...paths import ASSIGNMENT
+from ..intake.submissions import MAX_SUBMISSION_BYTES, Learner
+from ..judging.learners import file_graded
+from ..judging.settings import Settings
+from .worker import FromWorker, Job, accept, course_version, grade_job, resource_name
 
 if TYPE_CHECKING:  # only the type: a class on a cluster imports distributed when it connects
     from distributed import Future

@@ -25,9 +25,9 @@ from ros2nb.judge.subjects import HANDED, SUBJECTS_FOLDER_ENV
 from ros2nb.outcomes import CellChecked, CheckOutcome, NotebookChecked
 from ros2nb.typed_json import Unreadable, decoded
 
-from ..paths import ROOT, SOLUTIONS
-from . import sandbox
-from .scratch import Scratch, sandbox_env
+from ...paths import ROOT, SOLUTIONS
+from ..sandbox import bubblewrap
+from ..sandbox.scratch import Scratch, sandbox_env
 from .settings import JUDGE_TIMEOUT_S, Settings
 
 
@@ -82,23 +82,23 @@ def judge_notebook(scratch: Scratch, notebook: str, submitted: nbformat.Notebook
     argv = judge_argv(source, given / 'submission.ipynb', settings)
     env = sandbox_env(own / 'home', ROS2NB_WORKSPACE=str(workspace),
                       TMPDIR=str(own / 'tmp'), **{SUBJECTS_FOLDER_ENV: str(subjects)})
-    limits = sandbox.Limits(wall_s=JUDGE_TIMEOUT_S, cpu_step_s=settings.judge_cpu_for(notebook),
+    limits = bubblewrap.Limits(wall_s=JUDGE_TIMEOUT_S, cpu_step_s=settings.judge_cpu_for(notebook),
                             cpu_share=settings.cpu_share)
     try:
         if settings.sandboxed:
             env['FASTDDS_BUILTIN_TRANSPORTS'] = 'UDPv4'  # judge and subjects: own /dev/shm each
-            env['ROS2NB_SUBJECT_PREFIX'] = json.dumps(sandbox.inner_prefix(  # the course may
+            env['ROS2NB_SUBJECT_PREFIX'] = json.dumps(bubblewrap.inner_prefix(  # the course may
                 readable=[workspace, ROOT / 'src', subjects / HANDED],  # be under /tmp too
                 hidden=[*ANSWER_FOLDERS, own, given]))
             # The judge may read the course's reference nodes (a notebook handed in alone runs
             # on them where it relies on an earlier one's, as catch_up promises); its subjects
             # see only the copies it hands them.
-            box = sandbox.Sandbox(writable=[folder], env=env, cwd=given, nested=True,
+            box = bubblewrap.Sandbox(writable=[folder], env=env, cwd=given, nested=True,
                                   readable=[ROOT / 'src', workspace, given])
             result = box.run(argv, limits, steps=check_begins, stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE, text=True)
         else:  # no sandbox: its limits all the same
-            result = sandbox.run_to_end(sandbox.watched(
+            result = bubblewrap.run_to_end(bubblewrap.watched(
                 argv, limits, env={**os.environ, **env}, cwd=given, stdout=subprocess.PIPE,
                 stderr=subprocess.PIPE, text=True), steps=check_begins)
     except OSError as error:  # e.g. the notebook made its workspace unreadable

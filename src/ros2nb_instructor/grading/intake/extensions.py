@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Iterable, Mapping, Optional
 
-from ..paths import EXTENSIONS
+from ...paths import EXTENSIONS
 from . import due_dates
 from .course_settings import read_toml
 from .deadlines import CourseSettings

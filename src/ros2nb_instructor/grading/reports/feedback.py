@@ -19,7 +19,7 @@ import jinja2
 import nh3
 
 if TYPE_CHECKING:
-    from .deadlines import Lateness
+    from ..intake.deadlines import Lateness
 
 #: The grader's templates (``templates/*.j2``); every value they show is escaped.
 TEMPLATES = jinja2.Environment(loader=jinja2.PackageLoader(__package__, 'templates'),

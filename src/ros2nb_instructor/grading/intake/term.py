@@ -22,12 +22,11 @@ from nbgrader.api import Gradebook, MissingEntry
 from ros2nb.outcomes import CheckOutcome
 from ros2nb.typed_json import Unreadable, decoded
 
-from ..paths import ASSIGNMENT, SETTINGS, gradebook_url
+from ...paths import ASSIGNMENT, SETTINGS, gradebook_url
 from .course_settings import read_settings
 from .deadlines import NO_DEADLINES, CourseSettings, SettingsProblem
 from .extensions import EXTENSIONS, NONE, Extensions, ExtensionsProblem, read_extensions
-from .lms import PLATFORMS
-from .roster import RosterProblem, RosterRow, read_roster
+from .roster import PLATFORMS, RosterProblem, RosterRow, read_roster
 from .submissions import Learner, shown
 
 #: What grading made of each learner before nbgrader scored them, kept for ``--learner``.

@@ -44,7 +44,7 @@ class Settings:
     seconds; None: no limit) applies only in a sandbox; ``judge_cpu`` (the same for each
     check of a notebook's judge; None: :data:`JUDGE_CPU_S`) wherever the host can make a
     cgroup; ``cpu_share``, the CPUs each sandbox may use at most (a CPU quota,
-    :class:`~ros2nb_instructor.grading.running.Limits`; None: what the machine gives)."""
+    :class:`~ros2nb_instructor.grading.sandbox.running.Limits`; None: what the machine gives)."""
 
     cell_timeout: int
     notebook_timeout: int

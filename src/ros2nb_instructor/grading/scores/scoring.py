@@ -1,6 +1,6 @@
 """nbgrader scores batches of learners, then writes their feedback, in one process.
 
-``python -m ros2nb_instructor.grading.scoring COURSE``, started by
+``python -m ros2nb_instructor.grading.scores.scoring COURSE``, started by
 :class:`.gradebook.Scoring` on the instructor's host (trusted: it executes nothing of the
 learners').  Each line on its standard input is one batch: a JSON list of the ids nbgrader
 leaves out (every learner not in the batch); it answers each with a line ``{"ok": BOOL}``
@@ -25,7 +25,7 @@ from nbgrader.coursedir import CourseDirectory
 from nbgrader.preprocessors import ClearOutput, Execute
 from traitlets.config import Config
 
-from ..paths import ASSIGNMENT, gradebook_url
+from ...paths import ASSIGNMENT, gradebook_url
 
 
 def score_only_config(course: Path, excluded: str) -> Config:
@@ -64,7 +64,7 @@ def main(argv: list[str]) -> int:
     """Score each batch read on standard input (module docstring); nbgrader's log goes to
     standard error, which the grader appends to ``COURSE/grading.log``."""
     if len(argv) != 1:
-        print('Usage: python -m ros2nb_instructor.grading.scoring COURSE '
+        print('Usage: python -m ros2nb_instructor.grading.scores.scoring COURSE '
               '(batches on standard input: a JSON list of the ids to leave out, one per line)',
               file=sys.stderr)
         return 2

@@ -1,6 +1,6 @@
 """Running one learner notebook in its sandbox, and saying what happened while it ran.
 
-Runs on the instructor's host; the notebook runs in a sandbox (:mod:`.sandbox`) through
+Runs on the instructor's host; the notebook runs in a sandbox (:mod:`.bubblewrap`) through
 :mod:`.sandboxed.runner`.  What comes back is read only after the sandbox ended, and only
 the two files the runner was asked to write: the executed notebook and its
 :class:`~.sandboxed.runner.RunStatus`.
@@ -21,11 +21,11 @@ import nbformat
 
 from ros2nb.typed_json import Unreadable, decoded
 
-from ..paths import ROOT
-from . import sandbox
-from .paths_of_learners import NotARegularFile, read_regular
-from .sandboxed.runner import RunStatus
-from .scratch import Scratch, sandbox_env
+from ...paths import ROOT
+from ..sandbox import bubblewrap
+from ..sandbox.paths_of_learners import NotARegularFile, read_regular
+from ..sandbox.scratch import Scratch, sandbox_env
+from ..sandboxed.runner import RunStatus
 from .settings import Settings
 
 #: The program that runs in the sandbox: it executes the notebook with nbclient.
@@ -79,11 +79,11 @@ def run_notebook(scratch: Scratch, notebook: str, prepared: nbformat.NotebookNod
             str(out / f'{notebook}.run.ipynb'), f'--cell-timeout={settings.cell_timeout}',
             f'--folder={scratch.home / "notebooks"}']
     env = sandbox_env(scratch.home, ROS2NB_WORKSPACE=str(scratch.workspace))
-    limits = sandbox.Limits(wall_s=settings.notebook_timeout, cpu_s=settings.notebook_cpu,
+    limits = bubblewrap.Limits(wall_s=settings.notebook_timeout, cpu_s=settings.notebook_cpu,
                             cpu_share=settings.cpu_share)
     stopped, out_of_cpu = None, False
     if settings.sandboxed:
-        box = sandbox.Sandbox(writable=[scratch.home, out], env=env, cwd=scratch.home,
+        box = bubblewrap.Sandbox(writable=[scratch.home, out], env=env, cwd=scratch.home,
                               readable=[ROOT / 'src', given],
                               hidden=[ROOT / 'src' / 'ros2nb' / 'reference'])
         result = box.run(argv, limits, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)

@@ -1,10 +1,10 @@
 """Cgroups for a sandbox: a fresh group per sandbox limits its tasks and its memory and
 counts its CPU time.
 
-Part of :mod:`.sandbox` (runs on the instructor's host, as root while grading).  cgroup v1
+Part of :mod:`.bubblewrap` (runs on the instructor's host, as root while grading).  cgroup v1
 ``pids`` and ``memory`` (and ``cpuacct``, to count) when the host has them, else cgroup v2
 with both controllers delegated (v2 counts CPU time in every group); none when neither can be
-made (then :mod:`.sandbox` falls back to rlimits).
+made (then :mod:`.bubblewrap` falls back to rlimits).
 """
 
 from __future__ import annotations

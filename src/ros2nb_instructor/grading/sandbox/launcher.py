@@ -1,6 +1,6 @@
 """The sandbox launcher: ``python -I -S launcher.py --launch SPEC -- bwrap ...``.
 
-Part of :mod:`.sandbox`, run as a file by the isolated interpreter (no site-packages, so
+Part of :mod:`.bubblewrap`, run as a file by the isolated interpreter (no site-packages, so
 nothing of the course or the venv is imported): it joins the sandbox's cgroups, sets its
 rlimits, stages the bind sources in a private mount namespace, drops root and execs
 bubblewrap.
@@ -18,7 +18,7 @@ from typing import Any
 
 
 def _launch(spec: dict[str, Any], bwrap: list[str]) -> None:
-    """Runs as ``python -I -S sandbox.py --launch SPEC -- bwrap ...``: join the cgroups, set
+    """Runs as ``python -I -S launcher.py --launch SPEC -- bwrap ...``: join the cgroups, set
     rlimits, stage the bind sources in a private mount namespace, drop root, exec bwrap."""
     for procs in spec['procs']:
         Path(procs).write_text(str(os.getpid()))

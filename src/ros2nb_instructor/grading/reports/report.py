@@ -17,10 +17,10 @@ import io
 import statistics
 from pathlib import Path
 
-from ..paths import NOTEBOOKS, SOLUTIONS
+from ...paths import NOTEBOOKS, SOLUTIONS
+from ..intake.deadlines import late_by
+from ..intake.submissions import Learner
 from . import feedback, similarity
-from .deadlines import late_by
-from .submissions import Learner
 
 #: Failure lines listed (the most frequent first).
 TOP_FAILURES = 20

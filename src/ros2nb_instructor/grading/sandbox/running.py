@@ -1,7 +1,7 @@
 """What a sandbox may use (:class:`Limits`), how it ended (:class:`Result`), and a started one
 watched until it ends or runs out (:class:`Running`).
 
-Part of :mod:`.sandbox` (runs on the instructor's host).  One thread per sandbox watches its
+Part of :mod:`.bubblewrap` (runs on the instructor's host).  One thread per sandbox watches its
 wall time and, through its cgroup (:mod:`.cgroups`), the CPU time of all its processes
 together; the first limit that runs out kills the whole sandbox.
 """

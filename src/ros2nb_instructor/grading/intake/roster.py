@@ -20,9 +20,11 @@ from .mistakes import Mistakes
 #: The roster's columns: ``learner`` (the folder's name) and the platform's ids.
 ROSTER_COLUMNS = ('learner', 'name', 'first_name', 'last_name', 'lms_id', 'sis_id', 'login',
                   'email', 'section')
-#: The roster ids each platform can match a row by.
+#: The platforms an export is written for (:mod:`ros2nb_instructor.grading.export.lms`), each
+#: with the roster ids it can match a row by.
 MATCHED_BY = {'canvas': ('lms_id', 'sis_id', 'login'), 'moodle': ('sis_id', 'login', 'email'),
               'csv': ()}
+PLATFORMS = tuple(MATCHED_BY)
 #: Ids that name one person: two learners may not share one.
 UNIQUE = ('lms_id', 'sis_id', 'login', 'email')
 

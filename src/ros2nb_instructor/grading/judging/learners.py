@@ -1,6 +1,6 @@
 """Grading one learner: their notebooks in course order, each run, judged, made ready to score.
 
-Runs on the instructor's host (or a Dask worker, :mod:`.cluster_task`).  What grading makes
+Runs on the instructor's host (or a Dask worker, :mod:`.worker`).  What grading makes
 of a learner is one value, :class:`Graded`, the same wherever it was made: the course files
 it (:func:`file_graded`) and nbgrader scores it.
 """
@@ -16,13 +16,13 @@ from typing import Iterable, Mapping, Union
 import nbformat
 from ros2nb.outcomes import CheckOutcome
 
-from ..paths import ASSIGNMENT
+from ...paths import ASSIGNMENT
+from ..intake.submissions import Learner, readable
+from ..sandbox.scratch import HOME_BYTES, OUT_OF_SPACE, Scratch
 from . import notebooks as notebooks_of
-from .judging import Judges, Verdict
+from .judges import Judges, Verdict
 from .runs import run_note, run_notebook
-from .scratch import HOME_BYTES, OUT_OF_SPACE, Scratch
 from .settings import Settings
-from .submissions import Learner, readable
 
 #: How a note introduces the judge's flags (code that reaches into the course or its
 #: process, ros2nb.judge.flags): the grade does not depend on them.
@@ -75,7 +75,7 @@ class Judging:
 
     :ivar said: the notes of its run (output cut, a cell that ran too long, ...).
     :ivar executed: the notebook as the sandbox left it.
-    :ivar verdict: the judge's :class:`.judging.Verdict`, once it is done.
+    :ivar verdict: the judge's :class:`.judges.Verdict`, once it is done.
     """
 
     said: tuple[str, ...]

@@ -25,8 +25,8 @@ from typing import Callable, Iterator, Optional
 from ros2nb import temporary
 from ros2nb.terminal.workspace import WORKSPACE_NAME
 
+from ..intake.submissions import Learner
 from .paths_of_learners import mount_capped, nearly_full, real_folder_below, unmount
-from .submissions import Learner
 
 MiB = 1 << 20
 #: Bytes a learner's home (their workspace and everything their notebooks write) may hold.

@@ -17,13 +17,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Optional
 
-from ..paths import ASSIGNMENT, ROOT
-from . import sandbox
-from .judging import Judges
-from .learners import Graded, grade_learner
-from .scratch import grading_folder
-from .settings import Settings
-from .submissions import Learner
+from ...paths import ASSIGNMENT, ROOT
+from ..intake.submissions import Learner
+from ..judging.judges import Judges
+from ..judging.learners import Graded, grade_learner
+from ..judging.settings import Settings
+from ..sandbox import bubblewrap
+from ..sandbox.scratch import grading_folder
 
 #: The folders whose files make a course version: the code that runs and judges learners
 #: (ros2nb, ros2nb_instructor), the solutions (the hidden tests) and the pinned packages.
@@ -63,7 +63,7 @@ async def accept(version: str, sandboxed: bool, dask_worker: Any = None) -> Opti
     if mine != version:
         return (f'its course is version {mine}, the instructor\'s {version} (update it: git pull '
                 '&& make setup, or the course image of the instructor\'s commit)')
-    why = sandbox.problem() if sandboxed else None
+    why = bubblewrap.problem() if sandboxed else None
     if why:
         return (f'no sandbox can be made there ({why}); grading runs learners\' code '
                 '(NO_SANDBOX=1 grades trusted work unsandboxed)')

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Mapping, Optional, Sequence
 
-from .roster import Roster, RosterRow
+from ..intake.roster import Roster, RosterRow
 from .spreadsheets import Cell, write_csv
 
 #: Canvas's gradebook import: the learner's columns, then one per assignment.
@@ -38,8 +38,6 @@ CANVAS_COLUMNS = ('Student', 'ID', 'SIS User ID', 'SIS Login ID', 'Section')
 MOODLE_COLUMNS = ('First name', 'Last name', 'ID number', 'Username', 'Email address')
 #: Moodle's own name of an item's feedback column in its CSV export.
 MOODLE_FEEDBACK = 'Feedback for {}'
-#: The platforms an export is written for.
-PLATFORMS = ('canvas', 'moodle', 'csv')
 #: What the file of the learners who are not in the roster is called, beside the export.
 NOT_IN_ROSTER = 'not-in-roster.csv'
 
@@ -85,7 +83,7 @@ def _cell(mark: Mark) -> Cell:
 
 
 def write(lms: str, table: Table, roster: Optional[Roster], path: Path) -> list[str]:
-    """Write ``table`` for ``lms`` (:data:`PLATFORMS`) to ``path``, a row per roster learner
+    """Write ``table`` for ``lms`` (:data:`.roster.PLATFORMS`) to ``path``, a row per roster learner
     (every learner of ``table`` without a roster); the learners not in ``roster`` go to
     :data:`NOT_IN_ROSTER` beside it, and with none that file is removed.
 

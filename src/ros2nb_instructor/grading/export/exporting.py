@@ -12,7 +12,8 @@ platform's file is :mod:`.lms`'s.
 
 The same export is an nbgrader export plugin (:class:`CanvasExport`, :class:`MoodleExport`,
 :class:`CourseExport`: nbgrader's ``ExportPlugin``, ``export(gradebook)``), so
-``cd grading/nbgrader && nbgrader export --exporter=ros2nb_instructor.grading.exporting.CanvasExport
+``cd grading/nbgrader && nbgrader export
+--exporter=ros2nb_instructor.grading.export.exporting.CanvasExport
 --CanvasExport.roster=../../roster.csv`` writes the same file.
 """
 
@@ -28,15 +29,15 @@ from nbgrader.api import Gradebook, MissingEntry
 from nbgrader.plugins import ExportPlugin
 from traitlets import List, Unicode
 
-from ..paths import ASSIGNMENT, ROOT, SETTINGS, gradebook_url
-from .course_settings import read_settings
-from .deadlines import CourseSettings, SettingsProblem, assess
-from .extensions import EXTENSIONS, Extensions, ExtensionsProblem, read_extensions
-from .hand_in_times import TimeProblem, parse_time
-from .lms import PLATFORMS, Mark, Table, moodle_items, write
-from .roster import Roster, RosterProblem, read_roster
-from .submissions import Learner
-from .term import load_state
+from ...paths import ASSIGNMENT, ROOT, SETTINGS, gradebook_url
+from ..intake.course_settings import read_settings
+from ..intake.deadlines import CourseSettings, SettingsProblem, assess
+from ..intake.extensions import EXTENSIONS, Extensions, ExtensionsProblem, read_extensions
+from ..intake.hand_in_times import TimeProblem, parse_time
+from ..intake.roster import PLATFORMS, Roster, RosterProblem, read_roster
+from ..intake.submissions import Learner
+from ..intake.term import load_state
+from .lms import Mark, Table, moodle_items, write
 
 #: An example of DUE_BY=, for the line of a mistake.
 EXAMPLE_DUE_BY = '2026-10-20T00:00:00+02:00'
