@@ -352,10 +352,10 @@ def every_learner() -> dict[str, Learner]:
     """All three corpora, by name."""
     from corpus_attacks import ATTACKS
     from corpus_honest import HONEST
-    from corpus_reaching import REACHING
+    from corpus_reaching import REACHING, SEVENTH_TWINS
     from corpus_wrong import WRONG
     found = {}
-    for learner in [*HONEST, *WRONG, *ATTACKS, *REACHING]:
+    for learner in [*HONEST, *WRONG, *ATTACKS, *REACHING, *SEVENTH_TWINS]:
         assert learner.name not in found, learner.name
         found[learner.name] = learner
     return found

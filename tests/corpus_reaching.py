@@ -681,3 +681,76 @@ SIXTH = [
            '04 twin: the status from a module that is not there', seen=True),
 ]
 REACHING += SIXTH
+
+
+# ================================================================== the seventh class
+# A hostile class against the design that decides only by what the judge observes from outside
+# the learner's process (docs/decisions.md), each attacker beside its twin (the same code without
+# the part that gains), graded as the sixth class is.  ``extra['xfail']``: the reason an attack
+# still scores more than its twin (no fix yet; the test marks it an expected failure, strict).
+# ``extra['outside_tmp']``: graded with the grader's folder outside /tmp, as a grader whose
+# TMPDIR is elsewhere (a cluster's scratch disk) makes it.
+
+# ---- the grader's run of the notebook (the learner's kernel) sees the course's src with only
+# the reference nodes hidden: a cell the learner adds copies the rule (rules.py) and the
+# stand-ins (judge/stand_ins.py) into a module of its own in the package.  No %%part cell writes
+# that module, so the judge's check of what the cells wrote (judge.written) passes it by, and
+# the snapshot carries it to the judge's subjects beside the learner's file.
+COPIES_THE_ANSWERS = '''\
+from pathlib import Path as _Path
+_course = _Path(ros2nb.__file__).parent
+_here = ros2nb.current_workspace() / 'src' / 'sensor_simulator' / 'sensor_simulator'
+(_here / 'monitor_rules.py').write_text(
+    (_course / 'rules.py').read_text().replace('from .course import', 'from ros2nb.course import')
+    + '\\nstatus = monitor_status\\n')
+(_here / 'course_parts.py').write_text(
+    (_course / 'judge' / 'stand_ins.py').read_text()
+    .replace('from .. import course', 'from ros2nb import course')
+    .replace('from ..rules import monitor_status', 'from monitor_rules import monitor_status'))
+'''
+#: The learner's own folder on sys.path, so that a module beside their file imports.
+ON_PATH = ('        import os, sys\n'
+           '        sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))\n')
+MONITOR_OWN_MODULE = '''
+    def temperature_callback(self, msg):
+''' + ON_PATH + '''        status = __import__("monitor_rules").status(msg.data)
+        self.get_logger().info(f'Temperature: {msg.data:.2f}C - Status: {status}')
+'''
+#: The twins: the same answers, no cell that copies (corpus_attacks.py's wrong learners).
+OWN_MODULE_TWINS = {
+    '04': ('04 twin: the status from a module of the package that is not there',
+           {'monitor-callback': MONITOR_OWN_MODULE}, ('monitor-callback', 'monitor-readings'))}
+COPIED_ANSWERS = ("the grader's run of the notebook can read the course's rule and stand-ins, and "
+                  'a module no %%part cell writes reaches the judge; docs/decisions.md, the '
+                  'seventh class')
+
+# ---- a subject's sandbox hides the judge's /tmp under a tmpfs of its own, and of the judge's
+# folder only the judge's own files and its given ones: with the grader's folder outside /tmp,
+# every earlier subject's folder was in sight (read-only) of the next.
+SIBLINGS = CAPTURE.replace(
+    '_PLACES = [',
+    "_PLACES = [*__import__('glob').glob(_os.path.join(_os.path.dirname(_os.getcwd()), '*')),\n"
+    '           ')
+SENSOR_SIBLINGS = {key: text.replace(CAPTURE, SIBLINGS) for key, text in SENSOR_CAPTURED.items()}
+
+
+def _seventh(name: str, notebook: str, cells: dict, twin: str, seen: bool = False,
+             added: tuple = (), flagged: bool = True, **extra: object) -> Learner:
+    return Learner(f'{notebook} seventh: {name}', notebook, cells, twin=twin, seen=seen,
+                   flagged=flagged, added=added, extra={'seventh': True, **extra})
+
+
+SEVENTH = [
+    # 5 of 5 against its twin's 2 (seeds 11 and 12), flagged by the text scan: no fix yet (xfail).
+    _seventh("a cell copies the course's rule into a module of the package", '04',
+             OWN_MODULE_TWINS['04'][1], OWN_MODULE_TWINS['04'][0],
+             added=(('monitor-callback', COPIES_THE_ANSWERS),), xfail=COPIED_ANSWERS),
+    # Scored its twin's 1 of 6 with the grader's folder in /var/tmp (seed 11): kept as a
+    # standing check that no subject reads another's folder wherever the grader keeps it.
+    _seventh("the stand-ins captured, read from another subject's folder", '03',
+             SENSOR_SIBLINGS, '03 twin: a sensor from parts of its own that are not there',
+             seen=True, outside_tmp=True),
+]
+REACHING += SEVENTH
+SEVENTH_TWINS = [Learner(name, notebook, cells, loses=loses)
+                 for notebook, (name, cells, loses) in OWN_MODULE_TWINS.items()]

@@ -18,6 +18,9 @@ gives the "before" column of the closing notes.
 
 from __future__ import annotations
 
+import tempfile
+from pathlib import Path
+
 import pytest
 
 from corpora import (BESIDE_JUDGES_S, expected_score, grade_learner, judged_in_sandbox, score,
@@ -25,20 +28,25 @@ from corpora import (BESIDE_JUDGES_S, expected_score, grade_learner, judged_in_s
 from corpus_attacks import ATTACKS
 from corpus_checks import failed, scores_what_its_twin_scores
 from corpus_honest import HONEST
-from corpus_reaching import REACHING
+from corpus_reaching import REACHING, SEVENTH_TWINS
 from ros2nb.checks.drawn import new_seed
 from ros2nb_instructor.grading.sandbox import bubblewrap
 from ros2nb_instructor.grading.judging.settings import JUDGE_TIMEOUT_S as SANDBOXED_JUDGE_S
 
 #: Each test grades one learner.
 pytestmark = [pytest.mark.judge, pytest.mark.timeout(time_limit_s(1))]
-TWINS = {learner.name: learner for learner in [*ATTACKS, *HONEST]}
+TWINS = {learner.name: learner for learner in [*ATTACKS, *HONEST, *SEVENTH_TWINS]}
 #: The seeds of this run's gradings of the reaching attacks (each pytest-xdist worker draws
 #: its own: a new pair every run); the sixth class's attacks are graded with both.
 SEEDS = (new_seed(), new_seed())
 #: (attack, which seed): the sixth class's twice, the earlier attacks once.
-REACHING_RUNS = [(attack, run) for attack in REACHING
-                 for run in ((0, 1) if attack.extra.get('sixth') else (0,))]
+REACHING_RUNS = [pytest.param(attack, run, marks=[pytest.mark.xfail(
+    strict=True, reason=attack.extra['xfail'])] if 'xfail' in attack.extra else [],
+    id=f'{attack.name}-seed {run + 1}') for attack in REACHING
+    for run in ((0, 1) if attack.extra.get('sixth') or attack.extra.get('seventh') else (0,))]
+#: Where a grader whose temporary folder is not /tmp keeps its learners' folders (the seventh
+#: class's ``outside_tmp``): a subject's sandbox puts a tmpfs of its own on /tmp alone.
+OUTSIDE_TMP = Path('/var/tmp')
 
 
 @pytest.mark.parametrize('knows_nothing', [False, True],
@@ -70,19 +78,23 @@ def test_an_attack_scores_what_its_twin_scores(attack, tmp_path):
 @pytest.mark.sandbox
 @pytest.mark.skipif(bubblewrap.problem() is not None, reason=str(bubblewrap.problem()))
 @pytest.mark.timeout(SANDBOXED_JUDGE_S + BESIDE_JUDGES_S)  # one grading, the grader's way
-@pytest.mark.parametrize('attack, run', REACHING_RUNS,
-                         ids=[f'{a.name}-seed {run + 1}' for a, run in REACHING_RUNS])
+@pytest.mark.parametrize('attack, run', REACHING_RUNS)
 def test_reaching_in_scores_at_most_its_twin_and_says_so(attack, run, tmp_path):
     """Graded as the grader grades: in its sandboxes the course's answers are not on a
     subject's disk and no subject reads what another wrote, and no verdict comes from what
     the audit hooks saw (they only note it)."""
     seed, twin = SEEDS[run], TWINS[attack.twin]
-    attacked, flags = judged_in_sandbox(attack, tmp_path, seed=seed)
+    if attack.extra.get('outside_tmp'):
+        with tempfile.TemporaryDirectory(prefix='ros2nb-corpus-', dir=OUTSIDE_TMP) as root:
+            Path(root).chmod(0o711)  # the sandboxes' own user passes, as through tmp_path
+            attacked, flags = judged_in_sandbox(attack, Path(root), seed=seed)
+    else:
+        attacked, flags = judged_in_sandbox(attack, tmp_path, seed=seed)
     lost = failed(attacked)
     context = (seed, lost, flags)
     assert set(lost) >= set(twin.loses), context
     assert score(attack, attacked) <= expected_score(twin), context
-    if attack.extra.get('sixth'):
+    if attack.extra.get('sixth') or attack.extra.get('seventh'):
         assert score(attack, attacked) == expected_score(twin), context
     assert all(message and '\n' not in message for message in lost.values()), context
     assert any('at run time' in flag for flag in flags) == attack.seen, context
