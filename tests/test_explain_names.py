@@ -149,3 +149,15 @@ def test_a_parameter_the_function_ignores_is_no_other_names(tmp_path):
     told = _told(tmp_path, source, 'count', 1.0)
     assert told == "name 'random' is not defined: import it at the top of the file (or cell), " \
         'import random.'
+
+
+def test_a_use_of_a_parameter_misspelt_is_told_the_parameter(tmp_path):
+    """06's mutant ``rclpy.init(args=ags)`` in ``def main(args=None)``: the use slipped, and
+    the parameter is what is meant, never "name the parameter ags"."""
+    source = TOP + '''
+
+def main(args=None):
+    return dict(args=ags)
+'''
+    assert _told(tmp_path, source, 'main') == (
+        "name 'ags' is not defined: did you mean args? Names must match exactly.")

@@ -21,9 +21,9 @@ from typing import Any, Optional
 from ..errors import Ros2nbError, UsageError
 from .branches import unset_on_path
 from .frames import frames_of, learner_frame
-from .names import (builtin_meant, declared, import_of, learners_functions, place,
-                    raising_text, set_at_top, similar, stored, stored_near, unread_parameter,
-                    written_more)
+from .names import (builtin_meant, declared, import_of, learners_functions, one_edit_apart,
+                    place, raising_text, set_at_top, similar, stored, stored_near,
+                    unread_parameter, written_more)
 from .values import filled_wrongly, wrong_kind
 
 _CONSTRUCTOR_ARGUMENTS = re.compile(r'Invalid arguments passed to constructor: '
@@ -147,7 +147,8 @@ def _name(exc: NameError, frame: FrameType) -> str:
         return (f"name '{name}' is not defined, but {other} is ({place(frame.f_code, line)}): "
                 'spell a name the same where it is set and where it is used.')
     unread = unread_parameter(frame.f_code, name) if name not in frame.f_globals else None
-    if unread is not None:
+    if unread is not None and not (one_edit_apart(unread, name)  # this use slipped, not the def
+                                   and written_more(frame.f_code, unread, name)):
         function = frame.f_code.co_name
         return (f"name '{name}' is not defined: {function} calls its parameter {unread}, "
                 f'which it never reads ({place(frame.f_code, frame.f_code.co_firstlineno)}): '
