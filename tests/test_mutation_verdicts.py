@@ -129,6 +129,25 @@ def test_did_you_mean_the_learners_own_typo_is_bad():
     assert kind == 'bad' and any('suggests rot' in w for w in why), why
 
 
+def test_did_you_mean_a_top_level_slip_back_is_bad():
+    """04: TOPIC set as TOIC in the file's constants, read as TOPIC in the constructor: "did
+    you mean TOIC?" suggests the slip back; the line that names where TOIC is set is good."""
+    answer = next(a for a in answers('04') if a.key == '04-monitor-constructor')
+    old = 'Float32, TOPIC, self.temperature_callback, QUEUE_DEPTH)'
+    place = f'(temperature_subscriber.py line 24: {old})'
+    before = ("CheckFailed: TemperatureMonitor() raised: name 'TOPIC' is not defined: did you mean "
+              f'TOIC? Names must match exactly. {place}')
+    case = outcome(answer, 'hand-made', old, old, shown(before), affected=('TOPIC', 'TOIC'))
+    case['changed'] = []  # the mutant changed the given constants, not the answer
+    kind, why = verdict(case)
+    assert kind == 'bad' and 'lab: suggests TOIC, which the course does not define' in why, why
+    after = ("CheckFailed: TemperatureMonitor() raised: name 'TOPIC' is not defined, but TOIC is "
+             "(temperature_subscriber.py line 9: TOIC = 'temperature'): spell a name the same "
+             f'where it is set and where it is used. {place}')
+    case['lab'] = case['grading'] = shown(after)
+    assert verdict(case) == ('killed well', [])
+
+
 def test_a_line_at_code_the_mutant_left_alone_is_bad():
     """04: status = 'High' deleted, told about the log line, which it did not change, in
     words that fit an import."""

@@ -79,6 +79,9 @@ def check_dependencies(judge: Optional[Judge], reader: Any,
         raise CheckFailed(f'{files[0]} does not exist: run the pkg_create cell above first.')
     # What each file declares, read before the learner's reader runs: it may write them.
     wanted = [package_dependencies(files[0])]
+    # the call as the check makes it, named alike in the lab and by the grader (which sees
+    # no signature of the learner's): the file it passes, whatever the parameter is called
+    called = f'{reader.__name__}(package_xml)'
     if isinstance(reader, AnswerRef) and judge is not None:
         # The grader's own file: what it declares comes from its text, never from the copy
         # the learner's code can reach.
@@ -87,9 +90,9 @@ def check_dependencies(judge: Optional[Judge], reader: Any,
         files.append(folder / 'graded_reader' / 'package.xml')
         wanted.append(_depends(parse_package_string(_EXTRA_PACKAGE_XML)))
         outputs = answer_results(judge, reader, [[{'path': str(f)}] for f in files])
-        results = [decoded(o, f'{reader.name}(package_xml)') for o in outputs]
+        results = [decoded(o, called) for o in outputs]
     else:
-        results = [call_learner(reader, f) for f in files]
+        results = [call_learner(reader, f, label=called) for f in files]
     for file, want, got in zip(files, wanted, results):
         if not isinstance(got, list):
             raise CheckFailed(f'{reader.__name__}() returned {type_name_of(got)}; return a list of '

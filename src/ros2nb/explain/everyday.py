@@ -11,7 +11,6 @@ judge's subject.  Introduced in ``03-write-the-publisher.ipynb``.
 from __future__ import annotations
 
 import ast
-import builtins
 import inspect
 import textwrap
 import linecache
@@ -22,8 +21,9 @@ from typing import Any, Optional
 from ..errors import Ros2nbError, UsageError
 from .branches import unset_on_path
 from .frames import frames_of, learner_frame
-from .names import (declared, import_of, learners_functions, place, raising_text,
-                    similar, stored, stored_near)
+from .names import (builtin_meant, declared, import_of, learners_functions, one_edit_apart,
+                    place, raising_text, set_at_top, similar, stored, stored_near,
+                    unread_parameter, written_more)
 from .values import filled_wrongly, wrong_kind
 
 _CONSTRUCTOR_ARGUMENTS = re.compile(r'Invalid arguments passed to constructor: '
@@ -138,12 +138,27 @@ def _name(exc: NameError, frame: FrameType) -> str:
         other, line = spelt
         return (f"name '{name}' is not defined, but {other} is ({place(frame.f_code, line)}): "
                 'spell a name the same where it is set and where it is used.')
+    top = set_at_top(frame.f_code, name) if frame.f_code.co_name != '<module>' else None
+    if top is not None and top[0] in frame.f_globals:
+        other, line = top
+        if written_more(frame.f_code, other, name):  # the file spells it so: this use slipped
+            return (f"name '{name}' is not defined: did you mean {other}? Names must match "
+                    'exactly.')
+        return (f"name '{name}' is not defined, but {other} is ({place(frame.f_code, line)}): "
+                'spell a name the same where it is set and where it is used.')
+    unread = unread_parameter(frame.f_code, name) if name not in frame.f_globals else None
+    if unread is not None and not (one_edit_apart(unread, name)  # this use slipped, not the def
+                                   and written_more(frame.f_code, unread, name)):
+        function = frame.f_code.co_name
+        return (f"name '{name}' is not defined: {function} calls its parameter {unread}, "
+                f'which it never reads ({place(frame.f_code, frame.f_code.co_firstlineno)}): '
+                f'name the parameter {name}, or read {unread}.')
     own = similar(name, {*frame.f_locals, *frame.f_globals})
     imported = import_of(name)
     if imported and not own:
         return (f"name '{name}' is not defined: import it at the top of the file (or cell), "
                 f'{imported}.')
-    meant = own or similar(name, vars(builtins))
+    meant = own or builtin_meant(name)
     if meant:
         return (f"name '{name}' is not defined: did you mean {meant}? Names must match "
                 'exactly.')

@@ -8,9 +8,11 @@ change of case), the module that defines a name they did not import, and, throug
 
 from __future__ import annotations
 
+import builtins
 import difflib
 import dis
 import linecache
+import re
 import sys
 from pathlib import Path
 from types import CodeType
@@ -29,12 +31,39 @@ IMPORTS.update({'Node': 'from rclpy.node import Node', 'rclpy': 'import rclpy',
 
 def similar(name: str, candidates: Any) -> Optional[str]:
     """The candidate ``name`` was most likely meant to be (a typo away), or None; never one
-    that differs only in case (``node`` is no typo of ``Node``, ``Bool`` none of ``bool``)."""
+    that differs only in case (``node`` is no typo of ``Node``, ``Bool`` none of ``bool``),
+    nor one IPython keeps in a kernel's namespace for itself (``Out``, ``_i3``, ``exit``):
+    a grader's run of the same code has none of those."""
+    hidden = _kernels_own()
     names = sorted({c for c in candidates if isinstance(c, str) and not c.startswith('__')
-                    and c.lower() != name.lower()})
+                    and c.lower() != name.lower() and c not in hidden
+                    and (not c.startswith('_') or name.startswith('_'))})
     near = [c for c in names if len(name) > 2 and one_edit_apart(name, c)]  # msg, mgs
     found = near or difflib.get_close_matches(name, names, n=1, cutoff=0.75)
     return found[0] if found else None
+
+
+def _kernels_own() -> Any:
+    """The names IPython put into its kernel's namespace (none outside IPython)."""
+    shell = getattr(sys.modules.get('IPython'), 'get_ipython', lambda: None)()
+    return getattr(shell, 'user_ns_hidden', {})
+
+
+#: Shortest name a builtin is offered for: one letter off a shorter name (``ags``) is as
+#: near to ``abs`` as to anything the learner meant.
+_BUILTIN_SLIP_LETTERS = 4
+
+
+def builtin_meant(name: str) -> Optional[str]:
+    """The one builtin ``name`` is a slip of (``KeyboardIntrrupt``, ``supr``), or None: a
+    name of four letters or more, one edit from exactly one builtin.  A name further off
+    (``args`` from ``vars``) or shorter gets none: no suggestion is better than one the
+    learner never meant, and that the course does not use."""
+    if len(name) < _BUILTIN_SLIP_LETTERS:
+        return None
+    found = [b for b in vars(builtins) if not b.startswith('_')
+             and b.lower() != name.lower() and one_edit_apart(name, b)]
+    return found[0] if len(found) == 1 else None
 
 
 def one_edit_apart(a: str, b: str) -> bool:
@@ -97,6 +126,46 @@ def stored_near(code: CodeType, name: str) -> Optional[tuple[str, int]]:
                 one_edit_apart(name, instruction.argval):
             return instruction.argval, line
     return None
+
+
+def set_at_top(code: CodeType, name: str) -> Optional[tuple[str, int]]:
+    """``(other, line)``: a name one edit from ``name`` that the top level of the file or
+    cell ``code`` was written in sets (a constant, an import, a class), and the line that
+    sets it, or None: where a name a function reads was set under another spelling."""
+    source = ''.join(linecache.getlines(code.co_filename))
+    try:
+        module = compile(source, code.co_filename, 'exec', dont_inherit=True)
+    except (SyntaxError, ValueError):  # a file changed since, or no source at all
+        return None
+    return stored_near(module, name)
+
+
+def unread_parameter(code: CodeType, name: str) -> Optional[str]:
+    """The one parameter of the function ``code`` that it never reads (not ``self``), when
+    it is a slip of ``name`` or shares a word with it, or None: a parameter named otherwise
+    than the name its body reads (``def f(xml)``, then ``package_xml``; ``def main(ags)``,
+    then ``args``).  A callback's ``msg`` it ignores is no other name's."""
+    count = code.co_argcount + code.co_kwonlyargcount
+    read = set(code.co_cellvars)  # read in a comprehension or a function inside
+    for instruction in dis.get_instructions(code):
+        if instruction.opname.startswith('LOAD_FAST'):
+            value = instruction.argval
+            read.update(value if isinstance(value, tuple) else (value,))
+    unread = [p for p in code.co_varnames[:count] if p not in read and p not in ('self', 'cls')]
+    if len(unread) != 1:
+        return None
+    shared = set(unread[0].split('_')) & set(name.split('_')) - {''}
+    return unread[0] if shared or one_edit_apart(unread[0], name) else None
+
+
+def written_more(code: CodeType, one: str, other: str) -> bool:
+    """Whether the file or cell ``code`` was written in spells ``one`` more often than
+    ``other`` (comments included: the course's comments name its constants)."""
+    source = ''.join(linecache.getlines(code.co_filename))
+
+    def count(word: str) -> int:
+        return len(re.findall(rf'(?<![\w.]){re.escape(word)}(?!\w)', source))
+    return count(one) > count(other)
 
 
 def stored(code: CodeType, name: str, opname: str) -> Optional[int]:
