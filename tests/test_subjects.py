@@ -331,9 +331,10 @@ def test_a_watcher_held_back_in_every_look_still_counts_the_rest_as_waiting(monk
     only after the interval was cut to two looks, and the rest was owed to the next one, so
     the debt grew by every late look and every busy one: a main() that never starts ROS, and
     06's worker whose two timers share a group, sat idle beside such a judge, their idle time
-    never growing, until pytest's limit (docs/decisions.md).  Here the watcher's threads report what such a judge's did
-    (their run-queue seconds growing by HELD_SHARE of the wall clock) and it looks a second
-    late each time: the rest of each interval is the program's waiting, and it is given up."""
+    never growing, until pytest's limit (docs/decisions.md).  Here the watcher's threads
+    report what such a judge's did (their run-queue seconds growing by HELD_SHARE of the wall
+    clock) and it looks a second late each time: the rest of each interval is the program's
+    waiting, and it is given up."""
     limit = 1.0
     began = time.monotonic()
     monkeypatch.setattr(Patience, '_watcher_threads',
