@@ -320,6 +320,41 @@ def test_a_watcher_late_to_a_look_counts_two_looks_of_waiting():
         sleeper.wait()
 
 
+#: The share of every interval the watcher's busiest thread stands on the run queue in
+#: :func:`test_a_watcher_held_back_in_every_look_still_counts_the_rest_as_waiting`.
+HELD_SHARE = 0.8
+
+
+def test_a_watcher_held_back_in_every_look_still_counts_the_rest_as_waiting(monkeypatch):
+    """On a loaded machine a judge's threads stand on the run queue most of every interval
+    and its looks come late.  What the machine held it back was taken from an idle interval
+    only after the interval was cut to two looks, and the rest was owed to the next one, so
+    the debt grew by every late look and every busy one: a main() that never starts ROS, and
+    06's worker whose two timers share a group, sat idle beside such a judge, their idle time
+    never growing, until pytest's limit (docs/decisions.md).  Here the watcher's threads
+    report what such a judge's did (their run-queue seconds growing by HELD_SHARE of the wall
+    clock) and it looks a second late each time: the rest of each interval is the program's
+    waiting, and it is given up."""
+    limit = 1.0
+    began = time.monotonic()
+    monkeypatch.setattr(Patience, '_watcher_threads',
+                        lambda self: {1: HELD_SHARE * (time.monotonic() - began)})
+    sleeper = subprocess.Popen([sys.executable, '-c', 'import time\nprint("asleep", flush=True)'
+                                '\ntime.sleep(3600)'], stdout=subprocess.PIPE, text=True)
+    try:
+        assert sleeper.stdout.readline() == 'asleep\n'
+        patience = Patience(sleeper.pid, limit)
+        looks = 0
+        # each late look counts about (1 - HELD_SHARE) s; the failure prevented never gave up
+        while not patience.exhausted() and looks < 4 * limit / (1 - HELD_SHARE):
+            time.sleep(1.0)
+            looks += 1
+        assert patience.ran_out_idle, (looks, patience.idle_s)
+    finally:
+        sleeper.kill()
+        sleeper.wait()
+
+
 def test_a_busy_watcher_does_not_make_a_waiting_program_look_busy():
     """Only the watched tree's threads count. A judge that grades in the test process has
     executor and Fast DDS threads at work beside its watch; counted too, they stood ready in

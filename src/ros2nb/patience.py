@@ -159,7 +159,10 @@ class HeldBack:
     stood ready on the run queue (threads wait side by side: their sum is no time of
     anyone's).  The kernel brings a thread's count up to date only when the thread runs, so
     what one look misses a later one finds: it is owed, and taken from later intervals,
-    never more than an interval at a time.
+    never more than an interval at a time.  The caller takes from every interval, whatever
+    it makes of it: what the threads stood on the run queue while it looked elsewhere (an
+    interval it counts as work, or the part of a late look it leaves out) is owed by no
+    later interval, and, kept owed, it would be taken from every interval after it.
 
     :param threads: each thread's seconds on the run queue so far, by thread id (e.g.
         :func:`run_queue_seconds`), read at every look.
@@ -275,12 +278,16 @@ class Patience:
             return self._verdict
         cpu, queued, ready = tree_work(self.pids, skip=_this_thread())
         self._held.look()
+        # What the machine kept the watcher from running is taken from this interval, busy or
+        # idle, and from the whole of it: owed on, it was taken from every idle interval after
+        # (a judge's threads stand on a loaded machine's run queue most of every interval).
+        held = self._held.take(now - then)
         if not ready and cpu + queued - busy_then < BUSY_SHARE * (now - then):
-            # Looks come a LOOK_S apart; of a longer interval, what is beyond two looks was the
-            # watcher's lateness (its own work, or a thread of its process the machine starves
-            # holding the GIL it needs), not the trees' waiting, as before the first look.
-            interval = min(now - then, 2 * LOOK_S)
-            self.idle_s += interval - self._held.take(interval)
+            # Looks come a LOOK_S apart; of the rest of a longer interval, what is beyond two
+            # looks was the watcher's lateness (its own work, or a thread of its process the
+            # machine starves holding the GIL it needs), not the trees' waiting, as before the
+            # first look.
+            self.idle_s += min(now - then - held, 2 * LOOK_S)
         self._look = (now, cpu + queued)
         self._verdict = cpu - self.cpu_at_start >= self.limit_s or self.idle_s >= self.limit_s
         return self._verdict
