@@ -688,14 +688,14 @@ REACHING += SIXTH
 # the learner's process (docs/decisions.md), each attacker beside its twin (the same code without
 # the part that gains), graded as the sixth class is.  ``extra['xfail']``: the reason an attack
 # still scores more than its twin (no fix yet; the test marks it an expected failure, strict).
-# ``extra['stray']``: a file the attack adds, which the judge must flag and grade without.
 # ``extra['outside_tmp']``: graded with the grader's folder outside /tmp, as a grader whose
 # TMPDIR is elsewhere (a cluster's scratch disk) makes it.
 
 # ---- the grader's run of the notebook (the learner's kernel) sees the course's src with only
 # the reference nodes hidden: a cell the learner adds copies the rule (rules.py) and the
 # stand-ins (judge/stand_ins.py) into a module of its own in the package.  No %%part cell writes
-# that module: the judge grades a copy of the workspace without it (judge.written.strays).
+# that module, so the judge's check of what the cells wrote (judge.written) passes it by, and
+# the snapshot carries it to the judge's subjects beside the learner's file.
 COPIES_THE_ANSWERS = '''\
 from pathlib import Path as _Path
 _course = _Path(ros2nb.__file__).parent
@@ -720,6 +720,10 @@ MONITOR_OWN_MODULE = '''
 OWN_MODULE_TWINS = {
     '04': ('04 twin: the status from a module of the package that is not there',
            {'monitor-callback': MONITOR_OWN_MODULE}, ('monitor-callback', 'monitor-readings'))}
+COPIED_ANSWERS = ("the grader's run of the notebook can read the course's rule and stand-ins, and "
+                  'a module no %%part cell writes reaches the judge; docs/decisions.md, the '
+                  'seventh class')
+
 # ---- a subject's sandbox hides the judge's /tmp under a tmpfs of its own, and of the judge's
 # folder only the judge's own files and its given ones: with the grader's folder outside /tmp,
 # every earlier subject's folder was in sight (read-only) of the next.
@@ -737,11 +741,10 @@ def _seventh(name: str, notebook: str, cells: dict, twin: str, seen: bool = Fals
 
 
 SEVENTH = [
-    # 5 of 5 against its twin's 2 (seeds 11 and 12) while the judge graded every file of the
-    # snapshot; now graded without the module (judge.written.strays), and flagged.
+    # 5 of 5 against its twin's 2 (seeds 11 and 12), flagged by the text scan: no fix yet (xfail).
     _seventh("a cell copies the course's rule into a module of the package", '04',
              OWN_MODULE_TWINS['04'][1], OWN_MODULE_TWINS['04'][0],
-             added=(('monitor-callback', COPIES_THE_ANSWERS),), stray='monitor_rules.py'),
+             added=(('monitor-callback', COPIES_THE_ANSWERS),), xfail=COPIED_ANSWERS),
     # Scored its twin's 1 of 6 with the grader's folder in /var/tmp (seed 11): kept as a
     # standing check that no subject reads another's folder wherever the grader keeps it.
     _seventh("the stand-ins captured, read from another subject's folder", '03',

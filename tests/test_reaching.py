@@ -7,8 +7,8 @@
   ended as asked without the hook's last line had its channel cut, which is a note too.
 - Only the hook's own lines count, and a kind the judge does not know is dropped.
 - A notebook whose added cell writes the course's code into the learner's file has that
-  file graded as its ``%%part`` cells write it, and a file of its own left out; the course's
-  solutions and every honest and wrong learner of the corpora have none rewritten or left out.
+  file graded as its ``%%part`` cells write it; the course's solutions and every honest and
+  wrong learner of the corpora have none rewritten.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import pytest
 from corpora import NOTEBOOKS, Learner, every_learner, learner_workspace
 from ros2nb.judge.reaching import (CHANNEL_LOST, Counted, Reached, Reaching, parse_count,
                                    parse_seen)
-from ros2nb.judge.written import as_written, strays
+from ros2nb.judge.written import as_written
 
 
 class Subject:
@@ -123,10 +123,9 @@ def test_a_file_another_cell_wrote_is_graded_as_the_cells_write_it(learner, tmp_
     assert "the course\\'s code" not in text and '# changed' not in text, text
 
 
-def test_no_honest_wrong_or_course_notebook_has_a_file_rewritten_or_stray(tmp_path):
+def test_no_honest_wrong_or_course_notebook_has_a_file_rewritten(tmp_path):
     learners = [learner for learner in every_learner().values() if not learner.added]
     learners += [Learner(f'solution {n}', n, {}) for n in sorted(NOTEBOOKS) if n >= '03']
     for index, learner in enumerate(learners):
         with learner_workspace(learner, tmp_path / str(index)) as (ws, nb):
             assert as_written(nb, ws) == {}, learner.name
-            assert strays(nb, ws)[0] == [], learner.name

@@ -83,13 +83,12 @@ def main(argv: list[str]) -> int:
             # Only grading flags code (the flags parse cells with IPython, whose imports
             # every check of a learner's kernel would pay).
             from .flags import notebook_flags
-            from .written import REWRITTEN, as_written, course_files, stray_flags, strays
+            from .written import REWRITTEN, as_written
             source, submission = (json.loads(Path(p).read_text()) for p in argv[1:])
             rewritten = as_written(submission, session.workspace)
-            stray, cached = strays(submission, session.workspace)
             flags = notebook_flags(submission, session.workspace, source)
-            if rewritten or stray or cached:  # what another cell wrote is never graded
-                session.grade_as_written(rewritten, course_files(submission))
+            if rewritten:  # what another cell wrote into the package is never graded
+                session.grade_as_written(rewritten)
 
             began = [0.0]
 
@@ -105,7 +104,6 @@ def main(argv: list[str]) -> int:
             result = dataclasses.asdict(NotebookChecked(
                 grade(source, submission, session, checked, starting),
                 flags + [REWRITTEN.format(name=Path(r).name) for r in rewritten]
-                + stray_flags(stray)
                 + session.reaching.flags()))
     except SystemExit:  # ended from outside (_ended): the learner's processes go at once
         hurried = True

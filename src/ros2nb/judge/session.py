@@ -36,7 +36,7 @@ from ..subject_interface import ExecCells, LoadFile, StandIns
 from .observer import Observer
 from .reaching import Reaching
 from .stand_ins import source_of
-from .written import read_file_bytes
+from .written import workspace_files
 from .subjects import (HANDED, Output, SubjectHung, SubjectProcess, home_and_tmp, python_start,
                        subject_env, subject_prefix, subjects_folder)
 
@@ -234,17 +234,15 @@ class Session:
         return self.subject(('file', relative, *(['+', *stand_ins] if stand_ins else [])),
                             load)
 
-    def grade_as_written(self, files: dict[str, str], kept: set[str]) -> None:
-        """From now on, grade a copy of the workspace that holds only ``kept`` (paths in the
-        workspace: the files the course makes and the ``%%part`` cells write,
-        :func:`.written.course_files`), each of ``files`` (a path in the workspace -> its text)
-        written so: what the notebook's ``%%part`` cells write, where another cell changed the
-        file (:mod:`.written`).  A file is read without following a link; one too large to
-        read is left out, as a check would refuse it."""
-        found = {relative: data for relative in sorted(kept)
-                 if (data := read_file_bytes(self.workspace / relative)) is not None}
-        found.update({relative: text.encode() for relative, text in files.items()})
-        self.workspace = self.hand_over('as-written-', found)
+    def grade_as_written(self, files: dict[str, str]) -> None:
+        """From now on, grade a copy of the workspace in which each of ``files`` (a path in the
+        workspace -> its text) is written so: what the notebook's ``%%part`` cells write,
+        where another cell changed the file (:mod:`.written`).  A workspace too large to copy
+        is graded as it is."""
+        found = workspace_files(self.workspace)
+        if found is not None:
+            found.update({relative: text.encode() for relative, text in files.items()})
+            self.workspace = self.hand_over('as-written-', found)
 
     def answer_home(self, ref: AnswerRef, workspace: Optional[Path] = None) -> Path:
         """The home folder of the subject that runs ``ref`` (started now if need be)."""

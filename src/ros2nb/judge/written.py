@@ -11,9 +11,6 @@ the submission's ``%%part`` cells say it holds, through the workspace's record o
 cell wrote it, and the file must be its parts joined.  A file that is not is graded as the
 cells write it: the judge grades a copy of the workspace with that file written so
 (:meth:`ros2nb.judge.session.Session.grade_as_written`), and flags it for the instructor.
-That copy holds only the files the course makes and the ``%%part`` cells write: a file
-another cell added (a module holding the course's rule, copied in) is left out and flagged,
-and Python's bytecode caches are left out too (:func:`strays`).
 
 A part whose cell still holds the placeholder keeps the working version written before it
 (``write_part`` never replaces one with the placeholder): by an earlier ``%%part`` cell of the
@@ -32,30 +29,18 @@ from pathlib import Path
 from typing import Any, Optional
 
 from .. import course, nbmeta
-from ..terminal.files import AUTHOR_MARKERS, PARTS_RECORD, PLACEHOLDER, WRITTEN_RECORD
-from ..terminal.pkg_create import expected_files
+from ..terminal.files import AUTHOR_MARKERS, PARTS_RECORD, PLACEHOLDER
 
 #: The flag of a file the notebook's cells did not write as it is (graded as they write it).
 REWRITTEN = ("{name}: not what the notebook's %%part cells write (another cell changed it); "
              'graded as they write it')
-#: The flag of a file that neither the course makes nor a ``%%part`` cell writes.
-STRAY = ('{name}: a file that neither the course makes nor a %%part cell writes (another cell '
-         'wrote it); graded without it')
-#: Files the course's own cells write into the workspace beside the package (notebook 05's
-#: given cell writes the tutorial's main() as a script, to run it apart from the package).
-GIVEN_FILES = ('scripts/tutorial_main.py',)
-#: Folders of what Python and setuptools leave beside the sources they read (bytecode
-#: caches; a build's egg-info): left out of a graded copy, never flagged.
-LEFT_BY_TOOLS = ('__pycache__', '.egg-info')
-#: Files not the course's a flag names one by one; past them, one flag counts the rest.
-MOST_STRAYS_NAMED = 10
-#: Bytes read of one file at most (the package's files are small).
-MAX_BYTES = 1_000_000
+#: Bytes read of one file at most (the package's files are small), and files of a workspace.
+MAX_BYTES, MAX_FILES = 1_000_000, 2000
 
 
 def _read(path: Path) -> Optional[str]:
     """A file's text, never through a link; None when it cannot be read."""
-    data = read_file_bytes(path)
+    data = _read_bytes(path)
     return None if data is None else data.decode('utf-8', 'replace')
 
 
@@ -139,56 +124,26 @@ def as_written(submission: dict[str, Any], workspace: Path) -> dict[str, str]:
     return rewritten
 
 
-def course_files(submission: dict[str, Any]) -> set[str]:
-    """The files a graded copy of the workspace holds, relative to it: what ``ros2 pkg
-    create`` makes of the course's package, the package files ``submission``'s ``%%part``
-    cells write and those notebooks before it wrote (:data:`ros2nb.course.STEPS`), the files
-    the course's own cells write (:data:`GIVEN_FILES`), and the course's records."""
-    made = {f'src/{course.PACKAGE}/{relative}' for relative in expected_files(course.PACKAGE)}
-    return (made | set(cell_parts(submission)) | _earlier_files(submission) | set(GIVEN_FILES)
-            | {PARTS_RECORD, WRITTEN_RECORD})
-
-
-def _named_files() -> set[str]:
-    """Every package file the course names (:mod:`ros2nb.course`), of any notebook."""
-    package = f'src/{course.PACKAGE}/'
-    return {value for name, value in vars(course).items()
-            if name.endswith('_FILE') and isinstance(value, str) and value.startswith(package)}
-
-
-def strays(submission: dict[str, Any], workspace: Path) -> tuple[list[str], list[str]]:
-    """The files of ``workspace`` (a graded snapshot) that a graded copy leaves out
-    (:func:`course_files`), relative to it: ``(flagged, quiet)``.  ``quiet`` are the course's
-    files of other notebooks (an honest workspace holds them) and what Python and setuptools
-    leave beside the sources (:data:`LEFT_BY_TOOLS`: every kernel leaves bytecode caches, and
-    a cache may hold code its source does not); every other file is ``flagged``.
-
-    Another cell of the notebook runs where the course's own code is at hand: a module it
-    writes into the package (the course's rule, copied) would be graded beside the learner's
-    answer, which may import it.  Links are listed too; none is followed."""
-    kept, known = course_files(submission), _named_files()
-    flagged: list[str] = []
-    quiet: list[str] = []
-    for folder, dirs, names in os.walk(workspace):
-        dirs.sort()
-        for name in sorted(names) + [d for d in dirs if (Path(folder) / d).is_symlink()]:
-            relative = str((Path(folder) / name).relative_to(workspace))
-            if relative in kept:
+def workspace_files(workspace: Path) -> Optional[dict[str, bytes]]:
+    """Every file of ``workspace`` (a graded snapshot: sources, the parts' record, no build),
+    read without following a link; None when there are more than :data:`MAX_BYTES` times
+    :data:`MAX_FILES` bytes or files."""
+    found: dict[str, bytes] = {}
+    total = 0
+    for folder, _dirs, names in os.walk(workspace):
+        for name in names:
+            path = Path(folder) / name
+            data = _read_bytes(path)
+            if data is None:
                 continue
-            tools = any(part.endswith(LEFT_BY_TOOLS) for part in Path(relative).parts)
-            (quiet if tools or relative in known else flagged).append(relative)
-    return flagged, quiet
+            total += len(data)
+            found[str(path.relative_to(workspace))] = data
+            if total > MAX_BYTES * 8 or len(found) > MAX_FILES:
+                return None
+    return found
 
 
-def stray_flags(stray: list[str]) -> list[str]:
-    """The flags of files :func:`strays` found, :data:`MOST_STRAYS_NAMED` of them by name."""
-    named = [STRAY.format(name=relative) for relative in stray[:MOST_STRAYS_NAMED]]
-    rest = len(stray) - MOST_STRAYS_NAMED
-    return named + ([f'{rest} more files that neither the course makes nor a %%part cell '
-                     'writes; graded without them'] if rest > 0 else [])
-
-
-def read_file_bytes(path: Path) -> Optional[bytes]:
+def _read_bytes(path: Path) -> Optional[bytes]:
     """A regular file's bytes, never through a link (None: not one, or too large)."""
     try:
         fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
