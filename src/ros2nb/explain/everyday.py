@@ -134,16 +134,14 @@ def _name(exc: NameError, frame: FrameType) -> str:
         return (f"name 'self' is not defined: {frame.f_code.co_name}() is a function, not a "
                 f'method of a node, so there is no self: write {plain}, not self.{plain}.')
     spelt = stored_near(frame.f_code, name)
+    if spelt is None and frame.f_code.co_name != '<module>':
+        top = set_at_top(frame.f_code, name)
+        if top is not None and top[0] in frame.f_globals:
+            if written_more(frame.f_code, top[0], name):  # the file spells it so: this use slipped
+                return _did_you_mean(name, top[0])
+            spelt = top
     if spelt is not None:
         other, line = spelt
-        return (f"name '{name}' is not defined, but {other} is ({place(frame.f_code, line)}): "
-                'spell a name the same where it is set and where it is used.')
-    top = set_at_top(frame.f_code, name) if frame.f_code.co_name != '<module>' else None
-    if top is not None and top[0] in frame.f_globals:
-        other, line = top
-        if written_more(frame.f_code, other, name):  # the file spells it so: this use slipped
-            return (f"name '{name}' is not defined: did you mean {other}? Names must match "
-                    'exactly.')
         return (f"name '{name}' is not defined, but {other} is ({place(frame.f_code, line)}): "
                 'spell a name the same where it is set and where it is used.')
     unread = unread_parameter(frame.f_code, name) if name not in frame.f_globals else None
@@ -160,10 +158,13 @@ def _name(exc: NameError, frame: FrameType) -> str:
                 f'{imported}.')
     meant = own or builtin_meant(name)
     if meant:
-        return (f"name '{name}' is not defined: did you mean {meant}? Names must match "
-                'exactly.')
+        return _did_you_mean(name, meant)
     return (f"name '{name}' is not defined where this line runs: no line before it sets "
             f'{name}: set it first, or check its spelling.')
+
+
+def _did_you_mean(name: str, meant: str) -> str:
+    return f"name '{name}' is not defined: did you mean {meant}? Names must match exactly."
 
 
 def _constructor_arguments(exc: AssertionError) -> Optional[str]:

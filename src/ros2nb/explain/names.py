@@ -128,11 +128,16 @@ def stored_near(code: CodeType, name: str) -> Optional[tuple[str, int]]:
     return None
 
 
+def _source_of(code: CodeType) -> str:
+    """The text of the file or cell ``code`` was compiled from ('' when it is gone)."""
+    return ''.join(linecache.getlines(code.co_filename))
+
+
 def set_at_top(code: CodeType, name: str) -> Optional[tuple[str, int]]:
     """``(other, line)``: a name one edit from ``name`` that the top level of the file or
     cell ``code`` was written in sets (a constant, an import, a class), and the line that
     sets it, or None: where a name a function reads was set under another spelling."""
-    source = ''.join(linecache.getlines(code.co_filename))
+    source = _source_of(code)
     try:
         module = compile(source, code.co_filename, 'exec', dont_inherit=True)
     except (SyntaxError, ValueError):  # a file changed since, or no source at all
@@ -161,7 +166,7 @@ def unread_parameter(code: CodeType, name: str) -> Optional[str]:
 def written_more(code: CodeType, one: str, other: str) -> bool:
     """Whether the file or cell ``code`` was written in spells ``one`` more often than
     ``other`` (comments included: the course's comments name its constants)."""
-    source = ''.join(linecache.getlines(code.co_filename))
+    source = _source_of(code)
 
     def count(word: str) -> int:
         return len(re.findall(rf'(?<![\w.]){re.escape(word)}(?!\w)', source))
